@@ -1,0 +1,76 @@
+"""Exception and warning hierarchy of fogdrift.
+
+Every error a user can cause (bad file, bad parameter, too little data) is a
+:class:`FogdriftError`; the CLI prints its message as one line and exits 1.
+Messages follow ``<path>:<line>:<column>: <what is wrong>; expected <rule>, got <value>``
+where a location applies.  This module imports nothing from fogdrift.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "FogdriftError",
+    "DataFormatError",
+    "InsufficientDataError",
+    "ConfigError",
+    "NotFittedError",
+    "ModelFileError",
+    "FogdriftWarning",
+]
+
+
+class FogdriftError(Exception):
+    """Root of every error fogdrift raises on purpose."""
+
+
+def _location(path, line, column) -> str:
+    parts = [str(p) for p in (path, line, column) if p is not None]
+    return ":".join(parts)
+
+
+class DataFormatError(FogdriftError, ValueError):
+    """Input data are malformed (empty, non-numeric, NaN, unsorted time, gaps, bad unit).
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, ideally ``"<problem>; expected <rule>, got <value>"``.
+    path, line, column : optional
+        Where it is wrong. ``line`` is 1-based and counts every physical line of the
+        file (header included); ``column`` is 1-based or a column name.
+    """
+
+    def __init__(self, message: str, *, path=None, line=None, column=None):
+        self.path = None if path is None else str(path)
+        self.line = line
+        self.column = column
+        self.reason = message
+        where = _location(self.path, line, column)
+        super().__init__(f"{where}: {message}" if where else message)
+
+
+class InsufficientDataError(FogdriftError, ValueError):
+    """The record is too short for the requested analysis."""
+
+    def __init__(self, message: str, *, needed=None, got=None, path=None):
+        self.needed = needed
+        self.got = got
+        self.path = None if path is None else str(path)
+        prefix = f"{self.path}: " if self.path else ""
+        super().__init__(prefix + message)
+
+
+class ConfigError(FogdriftError, ValueError):
+    """A parameter value is invalid (names the parameter, the rule and the value)."""
+
+
+class NotFittedError(FogdriftError, AttributeError):
+    """A model method that needs ``fit`` was called before ``fit``."""
+
+
+class ModelFileError(FogdriftError, ValueError):
+    """A saved model file is missing, corrupt, of another format version or another class."""
+
+
+class FogdriftWarning(UserWarning):
+    """Base class of fogdrift's warnings."""

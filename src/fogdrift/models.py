@@ -1,0 +1,241 @@
+"""Estimator-style interface shared by every drift model, and the persistence baseline.
+
+Contract (scikit-learn shape, see ``docs`` and the style examples):
+
+* the constructor only stores hyper-parameters, under the names given, keyword-only;
+* ``fit(y_train, y_val=None)`` learns from the training block (and may use the chronologically
+  following validation block for early stopping) and returns ``self``; everything learned ends
+  in ``_``; normalisation statistics, shifts etc. come from ``y_train`` only;
+* ``predict(y, history=None)`` gives **one-step-ahead** predictions from measured data:
+  ``out[k]`` predicts ``y[k]`` from ``history`` (the measured samples immediately before
+  ``y``) and ``y[:k]``; entries with too little history are NaN;
+* ``forecast(h, history=None)`` runs free for ``h`` steps after the end of ``history``
+  (default: after the end of the training block), feeding predictions back;
+* ``save(path)`` writes ``path.json`` (class, format version, hyper-parameters, small state)
+  and ``path.npz`` (arrays); :func:`load_model` reads them back without pickle.
+
+Series are 1-D float arrays of drift samples in deg/h at a fixed sample interval.
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ConfigError, DataFormatError, ModelFileError, NotFittedError
+
+__all__ = ["DriftModel", "Persistence", "register_model", "load_model", "check_series", "MODEL_REGISTRY"]
+
+FORMAT_VERSION = 1
+
+#: Class name -> class, filled by :func:`register_model`; used by :func:`load_model`.
+MODEL_REGISTRY: dict[str, type] = {}
+
+
+def register_model(cls):
+    """Class decorator: make ``cls`` loadable by :func:`load_model` under its class name."""
+    MODEL_REGISTRY[cls.__name__] = cls
+    return cls
+
+
+def check_series(y, name: str = "y", *, min_length: int = 1) -> np.ndarray:
+    """Return ``y`` as a 1-D float64 array, or raise a clear error.
+
+    Raises
+    ------
+    DataFormatError
+        If ``y`` is not 1-D or holds NaN/inf (the message gives the first bad index).
+    ConfigError
+        If ``y`` is shorter than ``min_length``.
+    """
+    arr = np.asarray(y, dtype=np.float64)
+    if arr.ndim != 1:
+        raise DataFormatError(f"{name} must be a 1-D series; got shape {arr.shape}")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise DataFormatError(f"{name}[{i}] is {arr[i]!r}; expected finite values")
+    if arr.size < min_length:
+        raise ConfigError(f"{name} has {arr.size} samples; this model needs at least {min_length}")
+    return arr
+
+
+class DriftModel:
+    """Base class of drift models: parameter handling, fitted check, JSON + NPZ persistence.
+
+    Subclasses implement ``fit``, ``predict``, ``forecast`` and the two state hooks
+    ``_get_state() -> (meta: dict, arrays: dict[str, ndarray])`` and
+    ``_set_state(meta, arrays)``; ``meta`` must be JSON-serialisable.
+    """
+
+    #: Name shown in tables and reports.
+    label = "model"
+
+    @classmethod
+    def _param_names(cls) -> list[str]:
+        sig = inspect.signature(cls.__init__)
+        return [p.name for p in sig.parameters.values() if p.name != "self" and p.kind != p.VAR_KEYWORD]
+
+    def get_params(self) -> dict:
+        """Hyper-parameters exactly as given to the constructor."""
+        return {name: getattr(self, name) for name in self._param_names()}
+
+    def set_params(self, **params):
+        valid = set(self._param_names())
+        for key, value in params.items():
+            if key not in valid:
+                raise ConfigError(f"{type(self).__name__} has no parameter {key!r}; valid: {sorted(valid)}")
+            setattr(self, key, value)
+        return self
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
+        return f"{type(self).__name__}({args})"
+
+    # -- fitted state -------------------------------------------------------------------
+    def _is_fitted(self) -> bool:
+        return any(k.endswith("_") and not k.startswith("__") for k in vars(self))
+
+    def _check_fitted(self) -> None:
+        if not self._is_fitted():
+            raise NotFittedError(f"{type(self).__name__} is not fitted yet; call fit(y_train) first")
+
+    def _get_state(self):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _set_state(self, meta: dict, arrays: dict) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    # -- persistence ----------------------------------------------------------------------
+    def save(self, path) -> tuple[Path, Path]:
+        """Write ``<path>.json`` and ``<path>.npz``; returns both paths."""
+        self._check_fitted()
+        base = Path(path)
+        if base.suffix in (".json", ".npz"):
+            base = base.with_suffix("")
+        base.parent.mkdir(parents=True, exist_ok=True)
+        meta, arrays = self._get_state()
+        doc = {
+            "format": "fogdrift-model",
+            "format_version": FORMAT_VERSION,
+            "class": type(self).__name__,
+            "params": self.get_params(),
+            "state": meta,
+        }
+        json_path = base.with_suffix(".json")
+        npz_path = base.with_suffix(".npz")
+        json_path.write_text(json.dumps(doc, indent=2, default=_json_default))
+        np.savez(npz_path, **{k: np.asarray(v) for k, v in arrays.items()})
+        return json_path, npz_path
+
+    @classmethod
+    def load(cls, path):
+        """Load a model saved by :meth:`save`; the stored class must be ``cls`` or a subclass."""
+        model = load_model(path)
+        if not isinstance(model, cls):
+            raise ModelFileError(f"{path}: holds a {type(model).__name__}, not a {cls.__name__}")
+        return model
+
+
+def _json_default(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    raise TypeError(f"not JSON-serialisable: {type(obj).__name__}")
+
+
+def load_model(path) -> DriftModel:
+    """Load any registered drift model from ``<path>.json`` + ``<path>.npz`` (no pickle)."""
+    base = Path(path)
+    if base.suffix in (".json", ".npz"):
+        base = base.with_suffix("")
+    json_path, npz_path = base.with_suffix(".json"), base.with_suffix(".npz")
+    try:
+        doc = json.loads(json_path.read_text())
+    except FileNotFoundError:
+        raise ModelFileError(f"{json_path}: model file not found") from None
+    except json.JSONDecodeError as exc:
+        raise ModelFileError(f"{json_path}:{exc.lineno}:{exc.colno}: not valid JSON ({exc.msg})") from exc
+    if not isinstance(doc, dict) or doc.get("format") != "fogdrift-model":
+        raise ModelFileError(f"{json_path}: not a fogdrift model file")
+    if doc.get("format_version") != FORMAT_VERSION:
+        raise ModelFileError(
+            f"{json_path}: format version {doc.get('format_version')!r}; this fogdrift reads {FORMAT_VERSION}"
+        )
+    cls = MODEL_REGISTRY.get(doc.get("class"))
+    if cls is None:
+        _import_model_modules()
+        cls = MODEL_REGISTRY.get(doc.get("class"))
+    if cls is None:
+        raise ModelFileError(f"{json_path}: unknown model class {doc.get('class')!r}")
+    try:
+        with np.load(npz_path, allow_pickle=False) as npz:
+            arrays = {k: npz[k] for k in npz.files}
+    except FileNotFoundError:
+        raise ModelFileError(f"{npz_path}: model array file not found") from None
+    except (ValueError, OSError) as exc:
+        raise ModelFileError(f"{npz_path}: cannot read arrays ({exc})") from exc
+    model = cls(**doc.get("params", {}))
+    model._set_state(doc.get("state", {}), arrays)
+    return model
+
+
+def _import_model_modules() -> None:
+    """Import the modules that register model classes (lazy: JAX only when needed)."""
+    import importlib
+
+    for name in ("fogdrift.grey", "fogdrift.baselines", "fogdrift.elman"):
+        try:
+            importlib.import_module(name)
+        except ImportError:  # pragma: no cover - optional module missing
+            pass
+
+
+@register_model
+class Persistence(DriftModel):
+    """Persistence ("repeat the last value") baseline: predicts y[k] = y[k-1].
+
+    For a smoothed drift target this is hard to beat one step ahead (method notes §5.2);
+    every metric table shows it beside the learned models.
+
+    Attributes
+    ----------
+    last_ : float
+        Last training sample [deg/h], start of free-run forecasts.
+    """
+
+    label = "persistence"
+
+    def __init__(self):
+        pass
+
+    def fit(self, y_train, y_val=None):
+        y = check_series(y_train, "y_train", min_length=1)
+        self.last_ = float(y[-1])
+        return self
+
+    def predict(self, y, *, history=None):
+        self._check_fitted()
+        y = check_series(y, "y")
+        out = np.empty_like(y)
+        out[1:] = y[:-1]
+        if history is not None and len(history):
+            out[0] = check_series(history, "history")[-1]
+        else:
+            out[0] = np.nan
+        return out
+
+    def forecast(self, h: int, *, history=None):
+        self._check_fitted()
+        start = self.last_ if history is None else float(check_series(history, "history", min_length=1)[-1])
+        return np.full(int(h), start)
+
+    def _get_state(self):
+        return {"last_": self.last_}, {}
+
+    def _set_state(self, meta, arrays):
+        self.last_ = float(meta["last_"])
