@@ -1,0 +1,192 @@
+"""Contract checks run over every registered drift model class (the scikit-learn ``estimator_checks`` idea).
+
+The list is built from ``MODEL_REGISTRY`` after importing the modules that register models; the Elman
+classes are included when ``fogdrift.elman`` imports. Each class runs with small, fast hyper-parameters
+from ``TEST_PARAMS`` (a class missing there runs with ``FAST_OVERRIDES`` filtered to its signature).
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+
+import numpy as np
+import pytest
+from numpy.testing import assert_array_equal
+
+import fogdrift.baselines  # noqa: F401  (registers AR)
+import fogdrift.grey  # noqa: F401  (registers GM11)
+from fogdrift.errors import DataFormatError, NotFittedError
+from fogdrift.models import MODEL_REGISTRY, load_model
+
+try:  # written by another module owner; contract-checked whenever it imports
+    importlib.import_module("fogdrift.elman")
+except ImportError:  # pragma: no cover - depends on the checkout
+    pass
+
+_ELMAN_FAST = {"lags": 2, "hidden": 3, "epochs": 15, "patience": 5, "window": 32, "seed": 0}
+
+#: class name -> list of constructor kwargs to test (small and fast).
+TEST_PARAMS = {
+    "Persistence": [{}],
+    "AR": [{"order": 3}, {"order": "aic", "max_order": 4}],
+    "GM11": [{"mode": "rolling", "window": 6}, {"mode": "whole", "shift": 0.5}],
+    "Elman": [_ELMAN_FAST],
+    "GreyElman": [_ELMAN_FAST],
+}
+FAST_OVERRIDES = {"lags": 2, "hidden": 3, "epochs": 15, "patience": 5, "seed": 0}
+
+
+def _params_for(cls) -> list[dict]:
+    if cls.__name__ in TEST_PARAMS:
+        return TEST_PARAMS[cls.__name__]
+    names = set(inspect.signature(cls.__init__).parameters)
+    return [{k: v for k, v in FAST_OVERRIDES.items() if k in names}]
+
+
+CASES = [
+    pytest.param(cls, params, id=f"{name}-{i}")
+    for name, cls in sorted(MODEL_REGISTRY.items())
+    for i, params in enumerate(_params_for(cls))
+]
+
+
+def _series(seed: int, n: int = 200) -> np.ndarray:
+    """Seeded drift-like series [deg/h]: slow oscillation + trend + small noise."""
+    rng = np.random.default_rng(seed)
+    k = np.arange(n)
+    return 0.05 * np.sin(2 * np.pi * k / 60) + 1e-4 * k + rng.normal(0, 0.005, n)
+
+
+Y = _series(0)
+TRAIN, VAL, TEST = Y[:120], Y[120:160], Y[160:]
+HIST = Y[:160]
+
+
+def _fitted_state(model) -> dict:
+    return {k: v for k, v in vars(model).items() if k.endswith("_") and not k.startswith("__")}
+
+
+def _assert_state_equal(a: dict, b: dict):
+    assert a.keys() == b.keys()
+    for key in a:
+        va, vb = a[key], b[key]
+        if isinstance(va, (np.ndarray, list, tuple, float, int)) and not isinstance(va, bool):
+            assert_array_equal(np.asarray(va), np.asarray(vb), err_msg=key)
+        elif hasattr(va, "__dict__") or isinstance(va, dict):
+            # pytrees / parameter dicts: compare their leaves
+            import jax
+
+            la, lb = jax.tree_util.tree_leaves(va), jax.tree_util.tree_leaves(vb)
+            assert len(la) == len(lb), key
+            for x, y in zip(la, lb):
+                assert_array_equal(np.asarray(x), np.asarray(y), err_msg=key)
+        else:
+            assert va == vb, key
+
+
+@pytest.fixture(scope="module")
+def fitted_cache():
+    return {}
+
+
+def _fit(cls, params, cache, key="base"):
+    ck = (cls.__name__, repr(sorted(params.items())), key)
+    if ck not in cache:
+        cache[ck] = cls(**params).fit(TRAIN, VAL)
+    return cache[ck]
+
+
+def test_registry_has_the_expected_models():
+    assert {"Persistence", "AR", "GM11"} <= set(MODEL_REGISTRY)
+
+
+@pytest.mark.parametrize("cls, params", CASES)
+def test_constructor_stores_params_unchanged(cls, params):
+    model = cls(**params)
+    got = model.get_params()
+    for k, v in params.items():
+        assert got[k] is v, k
+    defaults = {p.name: p.default for p in inspect.signature(cls.__init__).parameters.values()
+                if p.name != "self" and p.kind != p.VAR_KEYWORD}
+    assert got == {**defaults, **params}
+    clone = cls(**got)
+    assert clone.get_params() == got
+    assert not _fitted_state(model)  # nothing learned in __init__
+
+
+@pytest.mark.parametrize("cls, params", CASES)
+def test_unfitted_model_raises(cls, params, tmp_path):
+    model = cls(**params)
+    with pytest.raises(NotFittedError):
+        model.predict(TEST, history=HIST)
+    with pytest.raises(NotFittedError):
+        model.forecast(3)
+    with pytest.raises(NotFittedError):
+        model.save(tmp_path / "m")
+
+
+@pytest.mark.parametrize("cls, params", CASES)
+def test_fit_returns_self_and_output_lengths(cls, params, fitted_cache):
+    model = cls(**params)
+    assert model.fit(TRAIN, VAL) is model
+    for y, hist in ((TEST, HIST), (TEST, None), (TEST[:1], HIST)):
+        out = model.predict(y, history=hist)
+        assert out.shape == y.shape
+    for h in (1, 7):
+        assert model.forecast(h).shape == (h,)
+        assert model.forecast(h, history=HIST).shape == (h,)
+    assert np.isfinite(model.predict(TEST, history=HIST)).all()
+
+
+@pytest.mark.parametrize("cls, params", CASES)
+def test_refit_same_data_same_predictions(cls, params, fitted_cache):
+    a = _fit(cls, params, fitted_cache)
+    b = cls(**params).fit(TRAIN, VAL)
+    assert_array_equal(a.predict(TEST, history=HIST), b.predict(TEST, history=HIST))
+    assert_array_equal(a.forecast(5), b.forecast(5))
+
+
+@pytest.mark.parametrize("cls, params", CASES)
+def test_save_load_round_trip(cls, params, fitted_cache, tmp_path):
+    model = _fit(cls, params, fitted_cache)
+    model.save(tmp_path / "model")
+    back = load_model(tmp_path / "model")
+    assert type(back) is cls
+    assert back.get_params() == model.get_params()
+    assert_array_equal(back.predict(TEST, history=HIST), model.predict(TEST, history=HIST))
+    assert_array_equal(back.predict(TEST), model.predict(TEST))
+    assert_array_equal(back.forecast(6), model.forecast(6))
+    assert_array_equal(back.forecast(6, history=HIST), model.forecast(6, history=HIST))
+
+
+@pytest.mark.parametrize("cls, params", CASES)
+def test_nan_input_raises_data_format_error(cls, params, fitted_cache):
+    bad = TRAIN.copy()
+    bad[17] = np.nan
+    with pytest.raises(DataFormatError):
+        cls(**params).fit(bad, VAL)
+    model = _fit(cls, params, fitted_cache)
+    bad_test = TEST.copy()
+    bad_test[3] = np.inf
+    with pytest.raises(DataFormatError):
+        model.predict(bad_test, history=HIST)
+    with pytest.raises(DataFormatError):
+        model.predict(TEST, history=np.r_[HIST[:-1], np.nan])
+
+
+@pytest.mark.parametrize("cls, params", CASES)
+def test_no_leakage_from_the_test_block(cls, params, fitted_cache):
+    """Fitted parameters depend on the training (and validation) block only.
+
+    A record whose test block is different gives a bit-identical fitted state, and predicting /
+    forecasting on any test block leaves the fitted state untouched.
+    """
+    model = _fit(cls, params, fitted_cache)
+    state = _fitted_state(model)
+    other = np.r_[TRAIN, VAL, _series(99)[160:] * 10.0 + 3.0]  # same train/val, very different test block
+    twin = cls(**params).fit(other[:120], other[120:160])
+    _assert_state_equal(_fitted_state(twin), state)
+    model.predict(other[160:], history=other[:160])
+    model.forecast(4, history=other)
+    _assert_state_equal(_fitted_state(model), state)
