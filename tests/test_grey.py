@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from fogdrift.errors import ConfigError, DataFormatError, InsufficientDataError, NotFittedError
+from fogdrift.errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError, NotFittedError
 from fogdrift.grey import (
     GM11,
     GM11Fit,
@@ -296,3 +296,10 @@ def test_gm11_save_load_identical(tmp_path):
         assert_allclose(back.forecast(7), model.forecast(7), rtol=0, atol=0)
         for k in ("shift_", "a_", "b_", "C_", "P_", "grade_", "n_train_", "class_ratio_pass_"):
             assert getattr(back, k) == getattr(model, k)
+
+
+def test_overflowing_time_response_warns():
+    fit = GM11Fit(a=-0.5, b=1.0, x0_first=1.0, n=5, shift=0.0)
+    with pytest.warns(FogdriftWarning, match="overflows"):
+        out = gm11_predict(fit, 3000)
+    assert np.isfinite(out[:100]).all() and np.isinf(out[-1])

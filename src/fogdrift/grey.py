@@ -244,6 +244,11 @@ def gm11_predict(fit: GM11Fit, n_total: int) -> np.ndarray:
     ConfigError
         If ``n_total`` is not a non-negative integer.
 
+    Warns
+    -----
+    FogdriftWarning
+        If e^{−ak} overflows (long horizons with a < 0); those values are ±inf.
+
     Notes
     -----
     Method notes §3.2: x̂⁰(1) = x̃⁰(1) and, for k ≥ 1,
@@ -263,7 +268,14 @@ def gm11_predict(fit: GM11Fit, n_total: int) -> np.ndarray:
         return out
     out[0] = fit.x0_first
     if n > 1:
-        out[1:] = _gm11_restored(fit.a, fit.b, fit.x0_first, np.arange(1, n))
+        with np.errstate(over="ignore", invalid="ignore"):
+            out[1:] = _gm11_restored(fit.a, fit.b, fit.x0_first, np.arange(1, n))
+    if not np.all(np.isfinite(out)):
+        warnings.warn(
+            f"GM(1,1) time response overflows (a = {fit.a:.4g} over {n} samples); non-finite values returned",
+            FogdriftWarning,
+            stacklevel=2,
+        )
     return out - fit.shift
 
 
