@@ -942,6 +942,16 @@ def _fused_tables(scheme, reverse):
     if hit is not None and hit[0] is scheme:
         return hit[1]
     steps = list(scheme.steps)[::-1] if reverse else list(scheme.steps)
+    # Only the approximation path is needed: the forward pass may drop trailing predict
+    # steps (they only change the detail channel), and the inverse pass, whose detail
+    # channel starts at zero, may drop leading update steps (they add 0 to the even channel).
+    drop = "update" if reverse else "predict"
+    if reverse:
+        while len(steps) > 1 and steps[0].kind == drop:
+            steps = steps[1:]
+    else:
+        while len(steps) > 1 and steps[-1].kind == drop:
+            steps = steps[:-1]
     kinds = np.array([1 if st.kind == "predict" else 0 for st in steps], dtype=np.int64)
     ptr = np.zeros(len(steps) + 1, dtype=np.int64)
     ptr[1:] = np.cumsum([len(st.taps) for st in steps])
@@ -951,6 +961,11 @@ def _fused_tables(scheme, reverse):
     tables = (kinds, ptr, offs, coefs, reach, max(int(reach[-1]), 1))  # halo >= 1 keeps edge segments non-empty
     _STEP_ARRAYS[key] = (scheme, tables)
     return tables
+
+
+def _fused_tables_full_reach(scheme) -> int:
+    """Halo for the symmetric head/tail segments: total reach of all steps (>= 1)."""
+    return max(sum(max(abs(o) for o, _ in st.taps) for st in scheme.steps), 1)
 
 
 def _sym_edges_forward(x, scheme, M, hE, hO):
@@ -1003,8 +1018,9 @@ def _fused_drift(x, scheme, level, periodic, out=None, noise=None):
     """
     kern = _numba_kernels()
     fwd_blocks, inv_blocks = kern[3], kern[4]
-    kf, pf, of, cf, rf, M = _fused_tables(scheme, reverse=False)
-    ki, pi, oi, ci, ri, _ = _fused_tables(scheme, reverse=True)
+    kf, pf, of, cf, rf, mf = _fused_tables(scheme, reverse=False)
+    ki, pi, oi, ci, ri, mi = _fused_tables(scheme, reverse=True)
+    M = max(mf, mi, _fused_tables_full_reach(scheme))
     lens = _band_lengths(x.shape[0], level, periodic)
     empty = np.empty(0)
     a = x
