@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from fogdrift.allan import AllanResult, allan_variance, edf_simple, tau_grid
+from fogdrift.allan import FAST_M0, AllanResult, allan_variance, edf_simple, tau_grid
 from fogdrift.errors import ConfigError, DataFormatError, InsufficientDataError
 
 R8 = [1.0, 3.0, 2.0, 5.0, 4.0, 4.0, 6.0, 3.0]
@@ -159,14 +159,13 @@ def test_fast_agrees_with_exact_within_bounds():
     n = 2**20
     y = rng.normal(size=n) + 0.002 * np.cumsum(rng.normal(size=n))
     exact = allan_variance(y, 0.01, taus=80)
-    fast = allan_variance(y, 0.01, taus=exact.tau_s, estimator="fast")
-    small = exact.m < 32
-    assert_array_equal(fast.m[: small.sum()], exact.m[small])
-    assert_allclose(fast.avar_dph2[: small.sum()], exact.avar_dph2[small], rtol=1e-12)
-    ex = allan_variance(y, 0.01, taus=fast.tau_s)  # exact at the (possibly rounded) fast taus
-    assert np.all(np.abs(fast.m / np.interp(fast.m, exact.m, exact.m) - 1) <= 1 / 32 + 1e-12)
-    assert np.all(fast.adev_dph >= ex.adev_lo68_dph) and np.all(fast.adev_dph <= ex.adev_hi68_dph)
-    assert np.all(fast.edf <= ex.edf * 1.05)
+    fast = allan_variance(y, 0.01, taus=80, estimator="fast")
+    assert_array_equal(fast.m, exact.m)
+    small = exact.m < 2 * FAST_M0
+    assert_allclose(fast.avar_dph2[small], exact.avar_dph2[small], rtol=1e-12)
+    assert np.all(fast.adev_dph >= exact.adev_lo68_dph) and np.all(fast.adev_dph <= exact.adev_hi68_dph)
+    assert np.all(fast.edf <= exact.edf + 1e-9) and np.all(fast.edf >= 0.5 * exact.edf)
+    assert np.all(fast.n_terms[~small] < exact.n_terms[~small])
 
 
 def test_fast_on_octaves_keeps_taus():

@@ -11,12 +11,15 @@ Three estimators share one compiled kernel (see :func:`allan_variance`):
 ``"non-overlapping"``
     the same sum over ``k = 0, m, 2m, ...`` only (``K - 1`` terms, ``K = floor(N/m)``).
 ``"fast"``
-    exact overlapping for ``m < 2 * FAST_M0``; for larger ``m`` the sum runs over every
-    ``b``-th start index, ``b = 2^floor(log2(m / FAST_M0))``, with ``m`` rounded to a
-    multiple of ``b``.  This equals the overlapping Allan variance of the data
-    block-averaged by ``b`` (because ``theta`` sampled every ``b`` points is the angle of the
-    block means), so it is an unbiased estimator with at least ``FAST_M0`` overlapping
-    offsets per cluster; its EDF is computed for that decimated series.
+    exact overlapping for ``m < 2 * FAST_M0`` (``FAST_M0 = 4``); for larger ``m`` the same
+    squared second differences are summed over every ``b``-th start index only,
+    ``b = 2^floor(log2(m / FAST_M0))`` (so at least ``FAST_M0`` overlapping offsets per
+    cluster length remain).  Each term is an exact term of the overlapping sum, so the
+    estimator is unbiased and the taus are exactly those requested; only its variance is
+    larger.  Its EDF is the Table-5 value of the series decimated by ``b`` (``N/b + 1``
+    points, ``m/b``), never more than the fully overlapping EDF; for white FM the loss is at
+    most about 7 %.  For b >= 8 every term touches its own cache lines, so the cost of a tau
+    falls like 1/b.
 
 Numerics (safe for 10^8 samples): the mean is removed before integrating (Allan variance is
 invariant to a constant), the angle is accumulated with Neumaier-compensated summation, and
@@ -63,7 +66,7 @@ ESTIMATORS = ("overlapping", "non-overlapping", "fast")
 IEEE952_ALPHAS = (2, 0, -1, -2)
 
 #: Fast estimator: exact for m < 2*FAST_M0, otherwise at least FAST_M0 offsets per cluster.
-FAST_M0 = 16
+FAST_M0 = 4
 
 #: Start indices per block of the compiled kernel (also the unit of pairwise summation).
 _BLOCK = 65536
@@ -337,6 +340,11 @@ def edf_simple(n_phase, m, alpha) -> float:
         raise ConfigError(f"n_phase must be an integer >= 3, got {n_phase!r}")
     if mm != int(m) or mm < 1 or 2 * mm > N - 1:
         raise ConfigError(f"m must be an integer in [1, (n_phase-1)/2] = [1, {(N - 1) / 2}], got {m!r}")
+    return _edf_formula(N, mm, a)
+
+
+def _edf_formula(N: float, mm: float, a: int) -> float:
+    """SP 1065 Table 5 formulas (see :func:`edf_simple`); unchecked, float arguments."""
     with np.errstate(divide="ignore", invalid="ignore"):
         N = np.float64(N)
         if a == 2:
@@ -346,7 +354,7 @@ def edf_simple(n_phase, m, alpha) -> float:
         elif a == 0:
             edf = (3 * (N - 1) / (2 * mm) - 2 * (N - 2) / N) * 4 * mm**2 / (4 * mm**2 + 5)
         elif a == -1:
-            if mm == 1:
+            if mm <= 1:
                 edf = 2 * (N - 2) ** 2 / (2.3 * N - 4.9)
             else:
                 edf = 5 * N**2 / (4 * mm * (N + 3 * mm))
@@ -473,13 +481,12 @@ def _check_rate(rate_dph) -> np.ndarray:
     return np.ascontiguousarray(y)
 
 
-def _fast_grid(m: np.ndarray):
-    """Strides b and rounded m for the fast estimator."""
+def _fast_strides(m: np.ndarray) -> np.ndarray:
+    """Start-index strides b of the fast estimator: 1 for m < 2*FAST_M0, else 2^floor(log2(m/FAST_M0))."""
     b = np.ones_like(m)
     big = m >= 2 * FAST_M0
     b[big] = 2 ** np.floor(np.log2(m[big] / FAST_M0)).astype(np.int64)
-    m_new = np.maximum(np.rint(m / b).astype(np.int64), 1) * b
-    return m_new, b
+    return b
 
 
 def allan_variance(
@@ -504,8 +511,7 @@ def allan_variance(
         Tau grid, see :func:`tau_grid` (``"octave"``, ``"decade"``, ``"all"``, an int for
         that many log-spaced taus, or an array of tau in s).
     estimator : {"overlapping", "non-overlapping", "fast"}, keyword-only
-        See the module docstring.  ``"fast"`` may round large m to a multiple of its stride;
-        the returned ``m``/``tau_s`` are the ones actually used.
+        See the module docstring.
     noise_alpha : "auto", "conservative", int or array_like, keyword-only
         Power-law alpha used for the EDF at each tau.  ``"auto"`` (default): from the local
         log-log slope mu of ADEV (least-squares slope over the taus within a factor 2 of
@@ -540,14 +546,14 @@ def allan_variance(
     Non-overlapping: [SP1065]_ eq. 7, ``sum_j (ybar_{j+1} - ybar_j)^2 / (2 (K - 1))``.
     EDF: :func:`edf_simple` with ``n_phase = N + 1`` (overlapping), with the ``K + 1``
     cluster-mean phase points and m = 1 (non-overlapping, i.e. the overlapping formula on the
-    decimated series), or ``floor(N/b) + 1`` points and ``m/b`` (fast); clipped to
-    ``[1, n_terms]``.  Bounds ([SP1065]_ eq. 44): ``avar * edf / chi2_{1-p/2}(edf)`` to
+    decimated series), or ``floor(N/b) + 1`` points and ``m/b`` but at most the overlapping
+    value (fast); clipped to ``[1, n_terms]``.  Bounds ([SP1065]_ eq. 44): ``avar * edf / chi2_{1-p/2}(edf)`` to
     ``avar * edf / chi2_{p/2}(edf)``, square-rooted for the deviation.
 
     Examples
     --------
     >>> r = allan_variance([1, 3, 2, 5, 4, 4, 6, 3], 1.0, taus=[1, 2, 3])
-    >>> [round(v, 10) for v in r.avar_dph2]
+    >>> [round(float(v), 10) for v in r.avar_dph2]
     [2.0, 0.7, 1.2777777778]
     """
     y = _check_rate(rate_dph)
@@ -559,12 +565,7 @@ def allan_variance(
         raise InsufficientDataError(f"an Allan variance needs at least 2 rate samples, got {n}", needed=2, got=n)
     m = tau_grid(n, dt, taus, max_fraction=max_fraction)
     if estimator == "fast":
-        m, strides = _fast_grid(m)
-        keep = np.ones(m.size, bool)
-        keep[1:] = np.diff(m) > 0
-        m, strides = m[keep], strides[keep]
-        valid = 2 * m <= n
-        m, strides = m[valid], strides[valid]
+        strides = _fast_strides(m)
     elif estimator == "non-overlapping":
         strides = m.copy()
     else:
@@ -598,7 +599,7 @@ def allan_variance(
     elif estimator == "non-overlapping":
         edf_n, edf_m = n // m + 1, np.ones_like(m)
     else:
-        edf_n, edf_m = n // strides + 1, m // strides
+        edf_n, edf_m = n / strides + 1, m / strides
 
     alphas, rule = _resolve_alpha(noise_alpha, tau_s, avar, estimator)
     if isinstance(alphas, str):  # conservative
@@ -608,6 +609,9 @@ def allan_variance(
         edf = cands[np.arange(m.size), pick]
     else:
         edf = np.array([_edf_safe(N_, m_, a) for N_, m_, a in zip(edf_n, edf_m, alphas)])
+    if estimator == "fast":  # a strided sum cannot have more EDF than the full overlapping one
+        full = np.array([_edf_safe(n_phase, m_, a) for m_, a in zip(m, alphas)])
+        edf = np.minimum(edf, full)
     edf = np.clip(np.nan_to_num(edf, nan=1.0, posinf=float(n_terms.max())), 1.0, np.maximum(n_terms, 1))
 
     from scipy.special import chdtri  # inverse survival function of chi^2: chdtri(df, q)
@@ -639,9 +643,10 @@ def allan_variance(
 
 
 def _edf_safe(n_phase, m, alpha) -> float:
+    """Table-5 EDF without argument checks; n_phase and m may be non-integer (fast estimator)."""
     if n_phase < 3 or 2 * m > n_phase - 1:
         return 1.0
-    return edf_simple(int(n_phase), int(m), int(alpha))
+    return _edf_formula(float(n_phase), float(m), int(alpha))
 
 
 def _resolve_alpha(noise_alpha, tau_s, avar, estimator):
