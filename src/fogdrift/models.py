@@ -83,6 +83,10 @@ class DriftModel:
         """Hyper-parameters exactly as given to the constructor."""
         return {name: getattr(self, name) for name in self._param_names()}
 
+    def _serialisable_params(self) -> dict:
+        """Hyper-parameters for a model file: callables (progress callbacks) are not saved."""
+        return {k: (None if callable(v) else v) for k, v in self.get_params().items()}
+
     def set_params(self, **params):
         valid = set(self._param_names())
         for key, value in params.items():
@@ -122,7 +126,7 @@ class DriftModel:
             "format": "fogdrift-model",
             "format_version": FORMAT_VERSION,
             "class": type(self).__name__,
-            "params": self.get_params(),
+            "params": self._serialisable_params(),
             "state": meta,
         }
         json_path = base.with_suffix(".json")

@@ -23,10 +23,12 @@ through the monotone conversion.  With ``n_boot > 0`` a seeded parametric bootst
 (``sigma*^2 = model chi2(edf')/edf'`` with the same density correction of the EDF) is used
 instead.
 
-A term is reported (``estimable=True``) only if its lower 95 % bound is above zero;
-otherwise its value is ``None``, ``hi95`` holds the 95 % upper bound and ``reason`` says
-why (for instance that the record is shorter than 3x the tau at which the term could
-start to dominate).  The classic IEEE slope read-outs are returned alongside as a
+A term whose lower 95 % bound is above zero is *resolved* (``reason`` empty).  A term whose
+interval reaches zero is still reported with ``lo95 = 0`` and a ``reason`` saying it is not
+resolved from zero.  A term is *not estimable* (``estimable=False``, ``value`` None,
+``hi95`` = its 95 % upper bound, ``reason`` says why) when it is a long-tau term (B, K, R) that the
+record does not resolve from zero (only a longer record can), or a short-tau term (Q, N) whose
+dominance region lies below the shortest measured tau (sample interval too coarse).  The classic IEEE slope read-outs are returned alongside as a
 cross-check.
 """
 
@@ -526,17 +528,22 @@ def _make_term(name, a, sd_a, lo_a, hi_a, tau, powers, coef, j) -> NoiseTerm:
     dominates = term >= rest
     head = (f"{name} ({_LONG_NAME[name]}) not resolved: A={a:.3g} +- {sd_a:.3g} (tau in s), "
             f"consistent with 0; 95 % upper bound {upper:.3g} {unit}")
-    if p >= 0:  # B, K, R grow relative to the other terms with tau: a longer record is needed
-        where = grid[dominates]
+    where = grid[dominates]
+    if p >= 0:
+        # B, K, R grow relative to the other terms with tau: when the record does not resolve them
+        # from zero, only a longer record can; report the upper bound, not a number.
         extra = ""
         if where.size and t_hi < 3.0 * where.min():
             extra = f" < 3x the tau {where.min():.3g} s where {name} at its upper bound would dominate"
         return NoiseTerm(name, None, unit, None, None, upper, False,
                          f"record too short: tau_max {t_hi:.3g} s{extra}; " + head)
-    where = grid[dominates]
-    if where.size and t_lo > where.max() / 3.0:
+    if p < 0 and where.size and t_lo > where.max() / 3.0:
         return NoiseTerm(name, None, unit, None, None, upper, False,
                          f"sample interval too coarse: tau_min {t_lo:.3g} s > 1/3 of the tau "
                          f"{where.max():.3g} s below which {name} at its upper bound would dominate; " + head)
-    return NoiseTerm(name, None, unit, None, None, upper, False, head)
+    # The measured tau range covers where the term would show, but the data do not separate it from
+    # zero: report the estimate with its interval [0, upper] rather than hiding it.
+    value = conv * math.sqrt(max(a, 0.0))
+    std = conv * sd_a / (2.0 * math.sqrt(a)) if a > 0 else None
+    return NoiseTerm(name, value, unit, std, 0.0, upper, True, head)
 
