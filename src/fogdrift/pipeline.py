@@ -1,0 +1,635 @@
+"""The whole method on one recording: characterise, separate, model, compensate, evaluate.
+
+``run_allan``, ``run_separation``, ``run_models`` and ``run_analysis`` are the library entry points behind
+``fogdrift allan``, ``separate``, ``model`` and ``analyze``. They return dataclasses; they never print or plot
+(:mod:`fogdrift.report` renders them).
+
+Order of operations in :func:`run_analysis`, per axis (method notes §5–6):
+
+1. optional Earth-rate removal for a latitude and axis orientation;
+2. the constant bias is the mean of the **training block** only, and is subtracted;
+3. Allan analysis of the original output at its native rate (whole record: Allan is invariant to constants);
+4. block-average to the modelling rate (default 1 Hz: drift lives below ~0.1 Hz, and a 4-level db2
+   approximation of a 100 Hz log still passes ~3 Hz);
+5. chronological train / validation / test split; lifting separation **inside each block** (never across the
+   split, because the wavelet drift is non-causal);
+6. drift models fitted on the training drift (validation block for early stopping);
+7. two compensated signals on the test block, both labelled:
+   *paper* = drift minus its one-step predicted drift (the drift residual, the paper's Table 2 / Fig. 9), and
+   *practical* = gyro output minus the one-step prediction made from the **causal** drift (what a real-time
+   compensator can do);
+8. Allan analysis of every compensated signal; metrics on the test block beside persistence.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.metadata
+import platform
+import time
+import warnings
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from .errors import ConfigError, FogdriftWarning, InsufficientDataError
+
+__all__ = [
+    "AnalysisConfig",
+    "AllanAxis",
+    "SeparationAxis",
+    "ModelAxis",
+    "CompensatedSignal",
+    "AnalysisAxis",
+    "AnalysisResult",
+    "MODEL_NAMES",
+    "make_model",
+    "run_allan",
+    "run_separation",
+    "run_models",
+    "run_analysis",
+]
+
+#: CLI/model names accepted in ``AnalysisConfig.models``, in report order.
+MODEL_NAMES = ("grey-elman", "elman", "gm11", "ar", "persistence")
+
+
+@dataclass
+class AnalysisConfig:
+    """Every setting of an analysis; stored in the result JSON.
+
+    Attributes
+    ----------
+    model_rate_hz : float or None
+        Modelling rate [Hz]: the rate is block-averaged to this before separation and drift modelling.
+        ``None`` keeps the native rate. Default 1 Hz (drift lives below ~0.1 Hz).
+    wavelet, level, mode
+        Lifting separation: wavelet name, decomposition level (int or ``"auto"``) and boundary mode
+        (``"symmetric"`` avoids joining the end of a block to its start; ``"periodization"`` is
+        PyWavelets-compatible).
+    train_fraction, val_fraction : float
+        Chronological split; the test block is the rest.
+    latitude_deg : float or None
+        If given, the Earth-rate projection for each axis in ``earth_axes`` is removed before the bias.
+    earth_axes : dict
+        Axis name -> orientation (``"up"``, ``"north"``, … or an east-north-up vector).
+    models : tuple of str
+        Names from :data:`MODEL_NAMES`.
+    lags, hidden, epochs, seed, activation, training
+        Elman / grey-Elman hyper-parameters (``lags`` is also the AR order).
+    gm_window : int
+        Rolling window [samples] of the one-step GM(1,1).
+    causal_window_s : float
+        Length [s] of the sliding window of the causal drift used by the practical compensation.
+    taus : str
+        Tau grid of the Allan analyses (``"octave"``, ``"decade"``, ``"all"`` or a number of log-spaced taus).
+    estimator : str
+        Allan estimator (``"overlapping"``, ``"non-overlapping"`` or ``"fast"``).
+    terms : tuple of str
+        Noise terms fitted (subset of Q, N, B, K, R).
+    fit_tau_s : tuple of (float or None, float or None)
+        Tau range [s] of the noise fit (None = no limit), e.g. to leave out a vibration bump that the
+        IEEE-952 model does not describe.
+    """
+
+    model_rate_hz: float | None = 1.0
+    wavelet: str = "db2"
+    level: int | str = 4
+    mode: str = "symmetric"
+    train_fraction: float = 0.6
+    val_fraction: float = 0.2
+    latitude_deg: float | None = None
+    earth_axes: dict = field(default_factory=dict)
+    models: tuple = MODEL_NAMES
+    lags: int = 4
+    hidden: int = 16
+    epochs: int = 2000
+    seed: int = 0
+    activation: str = "tanh"
+    training: str = "bptt"
+    gm_window: int = 8
+    causal_window_s: float = 128.0
+    taus: str = "octave"
+    estimator: str = "overlapping"
+    terms: tuple = ("Q", "N", "B", "K", "R")
+    fit_tau_s: tuple = (None, None)
+
+    def validate(self) -> "AnalysisConfig":
+        if not 0 < self.train_fraction < 1 or not 0 <= self.val_fraction < 1:
+            raise ConfigError(
+                f"train_fraction must be in (0, 1) and val_fraction in [0, 1); got {self.train_fraction}, {self.val_fraction}"
+            )
+        if self.train_fraction + self.val_fraction >= 1:
+            raise ConfigError(
+                f"train_fraction + val_fraction must leave a test block; got {self.train_fraction + self.val_fraction:.3g} >= 1"
+            )
+        unknown = [m for m in self.models if m not in MODEL_NAMES]
+        if unknown:
+            raise ConfigError(f"unknown model(s) {unknown}; expected a subset of {list(MODEL_NAMES)}")
+        if self.model_rate_hz is not None and not self.model_rate_hz > 0:
+            raise ConfigError(f"model_rate_hz must be > 0 Hz or None; got {self.model_rate_hz!r}")
+        if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
+            raise ConfigError(f"lags, hidden and epochs must be >= 1; got {self.lags}, {self.hidden}, {self.epochs}")
+        if not self.causal_window_s > 0:
+            raise ConfigError(f"causal_window_s must be > 0 s; got {self.causal_window_s!r}")
+        return self
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["models"] = list(self.models)
+        d["terms"] = list(self.terms)
+        d["fit_tau_s"] = list(self.fit_tau_s)
+        return d
+
+
+# ---------------------------------------------------------------------------------------------------------
+# result dataclasses
+
+
+@dataclass
+class AllanAxis:
+    """Allan analysis of one axis. ``allan`` is an AllanResult, ``noise`` a NoiseFit."""
+
+    name: str
+    allan: object
+    noise: object
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict()}
+
+
+@dataclass
+class SeparationAxis:
+    """Lifting separation of one axis at the modelling rate.
+
+    ``rate_dph`` is the (bias-removed) rate, ``drift_dph + noise_dph == rate_dph``; each of ``rows`` is
+    ``(label, AllanAxis)`` for original / drift / noise.
+    """
+
+    name: str
+    dt_s: float
+    level: int
+    rate_dph: np.ndarray
+    drift_dph: np.ndarray
+    noise_dph: np.ndarray
+    rows: list
+    level_scan: list | None = None
+
+    def to_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "dt_s": self.dt_s,
+            "level": self.level,
+            "n_samples": int(self.rate_dph.size),
+            "max_abs_reconstruction_error_dph": float(np.max(np.abs(self.drift_dph + self.noise_dph - self.rate_dph))),
+            "rows": [{"label": label, **row.to_dict()} for label, row in self.rows],
+            "level_scan": None if self.level_scan is None else [_plain(d) for d in self.level_scan],
+        }
+
+
+@dataclass
+class CompensatedSignal:
+    """A compensated signal on the test block and its Allan analysis.
+
+    ``kind`` is ``"reference"`` (uncompensated), ``"paper"`` (drift residual: wavelet drift minus the one-step
+    predicted drift, as in the paper's Table 2) or ``"practical"`` (output minus a causal one-step drift
+    prediction).
+    """
+
+    label: str
+    kind: str
+    model: str | None
+    signal_dph: np.ndarray
+    analysis: AllanAxis
+
+    def to_dict(self) -> dict:
+        return {"label": self.label, "kind": self.kind, "model": self.model, **self.analysis.to_dict()}
+
+
+@dataclass
+class ModelAxis:
+    """Drift models of one axis: split, drift per block, predictions and metrics on the test block."""
+
+    name: str
+    dt_s: float
+    split: dict
+    bias_dph: float
+    earth_rate_dph: float
+    rate_dph: np.ndarray  # bias-removed rate at the modelling rate (whole record)
+    drift_blocks: dict  # "train"/"val"/"test" -> drift separated inside that block
+    causal_drift_dph: np.ndarray  # causal (real-time) drift of the whole record, NaN during warm-up
+    predictions: dict  # model label -> one-step predictions of the test-block drift (paper target)
+    causal_predictions: dict  # model label -> one-step predictions from the causal drift (test block)
+    metrics: dict  # model label -> MetricsResult (paper target), scored from test index `score_from`
+    causal_metrics: dict  # model label -> MetricsResult (causal target)
+    p0_as_measured: dict  # model label -> (p0 model, p0 persistence) with bias + Earth rate added back [%]
+    fitted: dict  # model label -> fitted DriftModel
+    fit_seconds: dict
+    notes: list = field(default_factory=list)  # distinct warnings raised while evaluating
+    score_from: int = 0  # first test-block index that the metrics and Table 2 score
+
+    def to_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "dt_s": self.dt_s,
+            "split": self.split,
+            "bias_dph": self.bias_dph,
+            "earth_rate_dph": self.earth_rate_dph,
+            "metrics_paper_target": {k: v.to_dict() for k, v in self.metrics.items()},
+            "metrics_causal_target": {k: v.to_dict() for k, v in self.causal_metrics.items()},
+            "p0_as_measured_pct": {k: {"model": _f(a), "persistence": _f(b)} for k, (a, b) in self.p0_as_measured.items()},
+            "fit_seconds": self.fit_seconds,
+            "notes": self.notes,
+            "score_from_test_index": self.score_from,
+            "model_params": {k: _plain(m._serialisable_params()) for k, m in self.fitted.items()},
+        }
+
+
+@dataclass
+class AnalysisAxis:
+    """Everything :func:`run_analysis` finds for one axis."""
+
+    name: str
+    original: AllanAxis  # native rate, whole record
+    separation: SeparationAxis  # whole record at the modelling rate (figures 5, 6)
+    models: ModelAxis
+    table2: list  # CompensatedSignal rows, test block at the modelling rate
+
+    def to_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "original": self.original.to_dict(),
+            "separation": self.separation.to_dict(),
+            "models": self.models.to_dict(),
+            "table2": [row.to_dict() for row in self.table2],
+        }
+
+
+@dataclass
+class AnalysisResult:
+    """Result of :func:`run_analysis` (JSON via :meth:`to_dict`)."""
+
+    config: AnalysisConfig
+    source: str
+    sha256: str
+    record: dict
+    axes: list
+    versions: dict
+    wall_s: float
+    apply_to: "AnalysisResult | None" = None
+    applied: bool = False  # True when these axes were modelled by another recording's fitted models
+
+    def to_dict(self) -> dict:
+        return {
+            "fogdrift_result": "analysis",
+            "source": self.source,
+            "sha256": self.sha256,
+            "applied_models_from_other_recording": self.applied,
+            "config": self.config.to_dict(),
+            "record": self.record,
+            "versions": self.versions,
+            "wall_s": self.wall_s,
+            "axes": [a.to_dict() for a in self.axes],
+            "apply_to": None if self.apply_to is None else self.apply_to.to_dict(),
+        }
+
+
+# ---------------------------------------------------------------------------------------------------------
+# helpers
+
+
+def _f(x):
+    x = float(x)
+    return x if np.isfinite(x) else None
+
+
+def _plain(obj):
+    """JSON-able copy of a dataclass/dict/array tree."""
+    if hasattr(obj, "to_dict"):
+        return obj.to_dict()
+    if hasattr(obj, "__dataclass_fields__"):
+        return _plain(asdict(obj))
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _plain(obj.tolist())
+    if isinstance(obj, (np.floating, float)):
+        return _f(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
+def library_versions() -> dict:
+    out = {"python": platform.python_version(), "platform": platform.platform()}
+    for pkg in ("fogdrift", "numpy", "scipy", "numba", "jax", "optax", "matplotlib"):
+        try:
+            out[pkg] = importlib.metadata.version(pkg)
+        except importlib.metadata.PackageNotFoundError:
+            out[pkg] = None
+    return out
+
+
+def sha256_of(path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None) -> AllanAxis:
+    """Allan variance + noise fit of one 1-D rate series."""
+    from .allan import allan_variance
+    from .noise import fit_noise
+
+    res = allan_variance(rate_dph, dt_s, taus=cfg.taus, estimator=cfg.estimator, progress=progress)
+    lo, hi = cfg.fit_tau_s
+    tau_range = None if lo is None and hi is None else (lo or 0.0, hi or np.inf)
+    return AllanAxis(name=name, allan=res, noise=fit_noise(res, terms=tuple(cfg.terms), tau_range_s=tau_range))
+
+
+def _model_record(record, cfg: AnalysisConfig):
+    """Block-average a record to the modelling rate (or keep it)."""
+    if cfg.model_rate_hz is None:
+        return record
+    target_dt = 1.0 / cfg.model_rate_hz
+    if target_dt <= record.dt_s * (1 + 1e-9):
+        return record
+    factor = round(target_dt / record.dt_s)
+    return record.block_average(factor * record.dt_s)
+
+
+def make_model(name: str, cfg: AnalysisConfig, progress=None):
+    """Construct an unfitted drift model from its CLI name and the config's hyper-parameters."""
+    if name == "persistence":
+        from .models import Persistence
+
+        return Persistence()
+    if name == "ar":
+        from .baselines import AR
+
+        return AR(order=cfg.lags)
+    if name == "gm11":
+        from .grey import GM11
+
+        return GM11(mode="rolling", window=cfg.gm_window)
+    from .elman import Elman, GreyElman
+
+    cls = GreyElman if name == "grey-elman" else Elman
+    return cls(
+        lags=cfg.lags,
+        hidden=cfg.hidden,
+        activation=cfg.activation,
+        training=cfg.training,
+        epochs=cfg.epochs,
+        seed=cfg.seed,
+        progress=progress,
+    )
+
+
+def _separate(x, cfg: AnalysisConfig, dt_s):
+    from .lifting import separate
+
+    return separate(x, wavelet=cfg.wavelet, level=cfg.level, mode=cfg.mode, dt_s=dt_s)
+
+
+def _resolved_level(x, cfg: AnalysisConfig, dt_s) -> tuple[int, list | None]:
+    if cfg.level != "auto":
+        return int(cfg.level), None
+    from .lifting import choose_level, level_scan
+
+    scan = level_scan(x, dt_s, wavelet=cfg.wavelet, mode=cfg.mode)
+    return int(choose_level(scan)), scan
+
+
+def _split_indices(n: int, cfg: AnalysisConfig) -> dict:
+    n_train = int(round(n * cfg.train_fraction))
+    n_val = int(round(n * cfg.val_fraction))
+    split = {"train": [0, n_train], "val": [n_train, n_train + n_val], "test": [n_train + n_val, n]}
+    return split
+
+
+def _earth_rate(name: str, cfg: AnalysisConfig) -> float:
+    if cfg.latitude_deg is None or name not in cfg.earth_axes:
+        return 0.0
+    from .units import earth_rate_projection_dph
+
+    return float(earth_rate_projection_dph(cfg.latitude_deg, cfg.earth_axes[name]))
+
+
+def _check_earth_axes(record, cfg: AnalysisConfig) -> None:
+    unknown = [k for k in cfg.earth_axes if k not in record.axis_names]
+    if unknown:
+        raise ConfigError(f"Earth-rate axis {unknown} not in the record; its axes are {list(record.axis_names)}")
+    if cfg.earth_axes and cfg.latitude_deg is None:
+        raise ConfigError("an Earth-rate axis orientation was given without a latitude (--latitude DEG)")
+
+
+# ---------------------------------------------------------------------------------------------------------
+# entry points
+
+
+def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | None = None) -> list[AllanAxis]:
+    """Allan variance and noise identification of every axis of a record at its native rate."""
+    cfg = (cfg or AnalysisConfig()).validate()
+    return [analyse_allan(name, record.axis(name), record.dt_s, cfg, progress) for name in record.axis_names]
+
+
+def run_separation(record, cfg: AnalysisConfig | None = None) -> list[SeparationAxis]:
+    """Lifting separation of every axis (whole record, at the modelling rate) with Allan tables."""
+    cfg = (cfg or AnalysisConfig()).validate()
+    rec = _model_record(record, cfg)
+    out = []
+    for name in rec.axis_names:
+        x = np.asarray(rec.axis(name), dtype=np.float64)
+        # A constant goes wholly into the drift; remove it so the drift shows the variation only.
+        out.append(_separation_axis(name, x - x.mean(), rec.dt_s, cfg))
+    return out
+
+
+def _separation_axis(name, x, dt_s, cfg: AnalysisConfig) -> SeparationAxis:
+    """Separate one whole series and analyse original, drift and noise."""
+    level, scan = _resolved_level(x, cfg, dt_s)
+    drift, noise = _separate(x, _with_level(cfg, level), dt_s)
+    rows = [(label, analyse_allan(label, sig, dt_s, cfg)) for label, sig in
+            (("original", x), ("drift", drift), ("noise", noise))]
+    return SeparationAxis(name, dt_s, level, x, drift, noise, rows, scan)
+
+
+def _with_level(cfg: AnalysisConfig, level: int) -> AnalysisConfig:
+    return AnalysisConfig(**{**cfg.to_dict(), "level": int(level)})
+
+
+def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progress=None, fitted=None) -> ModelAxis:
+    """Split, separate inside each block, fit (unless ``fitted`` models are given) and evaluate one axis."""
+    from .lifting import causal_drift
+    from .metrics import evaluate, p0
+    from .models import Persistence
+
+    level = int(cfg.level)
+    split = _split_indices(rate.size, cfg)
+    need = max(3 * 2**level, cfg.lags + 2)
+    for block, (lo, hi) in split.items():
+        if hi - lo < need:
+            raise InsufficientDataError(
+                f"axis {name}: the {block} block has {hi - lo} samples at {1 / dt_s:.4g} Hz; needs at least {need} "
+                f"for level-{level} separation and {cfg.lags} lags (use a longer record, a higher --model-rate "
+                "or a lower --level)",
+                needed=need,
+                got=hi - lo,
+            )
+    (a, b), (c, d), (e, f) = split["train"], split["val"], split["test"]
+    blocks = {"train": rate[a:b], "val": rate[c:d], "test": rate[e:f]}
+    drift = {k: _separate(v, cfg, dt_s)[0] for k, v in blocks.items()}
+    history = np.concatenate([drift["train"], drift["val"]])
+
+    # The causal drift's warm-up (one window) must end inside the training block.
+    window = min(max(int(round(cfg.causal_window_s / dt_s)), 3 * 2**level), b)
+    causal = causal_drift(rate, window, wavelet=cfg.wavelet, level=level, mode=cfg.mode)
+    causal_hist = causal[:e][np.isfinite(causal[:e])]
+    causal_test = causal[e:f]
+
+    persistence = Persistence().fit(drift["train"])
+    persist_pred = persistence.predict(drift["test"], history=history)
+    persist_causal = persistence.predict(causal_test, history=causal_hist)
+    offset = bias + earth
+
+    models, fit_s = {}, {}
+    if fitted is None:
+        for model_name in cfg.models:
+            model = make_model(model_name, cfg, progress)
+            t0 = time.perf_counter()
+            model.fit(drift["train"], drift["val"])
+            fit_s[model.label] = time.perf_counter() - t0
+            models[model.label] = model
+    else:
+        models = dict(fitted)
+
+    predictions, causal_predictions, metrics, causal_metrics, p0_meas = {}, {}, {}, {}, {}
+    # Score only predictions whose inputs lie inside the test block: the first `lags` use history from the
+    # validation block, whose drift was separated on its own and carries that block's end effect.
+    skip = cfg.lags
+    # The p0 guard warns for every model; the tables show NaN, so keep each distinct message once.
+    with warnings.catch_warnings(record=True) as log:
+        warnings.simplefilter("always", FogdriftWarning)
+        for label, model in models.items():
+            yhat = model.predict(drift["test"], history=history)
+            yhat_c = model.predict(causal_test, history=causal_hist)
+            predictions[label], causal_predictions[label] = yhat, yhat_c
+            y, p, pp = drift["test"][skip:], yhat[skip:], persist_pred[skip:]
+            metrics[label] = evaluate(y, p, y_train=drift["train"], yhat_persistence=pp,
+                                      offset_convention="demeaned_by_train_mean")
+            causal_metrics[label] = evaluate(causal_test[skip:], yhat_c[skip:], y_train=drift["train"],
+                                             yhat_persistence=persist_causal[skip:],
+                                             offset_convention="demeaned_by_train_mean")
+            # Paper-compatible p0: bias and Earth rate added back ("as measured"), persistence beside it.
+            ok = np.isfinite(p) & np.isfinite(pp)
+            p0_meas[label] = (
+                p0(y[ok] + offset, p[ok] + offset, offset_convention="as_measured"),
+                p0(y[ok] + offset, pp[ok] + offset, offset_convention="as_measured"),
+            )
+    notes = sorted({str(w.message).split(":")[0] for w in log if issubclass(w.category, FogdriftWarning)})
+    return ModelAxis(
+        name=name, dt_s=dt_s, split=split, bias_dph=bias, earth_rate_dph=earth, rate_dph=rate,
+        drift_blocks=drift, causal_drift_dph=causal, predictions=predictions,
+        causal_predictions=causal_predictions, metrics=metrics, causal_metrics=causal_metrics,
+        p0_as_measured=p0_meas, fitted=models, fit_seconds=fit_s, notes=notes, score_from=skip,
+    )
+
+
+def _prepared_axis(record_m, name, cfg):
+    """Rate at the modelling rate with Earth rate and training-block bias removed."""
+    x = np.asarray(record_m.axis(name), dtype=np.float64)
+    earth = _earth_rate(name, cfg)
+    n_train = _split_indices(x.size, cfg)["train"][1]
+    bias = float(np.mean(x[:n_train]) - earth)
+    return x - earth - bias, bias, earth
+
+
+def run_models(record, cfg: AnalysisConfig | None = None, progress=None) -> list[ModelAxis]:
+    """Fit every configured drift model on every axis (training block) and evaluate on the test block."""
+    cfg = (cfg or AnalysisConfig()).validate()
+    _check_earth_axes(record, cfg)
+    rec = _model_record(record, cfg)
+    out = []
+    for name in rec.axis_names:
+        rate, bias, earth = _prepared_axis(rec, name, cfg)
+        lvl_cfg = _with_level(cfg, _resolved_level(rate, cfg, rec.dt_s)[0])
+        out.append(_fit_axis_models(name, rate, rec.dt_s, lvl_cfg, bias, earth, progress))
+    return out
+
+
+def _table2(ma: ModelAxis, cfg: AnalysisConfig) -> list[CompensatedSignal]:
+    """Allan analysis of original, drift and every compensated signal on the test block."""
+    e, f = ma.split["test"]
+    k = ma.score_from
+    raw = ma.rate_dph[e + k:f]
+    drift = ma.drift_blocks["test"][k:]
+    rows = [
+        CompensatedSignal("original (test block)", "reference", None, raw, analyse_allan("original", raw, ma.dt_s, cfg)),
+        CompensatedSignal("drift signal (test block)", "reference", None, drift, analyse_allan("drift", drift, ma.dt_s, cfg)),
+    ]
+    for label, yhat in ma.predictions.items():
+        yhat = yhat[k:]
+        ok = np.isfinite(yhat)
+        resid = drift[ok] - yhat[ok]
+        rows.append(CompensatedSignal(f"{label}: drift residual (paper)", "paper", label, resid,
+                                      analyse_allan(label, resid, ma.dt_s, cfg)))
+    for label, yhat in ma.causal_predictions.items():
+        yhat = yhat[k:]
+        ok = np.isfinite(yhat)
+        comp = raw[ok] - yhat[ok]
+        rows.append(CompensatedSignal(f"{label}: output - causal prediction (practical)", "practical", label, comp,
+                                      analyse_allan(label, comp, ma.dt_s, cfg)))
+    return rows
+
+
+def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | None = None, sha256: str | None = None,
+                 apply_to=None, progress=None, fitted_from: "AnalysisResult | None" = None) -> AnalysisResult:
+    """The whole method on one record (see the module docstring); ``apply_to`` is a second GyroRecord.
+
+    ``progress(epoch, n_epochs, train_loss, val_loss)`` is passed to the neural models.
+    With ``fitted_from`` (used for ``apply_to``), no model is fitted: the models of that analysis are applied
+    unchanged to the axes of the same name.
+    """
+    t_start = time.perf_counter()
+    cfg = (cfg or AnalysisConfig()).validate()
+    _check_earth_axes(record, cfg)
+    rec_m = _model_record(record, cfg)
+    axes = []
+    for name in record.axis_names:
+        original = analyse_allan(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s, cfg)
+        rate, bias, earth = _prepared_axis(rec_m, name, cfg)
+        sep = _separation_axis(name, rate, rec_m.dt_s, cfg)
+        lvl_cfg = _with_level(cfg, sep.level)
+        ma = _fit_axis_models(name, rate, rec_m.dt_s, lvl_cfg, bias, earth, progress,
+                              fitted=None if fitted_from is None else _fitted_models_for(name, fitted_from))
+        axes.append(AnalysisAxis(name, original, sep, ma, _table2(ma, lvl_cfg)))
+    result = AnalysisResult(
+        config=cfg,
+        source=source or record.source,
+        sha256=sha256 or (sha256_of(record.source) if Path(str(record.source)).is_file() else ""),
+        record=record.metadata(),
+        axes=axes,
+        versions=library_versions(),
+        wall_s=0.0,
+        applied=fitted_from is not None,
+    )
+    if apply_to is not None:
+        result.apply_to = run_analysis(apply_to, cfg, progress=progress, fitted_from=result)
+    result.wall_s = time.perf_counter() - t_start
+    return result
+
+
+def _fitted_models_for(name: str, fitted_from: AnalysisResult) -> dict:
+    source_axes = {a.name: a for a in fitted_from.axes}
+    if name not in source_axes:
+        raise ConfigError(
+            f"--apply-to: axis {name!r} has no fitted models; the fitted recording has axes {list(source_axes)}"
+        )
+    return source_axes[name].models.fitted

@@ -1,0 +1,90 @@
+"""CLI: commands run on the bundled recording, write their files, and bad input gives one clear line."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from fogdrift.cli import app
+
+runner = CliRunner()
+
+
+def _ok(result):
+    assert result.exit_code == 0, result.output + repr(result.exception)
+    return result.output
+
+
+def test_python_m_help():
+    proc = subprocess.run([sys.executable, "-m", "fogdrift", "--help"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0
+    for cmd in ("allan", "separate", "model", "analyze"):
+        assert cmd in proc.stdout
+
+
+def test_allan_on_bundled_recording(bundled_path, tmp_path):
+    out = _ok(runner.invoke(app, ["allan", str(bundled_path), "--out", str(tmp_path)]))
+    for unit in ("µrad", "deg/√h", "deg/h^1.5", "deg/h²"):
+        assert unit in out
+    for axis in ("gx", "gy", "gz"):
+        assert axis in out
+    doc = json.loads((tmp_path / "allan.json").read_text())
+    assert [a["name"] for a in doc["axes"]] == ["gx", "gy", "gz"]
+    header = (tmp_path / "allan.csv").read_text().splitlines()[0]
+    assert "tau_s" in header and "adev_dph" in header
+    assert (tmp_path / "allan.png").stat().st_size > 10_000
+    # The JSON's ADEV at tau = 1 s matches the data README's sanity table (gz: 8.706 deg/h).
+    gz = doc["axes"][2]["allan"]
+    i = int(np.argmin(np.abs(np.asarray(gz["tau_s"]) - 1.28)))
+    assert 5.0 < gz["adev_dph"][i] < 12.0
+
+
+@pytest.mark.parametrize(
+    "content, fragment",
+    [
+        ("t_s,gz\n0.0,1.0\n0.01,nan\n0.02,3.0\n", "bad.csv:3"),
+        ("t_s,gz\n0.0,1.0\n0.01,abc\n0.02,3.0\n", "bad.csv:3"),
+        ("t_s,gz\n0.0,1.0\n0.02,2.0\n0.01,3.0\n", "bad.csv:4"),
+        ("", "bad.csv"),
+    ],
+)
+def test_bad_input_is_one_clear_line(tmp_path, content, fragment):
+    path = tmp_path / "bad.csv"
+    path.write_text(content)
+    result = runner.invoke(app, ["allan", str(path), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 1
+    assert fragment in result.output
+    assert "Traceback" not in result.output
+    assert len([ln for ln in result.output.splitlines() if ln.strip()]) <= 3  # rich may wrap one line
+
+
+def test_unknown_unit_and_level_are_config_errors(bundled_path, tmp_path):
+    result = runner.invoke(app, ["allan", str(bundled_path), "--unit", "furlongs", "--out", str(tmp_path)])
+    assert result.exit_code == 1 and "furlongs" in result.output
+    result = runner.invoke(app, ["separate", str(bundled_path), "--level", "x", "--out", str(tmp_path)])
+    assert result.exit_code == 1 and "--level" in result.output
+
+
+def test_separate_writes_series_figures_and_table(bundled_path, tmp_path):
+    out = _ok(runner.invoke(app, ["separate", str(bundled_path), "--columns", "gz", "--out", str(tmp_path)]))
+    assert "drift" in out and "noise" in out
+    with np.load(tmp_path / "separation.npz") as z:
+        x, d, n = z["gz_input_dph"], z["gz_drift_dph"], z["gz_noise_dph"]
+    np.testing.assert_allclose(d + n, x, rtol=0, atol=1e-12 * np.abs(x).max())
+    assert x.size == 1847  # 184 718 samples at 100 Hz block-averaged to 1 Hz
+    for name in ("separation.csv", "separation_table.csv", "fig5_drift_noise_gz.png", "fig6_allan_gz.png"):
+        assert (tmp_path / name).exists()
+
+
+def test_model_command_small(bundled_path, tmp_path):
+    out = _ok(runner.invoke(app, ["model", str(bundled_path), "--columns", "gz", "--models", "ar,gm11,persistence",
+                                  "--out", str(tmp_path)]))
+    assert "persistence" in out and "RMSE [deg/h]" in out
+    doc = json.loads((tmp_path / "metrics.json").read_text())
+    assert set(doc["axes"][0]["metrics_paper_target"]) >= {"persistence"}
+    assert any(p.suffix == ".json" for p in (tmp_path / "models").iterdir())
