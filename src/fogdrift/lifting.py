@@ -1253,26 +1253,11 @@ class LevelDiagnostic:
 
 
 def _oadev_octaves(y: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """Overlapping ADEV of rate samples y at octave taus m = 1, 2, 4, ... <= n/10.
+    """Overlapping ADEV of rate samples y at octave taus m = 1, 2, 4, ... <= n/10 (via :mod:`fogdrift.allan`)."""
+    from .allan import allan_variance  # lazy: lifting stays importable on its own
 
-    NIST SP 1065 eq. 14 via the angle theta_k = dt * cumsum(y):
-    ``sigma^2(m) = sum (theta_{k+2m} - 2 theta_{k+m} + theta_k)^2 / (2 tau^2 (n - 2m + 1))``.
-    """
-    n = y.shape[0]
-    theta = np.empty(n + 1)
-    theta[0] = 0.0
-    np.cumsum((y - y.mean()) * dt_s, out=theta[1:])
-    ms = []
-    m = 1
-    while m <= max(1, n // 10):
-        ms.append(m)
-        m *= 2
-    taus = np.array(ms, dtype=float) * dt_s
-    adev = np.empty(len(ms))
-    for i, m in enumerate(ms):
-        d = theta[2 * m :] - 2.0 * theta[m : n + 1 - m] + theta[: n + 1 - 2 * m]
-        adev[i] = math.sqrt(float(d @ d) / (2.0 * (m * dt_s) ** 2 * d.shape[0]))
-    return taus, adev
+    res = allan_variance(y, dt_s, taus="octave", max_fraction=0.1)
+    return res.tau_s, res.adev_dph
 
 
 def _loglog_slope(taus, adev) -> float:

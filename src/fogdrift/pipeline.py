@@ -23,7 +23,6 @@ Order of operations in :func:`run_analysis`, per axis (method notes §5–6):
 
 from __future__ import annotations
 
-import hashlib
 import importlib.metadata
 import platform
 import time
@@ -35,6 +34,7 @@ from typing import Callable
 import numpy as np
 
 from .errors import ConfigError, FogdriftWarning, InsufficientDataError
+from .io import file_sha256
 
 __all__ = [
     "AnalysisConfig",
@@ -334,14 +334,6 @@ def library_versions() -> dict:
     return out
 
 
-def sha256_of(path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
-
-
 def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None) -> AllanAxis:
     """Allan variance + noise fit of one 1-D rate series."""
     from .allan import allan_variance
@@ -574,18 +566,16 @@ def _table2(ma: ModelAxis, cfg: AnalysisConfig) -> list[CompensatedSignal]:
         CompensatedSignal("original (test block)", "reference", None, raw, analyse_allan("original", raw, ma.dt_s, cfg)),
         CompensatedSignal("drift signal (test block)", "reference", None, drift, analyse_allan("drift", drift, ma.dt_s, cfg)),
     ]
-    for label, yhat in ma.predictions.items():
-        yhat = yhat[k:]
-        ok = np.isfinite(yhat)
-        resid = drift[ok] - yhat[ok]
-        rows.append(CompensatedSignal(f"{label}: drift residual (paper)", "paper", label, resid,
-                                      analyse_allan(label, resid, ma.dt_s, cfg)))
-    for label, yhat in ma.causal_predictions.items():
-        yhat = yhat[k:]
-        ok = np.isfinite(yhat)
-        comp = raw[ok] - yhat[ok]
-        rows.append(CompensatedSignal(f"{label}: output - causal prediction (practical)", "practical", label, comp,
-                                      analyse_allan(label, comp, ma.dt_s, cfg)))
+    compensations = (
+        ("drift residual (paper)", "paper", ma.predictions, drift),
+        ("output - causal prediction (practical)", "practical", ma.causal_predictions, raw),
+    )
+    for suffix, kind, predictions, target in compensations:
+        for label, yhat in predictions.items():
+            ok = np.isfinite(yhat[k:])  # NaN only during the models' warm-up
+            signal = target[ok] - yhat[k:][ok]
+            rows.append(CompensatedSignal(f"{label}: {suffix}", kind, label, signal,
+                                          analyse_allan(label, signal, ma.dt_s, cfg)))
     return rows
 
 
@@ -613,7 +603,7 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
     result = AnalysisResult(
         config=cfg,
         source=source or record.source,
-        sha256=sha256 or (sha256_of(record.source) if Path(str(record.source)).is_file() else ""),
+        sha256=sha256 or (file_sha256(record.source) if Path(str(record.source)).is_file() else ""),
         record=record.metadata(),
         axes=axes,
         versions=library_versions(),
