@@ -153,10 +153,11 @@ def _table(title, headers, rows) -> Table:
 
 
 def _print_noise_notes(label, noise):
-    from .report import not_estimable_notes
+    from .report import not_estimable_notes, readout_text
 
     for note in not_estimable_notes(noise):
         console.print(Text(f"  {label} {note}", style="dim"), highlight=False)
+    console.print(Text(f"  {label} slope read-outs (cross-check): {readout_text(noise)}"), highlight=False)
 
 
 def _metrics_table(title, rows) -> Table:

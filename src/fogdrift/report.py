@@ -74,6 +74,24 @@ def noise_row(noise) -> list[str]:
     return [term_text(noise.terms[name]) for name in ("Q", "N", "B", "K", "R")]
 
 
+_READOUT_LABELS = {
+    "Q_urad@tau=sqrt3s": ("Q at τ=√3 s on the -1 line", "µrad"),
+    "N_dprh@tau=1h": ("N at τ=1 h on the -1/2 line", "deg/√h"),
+    "B_dph@min": ("B from the minimum", "deg/h"),
+    "K_dphrh@tau=3h": ("K at τ=3 h on the +1/2 line", "deg/h^1.5"),
+    "R_dph2@tau=sqrt2h": ("R at τ=√2 h on the +1 line", "deg/h²"),
+}
+
+
+def readout_text(noise) -> str:
+    """The classic IEEE-952 slope read-outs, with units ('–' where the curve shows no such slope)."""
+    parts = []
+    for key, (label, unit) in _READOUT_LABELS.items():
+        value = noise.readouts.get(key)
+        parts.append(f"{label}: {'–' if value is None else _fmt(value) + ' ' + unit}")
+    return "; ".join(parts)
+
+
 def not_estimable_notes(noise) -> list[str]:
     return [f"{t.name}: {t.reason}" for t in noise.terms.values() if not t.estimable and t.reason]
 
@@ -453,6 +471,8 @@ def _analysis_section(result, fig_dir, title, fig_offset=0) -> str:
         notes = not_estimable_notes(ax.original.noise)
         if notes:
             parts.append('<p class="note">n/e = not estimable: ' + html.escape("; ".join(notes)) + "</p>")
+        parts.append('<p class="note">Slope read-outs (cross-check): '
+                     + html.escape(readout_text(ax.original.noise)) + "</p>")
         parts.append("<h4>Table 2: noise coefficients before and after compensation (test block, modelling rate)</h4>")
         parts.append(_table(("signal",) + NOISE_HEADERS, [[r.label] + noise_row(r.analysis.noise) for r in ax.table2],
                             "table2"))
