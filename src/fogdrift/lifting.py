@@ -327,6 +327,7 @@ def _numba_kernels():
     if _NUMBA is not None:
         return _NUMBA
     import numba
+    from numba import prange
 
     @numba.njit(cache=True, inline="always")
     def bmap(j, m, periodic):
@@ -448,13 +449,15 @@ def _numba_kernels():
             else:
                 step_local(E, O, r, w - r, ptr[k], ptr[k + 1], offs, coefs, sign)
 
-    @numba.njit(cache=True)
+    @numba.njit(cache=True, parallel=True)
     def fwd_blocks(x, n_pad, shift, kinds, ptr, offs, coefs, reach, M, scale_a, s_out, g_lo, g_hi, B):
-        # fused split + lifting + scaling of the approximation, block by block (halo M)
+        # fused split + lifting + scaling of the approximation, block by block (halo M);
+        # blocks are independent, so they run in parallel, each with its own buffers
         n = x.shape[0]
-        E = np.empty(B + 2 * M)
-        O = np.empty(B + 2 * M)
-        for a in range(g_lo, g_hi, B):
+        for ib in prange((g_hi - g_lo + B - 1) // B):
+            a = g_lo + ib * B
+            E = np.empty(B + 2 * M)
+            O = np.empty(B + 2 * M)
             b = min(a + B, g_hi)
             w = b - a + 2 * M
             base = a - M
@@ -477,7 +480,7 @@ def _numba_kernels():
             for i in range(b - a):
                 s_out[a + i] = E[M + i] * scale_a
 
-    @numba.njit(cache=True)
+    @numba.njit(cache=True, parallel=True)
     def inv_blocks(s, n_out, shift, kinds, ptr, offs, coefs, reach, M, scale_a, out, x, noise,
                    g_lo, g_hi, B):
         # fused unscaling + inverse lifting (zero detail band) + merge, block by block;
@@ -487,9 +490,10 @@ def _numba_kernels():
         n_pad = 2 * h
         do_noise = noise.shape[0] == out.shape[0]
         inv_a = 1.0 / scale_a
-        E = np.empty(B + 2 * M)
-        O = np.empty(B + 2 * M)
-        for a in range(g_lo, g_hi, B):
+        for ib in prange((g_hi - g_lo + B - 1) // B):
+            a = g_lo + ib * B
+            E = np.empty(B + 2 * M)
+            O = np.empty(B + 2 * M)
             b = min(a + B, g_hi)
             w = b - a + 2 * M
             base = a - M
