@@ -312,20 +312,24 @@ def _readouts(tau_s, adev):
     if t.size < 3:
         return out
     slope = np.gradient(np.log(s), np.log(t))
-    # line of slope mu through (t_i, s_i), evaluated at the read-off tau
+    i_min = int(np.argmin(s))
+    # line of slope mu through (t_i, s_i), evaluated at the read-off tau.  Falling terms (Q, N) are
+    # read left of the ADEV minimum, rising ones (K, R) right of it: a rising piece inside a
+    # short-tau bump (e.g. vibration) is not rate random walk.
     for key, mu, tau_read in (("Q_urad@tau=sqrt3s", -1.0, math.sqrt(3.0)),
                               ("N_dprh@tau=1h", -0.5, 3600.0),
                               ("K_dphrh@tau=3h", 0.5, 3.0 * 3600.0),
                               ("R_dph2@tau=sqrt2h", 1.0, math.sqrt(2.0) * 3600.0)):
-        i = int(np.argmin(np.abs(slope - mu)))
-        if abs(slope[i] - mu) <= 0.2:
+        side = np.arange(t.size) <= i_min if mu < 0 else np.arange(t.size) >= i_min
+        dist = np.where(side, np.abs(slope - mu), np.inf)
+        i = int(np.argmin(dist))
+        if dist[i] <= 0.2:
             val = s[i] * (tau_read / t[i]) ** mu
             if key.startswith("Q"):
                 val *= _URAD_PER_ARCSEC  # sigma(sqrt3 s) in (deg/h) s-units = arcsec
             out[key] = float(val)
-    i = int(np.argmin(s))
-    if 0 < i < s.size - 1:
-        out["B_dph@min"] = float(s[i] / B_FACTOR)
+    if 0 < i_min < s.size - 1:
+        out["B_dph@min"] = float(s[i_min] / B_FACTOR)
     return out
 
 
