@@ -42,12 +42,12 @@ from __future__ import annotations
 
 import csv
 import math
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
+from .errors import ConfigError, DataFormatError, InsufficientDataError
+from .units import check_dt_s
 
 __all__ = [
     "AllanResult",
@@ -185,14 +185,7 @@ class AllanResult:
 # ----------------------------------------------------------------------------------------
 # Tau grid
 # ----------------------------------------------------------------------------------------
-def _check_dt(dt_s) -> float:
-    try:
-        dt = float(dt_s)
-    except (TypeError, ValueError):
-        raise ConfigError(f"dt_s must be a number of seconds > 0, got {dt_s!r}") from None
-    if not (dt > 0 and math.isfinite(dt)):
-        raise ConfigError(f"dt_s must be a finite number of seconds > 0, got {dt_s!r}")
-    return dt
+_check_dt = check_dt_s
 
 
 def tau_grid(n_samples, dt_s, taus="octave", *, max_fraction=0.25) -> np.ndarray:

@@ -1300,12 +1300,9 @@ def level_scan(x, dt_s, wavelet="db2", max_level=None, mode="periodization") -> 
     scheme = get_wavelet(wavelet)
     mode = _check_mode(mode)
     y = _as_signal(x)
-    try:
-        dt_s = float(dt_s)
-    except (TypeError, ValueError):
-        raise ConfigError(f"dt_s must be a positive number of seconds, got {dt_s!r}") from None
-    if not (dt_s > 0 and math.isfinite(dt_s)):
-        raise ConfigError(f"dt_s must be a positive number of seconds, got {dt_s!r}")
+    from .units import check_dt_s
+
+    dt_s = check_dt_s(dt_s)
     n = y.shape[0]
     if n < 20:
         raise InsufficientDataError(f"level_scan needs at least 20 samples, got {n}", needed=20, got=n)

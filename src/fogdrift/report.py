@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import base64
 import html
-import io as _io
 import json
 import math
 from pathlib import Path
@@ -300,19 +299,22 @@ def plot_separation_allan(sep, path) -> Path:
     return _save(fig, path)
 
 
-def plot_models(model_axis, path, fig_no=8) -> Path:
-    """Fig. 8: one-step model predictions against the test-block drift."""
+def plot_models(model_axis, path, fig_no=8, *, residual=False) -> Path:
+    """Fig. 8: one-step predictions against the test-block drift; with ``residual``, Fig. 9: drift minus
+    each one-step prediction (the residual drift after compensation)."""
     plt = _plt()
     e, _ = model_axis.split["test"]
     y = model_axis.drift_blocks["test"]
     t = (e + np.arange(y.size)) * model_axis.dt_s
     fig, ax = plt.subplots(figsize=(9, 4))
-    ax.plot(t, y, "k-", lw=1.6, label="wavelet drift (test block)")
+    if not residual:
+        ax.plot(t, y, "k-", lw=1.6, label="wavelet drift (test block)")
     for label, yhat in model_axis.predictions.items():
-        ax.plot(t, yhat, lw=0.9, label=label)
+        ax.plot(t, y - yhat if residual else yhat, lw=0.8 if residual else 0.9, label=label)
     ax.set_xlabel("t [s]")
-    ax.set_ylabel("drift [deg/h]")
-    ax.set_title(f"One-step drift models, axis {model_axis.name} (Fig. {fig_no})")
+    ax.set_ylabel("residual [deg/h]" if residual else "drift [deg/h]")
+    what = "Residual after drift compensation" if residual else "One-step drift models"
+    ax.set_title(f"{what}, axis {model_axis.name} (Fig. {fig_no})")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     return _save(fig, path)
@@ -320,19 +322,7 @@ def plot_models(model_axis, path, fig_no=8) -> Path:
 
 def plot_residuals(model_axis, path, fig_no=9) -> Path:
     """Fig. 9: residual drift after compensation (drift minus one-step model) on the test block."""
-    plt = _plt()
-    e, _ = model_axis.split["test"]
-    y = model_axis.drift_blocks["test"]
-    t = (e + np.arange(y.size)) * model_axis.dt_s
-    fig, ax = plt.subplots(figsize=(9, 4))
-    for label, yhat in model_axis.predictions.items():
-        ax.plot(t, y - yhat, lw=0.8, label=label)
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("residual [deg/h]")
-    ax.set_title(f"Residual after drift compensation, axis {model_axis.name} (Fig. {fig_no})")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    return _save(fig, path)
+    return plot_models(model_axis, path, fig_no, residual=True)
 
 
 # -------------------------------------------------------------------------------------------------------------

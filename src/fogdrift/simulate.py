@@ -32,7 +32,7 @@ import math
 import numpy as np
 
 from .errors import ConfigError
-from .units import earth_rate_projection_dph
+from .units import check_dt_s, earth_rate_projection_dph
 
 __all__ = ["simulate", "URAD_PER_ARCSEC", "B_FLAT_FACTOR"]
 
@@ -143,12 +143,7 @@ def simulate(
         raise ConfigError(f"n_samples must be an integer >= 2, got {n_samples!r}") from None
     if n != n_samples or n < 2:
         raise ConfigError(f"n_samples must be an integer >= 2, got {n_samples!r}")
-    try:
-        dt = float(dt_s)
-    except (TypeError, ValueError):
-        raise ConfigError(f"dt_s must be a number of seconds > 0, got {dt_s!r}") from None
-    if not (dt > 0 and math.isfinite(dt)):
-        raise ConfigError(f"dt_s must be a finite number of seconds > 0, got {dt_s!r}")
+    dt = check_dt_s(dt_s)
     q = _nonneg("q_urad", q_urad) / URAD_PER_ARCSEC  # (deg/h) s
     arw = _nonneg("arw_dprh", arw_dprh) * 60.0  # (deg/h) sqrt(s)
     b = _nonneg("bias_instability_dph", bias_instability_dph)

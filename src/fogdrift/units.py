@@ -25,6 +25,7 @@ __all__ = [
     "increment_scale_to_dph",
     "earth_rate_projection_dph",
     "AXIS_DIRECTIONS",
+    "check_dt_s",
 ]
 
 #: WGS-84 Earth rotation rate 7.2921150e-5 rad/s expressed in deg/h (method notes §6).
@@ -46,6 +47,17 @@ INCREMENT_UNITS: dict[str, float] = {
     "rad": 180.0 / math.pi * 3600.0,
     "arcsec": 1.0,
 }
+
+
+def check_dt_s(dt_s, name: str = "dt_s") -> float:
+    """Return a sample interval [s] as a float, or raise ConfigError naming ``name`` if it is not finite and > 0."""
+    try:
+        dt = float(dt_s)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be a number of seconds > 0, got {dt_s!r}") from None
+    if not (dt > 0 and math.isfinite(dt)):
+        raise ConfigError(f"{name} must be a finite number of seconds > 0, got {dt_s!r}")
+    return dt
 
 
 def rate_scale_to_dph(unit: str) -> float:
