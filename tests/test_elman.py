@@ -293,3 +293,20 @@ def test_grey_global_frame_loses_to_persistence(drift):
     assert m.x1_std_ > 50  # a 1 % error on the normalised AGO scale is > 0.5 drift std
     persist = rmse(Persistence().fit(y[:N_TR]).predict(test, history=hist), test)
     assert rmse(m.predict(test, history=hist), test) > 2 * persist
+
+
+@pytest.mark.parametrize("activation", ["tanh", "logsig"])
+def test_windowed_training_kernel_equals_elman_forward(x64, activation):
+    """The batched kernel used for training computes, window by window, exactly eq. (11) as elman_forward."""
+    from fogdrift.elman import _window_pass
+
+    params = init_params(jax.random.key(5), 4, 6, dtype=jnp.float64)
+    rng = np.random.default_rng(5)
+    n_win, width = 7, 9
+    u = rng.standard_normal((width, n_win, 4))
+    h0s = rng.standard_normal((n_win, 6)) * 0.3
+    out, h_end = _window_pass(params, jnp.asarray(u), jnp.asarray(h0s), activation, False)
+    for w in range(n_win):
+        ref, hid = elman_forward(params, jnp.asarray(u[:, w, :]), jnp.asarray(h0s[w]), activation)
+        np.testing.assert_allclose(np.asarray(out[:, w]), np.asarray(ref[:, 0]), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(np.asarray(h_end[w]), np.asarray(hid[-1]), rtol=1e-12, atol=1e-12)
