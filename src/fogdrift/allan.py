@@ -46,7 +46,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import ConfigError, DataFormatError, InsufficientDataError
+from .errors import ConfigError, InsufficientDataError
+from ._util import check_series
 from .units import check_dt_s
 
 __all__ = [
@@ -499,17 +500,7 @@ def _phase_dph_samples(y: np.ndarray) -> np.ndarray:
 # Public estimator
 # ----------------------------------------------------------------------------------------
 def _check_rate(rate_dph) -> np.ndarray:
-    try:
-        y = np.asarray(rate_dph, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise DataFormatError(f"rate_dph must be a numeric 1-D array, got {type(rate_dph).__name__}") from None
-    if y.ndim != 1:
-        raise DataFormatError(f"rate_dph must be a 1-D series; expected shape (n_samples,), got {y.shape}")
-    bad = ~np.isfinite(y)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise DataFormatError(f"rate_dph[{i}] is {y[i]!r}; expected finite values")
-    return np.ascontiguousarray(y)
+    return np.ascontiguousarray(check_series(rate_dph, "rate_dph"))
 
 
 def _fast_strides(m: np.ndarray) -> np.ndarray:

@@ -71,7 +71,7 @@ EstOpt = Annotated[str, typer.Option("--estimator", help="overlapping, non-overl
 def _load(path, rate, unit, columns, time_column, gaps):
     from .io import load, load_segments
 
-    cols = None if columns is None else [c.strip() for c in columns.split(",") if c.strip()]
+    cols = _csv_list(columns)
     tcol = None if time_column.lower() == "none" else time_column
     kwargs = dict(columns=cols, time_column=tcol, rate_hz=rate, unit=unit)
     if gaps == "error":
@@ -83,6 +83,11 @@ def _load(path, rate, unit, columns, time_column, gaps):
                           f"({longest.n_samples} samples, {', '.join(longest.notes)})[/yellow]")
         return longest
     raise ConfigError(f"--gaps must be 'error' or 'longest', got {gaps!r}")
+
+
+def _csv_list(text: str | None) -> list[str] | None:
+    """'a, b,,c' -> ['a', 'b', 'c'] (None stays None)."""
+    return None if text is None else [t.strip() for t in text.split(",") if t.strip()]
 
 
 def _level(text: str):
@@ -188,7 +193,7 @@ def allan(
     with _errors():
         record = _load(file, rate, unit, columns, time_column, gaps)
         cfg = AnalysisConfig(taus=_taus(taus), estimator=estimator, fit_tau_s=_fit_taus(fit_taus),
-                             terms=tuple(t.strip().upper() for t in terms.split(",") if t.strip()))
+                             terms=tuple(t.upper() for t in _csv_list(terms)))
         with _progress("allan") as (allan_cb, _):
             results = run_allan(record, cfg, progress=allan_cb)
         console.print(_noise_table(
@@ -265,7 +270,7 @@ def model(
 
     with _errors():
         record = _load(file, rate, unit, columns, time_column, gaps)
-        cfg = AnalysisConfig(models=tuple(m.strip() for m in models.split(",") if m.strip()), hidden=hidden,
+        cfg = AnalysisConfig(models=tuple(_csv_list(models)), hidden=hidden,
                              lags=lags, epochs=epochs, seed=seed, training=training, wavelet=wavelet,
                              level=_level(level), mode=mode, model_rate_hz=model_rate or None)
         with _progress("model") as (_, epoch_cb):
@@ -321,7 +326,7 @@ def analyze(
             if not sep:
                 raise ConfigError(f"--earth-axis must look like AXIS=ORIENTATION (e.g. gz=up), got {item!r}")
             earth[name.strip()] = orient.strip()
-        cfg = AnalysisConfig(models=tuple(m.strip() for m in models.split(",") if m.strip()), hidden=hidden,
+        cfg = AnalysisConfig(models=tuple(_csv_list(models)), hidden=hidden,
                              lags=lags, epochs=epochs, seed=seed, wavelet=wavelet, level=_level(level), mode=mode,
                              model_rate_hz=model_rate or None, taus=_taus(taus), latitude_deg=latitude,
                              earth_axes=earth, fit_tau_s=_fit_taus(fit_taus))

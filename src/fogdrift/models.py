@@ -25,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ConfigError, DataFormatError, ModelFileError, NotFittedError
+from ._util import check_series, json_default
+from .errors import ConfigError, ModelFileError, NotFittedError
 
 __all__ = ["DriftModel", "Persistence", "register_model", "load_model", "check_series", "MODEL_REGISTRY"]
 
@@ -39,28 +40,6 @@ def register_model(cls):
     """Class decorator: make ``cls`` loadable by :func:`load_model` under its class name."""
     MODEL_REGISTRY[cls.__name__] = cls
     return cls
-
-
-def check_series(y, name: str = "y", *, min_length: int = 1) -> np.ndarray:
-    """Return ``y`` as a 1-D float64 array, or raise a clear error.
-
-    Raises
-    ------
-    DataFormatError
-        If ``y`` is not 1-D or holds NaN/inf (the message gives the first bad index).
-    ConfigError
-        If ``y`` is shorter than ``min_length``.
-    """
-    arr = np.asarray(y, dtype=np.float64)
-    if arr.ndim != 1:
-        raise DataFormatError(f"{name} must be a 1-D series; got shape {arr.shape}")
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise DataFormatError(f"{name}[{i}] is {arr[i]!r}; expected finite values")
-    if arr.size < min_length:
-        raise ConfigError(f"{name} has {arr.size} samples; this model needs at least {min_length}")
-    return arr
 
 
 class DriftModel:
@@ -131,7 +110,7 @@ class DriftModel:
         }
         json_path = base.with_suffix(".json")
         npz_path = base.with_suffix(".npz")
-        json_path.write_text(json.dumps(doc, indent=2, default=_json_default))
+        json_path.write_text(json.dumps(doc, indent=2, default=json_default))
         np.savez(npz_path, **{k: np.asarray(v) for k, v in arrays.items()})
         return json_path, npz_path
 
@@ -142,14 +121,6 @@ class DriftModel:
         if not isinstance(model, cls):
             raise ModelFileError(f"{path}: holds a {type(model).__name__}, not a {cls.__name__}")
         return model
-
-
-def _json_default(obj):
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    raise TypeError(f"not JSON-serialisable: {type(obj).__name__}")
 
 
 def load_model(path) -> DriftModel:

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ._util import json_default
+
 __all__ = [
     "NOISE_HEADERS",
     "noise_row",
@@ -153,16 +155,6 @@ def verdict(model_axis) -> list[str]:
 # files
 
 
-def _json_default(obj):
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if hasattr(obj, "to_dict"):
-        return obj.to_dict()
-    raise TypeError(f"not JSON-serialisable: {type(obj).__name__}")
-
-
 def _clean(obj):
     """Replace NaN/inf by None so the JSON is strict."""
     if isinstance(obj, float):
@@ -177,7 +169,7 @@ def _clean(obj):
 def write_json(obj, path) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    data = json.loads(json.dumps(obj, default=_json_default))
+    data = json.loads(json.dumps(obj, default=json_default))
     path.write_text(json.dumps(_clean(data), indent=2, allow_nan=False))
     return path
 
