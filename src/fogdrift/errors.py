@@ -4,9 +4,17 @@ Every error a user can cause (bad file, bad parameter, too little data) is a
 :class:`FogdriftError`; the CLI prints its message as one line and exits 1.
 Messages follow ``<path>:<line>:<column>: <what is wrong>; expected <rule>, got <value>``
 where a location applies.  This module imports nothing from fogdrift.
+
+Options in messages.  A message that tells the user which setting to change names it as
+``{opt:NAME}`` where ``NAME`` is the library parameter (``{opt:unit}``, ``{opt:gaps}``).
+``str(error)`` renders it as ``NAME=`` (the library spelling); the CLI renders the same error
+with :meth:`FogdriftError.render` and its table of flags, so the user reads ``--unit``.  One
+message, two audiences, no CLI knowledge in the library.
 """
 
 from __future__ import annotations
+
+import re
 
 __all__ = [
     "FogdriftError",
@@ -19,8 +27,35 @@ __all__ = [
 ]
 
 
+_OPT = re.compile(r"\{opt:([A-Za-z_][A-Za-z0-9_]*)\}")
+
+
+def render_options(text: str, flags: dict | None = None) -> str:
+    """Replace ``{opt:NAME}`` markers by ``flags[NAME]`` (or ``NAME=`` when not in ``flags``).
+
+    Examples
+    --------
+    >>> render_options("no unit given; pass {opt:unit}")
+    'no unit given; pass unit='
+    >>> render_options("no unit given; pass {opt:unit}", {"unit": "--unit"})
+    'no unit given; pass --unit'
+    """
+    flags = flags or {}
+    return _OPT.sub(lambda m: flags.get(m.group(1), m.group(1) + "="), text)
+
+
 class FogdriftError(Exception):
-    """Root of every error fogdrift raises on purpose."""
+    """Root of every error fogdrift raises on purpose.
+
+    The message may name settings as ``{opt:NAME}`` (see the module docstring).
+    """
+
+    def __str__(self) -> str:
+        return render_options(super().__str__())
+
+    def render(self, flags: dict | None = None) -> str:
+        """The message with ``{opt:NAME}`` markers rendered through ``flags`` (e.g. CLI flags)."""
+        return render_options(super().__str__(), flags)
 
 
 def _location(path, line, column) -> str:

@@ -143,4 +143,4 @@ def earth_rate_projection_dph(latitude_deg: float, axis="up") -> float:
             raise ConfigError(f"axis vector must be 3 finite numbers, not all zero, got {axis!r}")
         u = u / np.linalg.norm(u)
     lat = math.radians(float(latitude_deg))
-    return EARTH_RATE_DPH * (u[1] * math.cos(lat) + u[2] * math.sin(lat))
+    return float(EARTH_RATE_DPH * (u[1] * math.cos(lat) + u[2] * math.sin(lat)))
