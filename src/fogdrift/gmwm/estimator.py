@@ -23,7 +23,7 @@ shrunk 0.3x) are optimised.
 
 Standard errors: delta (sandwich) method in ``z``,
 ``Cov(z) = (A^T Omega A)^-1 A^T Omega V Omega A (A^T Omega A)^-1`` with ``A = d nu / d z^T``
-(analytic but for the GM ``beta`` column: a central difference, step 1e-5 in ``log beta``); with
+(analytic but for the GM ``beta`` column: a central difference, step 1e-3 in ``log beta``); with
 ``Omega = V^-1`` it is ``(A^T V^-1 A)^-1``.
 95 % intervals ``exp(z +- 1.96 se)``.  Weakly identified components get optimistic SEs;
 ``n_boot > 0`` adds parametric-bootstrap percentile intervals.

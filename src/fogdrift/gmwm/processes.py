@@ -424,7 +424,10 @@ class LatentModel:
 
         Every WV is linear in its variance parameter, so that column is the component's WV
         (twice it for the drift, quadratic in ``omega``); the GM ``beta`` column is a central
-        difference in ``log beta`` (step 1e-5, relative error about 1e-10).
+        difference in ``log beta`` with step 1e-3 (truncation error about 1e-7; where
+        ``m beta`` is small the WV hardly depends on ``beta`` and the column's relative
+        error can reach about 1e-4, which only affects the optimiser's path and the SEs at that
+        level).
         """
         th = self._theta(theta)
         t = np.asarray(tau, dtype=np.float64)
@@ -432,7 +435,7 @@ class LatentModel:
         for key, sl in zip(self.components, self.slices):
             p = th[sl]
             if key == "GM":
-                h = 1e-5
+                h = 1e-3
                 d_beta = (ar1_wv(p[0] * math.exp(h), p[1], t) - ar1_wv(p[0] * math.exp(-h), p[1], t)) / (2.0 * h)
                 cols.extend([d_beta, ar1_wv(p[0], p[1], t)])
             elif key == "DR":
@@ -493,7 +496,7 @@ class LatentModel:
                 for k, lab, s in zip(self.components, self.labels, self.slices)]
 
 
-_TERM = re.compile(r"^\s*(\d*)\s*([A-Za-z()]+)\s*$")
+_TERM = re.compile(r"^\s*(\d*)\s*([A-Za-z][A-Za-z0-9()\-]*)\s*$")
 
 
 def parse_model(model) -> LatentModel:
