@@ -355,8 +355,10 @@ def ieee_sdf(dt_s, *, q_urad=0.0, arw_dprh=0.0, bias_instability_dph=0.0, rrw_dp
     bias_instability_dph : float
         B in deg/h: flicker ``B^2 / (2 pi max(|f|, f_low))`` (flat WV ``0.2206 B^2``,
         AVAR ``0.4413 B^2``), flattened below ``f_low = dt_s / record_s`` cycles/sample,
-        i.e. below the inverse record length (any Haar/Allan quantity with ``2m <= N``
-        changes by less than 1e-3 relative with the cutoff; the integrals converge without it).
+        i.e. below the inverse record length.  The WV/AVAR integrals converge without a
+        cutoff; the covariances change by less than 1e-3 with it for ``m <= N/64`` but by a
+        few per cent at ``m ~ N/6`` (the longest clusters see the assumed low-frequency
+        content; tested).
     rrw_dphrh : float
         Rate random walk K in deg/h/sqrt(h): discrete random walk with step variance
         ``gamma2 = (K / 60)^2 dt``, SDF ``gamma2 / (4 sin^2(pi f))``.
