@@ -5,11 +5,14 @@ Procedure (:func:`select_model`; [GMWM]_ §5):
 1. **Short scales no candidate explains** (output low-pass filter, vibration, sample
    correlation of the electronics: the first octaves of the KVH DSP-1750 and LN-200
    curves) are detected, not hand-picked: starting from the first scale, every candidate
-   is fitted (step 1) to the scales ``j >= j0``; if no candidate reproduces the first
+   is fitted (step 1) to the scales ``j >= j0``; if no candidate (with a non-degenerate fit:
+   no parameter at a bound, no collapsed component) reproduces the first
    ``n_check`` used scales within ``|z| <= z_max`` (``z`` standardised by the model-based SD
    of the best-fitting candidate), scale ``j0`` is excluded, with the smallest ``|z|`` any
    candidate reached recorded as the reason, and the scan moves on.  It stops at the first
-   ``j0`` some candidate explains, or after ``max_excluded`` scales.
+   ``j0`` some candidate explains, or after ``max_excluded`` scales.  After step 5 the chosen
+   model's final (efficiently weighted) fit must explain the first ``n_check`` scales too;
+   otherwise scale ``j0`` is excluded with that reason and steps 1-5 are repeated.
 2. Every candidate is fitted on the remaining scales with **one common Omega** = ``V^-1``
    (WIC values are only comparable under the same Omega), ``V`` the model-based covariance
    at the iterated GMWM estimate of a pilot choice (the smallest ``Q_1 + 2p`` under the
@@ -50,7 +53,7 @@ import numpy as np
 
 from ..errors import ConfigError, FogdriftWarning, InsufficientDataError
 from .covariance import wvar_covariance
-from .estimator import GMWMFit, _check_wv, _finish, _model_V, _step1
+from .estimator import GMWMFit, _bounds, _check_wv, _finish, _model_V, _step1
 from .ieee import IEEEResult, to_ieee
 from .processes import LatentModel, parse_model
 
@@ -213,6 +216,16 @@ def longest_run_pvalue(n: int, run: int) -> float:
     return float(1.0 - ways[1:].sum() / 2.0 ** (n - 1))
 
 
+def _degenerate(mdl: LatentModel, theta, nu_hat, tau, share_min) -> bool:
+    """True if a (step-1) fit has a parameter at a bound or a component below ``share_min`` everywhere."""
+    lo, hi = _bounds(mdl, nu_hat, tau)
+    z = np.log(theta)
+    if np.any(z - lo < 1e-3) or np.any(hi - z < 1e-3):
+        return True
+    share = np.max(mdl.wv_components(theta, tau) / nu_hat[None, :], axis=1)
+    return bool(np.any(share < share_min))
+
+
 def _longest_run(x) -> int:
     s = np.sign(x)
     best = cur = 1
@@ -340,91 +353,24 @@ def select_model(wvar, candidates=None, *, exclude_short=True, max_excluded=None
         raise InsufficientDataError(f"{J} scales are too few for any candidate (need {p_min + 2})",
                                     needed=p_min + 2, got=J)
     max_ex = J // 3 if max_excluded is None else int(max_excluded)
-    j0 = 0
-    excluded: list[ExcludedScale] = []
-    step1 = None
+    opts = dict(z_max=z_max, se_log_max=se_log_max, run_alpha=run_alpha, share_min=share_min, snr_min=snr_min)
+    j0, excluded, step1 = 0, [], None
     while True:
+        j0, step1 = _scan(wv, models, j0, step1, excluded, exclude_short=exclude_short, max_ex=max_ex,
+                          n_check=n_check, p_max=p_max, n_starts=n_starts, z_max=z_max, share_min=share_min)
         idx = np.arange(j0, J)
-        # the scan warm-starts from the previous level's fits with one heuristic start
-        step1 = _fit_step1_all(wv, models, idx, n_starts if step1 is None else 1, prev=step1)
-        if not step1:
-            raise InsufficientDataError("too few scales remain for any candidate")
-        best = min(step1, key=lambda m: step1[m][1])
-        if not exclude_short or j0 >= max_ex or J - (j0 + 1) < p_max + 2:
-            break
+        results, chosen, ok, src = _choose(wv, models, idx, step1, opts)
+        # the final (efficiently weighted) fit must also explain the first scales
         nchk = min(n_check, idx.size)
-        sd = np.sqrt(np.diag(wvar_covariance(wv.tau_samples[idx[:nchk]], wv.n_coef[idx[:nchk]],
-                                             best.sdf(step1[best][0]), diagonal=True)) / wv.efficiency)
-        scores = {}
-        for mdl, (th1, *_rest) in step1.items():
-            nu = mdl.wv(th1, wv.tau_samples[idx[:nchk]])
-            scores[mdl] = float(np.max(np.abs(wv.nu2_dph2[idx[:nchk]] - nu) / sd))
-        closest = min(scores, key=scores.get)
-        if scores[closest] <= z_max:
+        zfirst = float(np.max(np.abs(chosen.fit.z_resid[:nchk])))
+        if not exclude_short or zfirst <= z_max or j0 >= max_ex or J - (j0 + 1) < p_max + 2:
             break
         excluded.append(ExcludedScale(
-            level=int(wv.level[j0]), scale_s=float(wv.scale_s[j0]), best_abs_z=scores[closest],
-            best_model=closest.name,
-            reason=(f"no candidate explains the scales from {wv.scale_s[j0]:.4g} s: the closest "
-                    f"({closest.name}) leaves max |z| = {scores[closest]:.3g} > {z_max:g} over the first {nchk}"),
+            level=int(wv.level[j0]), scale_s=float(wv.scale_s[j0]), best_abs_z=zfirst, best_model=chosen.model,
+            reason=(f"the selected model {chosen.model} leaves max |z| = {zfirst:.3g} > {z_max:g} over the "
+                    f"first {nchk} scales from {wv.scale_s[j0]:.4g} s"),
         ))
         j0 += 1
-    if j0 > 0:  # full multi-start on the final scales (plus the warm start)
-        step1 = _fit_step1_all(wv, models, idx, n_starts, prev=step1)
-    # pilot choice under the common step-1 weights (eta3, conservative): smallest Q_1 + 2p
-    pilot = min(step1, key=lambda m: step1[m][1] + 2.0 * m.n_params)
-
-    idx = np.arange(j0, J)
-    whiten_cls = __import__("fogdrift.gmwm.estimator", fromlist=["Whitener"]).Whitener
-
-    def score_all(ref: LatentModel):
-        own = _finish(wv, ref, idx, *step1[ref])  # the reference's own iterated fit
-        V = _model_V(ref, own.theta, wv, idx)
-        src = f"common: V at the iterated fit of {ref.name}"
-        whiten = whiten_cls(V=V)
-        out = []
-        for mdl in models:
-            if mdl not in step1:
-                out.append(CandidateScore(mdl.name, mdl.n_params, float("nan"), float("nan"), float("nan"),
-                                          False, ("hard: too few scales for this model",)))
-                continue
-            th1, q1, sols1, W1, ok1 = step1[mdl]
-            fit = _finish(wv, mdl, idx, th1, q1, sols1, W1, ok1, V=V, omega_source=src)
-            reasons = _checks(fit, mdl, z_max=z_max, se_log_max=se_log_max, run_alpha=run_alpha,
-                              share_min=share_min, snr_min=snr_min, whiten=whiten)
-            out.append(CandidateScore(mdl.name, mdl.n_params, fit.q, fit.penalty, fit.wic, not reasons,
-                                      tuple(reasons), fit))
-        fitted = [c for c in out if c.fit is not None]
-        passed = [c for c in fitted if c.passed]
-        if passed:
-            return out, min(passed, key=lambda c: c.wic), True, src
-        pool = [c for c in fitted if not c.hard_failure] or fitted
-        return out, min(pool, key=lambda c: c.wic), False, src
-
-    # pass 1: V of the pilot; then V of the provisional choice, until the choice is stable
-    # (a V from an over-fitted curve mis-weights the longest scales).  If nothing passes under
-    # a V, the next pilot in the ranking supplies V.
-    ranking = sorted(step1, key=lambda m: step1[m][1] + 2.0 * m.n_params)
-    ref, tried, fallback = ranking[0], [], None
-    for _ in range(4):
-        results, chosen, ok, src = score_all(ref)
-        tried.append(ref)
-        if fallback is None:
-            fallback = (results, chosen, ok, src)
-        new_ref = parse_model(chosen.model)
-        if ok and (new_ref == ref or new_ref in tried):
-            break
-        if ok:
-            ref = new_ref
-            continue
-        untried = [m for m in ranking if m not in tried]
-        if not untried:
-            results, chosen, ok, src = fallback
-            break
-        ref = untried[0]
-    else:
-        if not ok:
-            results, chosen, ok, src = fallback
     if not ok:
         warnings.warn(
             f"no candidate passed every sanity check; {chosen.model} (smallest WIC among the candidates "
@@ -435,3 +381,96 @@ def select_model(wvar, candidates=None, *, exclude_short=True, max_excluded=None
         selected=chosen.model, fit=chosen.fit, ieee=to_ieee(chosen.fit), candidates=results, excluded=excluded,
         levels_used=wv.level[idx], omega_source=src, passed_checks=ok,
     )
+
+
+def _scan(wv, models, j0, step1, excluded, *, exclude_short, max_ex, n_check, p_max, n_starts, z_max,
+          share_min):
+    """Advance ``j0`` past leading scales no non-degenerate candidate explains (appends to ``excluded``);
+    returns ``(j0, step1 fits on the scales j0..J-1)``."""
+    J = len(wv)
+    fresh = step1 is None
+    while True:
+        idx = np.arange(j0, J)
+        # the scan warm-starts from the previous level's fits with one heuristic start
+        step1 = _fit_step1_all(wv, models, idx, n_starts if step1 is None else 1, prev=step1)
+        if not step1:
+            raise InsufficientDataError("too few scales remain for any candidate")
+        if not exclude_short or j0 >= max_ex or J - (j0 + 1) < p_max + 2:
+            break
+        best = min(step1, key=lambda m: step1[m][1])
+        nchk = min(n_check, idx.size)
+        sd = np.sqrt(np.diag(wvar_covariance(wv.tau_samples[idx[:nchk]], wv.n_coef[idx[:nchk]],
+                                             best.sdf(step1[best][0]), diagonal=True)) / wv.efficiency)
+        scores = {}
+        for mdl, (th1, *_rest) in step1.items():
+            if _degenerate(mdl, th1, wv.nu2_dph2[idx], wv.tau_samples[idx].astype(float), share_min):
+                continue  # a collapsed fit (e.g. WN -> 0 with a fast GM) does not "explain" anything
+            nu = mdl.wv(th1, wv.tau_samples[idx[:nchk]])
+            scores[mdl] = float(np.max(np.abs(wv.nu2_dph2[idx[:nchk]] - nu) / sd))
+        if not scores:
+            break
+        closest = min(scores, key=scores.get)
+        if scores[closest] <= z_max:
+            break
+        excluded.append(ExcludedScale(
+            level=int(wv.level[j0]), scale_s=float(wv.scale_s[j0]), best_abs_z=scores[closest],
+            best_model=closest.name,
+            reason=(f"no candidate explains the scales from {wv.scale_s[j0]:.4g} s: the closest "
+                    f"({closest.name}) leaves max |z| = {scores[closest]:.3g} > {z_max:g} over the first {nchk}"),
+        ))
+        j0 += 1
+        fresh = False
+    if not fresh:  # full multi-start on the final scales (plus the warm start)
+        step1 = _fit_step1_all(wv, models, np.arange(j0, J), n_starts, prev=step1)
+    return j0, step1
+
+
+def _choose(wv, models, idx, step1, opts):
+    """Common-Omega fits, checks and the WIC choice; returns (scores, chosen, passed, omega source)."""
+    from .estimator import Whitener
+
+    def score_all(ref: LatentModel):
+        own = _finish(wv, ref, idx, *step1[ref])  # the reference's own iterated fit
+        V = _model_V(ref, own.theta, wv, idx)
+        src = f"common: V at the iterated fit of {ref.name}"
+        whiten = Whitener(V=V)
+        out = []
+        for mdl in models:
+            if mdl not in step1:
+                out.append(CandidateScore(mdl.name, mdl.n_params, float("nan"), float("nan"), float("nan"),
+                                          False, ("hard: too few scales for this model",)))
+                continue
+            fit = _finish(wv, mdl, idx, *step1[mdl], V=V, omega_source=src)
+            reasons = _checks(fit, mdl, whiten=whiten, **opts)
+            out.append(CandidateScore(mdl.name, mdl.n_params, fit.q, fit.penalty, fit.wic, not reasons,
+                                      tuple(reasons), fit))
+        fitted = [c for c in out if c.fit is not None]
+        passed = [c for c in fitted if c.passed]
+        if passed:
+            return out, min(passed, key=lambda c: c.wic), True, src
+        pool = [c for c in fitted if not c.hard_failure] or fitted
+        return out, min(pool, key=lambda c: c.wic), False, src
+
+    # pass 1: V of the pilot (smallest Q_1 + 2p under the common eta3 weights); then V of the
+    # provisional choice, until the choice is stable (a V from an over-fitted curve mis-weights the
+    # longest scales).  If nothing passes under a V, the next pilot in the ranking supplies V.
+    ranking = sorted(step1, key=lambda m: step1[m][1] + 2.0 * m.n_params)
+    ref, tried, fallback = ranking[0], [], None
+    for _ in range(4):
+        results, chosen, ok, src = score_all(ref)
+        tried.append(ref)
+        if fallback is None:
+            fallback = (results, chosen, ok, src)
+        new_ref = parse_model(chosen.model)
+        if ok and (new_ref == ref or new_ref in tried):
+            return results, chosen, ok, src
+        if ok:
+            ref = new_ref
+            continue
+        untried = [m for m in ranking if m not in tried]
+        if not untried:
+            break
+        ref = untried[0]
+    if ok:
+        return results, chosen, ok, src
+    return fallback
