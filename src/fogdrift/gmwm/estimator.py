@@ -55,7 +55,7 @@ from scipy import linalg, optimize, stats
 from scipy.linalg import lapack
 
 from ..errors import ConfigError, FogdriftWarning, InsufficientDataError, NotFittedError
-from .covariance import wvar_covariance
+from .covariance import model_wvar_covariance
 from .processes import PROCESSES, LatentModel, parse_model
 from .wvar import WvarResult
 
@@ -286,12 +286,12 @@ class _Problem:
         r = self.resid(z)
         return float(r @ r)
 
-    def solve(self, z0):
+    def solve(self, z0, max_nfev=2000):
         z0 = np.clip(np.asarray(z0, dtype=np.float64), self.lo + 1e-6, self.hi - 1e-6)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             res = optimize.least_squares(self.resid, z0, jac=self.jac, bounds=(self.lo, self.hi), method="trf",
-                                         xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=2000, x_scale="jac")
+                                         xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=max_nfev, x_scale="jac")
         return res.x, float(2.0 * res.cost), bool(res.success)
 
 
@@ -453,20 +453,24 @@ def _scale_index(wvar: WvarResult, scales) -> np.ndarray:
 
 
 def _model_V(model: LatentModel, theta, wv: WvarResult, idx) -> np.ndarray:
-    V = wvar_covariance(wv.tau_samples[idx], wv.n_coef[idx], model.sdf(theta))
+    V = model_wvar_covariance(model, theta, wv.tau_samples[idx], wv.n_coef[idx])
     return V / wv.efficiency
 
 
-def _best_solution(prob: _Problem, starts, n_keep):
-    best = None
+def _best_solution(prob: _Problem, starts, n_keep, screen_nfev=150):
+    """Optimise from each start with a small budget (most good starts converge in < 50
+    evaluations; degenerate ones creep towards a bound for thousands), then polish the best
+    with the full budget.  Returns the best (q, z, converged) and all (q, z, ok) sorted."""
     sols = []
     for z0 in starts[:n_keep]:
-        z, q, ok = prob.solve(z0)
+        z, q, ok = prob.solve(z0, max_nfev=screen_nfev)
         sols.append((q, z, ok))
-        if best is None or q < best[0]:
-            best = (q, z, ok)
     sols.sort(key=lambda s: s[0])
-    return best, sols
+    q, z, ok = sols[0]
+    if not ok:
+        z, q, ok = prob.solve(z, max_nfev=2000)
+        sols[0] = (q, z, ok)
+    return (q, z, ok), sols
 
 
 def _prepare(wvar, model, scales, weights):
@@ -505,9 +509,9 @@ def _step1(wv: WvarResult, mdl: LatentModel, idx, *, weights="eta3", n_starts=5,
         if s0.shape != (mdl.n_params,) or np.any(s0 <= 0):
             raise ConfigError(f"start must be {mdl.n_params} values > 0 {mdl.param_names}")
         starts = [s0] + starts
-    n_starts = max(1, int(n_starts))
+    n_starts = max(0 if start is not None else 1, int(n_starts))
     zstarts = [np.log(s) for s in starts]
-    keep = zstarts[:n_starts + 1]
+    keep = zstarts[:n_starts + 1] if n_starts else zstarts[:1]
     (q1, z1, ok1), sols1 = _best_solution(prob1, keep, len(keep))
     theta1 = mdl.sort_gm(np.exp(z1))
     return theta1, q1, sols1, W1, ok1
@@ -526,11 +530,11 @@ def _finish(wv: WvarResult, mdl: LatentModel, idx, theta1, q1, sols1, W1, ok1, *
             raise ConfigError(f"V must be ({J}, {J}) for the {J} scales used, got {Vf.shape}")
         Wf = Whitener(V=Vf, source=omega_source or "given V")
         prob = _Problem(mdl, nu_hat, tau, Wf)
-        (q, z, ok), _ = _best_solution(prob, [z1] + [s[1] for s in sols1[1:3]], 3)
+        (q, z, ok), _ = _best_solution(prob, [z1] + [s[1] for s in sols1[1:2]], 2)
         n_steps = 2
     elif steps >= 2:
         z, n_steps = z1, 1
-        extra = [s[1] for s in sols1[1:3]]
+        extra = [s[1] for s in sols1[1:2]]
         for k in range(1, steps):
             Vf = _model_V(mdl, mdl.from_free(z), wv, idx)
             Wf = Whitener(V=Vf, source=f"model V(theta_{k})")

@@ -261,6 +261,9 @@ class Process:
         None for a deterministic process (drift).
     ieee : callable
         ``ieee(theta, dt_s) -> {quantity: value}`` (keys carry units).
+    excess_kurtosis : float
+        Excess kurtosis of the iid innovations (0: Gaussian; QN: -1.2, uniform rounding);
+        enters the fourth-cumulant term of the WV covariance.
     """
 
     name: str
@@ -270,6 +273,7 @@ class Process:
     wv: Callable
     sdf: Callable | None
     ieee: Callable
+    excess_kurtosis: float = 0.0
 
 
 def _gm_ieee(th, dt):
@@ -291,6 +295,7 @@ PROCESSES: dict[str, Process] = {
         sdf=lambda th, f: 4.0 * th[0] * np.sin(np.pi * f) ** 2,
         ieee=lambda th, dt: {"Q_arcsec": math.sqrt(th[0]) * dt,
                              "Q_urad": math.sqrt(th[0]) * dt * 1e6 * math.pi / 648000.0},
+        excess_kurtosis=-1.2,
     ),
     "WN": Process(
         "WN", "white noise (angle random walk)", ("sigma2",), ("rate^2",),

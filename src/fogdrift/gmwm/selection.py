@@ -391,8 +391,8 @@ def _scan(wv, models, j0, step1, excluded, *, exclude_short, max_ex, n_check, p_
     fresh = step1 is None
     while True:
         idx = np.arange(j0, J)
-        # the scan warm-starts from the previous level's fits with one heuristic start
-        step1 = _fit_step1_all(wv, models, idx, n_starts if step1 is None else 1, prev=step1)
+        # the scan warm-starts from the previous level's fits only
+        step1 = _fit_step1_all(wv, models, idx, n_starts if step1 is None else 0, prev=step1)
         if not step1:
             raise InsufficientDataError("too few scales remain for any candidate")
         if not exclude_short or j0 >= max_ex or J - (j0 + 1) < p_max + 2:
