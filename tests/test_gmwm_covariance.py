@@ -183,3 +183,23 @@ def test_psd_and_cache_reuse():
     assert not np.allclose(V1, V2)
     assert_allclose(np.diag(wvar_covariance(tau, M, mdl.sdf([1.0, 1e-7, 0.01, 1e-4, 1e-4, 1e-7]), diagonal=True)),
                     np.diag(V1), rtol=1e-12)
+
+
+def test_fourth_cumulant_term_for_uniform_quantization_noise():
+    """QN from uniform rounding (excess kurtosis -1.2): 400 replicates, N = 2^14.  The Gaussian
+    formula overstates the SD by about 20 % and the adjacent correlation (0.40 vs about 0.13);
+    the model covariance with the fourth-cumulant term matches (SE of an SD ratio 3.5 %, of a
+    correlation 0.05)."""
+    n, levels = 2**14, 6
+    nus = np.array([haar_wvar(simulate_latent("QN", [1.0], n, seed=30_000 + s), 1.0, levels=levels).nu2_dph2
+                    for s in range(400)])
+    tau = 2 ** np.arange(1, levels + 1)
+    M = n - tau + 1
+    V = model_wvar_covariance("QN", [1.0], tau, M)
+    V_gauss = wvar_covariance(tau, M, parse_model("QN").sdf([1.0]))
+    sd = nus.std(axis=0, ddof=1)
+    assert np.all(np.abs(sd / np.sqrt(np.diag(V)) - 1.0) < 0.12)
+    assert np.all(sd / np.sqrt(np.diag(V_gauss)) < 0.92)
+    adj = np.diag(np.corrcoef(nus.T), 1)
+    assert np.all(np.abs(adj - np.diag(_corr(V), 1)) < 0.15)
+    assert np.all(adj < np.diag(_corr(V_gauss), 1) - 0.1)
