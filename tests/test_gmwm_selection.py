@@ -79,7 +79,7 @@ def test_ln200_x_short_scales_detected_and_n_as_published():
     assert abs(n.value / 0.0421 - 1.0) < 0.05
     assert n.hi95 / n.lo95 < 1.05  # six hours pin N down to about 1 %
     b = sel.ieee.b_min  # no flat region inside the record: the minimum is at the longest T
-    assert b.flagged and "upper bound" in b.note
+    assert b.flagged and "upper bound" in b.note and b.tau_s > 8640000 / 400 / 4
 
 
 def test_no_exclusion_when_the_model_explains_every_scale():

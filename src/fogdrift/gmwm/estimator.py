@@ -567,9 +567,11 @@ def _finish(wv: WvarResult, mdl: LatentModel, idx, theta1, q1, sols1, W1, ok1, *
     boot_lo = boot_hi = None
     if n_boot:
         boot_lo, boot_hi = _bootstrap(mdl, theta, wv, idx, int(n_boot), seed, n_starts)
+    with np.errstate(over="ignore"):
+        lo95, hi95 = np.exp(z - _Z95 * se), np.exp(z + _Z95 * se)
     return GMWMFit(
         model=mdl.name, param_names=mdl.param_names, theta=theta,
-        theta_lo95=np.exp(z - _Z95 * se), theta_hi95=np.exp(z + _Z95 * se),
+        theta_lo95=lo95, theta_hi95=hi95,
         z=z, se_z=se, cov_z=cov, q=q, df=df, j_pvalue=jp, penalty=penalty, wic=q + penalty,
         level=wv.level[idx], tau_samples=wv.tau_samples[idx], scale_s=wv.scale_s[idx],
         nu2_hat=nu_hat, nu2_fit=nu_fit, sd_nu2=sd, z_resid=(nu_hat - nu_fit) / sd, V=Vf,

@@ -16,7 +16,9 @@ B          ``sqrt(b2)`` (FLICKER)                 deg/h (flat ADEV 0.6643 B)
 
 Bias instability from GMs, both rules of [GMWM]_ §4, each with the averaging time where it
 occurs: (a) ``B = sqrt(max_T AVAR_GMsum(T)) / 0.6643`` (the GM bump read as a flicker
-plateau), and (b) the classical reading ``B = sqrt(min_T AVAR_total(T)) / 0.6643`` (biased
+plateau; only GMs that are the largest component at one or more fitted scales and whose WV
+peak, at scale ``3.785 T_c``, is at least twice the first scale used: a faster or buried GM
+is short-scale structure such as an output filter, not a flat region), and (b) the classical reading ``B = sqrt(min_T AVAR_total(T)) / 0.6643`` (biased
 up where WN/RW overlap).  A value is *flagged* when its T exceeds ``N dt / 4`` (the curve
 is extrapolated there).  Rule (b) is searched over ``T <= N dt / 2``; rule (a) wherever the
 GM peak is.
@@ -217,7 +219,15 @@ def to_ieee(fit) -> IEEEResult:
         else:
             terms.update(entries)
 
-    gm_idx = [i for i, k in enumerate(mdl.components) if k == "GM"]
+    # rule (a) uses the GMs resolved by the scales: WV peak (scale 3.785 T_c) at least twice the
+    # first scale; a faster GM is short-scale structure (e.g. an output filter), not bias instability
+    # and that are the largest component at one or more of the fitted scales (a GM buried under
+    # the WN everywhere does not make a flat region)
+    scales = np.asarray(fit.tau_samples, dtype=np.float64)
+    dominant = set(np.argmax(mdl.wv_components(np.exp(z), scales), axis=0).tolist())
+    first_scale = float(fit.scale_s[0])
+    gm_idx = [i for i, k in enumerate(mdl.components)
+              if k == "GM" and i in dominant and 3.785 * dt / math.exp(z[mdl.slices[i].start]) >= 2.0 * first_scale]
     b_gm = None
     if gm_idx:
         tcs = [dt / math.exp(z[mdl.slices[i].start]) for i in gm_idx]
@@ -253,7 +263,8 @@ def to_ieee(fit) -> IEEEResult:
     edge = tau_b >= m_b[-1] * dt * 0.999
     note = "sqrt(min implied total AVAR)/0.6643 (classical reading, biased up by WN/RW overlap)"
     if edge:
-        note += "; the minimum is at the longest T searched (N dt/2): only an upper bound"
+        note += ("; the minimum is at the longest T searched (N dt/2), beyond the reliable N dt/4: the "
+                 "implied AVAR still falls there, so this is an extrapolated upper bound at best")
     elif flagged:
         note += "; at T > N dt/4: extrapolated"
     b_min = BiasInstability(

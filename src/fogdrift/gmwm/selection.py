@@ -11,8 +11,10 @@ Procedure (:func:`select_model`; [GMWM]_ §5):
    of the best-fitting candidate), scale ``j0`` is excluded, with the smallest ``|z|`` any
    candidate reached recorded as the reason, and the scan moves on.  It stops at the first
    ``j0`` some candidate explains, or after ``max_excluded`` scales.  After step 5 the chosen
-   model's final (efficiently weighted) fit must explain the first ``n_check`` scales too;
-   otherwise scale ``j0`` is excluded with that reason and steps 1-5 are repeated.
+   model's final (efficiently weighted) fit must explain the first ``n_check`` scales too,
+   and, if no candidate passed the checks, not only through a GM whose WV peak lies below
+   twice the first scale (a filter artefact: it cannot be told from WN there); otherwise
+   scale ``j0`` is excluded with that reason and steps 1-5 are repeated.
 2. Every candidate is fitted on the remaining scales with **one common Omega** = ``V^-1``
    (WIC values are only comparable under the same Omega), ``V`` the model-based covariance
    at the iterated GMWM estimate of a pilot choice (the smallest ``Q_1 + 2p`` under the
@@ -226,6 +228,16 @@ def _degenerate(mdl: LatentModel, theta, nu_hat, tau, share_min) -> bool:
     return bool(np.any(share < share_min))
 
 
+def _unresolved_fast_gms(fit: GMWMFit) -> list[str]:
+    """GMs of a fit whose WV peak (scale 3.785 T_c) lies below twice the first scale used."""
+    mdl = fit.latent_model
+    out = []
+    for lab, sl, key in zip(mdl.labels, mdl.slices, mdl.components):
+        if key == "GM" and _GM_PEAK * fit.dt_s / fit.theta[sl.start] < 2.0 * fit.scale_s[0]:
+            out.append(f"{lab} (T_c = {fit.dt_s / fit.theta[sl.start]:.3g} s)")
+    return out
+
+
 def _longest_run(x) -> int:
     s = np.sign(x)
     best = cur = 1
@@ -360,16 +372,22 @@ def select_model(wvar, candidates=None, *, exclude_short=True, max_excluded=None
                           n_check=n_check, p_max=p_max, n_starts=n_starts, z_max=z_max, share_min=share_min)
         idx = np.arange(j0, J)
         results, chosen, ok, src = _choose(wv, models, idx, step1, opts)
-        # the final (efficiently weighted) fit must also explain the first scales
+        # the final (efficiently weighted) fit must also explain the first scales, and not only
+        # with a GM faster than the first scales resolve (an output-filter artefact, e.g. ADIS16405)
         nchk = min(n_check, idx.size)
         zfirst = float(np.max(np.abs(chosen.fit.z_resid[:nchk])))
-        if not exclude_short or zfirst <= z_max or j0 >= max_ex or J - (j0 + 1) < p_max + 2:
+        fast = [] if ok else _unresolved_fast_gms(chosen.fit)
+        if not exclude_short or (zfirst <= z_max and not fast) or j0 >= max_ex or J - (j0 + 1) < p_max + 2:
             break
-        excluded.append(ExcludedScale(
-            level=int(wv.level[j0]), scale_s=float(wv.scale_s[j0]), best_abs_z=zfirst, best_model=chosen.model,
-            reason=(f"the selected model {chosen.model} leaves max |z| = {zfirst:.3g} > {z_max:g} over the "
-                    f"first {nchk} scales from {wv.scale_s[j0]:.4g} s"),
-        ))
+        if zfirst > z_max:
+            why = (f"the selected model {chosen.model} leaves max |z| = {zfirst:.3g} > {z_max:g} over the "
+                   f"first {nchk} scales from {wv.scale_s[j0]:.4g} s")
+        else:
+            why = (f"no candidate passed, and the closest ({chosen.model}) explains the first scales only with "
+                   f"{', '.join(fast)}, whose WV peak lies below twice the first scale {wv.scale_s[j0]:.4g} s "
+                   "(a short-scale artefact such as an output filter)")
+        excluded.append(ExcludedScale(level=int(wv.level[j0]), scale_s=float(wv.scale_s[j0]), best_abs_z=zfirst,
+                                      best_model=chosen.model, reason=why))
         j0 += 1
     if not ok:
         warnings.warn(
