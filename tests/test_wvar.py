@@ -205,3 +205,12 @@ def test_errors():
         from_curve([0.003], [1.0], n_samples=1000, dt_s=0.001)
     with pytest.raises(ConfigError):
         from_curve([0.002], [1.0], n_samples=1000, dt_s=0.001, ci_low=[0.5])
+
+
+def test_compiled_pyramid_equals_numpy_pyramid():
+    x = np.random.default_rng(4).standard_normal((70_001, 2)) + [5.0, -3.0]  # > one parallel block
+    r = haar_wvar(x, 0.01)
+    for k in range(2):
+        xm = x[:, k] - x[:, k].mean()
+        ref = [float(np.mean(w * w)) for _, w in haar_coefficients(xm, len(r))]
+        assert_allclose(r.nu2_dph2[:, k], ref, rtol=1e-12)
