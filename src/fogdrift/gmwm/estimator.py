@@ -54,9 +54,9 @@ import numpy as np
 from scipy import linalg, optimize, stats
 from scipy.linalg import lapack
 
-from ..errors import ConfigError, FogdriftWarning, InsufficientDataError, NotFittedError
+from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError, NotFittedError
 from .covariance import model_wvar_covariance
-from .processes import PROCESSES, LatentModel, parse_model
+from .processes import LatentModel, parse_model
 from .wvar import WvarResult
 
 __all__ = ["GMWMFit", "GMWM", "gmwm_fit", "Whitener"]
@@ -424,8 +424,8 @@ def _check_wv(wvar) -> WvarResult:
         raise ConfigError(f"expected a WvarResult (from haar_wvar or from_curve), got {type(wvar).__name__}")
     if wvar.nu2_dph2.ndim != 1:
         raise ConfigError(
-            f"the wavelet variance has {wvar.n_axes} axes; fit one at a time with wvar.axis(k) "
-            "(or pass {opt:axis})"
+            f"the wavelet variance has {wvar.n_axes} axes {list(wvar.axis_names)}; fit one at a time: "
+            "wvar.axis(k)"
         )
     if np.any(~np.isfinite(wvar.nu2_dph2)) or np.any(wvar.nu2_dph2 <= 0):
         raise InsufficientDataError("every wavelet variance must be finite and > 0 (a constant or quantised "
@@ -659,7 +659,7 @@ def _bootstrap(mdl, theta, wv, idx, n_boot, seed, n_starts):
                        efficiency=wv.efficiency if wv.robust else 0.6)
         try:
             fb = gmwm_fit(wb, mdl, steps=1, scales=wv.level[idx], n_starts=min(n_starts, 3), start=theta)
-        except Exception:  # pragma: no cover - a failed replicate is skipped
+        except (FogdriftError, np.linalg.LinAlgError, linalg.LinAlgError):  # pragma: no cover - skipped replicate
             continue
         draws.append(fb.theta)
     d = np.array(draws)

@@ -162,7 +162,9 @@ def _delta(fun, z, cov):
         if not (vp > 0 and vm > 0):
             return v, float("inf")
         g[i] = (math.log(vp) - math.log(vm)) / (2.0 * _STEP)
-    var = float(g @ cov @ g) if np.all(np.isfinite(cov[np.ix_(g != 0, g != 0)])) else float("inf")
+    nz = g != 0  # parameters the quantity does not depend on may have infinite variance
+    sub = cov[np.ix_(nz, nz)]
+    var = float(g[nz] @ sub @ g[nz]) if np.all(np.isfinite(sub)) else float("inf")
     return v, math.sqrt(max(var, 0.0))
 
 

@@ -47,7 +47,6 @@ References
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass, field
 
@@ -64,7 +63,10 @@ __all__ = ["DEFAULT_CANDIDATES", "CandidateScore", "ExcludedScale", "SelectionRe
 
 _GM_PEAK = 3.785  # the WV of a GM peaks at scale ~3.785 T_c
 
-#: Default candidate set: WN with RW and one or two GMs, plus QN and drift variants.
+#: Default candidate set: WN with RW and one or two GMs, plus QN and drift variants.  FLICKER
+#: models (e.g. "WN+FLICKER+RW") can be passed explicitly; they are not in the default set
+#: because a flat stretch of a few octaves is equally well (and, for a Kalman filter, more
+#: usefully) described by GMs, and on the KVH/LN-200 curves the flicker term collapses.
 DEFAULT_CANDIDATES = (
     "WN", "WN+RW", "WN+GM", "WN+RW+GM", "WN+2GM", "WN+RW+2GM",
     "QN+WN", "QN+WN+RW", "QN+WN+GM", "QN+WN+RW+GM",
