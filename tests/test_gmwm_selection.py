@@ -118,3 +118,16 @@ def test_errors():
         select_model(haar_wvar(x, 0.01), ["WN+XX"])
     with pytest.raises(ConfigError):
         select_model(haar_wvar(x, 0.01), [])
+
+
+def test_bundled_rlg_disturbance_is_excluded_and_flagged(bundled_record):
+    """The bundled PSINS RLG (deg/h, parked vehicle): engine/people disturbance dominates the
+    first octaves; the scan stops at max_excluded = J // 3 = 5 and says whether the first kept
+    scales are explained (x: yes; z: no, so passed_checks is False and a warning is issued)."""
+    wv = haar_wvar(bundled_record.rate_dph, bundled_record.dt_s, axis_names=bundled_record.axis_names)
+    sel = select_model(wv.axis("gx"))
+    assert [e.level for e in sel.excluded] == [1, 2, 3, 4, 5] and "explained" in sel.scan_note
+    assert sel.passed_checks
+    with pytest.warns(FogdriftWarning, match="max_excluded"):
+        sel_z = select_model(wv.axis("gz"))
+    assert not sel_z.passed_checks and "still not explained" in sel_z.scan_note

@@ -160,6 +160,9 @@ class SelectionResult:
     omega_source : str
     passed_checks : bool
         False if no candidate passed every sanity check (fallback choice).
+    scan_note : str
+        Non-empty when the exclusion scan stopped at ``max_excluded`` (says whether the first
+        kept scales are still unexplained).
     """
 
     selected: str
@@ -170,6 +173,7 @@ class SelectionResult:
     levels_used: np.ndarray
     omega_source: str
     passed_checks: bool
+    scan_note: str = ""
 
     def candidate(self, model) -> CandidateScore:
         """The score of one candidate (by model string)."""
@@ -189,6 +193,7 @@ class SelectionResult:
             "levels_used": [int(v) for v in self.levels_used],
             "omega_source": self.omega_source,
             "passed_checks": bool(self.passed_checks),
+            "scan_note": self.scan_note,
         }
 
 
@@ -391,15 +396,24 @@ def select_model(wvar, candidates=None, *, exclude_short=True, max_excluded=None
         excluded.append(ExcludedScale(level=int(wv.level[j0]), scale_s=float(wv.scale_s[j0]), best_abs_z=zfirst,
                                       best_model=chosen.model, reason=why))
         j0 += 1
+    note = ""
+    if exclude_short and max_ex > 0 and j0 >= max_ex:
+        note = f"the exclusion scan stopped at max_excluded = {max_ex}"
+        if zfirst > z_max:
+            note += (f"; the first kept scales are still not explained (max |z| = {zfirst:.3g}): raise "
+                     "max_excluded or read the result with care")
+        else:
+            note += f"; the first kept scales are explained (max |z| = {zfirst:.3g})"
     if not ok:
         warnings.warn(
             f"no candidate passed every sanity check; {chosen.model} (smallest WIC among the candidates "
-            f"without hard failures) is returned with passed_checks=False: {'; '.join(chosen.reasons)}",
+            f"without hard failures) is returned with passed_checks=False: {'; '.join(chosen.reasons)}"
+            + (f" ({note})" if note else ""),
             FogdriftWarning, stacklevel=2,
         )
     return SelectionResult(
         selected=chosen.model, fit=chosen.fit, ieee=to_ieee(chosen.fit), candidates=results, excluded=excluded,
-        levels_used=wv.level[idx], omega_source=src, passed_checks=ok,
+        levels_used=wv.level[idx], omega_source=src, passed_checks=ok, scan_note=note,
     )
 
 
