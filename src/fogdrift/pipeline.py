@@ -387,7 +387,7 @@ def make_model(name: str, cfg: AnalysisConfig, progress=None):
 def _separate(x, cfg: AnalysisConfig, dt_s):
     from .lifting import separate
 
-    return separate(x, wavelet=cfg.wavelet, level=cfg.level, mode=cfg.mode, dt_s=dt_s)
+    return separate(x, wavelet=cfg.wavelet, level=cfg.level, mode=cfg.mode)
 
 
 def _resolved_level(x, cfg: AnalysisConfig, dt_s) -> tuple[int, list | None]:
