@@ -69,7 +69,7 @@ def test_noise_part_recovers_arw_and_drift_rmse():
     assert json.loads(json.dumps(d4.to_dict()))["level"] == 4
 
 
-@pytest.mark.parametrize("wavelet", ["db2"])
+@pytest.mark.parametrize("wavelet", ["db2", "db4"])
 @pytest.mark.parametrize("period,amp", [(256, 1.0), (256, 5.0), (1024, 1.0)])
 def test_choose_level_on_known_drift(period, amp, wavelet):
     # a period of 4*2**J samples keeps 94 % of its power in the drift (db2), so the right

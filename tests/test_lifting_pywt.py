@@ -88,6 +88,21 @@ def test_lift_unlift_one_level(n, wavelet, backend):
     np.testing.assert_allclose(L.unlift(a, d, wavelet, mode="symmetric"), x, atol=1e-12)
 
 
+def test_db4_impulse_bands_equal_pywt_filters():
+    # one level on unit impulses: the periodized db4 analysis rows are pywt's dec_lo/dec_hi
+    n = 32
+    rows_a = np.array([L.lift(np.eye(n)[j], "db4")[0] for j in range(n)]).T
+    rows_d = np.array([L.lift(np.eye(n)[j], "db4")[1] for j in range(n)]).T
+    pa = np.array([pywt.dwt(np.eye(n)[j], "db4", mode="periodization")[0] for j in range(n)]).T
+    pd = np.array([pywt.dwt(np.eye(n)[j], "db4", mode="periodization")[1] for j in range(n)]).T
+    np.testing.assert_allclose(rows_a, pa, atol=1e-14)
+    np.testing.assert_allclose(rows_d, pd, atol=1e-14)
+    w = pywt.Wavelet("db4")
+    # row 8 holds the 8 filter taps (in some order), and nothing else
+    np.testing.assert_allclose(np.sort(rows_a[8][np.abs(rows_a[8]) > 1e-14]), np.sort(w.dec_lo), atol=1e-14)
+    np.testing.assert_allclose(np.sort(rows_d[8][np.abs(rows_d[8]) > 1e-14]), np.sort(w.dec_hi), atol=1e-14)
+
+
 # ---------------------------------------------------------------- orthogonality (periodization)
 # For an orthogonal wavelet and n a multiple of 2**J (no padding), W is an orthogonal matrix,
 # so the drift W^T diag(1, 0) W x is an orthogonal projection of x: the two parts are

@@ -230,3 +230,5 @@ def test_documented_end_gain_of_the_symmetric_mode():
     assert gains[256] == pytest.approx(0.41, abs=0.01)
     assert max(gains.values()) == pytest.approx(9.34, abs=0.01) and max(gains, key=gains.get) == 257
     assert max(_last_row_gain(n, "db2", "periodization") for n in ns) <= 0.48
+    db4 = [_last_row_gain(n, "db4", "symmetric") for n in ns]
+    assert min(db4) == pytest.approx(0.20, abs=0.01) and max(db4) == pytest.approx(1.38, abs=0.01)

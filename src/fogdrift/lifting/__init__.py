@@ -34,10 +34,10 @@ Examples
 >>> import numpy as np
 >>> from fogdrift.lifting import choose_level, level_scan, separate
 >>> x = np.random.default_rng(0).standard_normal(4096)
->>> level = choose_level(level_scan(x, 0.1, "db2", max_level=5))  # white noise: the deepest
+>>> level = choose_level(level_scan(x, 0.1, "db4", max_level=5))  # white noise: the deepest
 >>> level
 5
->>> drift, noise = separate(x, "db2", level=level, mode="symmetric")
+>>> drift, noise = separate(x, "db4", level=level, mode="symmetric")
 >>> drift.shape == noise.shape == x.shape
 True
 """

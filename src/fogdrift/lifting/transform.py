@@ -22,8 +22,8 @@ Boundary modes
     the reflected steps amplify the last samples of the drift.  White-noise gain of the
     last drift sample (norm of the last row of the drift operator) at J = 4, over the 16
     residues of n mod 16 (the same for n = 256..271 and 1024..1039): db2 0.41 for n a
-    multiple of 16 but up to 9.3 (n = 16k + 1); haar 0.25 .. 1.39; periodization: db2
-    0.33 .. 0.48.  Records (and causal windows)
+    multiple of 16 but up to 9.3 (n = 16k + 1); db4 0.20 .. 1.38; haar 0.25 .. 1.39;
+    periodization: db2 0.33 .. 0.48, db4 0.21 .. 0.26.  Records (and causal windows)
     whose length is a multiple of ``2**J`` have even lengths at every level and do not show
     it.
 
@@ -56,7 +56,7 @@ def max_level(n: int, wavelet="db2", mode="periodization") -> int:
     """Largest decomposition level allowed for ``n`` samples.
 
     The rule is PyWavelets' ``dwt_max_level`` in both modes:
-    ``J_max = floor(log2(n / (L - 1)))`` with ``L`` the filter length (haar 2, db2 4),
+    ``J_max = floor(log2(n / (L - 1)))`` with ``L`` the filter length (haar 2, db2 4, db4 8),
     i.e. level J needs ``n >= (L - 1) * 2**J`` samples (db2: ``3 * 2**J``; level 4 needs 48).
     ``0`` when ``n < L - 1``.
 
@@ -64,6 +64,8 @@ def max_level(n: int, wavelet="db2", mode="periodization") -> int:
     --------
     >>> max_level(47), max_level(48)
     (3, 4)
+    >>> max_level(112, "db4")
+    4
     """
     scheme = get_wavelet(wavelet)
     _check_mode(mode)
