@@ -25,7 +25,9 @@ Boundary modes
     multiple of 16 but up to 9.3 (n = 16k + 1); db4 0.20 .. 1.38; haar 0.25 .. 1.39;
     periodization: db2 0.33 .. 0.48, db4 0.21 .. 0.26.  Records (and causal windows)
     whose length is a multiple of ``2**J`` have even lengths at every level and do not show
-    it.
+    it, so :func:`~fogdrift.lifting.separate` and :func:`~fogdrift.lifting.causal_drift`
+    extend a record by whole-sample reflection to such a length before separating it and
+    trim the result (last-sample gain then 0.26 .. 0.43 for db2, 0.22 .. 0.40 for db4).
 
 Units: the transform is unit-agnostic (coefficients carry the unit of ``x``).
 """
