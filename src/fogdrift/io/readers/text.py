@@ -173,8 +173,8 @@ class TextTable(Table):
     def _non_numeric(self, cell: str, lineno: int, j: int) -> DataFormatError:
         hint = ""
         if not self.decimal_comma and _DECIMAL_COMMA.match(cell):
-            hint = (" (a decimal comma; it is read only in files not separated by commas whose first data row "
-                    "shows it: write decimal points)")
+            hint = (" (a decimal comma: read only when the separator is not a comma and the first data row "
+                    "has one; write decimal points)")
         return DataFormatError(f"non-numeric value{hint}; expected a number, got {cell!r}",
                                path=self.path, line=lineno, column=self.label(j))
 
@@ -235,12 +235,12 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
         )
     first, second = content[0], (content[1] if len(content) > 1 else None)
     if delim == "auto":
-        delim, is_header, decimal_comma = _detect_layout(first, second)
+        delim, is_header = _detect_layout(first, second)
     else:
         is_header = not (_fits(first, delim, False) or (delim != "," and _fits(first, delim, True)))
-        data_line = second if is_header else first
-        decimal_comma = (data_line is not None and delim != "," and not _fits(data_line, delim, False)
-                         and _fits(data_line, delim, True))
+    data_line = second if is_header else first
+    decimal_comma = (data_line is not None and delim != ","
+                     and any(_DECIMAL_COMMA.match(f.strip()) for f in _split(data_line, delim)))
     fields = [f.strip() for f in _split(first, delim)]
     common = dict(delimiter=delim, n_fields=len(fields), is_gz=gzip_magic, decimal_comma=decimal_comma)
     if not is_header:
@@ -265,7 +265,7 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
 
 
 def _detect_layout(first: str, second):
-    """(delimiter, first line is a header, decimal comma) from the first two content lines.
+    """(delimiter, first line is a header) from the first two content lines.
 
     A delimiter fits a data line when it splits it into numbers only; candidates are tab,
     comma and semicolon (if present), then whitespace; a delimiter other than comma also
@@ -279,15 +279,15 @@ def _detect_layout(first: str, second):
     for dc in (False, True):
         for d in candidates(first):
             if not (dc and d == ",") and _fits(first, d, dc):
-                return d, False, dc
+                return d, False
     if second is not None:
         for dc in (False, True):
             for d in candidates(second):
                 if not (dc and d == ",") and _fits(second, d, dc) and len(_split(first, d)) == len(_split(second, d)):
-                    return d, True, dc
+                    return d, True
     counts = {c: first.count(c) for c in ("\t", ",", ";")}
     best = max(counts, key=counts.get)
-    return (best if counts[best] else None), True, False
+    return (best if counts[best] else None), True
 
 
 def _fits(line: str, delim, decimal_comma: bool) -> bool:
