@@ -18,13 +18,14 @@ import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fogdrift.errors import DataFormatError, FogdriftError, FogdriftWarning
 from fogdrift.io import GyroRecord, load, load_segments
 
-FUZZ = settings(max_examples=max(150, settings.default.max_examples), suppress_health_check=[HealthCheck.function_scoped_fixture])
+# 150 examples per property in the default profile (the explore profile raises it to 1000)
+FUZZ = settings(max_examples=max(150, settings.default.max_examples))
 
 OPTIONS = st.sampled_from([
     {}, {"dt_s": 0.01}, {"gaps": "split"}, {"columns": "gx"}, {"columns": [0]}, {"time_column": None, "rate_hz": 100.0},

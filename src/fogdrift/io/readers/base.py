@@ -22,7 +22,7 @@ import numpy as np
 
 from ...errors import DataFormatError
 
-__all__ = ["Table", "split_unit_label", "numeric_column", "PARSER_ERRORS"]
+__all__ = ["Table", "split_unit_label", "numeric_column", "describe_exception", "PARSER_ERRORS"]
 
 #: What third-party parsers (numpy.load, zipfile, gzip) raise on corrupt bytes; readers turn
 #: these into a DataFormatError naming the file.  RuntimeError covers zipfile's "encrypted"
@@ -55,6 +55,11 @@ def split_unit_label(label: str) -> tuple[str, str | None]:
     if m is None:
         return label, None
     return m.group("name"), (m.group("unit") or None)
+
+
+def describe_exception(exc: BaseException) -> str:
+    """``"<Type>: <message>"`` of a parser's exception on one line (for ``got ...`` in messages)."""
+    return " ".join(f"{type(exc).__name__}: {exc}".split())
 
 
 def numeric_column(arr: np.ndarray, path, what: str, column=None) -> np.ndarray:

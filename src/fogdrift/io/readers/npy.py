@@ -13,7 +13,7 @@ import numpy as np
 
 from ...errors import DataFormatError
 from ..hashing import file_sha256
-from .base import PARSER_ERRORS, Table, numeric_column
+from .base import PARSER_ERRORS, Table, describe_exception, numeric_column
 
 __all__ = ["open_table"]
 
@@ -31,7 +31,7 @@ def open_table(path: Path) -> Table:
         arr = np.load(p, mmap_mode="r", allow_pickle=False)
     except PARSER_ERRORS as exc:
         raise DataFormatError(
-            f"unreadable .npy file; expected a numeric NumPy array, got {type(exc).__name__}: {exc}", path=p
+            f"unreadable .npy file; expected a numeric NumPy array, got {describe_exception(exc)}", path=p
         ) from exc
     if arr.ndim not in (1, 2):
         raise DataFormatError(

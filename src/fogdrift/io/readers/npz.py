@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import DataFormatError
-from .base import PARSER_ERRORS, Table, numeric_column
+from .base import PARSER_ERRORS, Table, describe_exception, numeric_column
 
 __all__ = ["open_table"]
 
@@ -38,7 +38,7 @@ def open_table(path: Path) -> Table:
             arrays = {k: z[k] for k in z.files}
     except PARSER_ERRORS as exc:
         raise DataFormatError(
-            f"unreadable .npz file; expected NumPy arrays, got {type(exc).__name__}: {exc}", path=p
+            f"unreadable .npz file; expected NumPy arrays, got {describe_exception(exc)}", path=p
         ) from exc
     del raw
     if not arrays:

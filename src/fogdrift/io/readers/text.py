@@ -21,7 +21,7 @@ import numpy as np
 
 from ...errors import ConfigError, DataFormatError
 from ..hashing import hashing_stream
-from .base import Table, split_unit_label
+from .base import Table, describe_exception, split_unit_label
 
 __all__ = ["open_table", "TextTable", "delimiter_option"]
 
@@ -152,7 +152,7 @@ class TextTable(Table):
                     rows.append(row)
                     lines.append(lineno)
         except _STREAM_ERRORS as exc:
-            raise DataFormatError(f"unreadable file; expected text or gzip text, got error: {exc}",
+            raise DataFormatError(f"unreadable file; expected text or gzip text, got {describe_exception(exc)}",
                                   path=self.path) from exc
         data = np.array(rows, dtype=np.float64).reshape(len(rows), nf)
         return data, np.asarray(lines, dtype=np.int64)
@@ -227,7 +227,8 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
                     if len(content) == 2:
                         break
     except _STREAM_ERRORS as exc:
-        raise DataFormatError(f"unreadable file; expected text or gzip text, got error: {exc}", path=p) from exc
+        raise DataFormatError(f"unreadable file; expected text or gzip text, got {describe_exception(exc)}",
+                              path=p) from exc
     if not content:
         raise DataFormatError(
             "empty file; expected a header and/or numeric data rows, got no content "
