@@ -26,6 +26,8 @@ __all__ = [
     "earth_rate_projection_dph",
     "AXIS_DIRECTIONS",
     "check_dt_s",
+    "TIME_UNITS",
+    "time_scale_to_s",
 ]
 
 #: WGS-84 Earth rotation rate 7.2921150e-5 rad/s expressed in deg/h (method notes §6).
@@ -47,6 +49,34 @@ INCREMENT_UNITS: dict[str, float] = {
     "rad": 180.0 / math.pi * 3600.0,
     "arcsec": 1.0,
 }
+
+
+#: Multiply a time stamp in the key's unit by the value to get seconds (time columns, ``time_unit``).
+TIME_UNITS: dict[str, float] = {
+    "s": 1.0,
+    "ms": 1e-3,
+    "us": 1e-6,
+    "ns": 1e-9,
+}
+
+
+def time_scale_to_s(unit: str) -> float:
+    """Factor that converts a time stamp in ``unit`` to seconds.
+
+    Raises
+    ------
+    ConfigError
+        If ``unit`` is not a key of :data:`TIME_UNITS` (the message lists them).
+
+    Examples
+    --------
+    >>> time_scale_to_s("ms")
+    0.001
+    """
+    try:
+        return TIME_UNITS[unit]
+    except (KeyError, TypeError):
+        raise ConfigError(f"unknown time unit {unit!r}; expected one of {list(TIME_UNITS)}") from None
 
 
 def check_dt_s(dt_s, name: str = "dt_s") -> float:
