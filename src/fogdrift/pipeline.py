@@ -278,6 +278,7 @@ class AnalysisResult:
     axes: list
     versions: dict
     wall_s: float
+    model_record: dict = field(default_factory=dict)  # the record at the modelling rate (effective rate, factor)
     apply_to: "AnalysisResult | None" = None
     applied: bool = False  # True when these axes were modelled by another recording's fitted models
 
@@ -289,6 +290,7 @@ class AnalysisResult:
             "applied_models_from_other_recording": self.applied,
             "config": self.config.to_dict(),
             "record": self.record,
+            "model_record": self.model_record,
             "versions": self.versions,
             "wall_s": self.wall_s,
             "axes": [a.to_dict() for a in self.axes],
@@ -346,14 +348,12 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None) -> A
 
 
 def _model_record(record, cfg: AnalysisConfig):
-    """Block-average a record to the modelling rate (or keep it)."""
-    if cfg.model_rate_hz is None:
-        return record
-    target_dt = 1.0 / cfg.model_rate_hz
-    if target_dt <= record.dt_s * (1 + 1e-9):
-        return record
-    factor = round(target_dt / record.dt_s)
-    return record.block_average(factor * record.dt_s)
+    """Block-average a record to the modelling rate by an integer factor (``GyroRecord.to_rate``), or keep it.
+
+    A rate that does not divide the native rate by an integer, or lies above it, is a ConfigError naming the
+    nearest valid rates; the averaged record's metadata state the effective rate and the factor.
+    """
+    return record if cfg.model_rate_hz is None else record.to_rate(cfg.model_rate_hz)
 
 
 def make_model(name: str, cfg: AnalysisConfig, progress=None):
@@ -465,7 +465,10 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
 
     level = int(cfg.level)
     split = _split_indices(rate.size, cfg)
-    need = max(3 * 2**level, cfg.lags + 2)
+    from .lifting import get_wavelet
+
+    reach = (get_wavelet(cfg.wavelet).filter_length - 1) * 2**level  # support of the level-J drift filter
+    need = max(reach, cfg.lags + 2)
     for block, (lo, hi) in split.items():
         if hi - lo < need:
             raise InsufficientDataError(
@@ -481,7 +484,7 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
     history = np.concatenate([drift["train"], drift["val"]])
 
     # The causal drift's warm-up (one window) must end inside the training block.
-    window = min(max(int(round(cfg.causal_window_s / dt_s)), 3 * 2**level), b)
+    window = min(max(int(round(cfg.causal_window_s / dt_s)), reach), b)
     causal = causal_drift(rate, window, wavelet=cfg.wavelet, level=level, mode=cfg.mode)
     causal_hist = causal[:e][np.isfinite(causal[:e])]
     causal_test = causal[e:f]
@@ -603,8 +606,9 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
     result = AnalysisResult(
         config=cfg,
         source=source or record.source,
-        sha256=sha256 or (file_sha256(record.source) if Path(str(record.source)).is_file() else ""),
+        sha256=sha256 or record.sha256 or (file_sha256(record.source) if Path(str(record.source)).is_file() else ""),
         record=record.metadata(),
+        model_record=rec_m.metadata(),
         axes=axes,
         versions=library_versions(),
         wall_s=0.0,

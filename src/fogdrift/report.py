@@ -430,6 +430,16 @@ figure{margin:1em 0}img{max-width:100%}
 """
 
 
+def _effective_rate(result) -> str:
+    """The modelling rate actually used: the averaged record's rate and its block-average factor."""
+    m = getattr(result, "model_record", None) or {}
+    fs, k = m.get("fs_hz"), m.get("block_average_factor") or 1
+    if fs is None:
+        return "native rate"
+    native = m.get("native_fs_hz") or fs
+    return f"{fs:.6g} Hz (native {native:.6g} Hz averaged in blocks of {k})" if k > 1 else f"{fs:.6g} Hz (native)"
+
+
 def _analysis_section(result, fig_dir, title, fig_offset=0) -> str:
     parts = [f"<h2>{html.escape(title)}</h2>"]
     rec = result.record
@@ -441,7 +451,7 @@ def _analysis_section(result, fig_dir, title, fig_offset=0) -> str:
         ["duration [s]", _fmt(rec.get("duration_s"))],
         ["axes", ", ".join(rec.get("axis_names", []))],
         ["input unit (converted to deg/h)", rec.get("input_unit")],
-        ["modelling rate [Hz]", result.config.model_rate_hz],
+        ["modelling rate (effective)", _effective_rate(result)],
         ["wavelet / level / mode", f"{result.config.wavelet} / {result.config.level} / {result.config.mode}"],
         ["split train / val / test", f"{result.config.train_fraction} / {result.config.val_fraction} / "
                                      f"{1 - result.config.train_fraction - result.config.val_fraction:.2g}"],
