@@ -1,0 +1,83 @@
+"""``fogdrift analyze``: the whole method on one recording, with an HTML report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ..errors import ConfigError
+from ._app import (EstOpt, FitTausOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, console,
+                   csv_list, errors, parse_fit_taus, parse_level, parse_taus, progress, with_load_options)
+from ._tables import metrics_table, noise_table
+from .model import EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt
+
+
+@app.command()
+@with_load_options
+def analyze(
+    load,
+    latitude: Annotated[Optional[float], typer.Option("--latitude", help="Latitude [deg] for Earth-rate removal.")]
+    = None,
+    earth_axis: Annotated[Optional[list[str]], typer.Option(
+        "--earth-axis", help="AXIS=ORIENTATION (up, down, north, south, east, west), repeatable.")] = None,
+    apply_to: Annotated[Optional[Path], typer.Option("--apply-to", help="Second recording: apply the fitted "
+                                                     "models unchanged to it.")] = None,
+    models: ModelsOpt = "grey-elman,elman,gm11,ar,persistence",
+    hidden: HiddenOpt = 16,
+    lags: LagsOpt = 4,
+    epochs: EpochsOpt = 2000,
+    seed: SeedOpt = 0,
+    training: TrainingOpt = "bptt",
+    wavelet: WaveletOpt = "db2",
+    level: LevelOpt = "4",
+    mode: ModeOpt = "symmetric",
+    model_rate: ModelRateOpt = 1.0,
+    taus: TausOpt = "octave",
+    estimator: EstOpt = "overlapping",
+    terms: Annotated[str, typer.Option("--terms", help="Noise terms to fit, e.g. Q,N,B,K,R.")] = "Q,N,B,K,R",
+    fit_taus: FitTausOpt = ":",
+    train_fraction: Annotated[float, typer.Option("--train-fraction", help="Chronological training share.")] = 0.6,
+    val_fraction: Annotated[float, typer.Option("--val-fraction", help="Validation share (early stopping).")] = 0.2,
+    causal_window: Annotated[float, typer.Option(
+        "--causal-window", help="Window [s] of the causal (real-time) drift of the practical compensation.")] = 128.0,
+    gm_window: Annotated[int, typer.Option("--gm-window", help="Rolling window [samples] of the one-step GM(1,1).")]
+    = 8,
+    out: OutOpt = Path("out/analyze"),
+):
+    """The whole method: Allan analysis, separation, drift models, compensation, Table 2 and an HTML report."""
+    from ..pipeline import AnalysisConfig, run_analysis
+    from ..report import metrics_rows, noise_row, verdict, write_report
+
+    with errors():
+        record = load.load()
+        other = load.load(apply_to) if apply_to else None
+        earth = {}
+        for item in earth_axis or []:
+            name, sep, orient = item.partition("=")
+            if not sep:
+                raise ConfigError(f"--earth-axis must look like AXIS=ORIENTATION (e.g. gz=up), got {item!r}")
+            earth[name.strip()] = orient.strip()
+        cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
+                             training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
+                             model_rate_hz=model_rate or None, taus=parse_taus(taus), estimator=estimator,
+                             terms=tuple(t.upper() for t in csv_list(terms)), latitude_deg=latitude,
+                             earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), train_fraction=train_fraction,
+                             val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window)
+        with progress("analyze") as (_, epoch_cb):
+            result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb)
+        for res, title in ((result, load.file.name), (result.apply_to, apply_to.name if apply_to else "")):
+            if res is None:
+                continue
+            for ax in res.axes:
+                console.print(noise_table(f"{title} axis {ax.name}: Table 2 (test block, {ax.models.dt_s:g} s "
+                                          "samples; 95 % intervals)",
+                                          [["original (whole record, native rate)"] + noise_row(ax.original.noise)]
+                                          + [[r.label] + noise_row(r.analysis.noise) for r in ax.table2]))
+                console.print(metrics_table(f"{title} axis {ax.name}: one-step metrics on the test block",
+                                            metrics_rows(ax.models)))
+                for line in verdict(ax.models):
+                    console.print("  " + line, highlight=False)
+        path = write_report(result, record, out)
+        console.print(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
