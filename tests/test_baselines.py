@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from fogdrift.baselines import AR, ar_aic, ar_fit
+from fogdrift.models.ar import AR, ar_aic, ar_fit
 from fogdrift.errors import ConfigError, InsufficientDataError, NotFittedError
-from fogdrift.grey import GM11
+from fogdrift.models.grey import GM11
 from fogdrift.metrics import rmse
 from fogdrift.models import Persistence, load_model
 

@@ -1,4 +1,4 @@
-"""Tests of fogdrift.elman: Elman / grey-Elman networks (Tang et al. 2012, eqs. (11)-(13)).
+"""Tests of fogdrift.models.elman: Elman / grey-Elman networks (Tang et al. 2012, eqs. (11)-(13)).
 
 Independent checks used here:
 
@@ -19,7 +19,16 @@ import pytest
 jax = pytest.importorskip("jax")
 import jax.numpy as jnp  # noqa: E402
 
-from fogdrift.elman import Elman, GreyElman, elman_forward, elman_loss, fit_many, init_params  # noqa: E402
+from fogdrift.models.elman import (  # noqa: E402
+    Elman,
+    ElmanCell,
+    GreyElman,
+    elman_forward,
+    elman_loss,
+    fit_many,
+    init_params,
+)
+from fogdrift.models.training import RecurrentCell  # noqa: E402
 from fogdrift.errors import ConfigError, InsufficientDataError, NotFittedError  # noqa: E402
 from fogdrift.models import Persistence, load_model  # noqa: E402
 
@@ -296,17 +305,21 @@ def test_grey_global_frame_loses_to_persistence(drift):
 
 
 @pytest.mark.parametrize("activation", ["tanh", "logsig"])
-def test_windowed_training_kernel_equals_elman_forward(x64, activation):
-    """The batched kernel used for training computes, window by window, exactly eq. (11) as elman_forward."""
-    from fogdrift.elman import _window_pass
-
-    params = init_params(jax.random.key(5), 4, 6, dtype=jnp.float64)
+def test_cell_scans_equal_elman_forward(x64, activation):
+    """The batched fast path used for training (ElmanCell.scan), the generic scan of ElmanCell.step
+    (RecurrentCell.scan: vmap inside lax.scan, what a GRU/LSTM cell would get) and elman_forward
+    (eq. 11) compute the same outputs and final states, window by window."""
+    cell = ElmanCell(activation)
+    params = cell.init(jax.random.key(5), 4, 6, dtype=jnp.float64)
     rng = np.random.default_rng(5)
     n_win, width = 7, 9
-    u = rng.standard_normal((width, n_win, 4))
-    h0s = rng.standard_normal((n_win, 6)) * 0.3
-    out, h_end = _window_pass(params, jnp.asarray(u), jnp.asarray(h0s), activation, False)
+    u = jnp.asarray(rng.standard_normal((width, n_win, 4)))
+    h0s = jnp.asarray(rng.standard_normal((n_win, 6)) * 0.3)
+    h_fast, y_fast = cell.scan(params, h0s, u)
+    h_gen, y_gen = RecurrentCell.scan(cell, params, h0s, u)
+    assert y_fast.shape == y_gen.shape == (width, n_win, 1)
     for w in range(n_win):
-        ref, hid = elman_forward(params, jnp.asarray(u[:, w, :]), jnp.asarray(h0s[w]), activation)
-        np.testing.assert_allclose(np.asarray(out[:, w]), np.asarray(ref[:, 0]), rtol=1e-12, atol=1e-12)
-        np.testing.assert_allclose(np.asarray(h_end[w]), np.asarray(hid[-1]), rtol=1e-12, atol=1e-12)
+        ref, hid = elman_forward(params, u[:, w, :], h0s[w], activation)
+        for out, h_end in ((y_fast, h_fast), (y_gen, h_gen)):
+            np.testing.assert_allclose(np.asarray(out[:, w, 0]), np.asarray(ref[:, 0]), rtol=1e-12, atol=1e-12)
+            np.testing.assert_allclose(np.asarray(h_end[w]), np.asarray(hid[-1]), rtol=1e-12, atol=1e-12)

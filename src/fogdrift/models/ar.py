@@ -1,7 +1,7 @@
-"""Linear baselines for drift models: least-squares AR(p) with intercept.
+"""Linear baseline for drift models: least-squares AR(p) with intercept (:func:`ar_fit`, :func:`ar_aic`, :class:`AR`).
 
-Persistence lives in :mod:`fogdrift.models`. Series are 1-D float arrays of drift rate in deg/h at
-a fixed sample interval.
+Persistence lives in :mod:`fogdrift.models.persistence`. Series are 1-D float arrays of drift rate
+in deg/h at a fixed sample interval.
 
 References
 ----------
@@ -18,8 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ConfigError, InsufficientDataError
-from .models import DriftModel, check_series, register_model
+from .._util import check_series
+from ..errors import ConfigError, InsufficientDataError
+from .base import DriftModel
 
 __all__ = ["ARFit", "ar_fit", "ar_aic", "AR"]
 
@@ -166,7 +167,6 @@ def ar_aic(y, max_order: int) -> np.ndarray:
     return out
 
 
-@register_model
 class AR(DriftModel):
     """Least-squares AR(p) with intercept: the linear one-step baseline.
 

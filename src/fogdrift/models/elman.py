@@ -1,4 +1,4 @@
-"""Elman recurrent network and the grey (AGO) Elman drift model, in JAX + optax.
+"""Elman recurrent network and the grey (AGO) Elman drift model, in JAX.
 
 Functional core
 ---------------
@@ -9,7 +9,9 @@ One Elman cell as in Tang et al. (2012), eq. (11), and Elman (1990)::
 
 with ``f`` = tanh ("tanh", MATLAB ``tansig``) or the logistic function ("logsig").
 :func:`init_params`, :func:`elman_forward` (a ``jax.lax.scan`` over time) and
-:func:`elman_loss` (eq. (12), sum of squared errors, or the mean) are pure functions.
+:func:`elman_loss` (eq. (12), sum of squared errors, or the mean) are pure functions;
+:class:`ElmanCell` is the same cell behind the interface of :mod:`fogdrift.models.training`,
+which holds the windowed truncated-BPTT / BP training loop, early stopping and the optimizers.
 
 Estimators
 ----------
@@ -18,9 +20,10 @@ samples (z-scored with training-block statistics) and whose hidden state runs al
 series. :class:`GreyElman` is the paper's "AGO -> Elman -> IAGO" model (method notes §4.1 (b)).
 :func:`fit_many` trains one model per seed at once with ``jax.vmap``.
 
-This is the only fogdrift module that imports JAX at top level. Everything runs unchanged on
-CPU or GPU. float32 is the default; ``dtype="float64"`` needs JAX's 64-bit mode switched on by
-the caller (``JAX_ENABLE_X64=1`` or ``jax.config.update("jax_enable_x64", True)``).
+This module and :mod:`fogdrift.models.training` are the only fogdrift modules that import JAX.
+Everything runs unchanged on CPU or GPU. float32 is the default; ``dtype="float64"`` needs JAX's
+64-bit mode switched on by the caller (``JAX_ENABLE_X64=1`` or
+``jax.config.update("jax_enable_x64", True)``).
 
 References
 ----------
@@ -34,29 +37,31 @@ from __future__ import annotations
 import functools
 import math
 import warnings
+from dataclasses import dataclass
 
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optax
 
-from .errors import ConfigError, FogdriftWarning, InsufficientDataError
-from .models import DriftModel, check_series, register_model
+from .._util import check_series
+from ..errors import ConfigError, FogdriftWarning, InsufficientDataError
+from .base import DriftModel
+from .training import (
+    LOSSES,
+    TRAINGDX,  # noqa: F401  (MATLAB traingdx constants, kept importable from here)
+    TRAININGS,
+    RecurrentCell,
+    TrainResult,
+    fit_recurrent,
+    fit_recurrent_many,
+    train_config,
+    window_data,
+)
 
-__all__ = ["init_params", "elman_forward", "elman_loss", "Elman", "GreyElman", "fit_many"]
+__all__ = ["init_params", "elman_forward", "elman_loss", "ElmanCell", "Elman", "GreyElman", "fit_many"]
 
 _ACTIVATIONS = ("tanh", "logsig")
-_LOSSES = ("sse", "mse")
-_TRAININGS = ("bptt", "bp")
-_OPTIMIZERS = ("adam", "traingdx")
 _DTYPES = ("float32", "float64")
-#: MATLAB traingdx defaults (method notes §4.2): momentum, lr increase/decrease, max perf increase.
-TRAINGDX = {"mc": 0.9, "lr_inc": 1.05, "lr_dec": 0.7, "max_perf_inc": 1.04}
-#: Relative improvement of the validation loss that resets the patience counter.
-_IMPROVE_RTOL = 1e-4
-#: Epochs run per compiled call (the host checks the stopping rule between chunks).
-_CHUNK = 25
-
 
 # ------------------------------------------------------------------------------------------
 # functional core
@@ -193,10 +198,10 @@ def elman_loss(params, inputs, targets, *, h0=None, activation="tanh", loss="sse
     jax.Array
         Scalar loss.
     """
-    if loss not in _LOSSES:
-        raise ConfigError(f"loss must be one of {_LOSSES}; got {loss!r}")
-    if training not in _TRAININGS:
-        raise ConfigError(f"training must be one of {_TRAININGS}; got {training!r}")
+    if loss not in LOSSES:
+        raise ConfigError(f"loss must be one of {LOSSES}; got {loss!r}")
+    if training not in TRAININGS:
+        raise ConfigError(f"training must be one of {TRAININGS}; got {training!r}")
     out, _ = elman_forward(params, inputs, h0, activation, stop_context_gradient=(training == "bp"))
     targets = jnp.asarray(targets).reshape(out.shape[0], -1)
     err2 = jnp.sum((out - targets) ** 2, axis=1)
@@ -208,140 +213,58 @@ def elman_loss(params, inputs, targets, *, h0=None, activation="tanh", loss="sse
     return total if loss == "sse" else total / count
 
 
-# ------------------------------------------------------------------------------------------
-# windowed training kernel (private; inputs assumed clean)
-# ------------------------------------------------------------------------------------------
-def _window_pass(params, u_w, h0s, activation, bp):
-    """Forward over all windows at once (time-major, private).
 
-    u_w (W, n_win, p), h0s (n_win, H) -> outputs (W, n_win), final states (n_win, H).
-    Same recurrence as :func:`elman_forward`, batched over windows without ``vmap``.
+
+@dataclass(frozen=True)
+class ElmanCell(RecurrentCell):
+    """The Elman cell of eq. (11) behind the :class:`~fogdrift.models.training.RecurrentCell` interface.
+
+    Parameters
+    ----------
+    activation : {"tanh", "logsig"}
+        Hidden transfer function f.
+    n_outputs : int
+        Linear outputs m.
+
+    Notes
+    -----
+    :meth:`step` is one step of one sample. :meth:`scan` (used by the training loop) computes
+    the input projection W_u u(k) + b_h and the read-out outside the time loop and runs the
+    recurrence h <- f(a(k) + h W_cᵀ) on all sequences at once; it equals a scan of :meth:`step`
+    (and :func:`elman_forward`) to rounding.
+
+    Examples
+    --------
+    >>> cell = ElmanCell("tanh")
+    >>> p = cell.init(jax.random.key(0), 4, 16)
+    >>> h, y = cell.step(p, jnp.zeros(16), jnp.ones(4))
+    >>> h.shape, y.shape
+    ((16,), (1,))
     """
-    f = _activation_fn(activation)
-    w_c_t = params["W_c"].T
-    pre = u_w @ params["W_u"].T + params["b_h"]
 
-    def step(h, a):
-        if bp:
-            h = jax.lax.stop_gradient(h)
-        h = f(a + h @ w_c_t)
-        return h, h
+    activation: str = "tanh"
+    n_outputs: int = 1
 
-    h_end, hid = jax.lax.scan(step, h0s, pre)
-    return (hid @ params["W_o"].T + params["b_o"])[..., 0], h_end
+    def init(self, key, n_in, n_hidden, dtype=jnp.float32):
+        return init_params(key, n_in, n_hidden, self.n_outputs, dtype=dtype)
 
+    def step(self, params, h, x):
+        h = _activation_fn(self.activation)(params["W_u"] @ x + params["W_c"] @ h + params["b_h"])
+        return h, params["W_o"] @ h + params["b_o"]
 
-def _group(x, g, n_groups):
-    """Windows g, g + G, g + 2G, ... of a time-major (W, n_win, ...) array -> (W, n_win / G, ...)."""
-    x4 = x.reshape((x.shape[0], x.shape[1] // n_groups, n_groups) + x.shape[2:])
-    return jax.lax.dynamic_index_in_dim(x4, g, axis=2, keepdims=False)
+    def scan(self, params, h0, xs, *, stop_context_gradient=False):
+        f = _activation_fn(self.activation)
+        w_c_t = params["W_c"].T
+        pre = xs @ params["W_u"].T + params["b_h"]
 
+        def body(h, a):
+            if stop_context_gradient:
+                h = jax.lax.stop_gradient(h)
+            h = f(a + h @ w_c_t)
+            return h, h
 
-def _batch_loss(params, data, h0s, g, cfg):
-    """Loss of one interleaved group of training windows (the whole set when there is one group)."""
-    u_w, t_w, m_tr, _, _ = data
-    n_groups = cfg["groups"]
-    u, t, m = (_group(a, g, n_groups) for a in (u_w, t_w, m_tr))
-    h0 = h0s.reshape((h0s.shape[0] // n_groups, n_groups, h0s.shape[1]))[:, g]
-    out, _ = _window_pass(params, u, h0, cfg["activation"], cfg["training"] == "bp")
-    sse = jnp.sum((out - t) ** 2 * m)
-    return sse if cfg["loss"] == "sse" else sse / jnp.maximum(jnp.sum(m), 1.0)
-
-
-def _full_pass(params, data, h0s, cfg):
-    """Forward over every window: (training loss, validation loss, final state of each window)."""
-    u_w, t_w, m_tr, m_va, dyn = data
-    out, h_end = _window_pass(params, u_w, h0s, cfg["activation"], False)
-    err2 = (out - t_w) ** 2
-    sse_tr, sse_va = jnp.sum(err2 * m_tr), jnp.sum(err2 * m_va)
-    if cfg["loss"] == "mse":
-        sse_tr = sse_tr / dyn["n_tr"]
-        sse_va = sse_va / jnp.maximum(dyn["n_va"], 1.0)
-    return sse_tr, sse_va, h_end
-
-
-def _shift_context(h_end, h_first):
-    """Context entering window j is the state window j-1 ended with (previous pass)."""
-    return jax.lax.stop_gradient(jnp.concatenate([h_first[None, :], h_end[:-1]], axis=0))
-
-
-def _make_optimizer(cfg):
-    parts = []
-    if cfg["clip_norm"]:
-        parts.append(optax.clip_by_global_norm(cfg["clip_norm"]))
-    if cfg["weight_decay"] > 0:
-        parts.append(optax.adamw(cfg["lr"], weight_decay=cfg["weight_decay"]))
-    else:
-        parts.append(optax.adam(cfg["lr"]))
-    return optax.chain(*parts)
-
-
-def _init_opt_state(params, cfg):
-    if cfg["optimizer"] == "adam":
-        return _make_optimizer(cfg).init(params)
-    zeros = jax.tree_util.tree_map(jnp.zeros_like, params)
-    return {"lr": jnp.asarray(cfg["lr"], dtype=params["W_c"].dtype), "dX": zeros}
-
-
-def _epoch(carry, _, data, cfg):
-    """One epoch: one update per group of windows, then a full pass for the stopping rule."""
-    params0, opt0, h0s, best, best_val, best_epoch, wait, stopped, epoch = carry
-    dyn = data[4]
-    tmap = jax.tree_util.tree_map
-
-    if cfg["optimizer"] == "adam":
-        opt = _make_optimizer(cfg)
-
-        def update(c, g):
-            p, o = c
-            grads = jax.grad(_batch_loss)(p, data, h0s, g, cfg)
-            updates, o = opt.update(grads, o, p)
-            return (optax.apply_updates(p, updates), o), None
-
-        (params, opt_state), _ = jax.lax.scan(update, (params0, opt0), jnp.arange(cfg["groups"]))
-    else:  # MATLAB traingdx (one batch): momentum + adaptive lr, reject steps raising perf > 4 %
-        perf, grads = jax.value_and_grad(_batch_loss)(params0, data, h0s, 0, cfg)
-        lr = opt0["lr"]
-        g_desc = tmap(jnp.negative, grads)
-        dx_prev = tmap(lambda d, g: jnp.where(epoch == 0, lr * g, d), opt0["dX"], g_desc)
-        mc = TRAINGDX["mc"]
-        dx = tmap(lambda d, g: mc * d + (1.0 - mc) * lr * g, dx_prev, g_desc)
-        trial = tmap(jnp.add, params0, dx)
-        perf2 = _batch_loss(trial, data, h0s, 0, cfg)
-        accept = perf2 / perf <= TRAINGDX["max_perf_inc"]
-        lr_new = jnp.where(accept, jnp.where(perf2 < perf, lr * TRAINGDX["lr_inc"], lr), lr * TRAINGDX["lr_dec"])
-        dx_new = tmap(lambda d, g: jnp.where(accept, d, lr_new * g), dx, g_desc)
-        params = tmap(lambda t, p: jnp.where(accept, t, p), trial, params0)
-        opt_state = {"lr": lr_new.astype(lr.dtype), "dX": dx_new}
-
-    loss_tr, loss_va, h_end = _full_pass(params, data, h0s, cfg)
-    monitor = jnp.where(dyn["n_va"] > 0, loss_va, loss_tr)
-    active = jnp.logical_not(stopped)
-    threshold = jnp.where(jnp.isfinite(best_val), best_val * (1.0 - _IMPROVE_RTOL), jnp.inf)
-    improved = active & (monitor < threshold)
-    best = tmap(lambda b, p: jnp.where(improved, p, b), best, params)
-    best_val = jnp.where(improved, monitor, best_val)
-    best_epoch = jnp.where(improved, epoch, best_epoch)
-    wait = jnp.where(improved, 0, wait + active.astype(wait.dtype))
-    now_stopped = stopped | (wait >= dyn["patience"]) | (epoch + 1 >= dyn["epochs"])
-    # a stopped model is frozen, so results do not depend on how epochs are chunked or batched
-    params = tmap(lambda n, p: jnp.where(stopped, p, n), params, params0)
-    opt_state = tmap(lambda n, o: jnp.where(stopped, o, n), opt_state, opt0)
-    h0s = jnp.where(stopped, h0s, _shift_context(h_end, h0s[0]))
-    carry = (params, opt_state, h0s, best, best_val, best_epoch, wait, now_stopped, epoch + active.astype(epoch.dtype))
-    return carry, (loss_tr, monitor, active)
-
-
-@functools.lru_cache(maxsize=64)
-def _chunk_fn(cfg_items: tuple, batched: bool):
-    cfg = dict(cfg_items)
-
-    def run(carry, data):
-        return jax.lax.scan(lambda c, x: _epoch(c, x, data, cfg), carry, None, length=_CHUNK)
-
-    if batched:
-        run = jax.vmap(run, in_axes=(0, None))
-    return jax.jit(run)
+        h_end, hid = jax.lax.scan(body, h0, pre)
+        return h_end, hid @ params["W_o"].T + params["b_o"]
 
 
 @functools.partial(jax.jit, static_argnames=("activation",))
@@ -357,7 +280,6 @@ def _bucket(n: int) -> int:
     return max(64, 1 << (int(n) - 1).bit_length())
 
 
-@register_model
 class Elman(DriftModel):
     """Elman recurrent network as a one-step drift predictor (Tang et al. 2012, eq. (11)).
 
@@ -440,7 +362,7 @@ class Elman(DriftModel):
     """
 
     label = "Elman"
-    _grey_mode = None  # None: plain Elman; "latest" / "global": grey-Elman framings
+    uses_validation = True  # early stopping (and the best-epoch choice) on y_val or the held-out tail
 
     def __init__(self, *, lags=4, hidden=16, activation="tanh", loss="sse", training="bptt", optimizer=None,
                  learning_rate=None, epochs=2000, patience=100, val_fraction=0.2, window=64, batch_size=2048,
@@ -464,7 +386,8 @@ class Elman(DriftModel):
         self.progress = progress
 
     # -- validation -----------------------------------------------------------------------
-    def _validate(self) -> dict:
+    def _validate(self):
+        """Check every hyper-parameter; returns the validated :class:`TrainConfig`."""
         def integer(name, lo):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
@@ -477,34 +400,16 @@ class Elman(DriftModel):
                 raise ConfigError(f"{name} must be one of {options}; got {v!r}")
             return v
 
-        lags, hidden = integer("lags", 1), integer("hidden", 1)
-        epochs, patience = integer("epochs", 1), integer("patience", 1)
-        integer("seed", 0)
-        activation, loss = choice("activation", _ACTIVATIONS), choice("loss", _LOSSES)
-        training, dtype = choice("training", _TRAININGS), choice("dtype", _DTYPES)
-        optimizer = self.optimizer
-        if optimizer is None:
-            optimizer = "adam" if training == "bptt" else "traingdx"
-        elif optimizer not in _OPTIMIZERS:
-            raise ConfigError(f"optimizer must be one of {_OPTIMIZERS} or None; got {optimizer!r}")
-        lr = self.learning_rate
-        if lr is None:
-            lr = 1e-3 if optimizer == "adam" else 0.01
-        if not (isinstance(lr, (int, float)) and lr > 0 and math.isfinite(lr)):
-            raise ConfigError(f"learning_rate must be a positive number or None; got {self.learning_rate!r}")
+        integer("lags", 1), integer("hidden", 1), integer("seed", 0)
+        choice("activation", _ACTIVATIONS)
+        dtype = choice("dtype", _DTYPES)
+        config = train_config(loss=self.loss, training=self.training, optimizer=self.optimizer,
+                              learning_rate=self.learning_rate, epochs=self.epochs, patience=self.patience,
+                              window=self.window, batch_size=self.batch_size, clip_norm=self.clip_norm,
+                              weight_decay=self.weight_decay)
         vf = self.val_fraction
         if not (isinstance(vf, (int, float)) and 0.0 <= vf < 1.0):
             raise ConfigError(f"val_fraction must be in [0, 1); got {vf!r}")
-        if self.window is not None:
-            integer("window", 1)
-        if self.batch_size is not None:
-            integer("batch_size", 1)
-        cn = self.clip_norm
-        if cn is not None and not (isinstance(cn, (int, float)) and cn > 0):
-            raise ConfigError(f"clip_norm must be a positive number or None; got {cn!r}")
-        wd = self.weight_decay
-        if not (isinstance(wd, (int, float)) and wd >= 0):
-            raise ConfigError(f"weight_decay must be a number >= 0; got {wd!r}")
         if self.progress is not None and not callable(self.progress):
             raise ConfigError(f"progress must be callable or None; got {self.progress!r}")
         if dtype == "float64" and not jax.config.jax_enable_x64:
@@ -512,9 +417,10 @@ class Elman(DriftModel):
                 "dtype='float64' needs JAX 64-bit mode; set JAX_ENABLE_X64=1 or call "
                 "jax.config.update('jax_enable_x64', True) first, or use dtype='float32'"
             )
-        return {"lags": lags, "hidden": hidden, "epochs": epochs, "patience": patience, "activation": activation,
-                "loss": loss, "training": training, "optimizer": optimizer, "lr": float(lr),
-                "clip_norm": None if cn is None else float(cn), "weight_decay": float(wd)}
+        return config
+
+    def _cell(self) -> ElmanCell:
+        return ElmanCell(activation=self.activation)
 
     # -- data transforms ---------------------------------------------------------------------
     def _design(self, s: np.ndarray, x1_start: float = 0.0):
@@ -533,8 +439,12 @@ class Elman(DriftModel):
 
     # -- fitting ------------------------------------------------------------------------------
     def _prepare(self, y_train, y_val):
-        cfg = self._validate()
-        p = cfg["lags"]
+        """Validate, set the training-part statistics, and window the (input, target) rows.
+
+        Returns ``(TrainConfig, TrainingData, y_train as array)``.
+        """
+        config = self._validate()
+        p = int(self.lags)
         y = check_series(y_train, "y_train", min_length=p + 2)
         if y_val is None:
             n_va = int(round(self.val_fraction * y.size))
@@ -546,6 +456,7 @@ class Elman(DriftModel):
                 f"the training part has {s_fit.size} samples; lags={p} needs at least {p + 2}",
                 needed=p + 2, got=int(s_fit.size),
             )
+        # normalisation from the training part only (method notes §4.1, §5.1)
         self.x_mean_ = float(np.mean(s_fit))
         std = float(np.std(s_fit))
         if not std > 0:
@@ -554,52 +465,17 @@ class Elman(DriftModel):
         self.x_std_ = std
         self.n_train_ = int(s_fit.size)
         self._stats_extra(s_fit)
-        s_all = np.concatenate([s_fit, s_va])
-        u, t, _, _ = self._design(s_all)
-        n_rows = u.shape[0]
-        n_tr = s_fit.size - p
-        rows = np.arange(n_rows)
-        m_tr, m_va = (rows < n_tr).astype(np.float64), (rows >= n_tr).astype(np.float64)
-        win = n_rows if self.window is None else min(int(self.window), n_rows)
-        n_win = -(-n_rows // win)
-        if cfg["optimizer"] == "traingdx" or self.batch_size is None:
-            groups = 1
-        else:
-            groups = -(-n_win // max(1, int(self.batch_size) // win))
-        n_win = groups * -(-n_win // groups)  # whole groups; padding windows are masked out
-        pad = n_win * win - n_rows
-        cfg["groups"] = int(groups)
-        dt = jnp.dtype(self.dtype)
+        # one sequence: training rows, then validation rows whose lags reach back into the training part
+        u, t, _, _ = self._design(np.concatenate([s_fit, s_va]))
+        data = window_data(u, t, s_fit.size - p, config, dtype=self.dtype)
+        return config, data, y
 
-        def shape(a, fill=0.0):
-            a = np.concatenate([a, np.full((pad,) + a.shape[1:], fill)])
-            a = np.swapaxes(a.reshape((n_win, win) + a.shape[1:]), 0, 1)  # time-major (win, n_win, ...)
-            return jnp.asarray(np.ascontiguousarray(a), dtype=dt)
-
-        cfg.update(n_tr=int(n_tr), n_va=int(n_rows - n_tr), n_win=int(n_win))
-        dyn = {"n_tr": jnp.asarray(cfg["n_tr"], dt), "n_va": jnp.asarray(cfg["n_va"], dt),
-               "patience": jnp.asarray(cfg["patience"], jnp.int32), "epochs": jnp.asarray(cfg["epochs"], jnp.int32)}
-        data = (shape(u), shape(t), shape(m_tr), shape(m_va), dyn)
-        return cfg, data, y
-
-    def _init_carry(self, cfg, seed):
-        dt = jnp.dtype(self.dtype)
-        params = init_params(jax.random.key(int(seed)), cfg["lags"], cfg["hidden"], 1, dtype=dt)
-        h0s = jnp.zeros((cfg["n_win"], cfg["hidden"]), dtype=dt)
-        return (params, _init_opt_state(params, cfg), h0s, params, jnp.asarray(jnp.inf, dt),
-                jnp.asarray(0, jnp.int32), jnp.asarray(0, jnp.int32), jnp.asarray(False), jnp.asarray(0, jnp.int32))
-
-    @staticmethod
-    def _static_cfg(cfg):
-        keys = ("activation", "loss", "training", "optimizer", "lr", "clip_norm", "weight_decay", "groups")
-        return tuple((k, cfg[k]) for k in keys)
-
-    def _finish(self, cfg, best, curves, best_epoch, n_epochs, y_block):
-        self.params_ = {k: np.asarray(v) for k, v in best.items()}
-        self.loss_curve_ = np.asarray(curves[0][:n_epochs], dtype=np.float64)
-        self.val_curve_ = np.asarray(curves[1][:n_epochs], dtype=np.float64)
-        self.best_epoch_ = int(best_epoch)
-        self.n_epochs_ = int(n_epochs)
+    def _finish(self, result: TrainResult, y_block):
+        self.params_ = {k: np.asarray(v) for k, v in result.params.items()}
+        self.loss_curve_ = result.loss_curve
+        self.val_curve_ = result.val_curve
+        self.best_epoch_ = result.best_epoch
+        self.n_epochs_ = result.n_epochs
         self._set_start_state(y_block)
         return self
 
@@ -607,25 +483,12 @@ class Elman(DriftModel):
         """Train on ``y_train`` [deg/h], early-stopping on ``y_val`` (or the held-out tail).
 
         ``y_val`` must follow ``y_train`` immediately in time; its lags reach back into
-        ``y_train``. Returns ``self``.
+        ``y_train``. The z-score statistics come from ``y_train`` (hold-out excluded) only.
+        Returns ``self``.
         """
-        cfg, data, y = self._prepare(y_train, y_val)
-        fn = _chunk_fn(self._static_cfg(cfg), False)
-        carry = self._init_carry(cfg, self.seed)
-        tr_curve, va_curve = [], []
-        while True:
-            carry, (tr, va, active) = fn(carry, data)
-            active = np.asarray(active)
-            n_new = int(active.sum())
-            tr, va = np.asarray(tr)[:n_new], np.asarray(va)[:n_new]
-            if self.progress is not None:
-                for i in range(n_new):
-                    self.progress(len(tr_curve) + i + 1, cfg["epochs"], float(tr[i]), float(va[i]))
-            tr_curve.extend(tr.tolist())
-            va_curve.extend(va.tolist())
-            if bool(carry[7]):
-                break
-        return self._finish(cfg, carry[3], (tr_curve, va_curve), int(carry[5]), len(tr_curve), y)
+        config, data, y = self._prepare(y_train, y_val)
+        result = fit_recurrent(self._cell(), int(self.hidden), config, data, seed=self.seed, progress=self.progress)
+        return self._finish(result, y)
 
     # -- prediction ----------------------------------------------------------------------------
     def _params_j(self):
@@ -738,7 +601,6 @@ class Elman(DriftModel):
             setattr(self, key, np.asarray(arrays[key]))
 
 
-@register_model
 class GreyElman(Elman):
     """Grey Elman network: AGO of the drift -> Elman on AGO values -> IAGO (Tang et al. 2012, §5).
 
@@ -860,35 +722,13 @@ def fit_many(model, y_train, y_val=None, *, seeds):
         raise ConfigError("seeds must hold at least one seed; got an empty sequence")
     models = [type(model)(**{**model.get_params(), "seed": s}) for s in seeds]
     base = models[0]
-    cfg, data, y = base._prepare(y_train, y_val)
+    config, data, y = base._prepare(y_train, y_val)
     for m in models[1:]:
         m._validate()
         for key in ("x_mean_", "x_std_", "n_train_", "x1_mean_", "x1_std_"):
             if hasattr(base, key):
                 setattr(m, key, getattr(base, key))
-    carries = [base._init_carry(cfg, s) for s in seeds]
-    carry = jax.tree_util.tree_map(lambda *xs: jnp.stack(xs), *carries)
-    fn = _chunk_fn(base._static_cfg(cfg), True)
-    tr_all, va_all, act_all = [], [], []
-    done = 0
-    while True:
-        carry, (tr, va, active) = fn(carry, data)
-        tr, va, active = np.asarray(tr), np.asarray(va), np.asarray(active)
-        tr_all.append(tr)
-        va_all.append(va)
-        act_all.append(active)
-        if model.progress is not None:
-            for i in range(tr.shape[1]):
-                live = active[:, i]
-                if live.any():
-                    done += 1
-                    model.progress(done, cfg["epochs"], float(tr[live, i].mean()), float(va[live, i].mean()))
-        if bool(np.all(np.asarray(carry[7]))):
-            break
-    tr_all, va_all = np.concatenate(tr_all, axis=1), np.concatenate(va_all, axis=1)
-    act_all = np.concatenate(act_all, axis=1)
-    for j, m in enumerate(models):
-        n_ep = int(act_all[j].sum())
-        best = {k: v[j] for k, v in carry[3].items()}
-        m._finish(cfg, best, (tr_all[j], va_all[j]), int(carry[5][j]), n_ep, y)
+    results = fit_recurrent_many(base._cell(), int(base.hidden), config, data, seeds=seeds, progress=model.progress)
+    for m, result in zip(models, results):
+        m._finish(result, y)
     return models

@@ -25,8 +25,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
-from .models import DriftModel, check_series, register_model
+from .._util import check_series
+from ..errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
+from .base import DriftModel
 
 __all__ = [
     "ago",
@@ -527,7 +528,6 @@ def auto_shift(y_train, *, margin: float = 1.0) -> float:
 _MODES = ("rolling", "whole")
 
 
-@register_model
 class GM11(DriftModel):
     """GM(1,1) drift model with a recorded, training-only shift.
 
