@@ -88,7 +88,14 @@ def test_describe_models_lists_every_row_in_order():
     assert [line.split(":")[0] for line in lines] == list(MODEL_NAMES)
 
 
-def test_unknown_class_attribute():
+def test_old_module_paths_are_aliases():
+    import fogdrift.baselines
+    import fogdrift.grey
+    import fogdrift.models.ar
+    import fogdrift.models.grey
+
+    assert fogdrift.grey.GM11 is fogdrift.models.grey.GM11 and fogdrift.grey.gm11_fit is fogdrift.models.grey.gm11_fit
+    assert fogdrift.baselines.AR is fogdrift.models.ar.AR
     with pytest.raises(AttributeError):
         models.NoSuchModel  # noqa: B018
 
