@@ -104,10 +104,10 @@ def model_spec(name: str) -> ModelSpec:
     --------
     >>> model_spec("GM11").cls
     'GM11'
-    >>> model_spec("lstm")
+    >>> model_spec("lstm")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    fogdrift.errors.ConfigError: unknown drift model 'lstm'; pass models= as a subset of grey-elman, elman, gm11, ar, persistence
+    fogdrift.errors.ConfigError: unknown drift model 'lstm'; pass models= as a subset of grey-elman, elman, gm11, ...
     """
     key = name.strip().lower() if isinstance(name, str) else None
     for spec in MODELS:
@@ -174,8 +174,8 @@ def describe_models() -> str:
 
     Examples
     --------
-    >>> print(describe_models().splitlines()[-1])
-    persistence: repeat the last value (the baseline every table shows)
+    >>> print(describe_models().splitlines()[0])
+    grey-elman: Elman network on the AGO of the drift, restored by IAGO (Tang et al. 2012)
     """
     return "\n".join(f"{spec.name}: {spec.description}" for spec in MODELS)
 
