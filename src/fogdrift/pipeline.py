@@ -35,6 +35,8 @@ import numpy as np
 
 from .errors import ConfigError, FogdriftWarning, InsufficientDataError
 from .io import file_sha256
+from .models import MODEL_NAMES  # registry order = report order
+from .models import build_model as make_model  # make_model(name, cfg, progress=None), old name kept for now
 
 __all__ = [
     "AnalysisConfig",
@@ -51,9 +53,6 @@ __all__ = [
     "run_models",
     "run_analysis",
 ]
-
-#: CLI/model names accepted in ``AnalysisConfig.models``, in report order.
-MODEL_NAMES = ("grey-elman", "elman", "gm11", "ar", "persistence")
 
 
 @dataclass
@@ -354,34 +353,6 @@ def _model_record(record, cfg: AnalysisConfig):
     nearest valid rates; the averaged record's metadata state the effective rate and the factor.
     """
     return record if cfg.model_rate_hz is None else record.to_rate(cfg.model_rate_hz)
-
-
-def make_model(name: str, cfg: AnalysisConfig, progress=None):
-    """Construct an unfitted drift model from its CLI name and the config's hyper-parameters."""
-    if name == "persistence":
-        from .models import Persistence
-
-        return Persistence()
-    if name == "ar":
-        from .baselines import AR
-
-        return AR(order=cfg.lags)
-    if name == "gm11":
-        from .grey import GM11
-
-        return GM11(mode="rolling", window=cfg.gm_window)
-    from .elman import Elman, GreyElman
-
-    cls = GreyElman if name == "grey-elman" else Elman
-    return cls(
-        lags=cfg.lags,
-        hidden=cfg.hidden,
-        activation=cfg.activation,
-        training=cfg.training,
-        epochs=cfg.epochs,
-        seed=cfg.seed,
-        progress=progress,
-    )
 
 
 def _separate(x, cfg: AnalysisConfig, dt_s):
