@@ -124,15 +124,23 @@ class AnalysisConfig:
             raise ConfigError(
                 f"train_fraction + val_fraction must leave a test block; got {self.train_fraction + self.val_fraction:.3g} >= 1"
             )
-        unknown = [m for m in self.models if m not in MODEL_NAMES]
-        if unknown:
-            raise ConfigError(f"unknown model(s) {unknown}; expected a subset of {list(MODEL_NAMES)}")
+        from .models import model_spec
+
+        if not self.models:
+            raise ConfigError(f"no drift model given; pass {{opt:models}} with one or more of {list(MODEL_NAMES)}")
+        # canonical registry names (any case accepted); an unknown name is an error, never a fallback
+        self.models = tuple(dict.fromkeys(model_spec(m).name for m in self.models))
         if self.model_rate_hz is not None and not self.model_rate_hz > 0:
             raise ConfigError(f"model_rate_hz must be > 0 Hz or None; got {self.model_rate_hz!r}")
         if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
             raise ConfigError(f"lags, hidden and epochs must be >= 1; got {self.lags}, {self.hidden}, {self.epochs}")
         if not self.causal_window_s > 0:
             raise ConfigError(f"causal_window_s must be > 0 s; got {self.causal_window_s!r}")
+        if self.latitude_deg is not None and not -90.0 <= float(self.latitude_deg) <= 90.0:
+            raise ConfigError(f"latitude must be in [-90, 90] deg; got {self.latitude_deg!r} (option {{opt:latitude_deg}})")
+        if self.latitude_deg is not None and not self.earth_axes:
+            raise ConfigError("a latitude was given without the axis it applies to; pass {opt:earth_axes} AXIS=up|down|"
+                              "north|south|east|west (the Earth-rate component depends on the axis orientation)")
         return self
 
     def to_dict(self) -> dict:

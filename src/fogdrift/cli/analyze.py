@@ -11,7 +11,7 @@ from ..errors import ConfigError
 from ._app import (EstOpt, FitTausOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, console,
                    csv_list, errors, parse_fit_taus, parse_level, parse_taus, progress, with_load_options)
 from ._tables import metrics_table, noise_table
-from .model import EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt
+from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt
 
 
 @app.command()
@@ -24,7 +24,7 @@ def analyze(
         "--earth-axis", help="AXIS=ORIENTATION (up, down, north, south, east, west), repeatable.")] = None,
     apply_to: Annotated[Optional[Path], typer.Option("--apply-to", help="Second recording: apply the fitted "
                                                      "models unchanged to it.")] = None,
-    models: ModelsOpt = "grey-elman,elman,gm11,ar,persistence",
+    models: ModelsOpt = ALL_MODELS,
     hidden: HiddenOpt = 16,
     lags: LagsOpt = 4,
     epochs: EpochsOpt = 2000,

@@ -11,7 +11,12 @@ from ._app import (LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app, con
                    parse_level, progress, with_load_options)
 from ._tables import metrics_table
 
-ModelsOpt = Annotated[str, typer.Option("--models", help="Comma-separated: grey-elman, elman, gm11, ar, persistence.")]
+from ..models import MODEL_NAMES, describe_models
+
+#: Default of --models: every registered model, in report order.
+ALL_MODELS = ",".join(MODEL_NAMES)
+ModelsOpt = Annotated[str, typer.Option(
+    "--models", help="Comma-separated drift models (any case): " + "; ".join(describe_models()) + ".")]
 HiddenOpt = Annotated[int, typer.Option("--hidden", help="Elman hidden units.")]
 LagsOpt = Annotated[int, typer.Option("--lags", help="Input lags p of Elman/grey-Elman, order of AR.")]
 EpochsOpt = Annotated[int, typer.Option("--epochs", help="Maximum training epochs (early stopping on validation).")]
@@ -23,7 +28,7 @@ TrainingOpt = Annotated[str, typer.Option("--training", help="bptt (Adam) or bp 
 @with_load_options
 def model(
     load,
-    models: ModelsOpt = "grey-elman,elman,gm11,ar,persistence",
+    models: ModelsOpt = ALL_MODELS,
     hidden: HiddenOpt = 16,
     lags: LagsOpt = 4,
     epochs: EpochsOpt = 2000,
