@@ -53,17 +53,23 @@ def test_conversion_rejects_bad_A(bad):
 
 
 # --- exact curves -----------------------------------------------------------------------
+def _curve(var, tau_s, edf=1e5, statistic="adev", dt_s=None):
+    """An AllanResult holding a given (exact) variance curve."""
+    tau_s = np.asarray(tau_s, float)
+    dev = np.sqrt(var)
+    e = np.broadcast_to(np.asarray(edf, float), tau_s.shape).copy()
+    return AllanResult(
+        tau_s=tau_s, m=np.arange(1, tau_s.size + 1), var_dph2=np.asarray(var, float), dev_dph=dev,
+        n_terms=np.full(tau_s.size, 10**6), edf=e, dev_lo68_dph=dev, dev_hi68_dph=dev,
+        dev_lo95_dph=dev, dev_hi95_dph=dev, noise_alpha=np.zeros(tau_s.size, int),
+        estimator="overlapping", edf_rule="test", dt_s=float(tau_s[0]) if dt_s is None else dt_s,
+        n_samples=10**6, statistic=statistic,
+    )
+
+
 def _exact_allan(A, tau_s, edf=1e5):
     tau_s = np.asarray(tau_s, float)
-    avar = sum(a * tau_s**p for a, p in zip(A, range(-2, 3)))
-    adev = np.sqrt(avar)
-    e = np.full(tau_s.size, edf)
-    return AllanResult(
-        tau_s=tau_s, m=np.arange(1, tau_s.size + 1), avar_dph2=avar, adev_dph=adev,
-        n_terms=np.full(tau_s.size, 10**6), edf=e, adev_lo68_dph=adev, adev_hi68_dph=adev,
-        adev_lo95_dph=adev, adev_hi95_dph=adev, noise_alpha=np.zeros(tau_s.size, int),
-        estimator="overlapping", edf_rule="test", dt_s=float(tau_s[0]), n_samples=10**6,
-    )
+    return _curve(sum(a * tau_s**p for a, p in zip(A, range(-2, 3))), tau_s, edf)
 
 
 @pytest.mark.parametrize("method", ["wls-nnls", "log"])
