@@ -27,7 +27,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.stats import chi2
 
 from fogdrift.allan import P68, allan_variance, chi2_bounds, edf_greenhall, edf_simple
-from fogdrift.allan.ci import greenhall_constants
+from fogdrift.allan.ci import GREENHALL_AB, greenhall_constants
 from fogdrift.errors import ConfigError, InsufficientDataError
 
 
@@ -153,6 +153,13 @@ def test_greenhall_constants_reproduce_published_tables(modified, table):
             a0, a1 = greenhall_constants(alpha, d, modified)
             assert a0 == pytest.approx(published[0], rel=3e-3, abs=1e-3), (alpha, d)
             assert a1 == pytest.approx(published[1], rel=3e-3, abs=1e-3), (alpha, d)
+
+
+def test_tabulated_constants_are_the_quadrature():
+    assert len(GREENHALL_AB) == 23
+    for (alpha, d, modified), (a0, a1) in GREENHALL_AB.items():
+        q0, q1 = greenhall_constants(alpha, d, modified)
+        assert a0 == pytest.approx(q0, rel=1e-10) and a1 == pytest.approx(q1, rel=1e-10)
 
 
 def test_greenhall_table3_flicker_pm_normalisation():

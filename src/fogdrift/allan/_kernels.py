@@ -146,25 +146,22 @@ def _diff3_py(p, ms, strides, block):  # pragma: no cover - runs compiled
     return part
 
 
-def _window2_py(p, m, min_block):  # pragma: no cover - runs compiled
-    """Per-block sums of S_k^2, S_k = W[k] - 2 W[k+m] + W[k+2m] with W[k] = sum_{i=k}^{k+m-1} p[i],
-    over every start index k = 0 .. len(p) - 3m; one m per call.
+def _window2_py(p, item_m, item_k0, item_k1):  # pragma: no cover - runs compiled
+    """Per-item sums of S_k^2, S_k = W[k] - 2 W[k+m] + W[k+2m] with W[k] = sum_{i=k}^{k+m-1} p[i],
+    over start indices k0 <= k < k1 of each work item (m, k0, k1).
 
-    Operator (1, -2, 1) on m-point window sums (modified Allan).  Each block of start indices (at
-    least ``min_block`` and at least 4 m long) computes its first S directly from its first phase
-    point as reference (3 m additions; the operator sums to zero, so the reference cancels) and
-    then steps S_{k+1} = S_k + (p[k+3m] - 3 p[k+2m] + 3 p[k+m] - p[k]): the increment is the
-    third difference of p, so the running value carries rounding of its own size only.
-    O(len(p)) work per m.
+    Operator (1, -2, 1) on m-point window sums (modified Allan).  The items (blocks of start
+    indices of every tau) run in parallel in one region.  Each computes its first S directly from
+    its first phase point as reference (3 m additions; the operator sums to zero, so the reference
+    cancels) and then steps S_{k+1} = S_k + (p[k+3m] - 3 p[k+2m] + 3 p[k+m] - p[k]): the increment
+    is the third difference of p, so the running value carries rounding of its own size only.
     """
-    n_phase = p.size
-    n_terms = n_phase - 3 * m + 1
-    block = max(min_block, 4 * m)
-    nblocks = (n_terms + block - 1) // block
-    part = np.zeros(nblocks)
-    for ib in prange(nblocks):
-        k0 = ib * block
-        k1 = min(n_terms, k0 + block)
+    nitems = item_m.size
+    part = np.zeros(nitems)
+    for it in prange(nitems):
+        m = item_m[it]
+        k0 = item_k0[it]
+        k1 = item_k1[it]
         ref = p[k0]
         w0 = 0.0
         w1 = 0.0
@@ -182,8 +179,22 @@ def _window2_py(p, m, min_block):  # pragma: no cover - runs compiled
         for k in range(a.size):
             s += (d[k] - a[k]) + 3.0 * (b[k] - c[k])
             acc += s * s
-        part[ib] = acc
+        part[it] = acc
     return part
+
+
+def _window_items(n_phase: int, m: np.ndarray, min_block: int):
+    """Work items (m, k0, k1) of the window kernel: blocks of max(min_block, 4 m) start indices."""
+    ims, k0s, k1s, owner = [], [], [], []
+    for j, mm in enumerate(np.asarray(m, dtype=np.int64)):
+        n_terms = n_phase - 3 * int(mm) + 1
+        block = max(min_block, 4 * int(mm))
+        starts = np.arange(0, n_terms, block, dtype=np.int64)
+        ims.append(np.full(starts.size, mm, dtype=np.int64))
+        k0s.append(starts)
+        k1s.append(np.minimum(starts + block, n_terms))
+        owner.append(np.full(starts.size, j, dtype=np.int64))
+    return np.concatenate(ims), np.concatenate(k0s), np.concatenate(k1s), np.concatenate(owner)
 
 
 def _compiled():
@@ -238,5 +249,7 @@ def operator_sums(p: np.ndarray, m: np.ndarray, strides: np.ndarray, coefficient
     if window:
         if np.any(strides != 1):
             raise ValueError("the window kernel runs over every start index (stride 1)")
-        return np.array([kern(p, int(mm), WINDOW_BLOCK).sum() for mm in m], dtype=np.float64)
+        item_m, k0, k1, owner = _window_items(p.size, m, WINDOW_BLOCK)
+        part = kern(p, item_m, k0, k1)
+        return np.array([part[owner == j].sum() for j in range(np.asarray(m).size)], dtype=np.float64)
     return kern(p, m, strides, BLOCK).sum(axis=0)

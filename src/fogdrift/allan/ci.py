@@ -10,8 +10,9 @@ Kept apart, as in allantools' ``ci.py``:
   closed formula for the Hadamard or modified Allan EDF; it refers to this algorithm
   (Sec. 5.3), which is what Stable32 and allantools implement.  fogdrift implements it from the
   paper's equations (7)-(10) and (13); the asymptotic constants of its Tables 1-3 are
-  *computed* here (by quadrature and in closed form, :func:`greenhall_constants`) and checked
-  against the published, rounded table values in the tests.  For white PM (alpha = +2) of the
+  *computed* here (by quadrature and in closed form, :func:`greenhall_constants`, stored to 12
+  digits in :data:`GREENHALL_AB`) and checked against the published, rounded table values in
+  the tests.  For white PM (alpha = +2) of the
   unmodified variances the basic sum has only d non-zero lags and is summed exactly for every
   record length (the paper's closed form holds when ``ceil(M/S) > d``; the exact sum also
   covers the short records it leaves out);
@@ -34,6 +35,7 @@ from __future__ import annotations
 import math
 import warnings
 from functools import lru_cache
+from types import MappingProxyType
 
 import numpy as np
 
@@ -43,6 +45,7 @@ __all__ = [
     "edf_simple",
     "edf_greenhall",
     "greenhall_constants",
+    "GREENHALL_AB",
     "chi2_bounds",
     "resolve_alpha",
     "alpha_from_slope",
@@ -253,6 +256,44 @@ def greenhall_constants(alpha: int, d: int, modified: bool) -> tuple[float, floa
     return 2.0 * i0 / norm, 2.0 * i1 / norm
 
 
+#: (a0, a1) of :func:`greenhall_constants` for every (alpha, d, modified) the algorithm needs,
+#: computed once by that function (12 digits; ``test_allan_ci`` recomputes them by quadrature
+#: and compares them with the published, rounded Tables 1-2).  Data, so that an EDF does not
+#: pay ~0.3 s of quadrature per noise type.
+GREENHALL_AB = MappingProxyType({
+    (2, 1, True): (0.666666666667, 0.333333333333),
+    (1, 1, True): (0.839609844672, 0.345378900016),
+    (0, 1, True): (1.07857142857, 0.367857142857),
+    (2, 2, True): (0.777777777778, 0.5),
+    (1, 2, True): (0.996652190045, 0.615594030578),
+    (0, 2, True): (1.03333333333, 0.607142857143),
+    (-1, 2, True): (1.04759308687, 0.533911715442),
+    (-2, 2, True): (1.30223327331, 0.535499624343),
+    (2, 3, True): (0.88, 0.666666666667),
+    (1, 3, True): (1.14099936692, 0.842805644798),
+    (0, 3, True): (1.18392857143, 0.848214285714),
+    (-1, 3, True): (1.18023979145, 0.815800254393),
+    (-2, 3, True): (1.17511904762, 0.777398989899),
+    (1, 1, False): (78.5635344306, 25.1708556546),
+    (0, 1, False): (0.666666666667, 0.166666666667),
+    (1, 2, False): (789.530796012, 410.428653196),
+    (0, 2, False): (0.666666666667, 0.333333333333),
+    (-1, 2, False): (0.852204147712, 0.374732175732),
+    (-2, 2, False): (1.07857142857, 0.367857142857),
+    (1, 3, False): (9948.55100075, 6520.10025389),
+    (0, 3, False): (0.777777777778, 0.5),
+    (-1, 3, False): (0.996997298895, 0.616716835822),
+    (-2, 3, False): (1.03333333333, 0.607142857143),
+})
+
+
+def _constants(alpha: int, d: int, modified: bool) -> tuple[float, float]:
+    try:
+        return GREENHALL_AB[(alpha, d, modified)]
+    except KeyError:  # pragma: no cover - every valid combination is tabulated
+        return greenhall_constants(alpha, d, modified)
+
+
 def _table3(d: int) -> tuple[float, float]:
     """[GR2003]_ Table 3: sz(0, m, +1, d) = b0 + b1 ln m + O(1/m^2) for flicker PM.
 
@@ -360,7 +401,7 @@ def edf_greenhall(alpha, d, m, n_phase, *, overlapping=True, modified=False) -> 
         if J <= _JMAX:
             return M * float(_sz(0.0, 1.0, a, d)) ** 2 / _basic_sum(J, M, S, 1.0, a, d)
         if r > d + 1:
-            a0, a1 = greenhall_constants(a, d, True)
+            a0, a1 = _constants(a, d, True)
             return 1.0 / ((a0 - a1 / r) / r)
         return _JMAX * float(_sz(0.0, 1.0, a, d)) ** 2 / _basic_sum(_JMAX, _JMAX, _JMAX / r, 1.0, a, d)
 
@@ -369,7 +410,7 @@ def edf_greenhall(alpha, d, m, n_phase, *, overlapping=True, modified=False) -> 
             Fp = float(mm) if mm * (d + 1) <= _JMAX else math.inf
             return M * float(_sz(0.0, Fp, a, d)) ** 2 / _basic_sum(J, M, S, Fp, a, d)
         if r > d + 1:
-            a0, a1 = greenhall_constants(a, d, False)
+            a0, a1 = _constants(a, d, False)
             return 1.0 / ((a0 - a1 / r) / r)
         return _JMAX * float(_sz(0.0, math.inf, a, d)) ** 2 / _basic_sum(_JMAX, _JMAX, _JMAX / r, math.inf, a, d)
 
@@ -379,7 +420,7 @@ def edf_greenhall(alpha, d, m, n_phase, *, overlapping=True, modified=False) -> 
     b0, b1 = _table3(d)
     norm = (b0 + b1 * math.log(mm)) ** 2
     if r > d + 1:
-        a0, a1 = greenhall_constants(1, d, False)
+        a0, a1 = _constants(1, d, False)
         return norm * r / (a0 - a1 / r)
     mp = _JMAX / r
     return norm * _JMAX / _basic_sum(_JMAX, _JMAX, mp, mp, 1, d)

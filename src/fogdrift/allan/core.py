@@ -136,7 +136,8 @@ def allan_variance(
       non-overlapping ([SP1065]_ eqs. 17-18): ``sum_j (ybar_{j+2} - 2 ybar_{j+1} + ybar_j)^2 / (6 (K - 2))``.
     * Modified Allan ([SP1065]_ eq. 14)::
 
-        mod sigma^2(tau) = 1 / (2 m^2 tau^2 (N - 3m + 2)) * sum_{j=0}^{N-3m+1} ( sum_{i=j}^{j+m-1} p_{i+2m} - 2 p_{i+m} + p_i )^2
+        mod sigma^2(tau) = 1 / (2 m^2 tau^2 (N - 3m + 2))
+                           * sum_{j=0}^{N-3m+1} ( sum_{i=j}^{j+m-1} p_{i+2m} - 2 p_{i+m} + p_i )^2
 
     EDF: Allan -- :func:`~fogdrift.allan.edf_simple` with ``n_phase = N + 1`` (overlapping),
     with the ``K + 1`` cluster-mean phase points and m = 1 (non-overlapping, i.e. the
