@@ -5,19 +5,20 @@ deviations, the compiled operators against a plain evaluation of the statistics 
 numerical robustness against a large offset, EDF/bounds, the fast estimator and validation.
 (EDF formulas in detail: ``test_allan_ci.py``.)
 
-NBS14 reference values (Riley's test suite for frequency-stability software):
+NBS14 reference values (Riley's test suite for frequency-stability software; the numbers were
+taken from the NBS14 tables of NIST SP 1065 (pp. 107-108) and of W. J. Riley, "The Calculation
+of Time Domain Frequency Stability" (Tables II and III), as quoted in the test suites of
+allantools and allantoolkit -- the documents themselves were not available to this project):
 
 * 10-point frequency set (R17): ADEV and overlapping ADEV (method notes R17); MDEV 91.22945,
-  74.78849 and overlapping HDEV 70.80607, 85.61487 at tau = 1, 2 (NIST SP 1065, Sec. 12,
-  table of the 10-point results, as reproduced by Stable32/allantools); non-overlapping HDEV
-  70.80608, 116.7980 (W. J. Riley, "The Calculation of Time Domain Frequency Stability",
-  Table II).
+  74.78849 and overlapping HDEV 70.80607, 85.61487 at tau = 1, 2 (SP 1065); non-overlapping
+  HDEV 70.80608, 116.7980 (Riley, Table II).
 * 1000-point set (generator n_{i+1} = 16807 n_i mod 2147483647, n_0 = 1234567890, value
   n_i / 2147483647): at tau = 1, 10, 100 ADEV 2.922319e-01, 9.965736e-02, 3.897804e-02;
   overlapping ADEV ..., 9.159953e-02, 3.241343e-02; MDEV ..., 6.172376e-02, 2.170921e-02;
-  overlapping HDEV 2.943883e-01, 9.581083e-02, 3.237638e-02 (SP 1065, table of the
-  1000-point results); non-overlapping HDEV ..., 1.052754e-01, 3.910860e-02 (Riley,
-  Table III).  All published to 7 significant digits, so compared at 1e-6 relative.
+  overlapping HDEV 2.943883e-01, 9.581083e-02, 3.237638e-02 (SP 1065); non-overlapping HDEV
+  ..., 1.052754e-01, 3.910860e-02 (Riley, Table III).  All published to 7 significant
+  digits, so compared at 1e-6 relative.
 """
 
 from __future__ import annotations

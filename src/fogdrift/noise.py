@@ -412,8 +412,8 @@ def fit_noise(
     allan : AllanResult
         From :func:`fogdrift.allan.allan_variance`: any statistic (``adev``, ``hdev``, ``mdev``);
         its ``statistic`` field selects the laws (:data:`VARIANCE_LAWS`), its ``edf`` the
-        weights.  Any object with ``statistic``, ``tau_s``, ``var_dph2``, ``dev_dph``, ``edf``
-        and ``dt_s`` will do.
+        weights.  Any object with ``statistic``, ``tau_s``, ``var_dph2``, ``edf`` and ``dt_s``
+        will do.
     terms : sequence of str or None, keyword-only
         Terms to fit, a subset of ``("Q", "N", "B", "K", "R")``; None (default): every term the
         statistic can estimate (:func:`default_terms`: all five, or Q, N, B, K for ``hdev``).

@@ -6,16 +6,19 @@ Kept apart, as in allantools' ``ci.py``:
   the overlapping Allan variance (used for ``statistic="adev"``);
 * :func:`edf_greenhall` -- the general EDF algorithm of Greenhall & Riley [GR2003]_ for
   variances built from d-th differences of phase: the Allan (d = 2), Hadamard (d = 3) and
-  modified Allan (d = 2, ``modified=True``) variances, overlapping or not.  [SP1065]_ gives no
-  closed formula for the Hadamard or modified Allan EDF; it refers to this algorithm
-  (Sec. 5.3), which is what Stable32 and allantools implement.  fogdrift implements it from the
-  paper's equations (7)-(10) and (13); the asymptotic constants of its Tables 1-3 are
-  *computed* here (by quadrature and in closed form, :func:`greenhall_constants`, stored to 12
-  digits in :data:`GREENHALL_AB`) and checked against the published, rounded table values in
-  the tests.  For white PM (alpha = +2) of the
-  unmodified variances the basic sum has only d non-zero lags and is summed exactly for every
-  record length (the paper's closed form holds when ``ceil(M/S) > d``; the exact sum also
-  covers the short records it leaves out);
+  modified Allan (d = 2, ``modified=True``) variances, overlapping or not.  Table 5 of
+  [SP1065]_ covers the overlapping Allan variance only; for the Hadamard and modified Allan
+  variances fogdrift uses this algorithm, as Stable32 and allantools do (no simpler published
+  formula was found for them; the text of SP 1065 itself was not available to check further).
+  It is implemented from the paper's equations (7)-(10) and (13), not an approximation of
+  them; the asymptotic constants of its Tables 1-3 are *computed* here (by quadrature and in
+  closed form, :func:`greenhall_constants`, stored to 12 digits in :data:`GREENHALL_AB`) and
+  checked against the published, rounded table values in the tests.  For white PM
+  (alpha = +2) of the unmodified variances the basic sum has only d non-zero lags and is
+  summed exactly for every record length (the paper's closed form holds when
+  ``ceil(M/S) > d``; the exact sum also covers the short records it leaves out).  Note that
+  the algorithm models continuous-time noise: for white FM at small m and few terms its EDF
+  differs from that of i.i.d. rate samples (e.g. 14.3 instead of 12.2 at N = 20, m = 1);
 * :func:`chi2_bounds` -- ``[var edf / chi2_{1-q/2}(edf), var edf / chi2_{q/2}(edf)]``,
   [SP1065]_ Sec. 5.3 (eqs. 44-45);
 * :func:`resolve_alpha` -- the power-law alpha assumed at each tau (given, from the local

@@ -169,7 +169,7 @@ STATISTICS = MappingProxyType(
             edf_method="greenhall",
             dev_slopes=_SLOPES_UNMODIFIED,
             equation="SP 1065 eqs. 17-18 (non-overlapping, p. 20) and 20 (overlapping, p. 21)",
-            edf_source="Greenhall & Riley (2003) with d = 3 (SP 1065 Sec. 5.3 gives no simple formula)",
+            edf_source="Greenhall & Riley (2003) with d = 3 (SP 1065 Table 5 covers the Allan variance only)",
         ),
         "mdev": Statistic(
             name="mdev",
@@ -182,7 +182,7 @@ STATISTICS = MappingProxyType(
             edf_method="greenhall",
             dev_slopes=_SLOPES_MODIFIED,
             equation="SP 1065 eq. 14 (p. 17)",
-            edf_source="Greenhall & Riley (2003) with d = 2, modified (SP 1065 Sec. 5.3 gives no simple formula)",
+            edf_source="Greenhall & Riley (2003) with d = 2, modified (SP 1065 Table 5 covers the Allan variance only)",
         ),
     }
 )
