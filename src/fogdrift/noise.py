@@ -1,16 +1,26 @@
-"""IEEE-952 noise identification from an Allan variance curve.
+"""IEEE-952 noise identification from an Allan-family curve (Allan, Hadamard, modified Allan).
 
-The model (IEEE Std 952-1997 Annex C; method notes 2.2-2.5), sigma in deg/h and tau in s::
+The model (IEEE Std 952-1997 Annex C; method notes 2.2-2.5), sigma in deg/h and tau in s: the
+five terms are independent, so their variances add,
 
-    sigma^2(tau) = A_-2 tau^-2 + A_-1 tau^-1 + A_0 + A_1 tau + A_2 tau^2
-    A_-2 = 3 Q^2,  A_-1 = N^2,  A_0 = (2 ln2 / pi) B^2,  A_1 = K^2 / 3,  A_2 = R^2 / 2
+    sigma^2(tau) = sum_n A_n g_n(tau),   e.g. for the Allan variance
+    A_Q tau^-2 + A_N tau^-1 + A_B + A_K tau + A_R tau^2,
+    A_Q = 3 Q^2,  A_N = N^2,  A_B = (2 ln2 / pi) B^2,  A_K = K^2 / 3,  A_R = R^2 / 2
 
-is fitted with non-negative coefficients by relative-error weighted least squares
+(Q, N, B, K, R in the Allan-law units: (deg/h) s, (deg/h) sqrt(s), deg/h, (deg/h)/sqrt(s),
+(deg/h)/s).  :data:`TERM_TABLE` holds the statistic-independent facts of each term (name,
+units, header, the conversion to the reported unit, its Allan law); :data:`VARIANCE_LAWS`
+holds each statistic's law ``g_n`` and constant (the Hadamard and modified Allan variances
+weight the terms differently, and the Hadamard variance cannot see a rate ramp at all).  Both
+live in :mod:`fogdrift.noise_terms` and are re-exported here.  :func:`fit_noise` reads the law
+table of the result's ``statistic``.
+
+The curve is fitted with non-negative coefficients by relative-error weighted least squares
 (weights ``edf/2``, i.e. each residual divided by its standard deviation
 ``sigma_model^2 sqrt(2/edf)``), iterated with the model in the denominator (IRLS).
-Coefficients are then converted to the usual units with :func:`coefficients_from_A`.
+Coefficients are then converted to the usual units (:meth:`TermSpec.from_A`).
 
-Uncertainty.  Allan variances at neighbouring taus come from the same data and are
+Uncertainty.  Variances at neighbouring taus come from the same data and are
 positively correlated, which a plain WLS covariance ignores.  fogdrift therefore computes the
 covariance from the *full* weighted design (all fitted terms, not only the active set) with
 each point's weight divided by the number of grid points per octave around it (so a dense
@@ -39,12 +49,33 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .allan import AllanResult
 from .errors import ConfigError, InsufficientDataError
+from .noise_terms import (  # noqa: F401  (re-exported: the term table's public home is noise_terms)
+    TERM_HEADERS,
+    TERM_TABLE,
+    TERM_UNITS,
+    TERMS,
+    UNESTIMABLE,
+    VARIANCE_LAWS,
+    TermLaw,
+    TermSpec,
+    default_terms,
+    laws_of,
+    term_spec,
+)
+from .units import B_FACTOR, URAD_PER_ARCSEC
 
 __all__ = [
     "TERMS",
     "TERM_UNITS",
+    "TERM_HEADERS",
+    "TERM_TABLE",
+    "TermSpec",
+    "term_spec",
+    "TermLaw",
+    "VARIANCE_LAWS",
+    "UNESTIMABLE",
+    "default_terms",
     "NoiseTerm",
     "NoiseFit",
     "fit_noise",
@@ -53,17 +84,6 @@ __all__ = [
     "B_FACTOR",
 ]
 
-#: Noise terms in order of the power of tau in sigma^2: Q tau^-2, N tau^-1, B, K tau, R tau^2.
-TERMS = ("Q", "N", "B", "K", "R")
-_POWER = {"Q": -2, "N": -1, "B": 0, "K": 1, "R": 2}
-#: Units in which :class:`NoiseFit` reports each term.
-TERM_UNITS = {"Q": "urad", "N": "deg/sqrt(h)", "B": "deg/h", "K": "deg/h^1.5", "R": "deg/h^2"}
-_LONG_NAME = {"Q": "quantization", "N": "angle random walk", "B": "bias instability",
-              "K": "rate random walk", "R": "rate ramp"}
-
-#: sqrt(2 ln 2 / pi): the flat Allan deviation of flicker rate noise in units of B.
-B_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)
-_URAD_PER_ARCSEC = 1e6 * math.pi / (180.0 * 3600.0)
 _Z95 = 1.959963984540054
 
 
@@ -112,7 +132,10 @@ class NoiseFit:
     q_arcsec : NoiseTerm
         Q in arcsec.
     A : ndarray, shape (5,)
-        Fitted A_-2..A_2 in units of sigma^2 [(deg/h)^2] with tau in s (0 for unfitted terms).
+        Fitted coefficient of each term Q, N, B, K, R: the constant of its leading power of tau
+        in the statistic's law (:data:`VARIANCE_LAWS`), in units of sigma^2 [(deg/h)^2] with tau
+        in s (0 for unfitted terms).  For the Allan variance these are A_-2 .. A_2 of
+        ``sigma^2 = sum_n A_n tau^n``.
     A_cov : ndarray, shape (5, 5)
         Covariance of ``A`` (zero rows/columns for unfitted terms).
     fitted_terms : tuple of str
@@ -123,11 +146,17 @@ class NoiseFit:
     readouts : dict[str, float or None]
         Classic IEEE-952 slope read-outs (units in the keys), None where the curve shows no
         such slope: ``"Q_urad@tau=sqrt3s"``, ``"N_dprh@tau=1h"``, ``"B_dph@min"``,
-        ``"K_dphrh@tau=3h"``, ``"R_dph2@tau=sqrt2h"``.
+        ``"K_dphrh@tau=3h"``, ``"R_dph2@tau=sqrt2h"``.  The keys name the Allan read-off
+        points; for another statistic the value is the coefficient read off that statistic's
+        own slope line through its own law (e.g. the -3/2 line of white PM in MDEV).
     chi2_red : float
         Reduced chi-squared of the (density-corrected) weighted fit.
     n_points : int
         Number of taus used.
+    statistic : str
+        The statistic the curve was (``"adev"``, ``"hdev"``, ``"mdev"``).
+    dt_s : float or None
+        Sample interval of the curve in s (the modified Allan laws depend on it).
     """
 
     terms: dict
@@ -141,6 +170,8 @@ class NoiseFit:
     readouts: dict
     chi2_red: float
     n_points: int
+    statistic: str = "adev"
+    dt_s: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-serialisable dict."""
@@ -156,19 +187,41 @@ class NoiseFit:
             "readouts": {k: (None if v is None else float(v)) for k, v in self.readouts.items()},
             "chi2_red": float(self.chi2_red),
             "n_points": int(self.n_points),
+            "statistic": self.statistic,
+            "dt_s": None if self.dt_s is None else float(self.dt_s),
         }
 
-    def model_adev_dph(self, tau_s) -> np.ndarray:
-        """Fitted Allan deviation sqrt(sum_n A_n tau^n) in deg/h at ``tau_s`` (s)."""
+    def _term_var(self, name, tau_s, statistic) -> np.ndarray:
+        term_spec(name)
+        own = laws_of(self.statistic)
+        i = TERMS.index(name)
+        target = laws_of(self.statistic if statistic is None else statistic)
         t = np.asarray(tau_s, dtype=np.float64)
-        return np.sqrt(sum(self.A[i] * t ** p for i, p in enumerate(range(-2, 3))))
+        if name not in own or name not in target or self.A[i] == 0:
+            return np.zeros_like(t)  # a term a statistic cannot see contributes nothing to it
+        x2 = self.A[i] / own[name].scale(self.dt_s)  # the coefficient X^2 in the Allan-law units
+        return x2 * target[name].scale(self.dt_s) * target[name].shape(t, self.dt_s)
+
+    def model_dev_dph(self, tau_s, statistic=None) -> np.ndarray:
+        """Deviation of the fitted model in deg/h at ``tau_s`` (s).
+
+        ``statistic`` (default: the fitted one) evaluates the fitted coefficients under another
+        statistic's laws, e.g. ``"adev"`` for the Allan deviation a Hadamard fit implies (a term
+        the target statistic cannot see contributes nothing).
+        """
+        return np.sqrt(sum(self._term_var(k, tau_s, statistic) for k in TERMS))
+
+    def term_dev_dph(self, name, tau_s, statistic=None) -> np.ndarray:
+        """Deviation of one fitted term in deg/h at ``tau_s`` (s); ``statistic`` as in :meth:`model_dev_dph`."""
+        return np.sqrt(self._term_var(name, tau_s, statistic))
+
+    def model_adev_dph(self, tau_s) -> np.ndarray:
+        """Allan deviation of the fitted model in deg/h (``sqrt(sum_n A_n tau^n)`` for an Allan fit)."""
+        return self.model_dev_dph(tau_s, "adev")
 
     def term_adev_dph(self, name, tau_s) -> np.ndarray:
-        """Allan deviation of one fitted term, sqrt(A_n tau^n), in deg/h at ``tau_s`` (s)."""
-        if name not in _POWER:
-            raise ConfigError(f"term must be one of {TERMS}, got {name!r}")
-        t = np.asarray(tau_s, dtype=np.float64)
-        return np.sqrt(self.A[_POWER[name] + 2] * t ** _POWER[name])
+        """Allan deviation of one fitted term in deg/h (``sqrt(A_n tau^n)`` for an Allan fit)."""
+        return self.term_dev_dph(name, tau_s, "adev")
 
 
 # ----------------------------------------------------------------------------------------
@@ -181,25 +234,31 @@ def _check_A(A) -> np.ndarray:
     return a
 
 
-def coefficients_from_A(A) -> dict[str, float]:
-    """IEEE-952 coefficients from A_-2..A_2 (sigma^2 in (deg/h)^2, tau in s).
+def coefficients_from_A(A, *, statistic="adev", dt_s=None) -> dict[str, float]:
+    """IEEE-952 coefficients from the fitted A of each term (sigma^2 in (deg/h)^2, tau in s).
 
     Parameters
     ----------
     A : array_like, shape (5,)
-        Non-negative A_-2, A_-1, A_0, A_1, A_2.
+        Non-negative coefficients of Q, N, B, K, R in the statistic's law (for the Allan
+        variance: A_-2, A_-1, A_0, A_1, A_2).
+    statistic : str, keyword-only
+        Whose laws (:data:`VARIANCE_LAWS`); default ``"adev"``.
+    dt_s : float or None, keyword-only
+        Sample interval in s (needed for ``"mdev"``, whose white-PM constant is 3 dt).
 
     Returns
     -------
     dict
         ``Q`` [urad], ``Q_arcsec`` [arcsec], ``N`` [deg/sqrt(h)], ``B`` [deg/h],
-        ``K`` [deg/h^1.5], ``R`` [deg/h^2].
+        ``K`` [deg/h^1.5], ``R`` [deg/h^2] (R is absent for ``"hdev"``).
 
     Notes
     -----
-    Method notes 2.3: Q[arcsec] = sqrt(A_-2/3) (1 (deg/h) s = 1 arcsec),
+    Method notes 2.3 (Allan): Q[arcsec] = sqrt(A_-2/3) (1 (deg/h) s = 1 arcsec),
     Q[urad] = 4.848137 sqrt(A_-2/3), N = sqrt(A_-1)/60, B = sqrt(A_0)/0.664282,
-    K = 60 sqrt(3 A_1), R = 3600 sqrt(2 A_2).
+    K = 60 sqrt(3 A_1), R = 3600 sqrt(2 A_2); in general ``to_unit sqrt(A / c)`` with the
+    statistic's constant c (:meth:`TermSpec.from_A`).
 
     Examples
     --------
@@ -208,15 +267,14 @@ def coefficients_from_A(A) -> dict[str, float]:
     {'Q': 1.0, 'Q_arcsec': 0.206265, 'N': 0.005, 'B': 0.01, 'K': 0.02, 'R': 0.05}
     """
     a = _check_A(A)
-    q_arcsec = math.sqrt(a[0] / 3.0)
-    return {
-        "Q": q_arcsec * _URAD_PER_ARCSEC,
-        "Q_arcsec": q_arcsec,
-        "N": math.sqrt(a[1]) / 60.0,
-        "B": math.sqrt(a[2]) / B_FACTOR,
-        "K": 60.0 * math.sqrt(3.0 * a[3]),
-        "R": 3600.0 * math.sqrt(2.0 * a[4]),
-    }
+    laws = laws_of(statistic)
+    out = {}
+    for i, name in enumerate(TERMS):
+        if name in laws:
+            out[name] = TERM_TABLE[name].from_A(a[i], laws[name].scale(dt_s))
+            if name == "Q":
+                out["Q_arcsec"] = out["Q"] / URAD_PER_ARCSEC
+    return out
 
 
 def paper_table1_from_A(A) -> dict[str, float]:
@@ -249,14 +307,9 @@ def paper_table1_from_A(A) -> dict[str, float]:
     }
 
 
-#: coefficient = _CONV[name] * sqrt(A_n)
-_CONV = {
-    "Q": _URAD_PER_ARCSEC / math.sqrt(3.0),
-    "N": 1.0 / 60.0,
-    "B": 1.0 / B_FACTOR,
-    "K": 60.0 * math.sqrt(3.0),
-    "R": 3600.0 * math.sqrt(2.0),
-}
+def _conv(name, law, dt_s) -> float:
+    """coefficient[unit] = _conv * sqrt(A) for a term under a law."""
+    return TERM_TABLE[name].to_unit / math.sqrt(law.scale(dt_s))
 
 
 # ----------------------------------------------------------------------------------------
@@ -303,54 +356,67 @@ def _log_fit(X, y, edf, start):
     return coef
 
 
-def _readouts(tau_s, adev):
-    """Classic IEEE-952 slope read-outs (tau in s, adev in deg/h)."""
+#: Read-out keys (legacy names: the Allan read-off points) of the slope terms.
+_READOUT_KEYS = {"Q": "Q_urad@tau=sqrt3s", "N": "N_dprh@tau=1h", "K": "K_dphrh@tau=3h", "R": "R_dph2@tau=sqrt2h"}
+
+
+def _readouts(tau_s, dev, laws, dt_s):
+    """Classic IEEE-952 slope read-outs (tau in s, deviation in deg/h) under a statistic's laws.
+
+    For each slope term the point whose local log-log slope is nearest the term's slope
+    ``power/2`` (within 0.2) is taken as on the term's line, and the coefficient read from it
+    through the law: ``to_unit * dev / sqrt(scale * shape(tau))``.  For the Allan deviation this
+    is the IEEE-952 rule (sigma(sqrt3 s) = Q, sigma(1 h) = N, sigma(3 h) = K, sigma(sqrt2 h) = R on
+    the -1, -1/2, +1/2, +1 lines).  B is read at the minimum: ``dev_min / sqrt(c_B)``.
+    """
     out = {"Q_urad@tau=sqrt3s": None, "N_dprh@tau=1h": None, "B_dph@min": None,
            "K_dphrh@tau=3h": None, "R_dph2@tau=sqrt2h": None}
-    ok = adev > 0
-    t, s = tau_s[ok], adev[ok]
+    ok = dev > 0
+    t, s = tau_s[ok], dev[ok]
     if t.size < 3:
         return out
     slope = np.gradient(np.log(s), np.log(t))
     i_min = int(np.argmin(s))
-    # line of slope mu through (t_i, s_i), evaluated at the read-off tau.  Falling terms (Q, N) are
-    # read left of the ADEV minimum, rising ones (K, R) right of it: a rising piece inside a
-    # short-tau bump (e.g. vibration) is not rate random walk.
-    for key, mu, tau_read in (("Q_urad@tau=sqrt3s", -1.0, math.sqrt(3.0)),
-                              ("N_dprh@tau=1h", -0.5, 3600.0),
-                              ("K_dphrh@tau=3h", 0.5, 3.0 * 3600.0),
-                              ("R_dph2@tau=sqrt2h", 1.0, math.sqrt(2.0) * 3600.0)):
+    # Falling terms (Q, N) are read left of the minimum, rising ones (K, R) right of it: a rising
+    # piece inside a short-tau bump (e.g. vibration) is not rate random walk.
+    for name, key in _READOUT_KEYS.items():
+        if name not in laws:
+            continue
+        law = laws[name]
+        mu = law.power / 2.0
         side = np.arange(t.size) <= i_min if mu < 0 else np.arange(t.size) >= i_min
         dist = np.where(side, np.abs(slope - mu), np.inf)
         i = int(np.argmin(dist))
         if dist[i] <= 0.2:
-            val = s[i] * (tau_read / t[i]) ** mu
-            if key.startswith("Q"):
-                val *= _URAD_PER_ARCSEC  # sigma(sqrt3 s) in (deg/h) s-units = arcsec
-            out[key] = float(val)
-    if 0 < i_min < s.size - 1:
-        out["B_dph@min"] = float(s[i_min] / B_FACTOR)
+            shape = float(law.shape(t[i], dt_s))
+            out[key] = float(TERM_TABLE[name].to_unit * s[i] / math.sqrt(law.scale(dt_s) * shape))
+    if "B" in laws and 0 < i_min < s.size - 1:
+        out["B_dph@min"] = float(s[i_min] / math.sqrt(laws["B"].scale(dt_s)))
     return out
 
 
 def fit_noise(
-    allan: AllanResult,
+    allan,
     *,
-    terms=TERMS,
+    terms=None,
     method="wls-nnls",
     n_boot=0,
     seed=0,
     tau_range_s=None,
     n_iter=4,
 ) -> NoiseFit:
-    """Fit IEEE-952 noise terms to an Allan variance curve.
+    """Fit IEEE-952 noise terms to an Allan-family curve.
 
     Parameters
     ----------
     allan : AllanResult
-        From :func:`fogdrift.allan.allan_variance` (its ``edf`` gives the weights).
-    terms : sequence of str, keyword-only
-        Terms to fit, a subset of ``("Q", "N", "B", "K", "R")``.
+        From :func:`fogdrift.allan.allan_variance`: any statistic (``adev``, ``hdev``, ``mdev``);
+        its ``statistic`` field selects the laws (:data:`VARIANCE_LAWS`), its ``edf`` the
+        weights.  Any object with ``statistic``, ``tau_s``, ``var_dph2``, ``edf`` and ``dt_s``
+        will do.
+    terms : sequence of str or None, keyword-only
+        Terms to fit, a subset of ``("Q", "N", "B", "K", "R")``; None (default): every term the
+        statistic can estimate (:func:`default_terms`: all five, or Q, N, B, K for ``hdev``).
     method : {"wls-nnls", "log"}, keyword-only
         ``"wls-nnls"``: relative-error weighted non-negative least squares with IRLS
         (method notes 2.5, items 1-2).  ``"log"``: minimise
@@ -373,14 +439,16 @@ def fit_noise(
     Raises
     ------
     ConfigError
-        Unknown term/method, bad ``n_boot`` or ``tau_range_s``.
+        Unknown term/method/statistic, a term the statistic cannot estimate (R with ``hdev``),
+        bad ``n_boot`` or ``tau_range_s``.
     InsufficientDataError
         Fewer usable taus (sigma^2 > 0) than fitted terms + 1.
 
     Notes
     -----
-    Minimises ``sum_i (edf_i/2) ((sum_n A_n tau_i^n - s_i^2) / d_i)^2`` with ``A_n >= 0``,
-    where ``d_i`` is ``s_i^2`` in the first pass and the fitted model afterwards (Lv et al.,
+    Minimises ``sum_i (edf_i/2) ((sum_n A_n g_n(tau_i) - s_i^2) / d_i)^2`` with ``A_n >= 0``,
+    where ``g_n`` is the term's law under the statistic (``tau^n`` for the Allan variance),
+    ``d_i`` is ``s_i^2`` in the first pass and the fitted model afterwards (Lv et al.,
     Optik 126 (2015) 2529; method notes 2.5).  See the module docstring for uncertainties
     and the estimability rule.
 
@@ -392,22 +460,38 @@ def fit_noise(
     >>> fit = fit_noise(allan_variance(y, 0.1), terms=("N", "K"))
     >>> round(fit.terms["N"].value, 3), fit.terms["K"].estimable
     (0.01, False)
+    >>> fit_h = fit_noise(allan_variance(y, 0.1, statistic="hdev"), terms=("N", "K"))
+    >>> fit_h.statistic, round(fit_h.terms["N"].value, 3)
+    ('hdev', 0.01)
     """
-    if not isinstance(allan, AllanResult):
-        raise ConfigError(f"allan must be an AllanResult, got {type(allan).__name__}")
+    statistic = getattr(allan, "statistic", None)
+    if not isinstance(statistic, str) or not all(hasattr(allan, a) for a in ("tau_s", "var_dph2", "edf", "dt_s")):
+        raise ConfigError(f"allan must be an AllanResult (with statistic, tau_s, var_dph2, edf, dt_s), "
+                          f"got {type(allan).__name__}")
+    laws = laws_of(statistic)
+    if terms is None:
+        terms = default_terms(statistic)
     if isinstance(terms, str):
         terms = tuple(terms)
     terms = tuple(terms)
     bad = [t for t in terms if t not in TERMS]
     if bad or not terms or len(set(terms)) != len(terms):
         raise ConfigError(f"terms must be distinct names from {TERMS}, got {terms!r}")
+    for t in terms:
+        if t not in laws:
+            raise ConfigError(
+                f"statistic={statistic!r} cannot estimate {t} ({TERM_TABLE[t].long_name}): "
+                f"{UNESTIMABLE.get((statistic, t), 'no law for it')}; drop {t} from {{opt:terms}} "
+                f"or use {{opt:statistic}} adev"
+            )
     terms = tuple(t for t in TERMS if t in terms)
     if method not in ("wls-nnls", "log"):
         raise ConfigError(f"method must be 'wls-nnls' or 'log', got {method!r}")
     if int(n_boot) != n_boot or n_boot < 0:
         raise ConfigError(f"n_boot must be an integer >= 0, got {n_boot!r}")
+    dt_s = None if allan.dt_s is None else float(allan.dt_s)
     tau = np.asarray(allan.tau_s, dtype=np.float64)
-    avar = np.asarray(allan.avar_dph2, dtype=np.float64)
+    avar = np.asarray(allan.var_dph2, dtype=np.float64)
     edf = np.asarray(allan.edf, dtype=np.float64)
     use = (avar > 0) & np.isfinite(avar) & (edf > 0)
     if tau_range_s is not None:
@@ -426,8 +510,8 @@ def fit_noise(
             got=int(use.sum()),
         )
     tau, avar, edf = tau[use], avar[use], edf[use]
-    powers = np.array([_POWER[t] for t in terms])
-    X = tau[:, None] ** powers[None, :]
+    term_laws = [laws[t] for t in terms]
+    X = np.column_stack([law.shape(tau, dt_s) for law in term_laws])
 
     coef, den = _wnnls(X, avar, edf, n_iter)
     if method == "log":
@@ -472,7 +556,7 @@ def fit_noise(
 
     A = np.zeros(5)
     A_cov = np.zeros((5, 5))
-    idx = powers + 2
+    idx = np.array([TERMS.index(t) for t in terms])
     A[idx] = coef
     A_cov[np.ix_(idx, idx)] = cov
 
@@ -484,13 +568,14 @@ def fit_noise(
             lo_a = lo_a if lo_a > 0 else 0.0
         else:
             lo_a, hi_a = max(0.0, coef[j] - _Z95 * sd_a), coef[j] + _Z95 * sd_a
-        results[name] = _make_term(name, coef[j], sd_a, lo_a, hi_a, tau, powers, coef, j)
+        results[name] = _make_term(name, coef[j], sd_a, lo_a, hi_a, tau, term_laws, coef, j, dt_s)
     for name in TERMS:
         if name not in results:
-            results[name] = NoiseTerm(name, None, TERM_UNITS[name], None, None, None, False,
-                                      f"not fitted (terms={terms})")
+            why = (f"not fitted (terms={terms})" if name in laws
+                   else f"not estimable with statistic={statistic!r}: {UNESTIMABLE.get((statistic, name), '')}")
+            results[name] = NoiseTerm(name, None, TERM_UNITS[name], None, None, None, False, why)
     qt = results["Q"]
-    f = 1.0 / _URAD_PER_ARCSEC
+    f = 1.0 / URAD_PER_ARCSEC
 
     def _sc(v):
         return None if v is None else v * f
@@ -506,31 +591,35 @@ def fit_noise(
         tau_min_s=float(tau.min()),
         tau_max_s=float(tau.max()),
         method=method_name,
-        readouts=_readouts(np.asarray(allan.tau_s, float), np.asarray(allan.adev_dph, float)),
+        readouts=_readouts(np.asarray(allan.tau_s, float), np.sqrt(np.asarray(allan.var_dph2, float)), laws, dt_s),
         chi2_red=chi2_red,
         n_points=int(tau.size),
+        statistic=statistic,
+        dt_s=dt_s,
     )
 
 
-def _make_term(name, a, sd_a, lo_a, hi_a, tau, powers, coef, j) -> NoiseTerm:
+def _make_term(name, a, sd_a, lo_a, hi_a, tau, term_laws, coef, j, dt_s) -> NoiseTerm:
     """NoiseTerm from the fitted A (and its interval); applies the estimability rule."""
-    conv, unit = _CONV[name], TERM_UNITS[name]
+    law = term_laws[j]
+    conv, unit = _conv(name, law, dt_s), TERM_UNITS[name]
     if a > 0 and lo_a > 0:
         value = conv * math.sqrt(a)
         std = conv * sd_a / (2.0 * math.sqrt(a))
         return NoiseTerm(name, value, unit, std, conv * math.sqrt(lo_a), conv * math.sqrt(hi_a), True, "")
     upper = conv * math.sqrt(max(hi_a, 0.0))
-    # where would a term at its upper bound start to dominate the rest of the model?
-    p = _POWER[name]
+    # where would a term at its upper bound start to dominate the rest of the model?  (leading
+    # powers only: the small-m corrections of the modified Allan laws do not extrapolate)
+    p = law.power
     rest_coef = coef.copy()
     rest_coef[j] = 0.0
     t_lo, t_hi = float(tau.min()), float(tau.max())
     grid = np.logspace(math.log10(t_lo) - 6, math.log10(t_hi) + 6, 1201)
-    Xg = grid[:, None] ** powers[None, :].astype(np.float64)
+    Xg = np.column_stack([lw.shape(grid, dt_s, leading_only=True) for lw in term_laws])
     rest = Xg @ rest_coef
     term = max(hi_a, 0.0) * grid**p
     dominates = term >= rest
-    head = (f"{name} ({_LONG_NAME[name]}) not resolved: A={a:.3g} +- {sd_a:.3g} (tau in s), "
+    head = (f"{name} ({TERM_TABLE[name].long_name}) not resolved: A={a:.3g} +- {sd_a:.3g} (tau in s), "
             f"consistent with 0; 95 % upper bound {upper:.3g} {unit}")
     where = grid[dominates]
     if p >= 0:
@@ -550,4 +639,3 @@ def _make_term(name, a, sd_a, lo_a, hi_a, tau, powers, coef, j) -> NoiseTerm:
     value = conv * math.sqrt(max(a, 0.0))
     std = conv * sd_a / (2.0 * math.sqrt(a)) if a > 0 else None
     return NoiseTerm(name, value, unit, std, 0.0, upper, True, head)
-
