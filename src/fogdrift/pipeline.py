@@ -86,8 +86,12 @@ class AnalysisConfig:
         Tau grid of the Allan analyses (``"octave"``, ``"decade"``, ``"all"`` or a number of log-spaced taus).
     estimator : str
         Allan estimator (``"overlapping"``, ``"non-overlapping"`` or ``"fast"``).
-    terms : tuple of str
-        Noise terms fitted (subset of Q, N, B, K, R).
+    statistic : str
+        Allan-family statistic of the noise analyses (``"adev"``, ``"hdev"`` or ``"mdev"``).
+    terms : tuple of str or None
+        ``None`` (default): the noise model is selected from the data; a tuple fixes the terms fitted.
+    outliers : str
+        ``"warn"`` (report samples beyond 6 robust sigma), ``"clip"`` or ``"replace"`` them before the analyses.
     fit_tau_s : tuple of (float or None, float or None)
         Tau range [s] of the noise fit (None = no limit), e.g. to leave out a vibration bump that the
         IEEE-952 model does not describe.
@@ -112,8 +116,10 @@ class AnalysisConfig:
     causal_window_s: float = 128.0
     taus: str = "octave"
     estimator: str = "overlapping"
-    terms: tuple = ("Q", "N", "B", "K", "R")
+    statistic: str = "adev"
+    terms: tuple | None = None
     fit_tau_s: tuple = (None, None)
+    outliers: str = "warn"
 
     def validate(self) -> "AnalysisConfig":
         if not 0 < self.train_fraction < 1 or not 0 <= self.val_fraction < 1:
@@ -130,6 +136,13 @@ class AnalysisConfig:
             raise ConfigError(f"no drift model given; pass {{opt:models}} with one or more of {list(MODEL_NAMES)}")
         # canonical registry names (any case accepted); an unknown name is an error, never a fallback
         self.models = tuple(dict.fromkeys(model_spec(m).name for m in self.models))
+        from .allan import STATISTICS
+        from .outliers import OUTLIER_ACTIONS
+
+        if self.statistic not in STATISTICS:
+            raise ConfigError(f"statistic must be one of {tuple(STATISTICS)}, got {self.statistic!r} ({{opt:statistic}})")
+        if self.outliers not in OUTLIER_ACTIONS:
+            raise ConfigError(f"outliers must be one of {OUTLIER_ACTIONS}, got {self.outliers!r} ({{opt:outliers}})")
         if self.model_rate_hz is not None and not self.model_rate_hz > 0:
             raise ConfigError(f"model_rate_hz must be > 0 Hz or None; got {self.model_rate_hz!r}")
         if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
@@ -146,7 +159,7 @@ class AnalysisConfig:
     def to_dict(self) -> dict:
         d = asdict(self)
         d["models"] = list(self.models)
-        d["terms"] = list(self.terms)
+        d["terms"] = None if self.terms is None else list(self.terms)
         d["fit_tau_s"] = list(self.fit_tau_s)
         return d
 
@@ -157,14 +170,17 @@ class AnalysisConfig:
 
 @dataclass
 class AllanAxis:
-    """Allan analysis of one axis. ``allan`` is an AllanResult, ``noise`` a NoiseFit."""
+    """Allan analysis of one axis. ``allan`` is an AllanResult, ``noise`` a NoiseFit, ``outliers`` an
+    OutlierReport of the rate that was analysed (None when not checked)."""
 
     name: str
     allan: object
     noise: object
+    outliers: object = None
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict()}
+        return {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict(),
+                "outliers": None if self.outliers is None else self.outliers.to_dict()}
 
 
 @dataclass
@@ -343,15 +359,47 @@ def library_versions() -> dict:
     return out
 
 
-def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None) -> AllanAxis:
-    """Allan variance + noise fit of one 1-D rate series."""
+def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False) -> AllanAxis:
+    """Allan-family variance and noise identification of one 1-D rate series.
+
+    The curve is computed on the configured grid (``cfg.taus``) for display; the noise fit always uses an octave
+    grid of the same data, so its numbers do not depend on the display grid.  With ``check_outliers`` the rate is
+    checked for samples beyond 6 robust sigma and, if ``cfg.outliers`` says so, clipped or replaced first.
+    """
     from .allan import allan_variance
     from .noise import fit_noise
 
-    res = allan_variance(rate_dph, dt_s, taus=cfg.taus, estimator=cfg.estimator, progress=progress)
+    outliers = None
+    if check_outliers:
+        from .outliers import treat_outliers
+
+        rate_dph, outliers = treat_outliers(rate_dph, cfg.outliers)
+    res = allan_variance(rate_dph, dt_s, taus=cfg.taus, estimator=cfg.estimator, statistic=cfg.statistic,
+                         progress=progress)
+    fit_curve = res if cfg.taus == "octave" else allan_variance(rate_dph, dt_s, taus="octave",
+                                                                estimator=cfg.estimator, statistic=cfg.statistic)
     lo, hi = cfg.fit_tau_s
-    tau_range = None if lo is None and hi is None else (lo or 0.0, hi or np.inf)
-    return AllanAxis(name=name, allan=res, noise=fit_noise(res, terms=tuple(cfg.terms), tau_range_s=tau_range))
+    tau_range = None if lo is None and hi is None else (lo, hi)
+    noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range)
+    if outliers is not None:
+        noise.outliers = outliers.to_dict()
+    return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers)
+
+
+def _treated_record(record, cfg: AnalysisConfig):
+    """The record with outliers clipped or replaced per ``cfg.outliers`` (unchanged for "warn"), and the reports."""
+    import dataclasses
+
+    from .outliers import treat_outliers
+
+    data = np.array(record.rate_dph, dtype=np.float64)
+    reports = {}
+    for k, name in enumerate(record.axis_names):
+        data[:, k], reports[name] = treat_outliers(data[:, k], cfg.outliers)
+    if cfg.outliers == "warn" or not any(r.count for r in reports.values()):
+        return record, reports
+    note = f"outliers {cfg.outliers}: " + ", ".join(f"{n} {r.count}" for n, r in reports.items())
+    return dataclasses.replace(record, rate_dph=data, notes=tuple(record.notes) + (note,)), reports
 
 
 def _model_record(record, cfg: AnalysisConfig):
@@ -408,7 +456,8 @@ def _check_earth_axes(record, cfg: AnalysisConfig) -> None:
 def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | None = None) -> list[AllanAxis]:
     """Allan variance and noise identification of every axis of a record at its native rate."""
     cfg = (cfg or AnalysisConfig()).validate()
-    return [analyse_allan(name, record.axis(name), record.dt_s, cfg, progress) for name in record.axis_names]
+    return [analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True)
+            for name in record.axis_names]
 
 
 def run_separation(record, cfg: AnalysisConfig | None = None) -> list[SeparationAxis]:
@@ -572,10 +621,13 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
     t_start = time.perf_counter()
     cfg = (cfg or AnalysisConfig()).validate()
     _check_earth_axes(record, cfg)
+    record, outlier_reports = _treated_record(record, cfg)
     rec_m = _model_record(record, cfg)
     axes = []
     for name in record.axis_names:
         original = analyse_allan(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s, cfg)
+        original.outliers = outlier_reports[name]
+        original.noise.outliers = outlier_reports[name].to_dict()
         rate, bias, earth = _prepared_axis(rec_m, name, cfg)
         sep = _separation_axis(name, rate, rec_m.dt_s, cfg)
         lvl_cfg = _with_level(cfg, sep.level)

@@ -76,6 +76,13 @@ TausOpt = Annotated[str, typer.Option("--taus", help="Tau grid: octave, decade, 
 FitTausOpt = Annotated[str, typer.Option("--fit-taus", help="Tau range of the noise fit MIN:MAX [s], "
                                                             "either side may be empty, e.g. '1:'.")]
 EstOpt = Annotated[str, typer.Option("--estimator", help="overlapping, non-overlapping or fast.")]
+TermsOpt = Annotated[str, typer.Option(
+    "--terms", help="Fix the noise model, e.g. N,K (default: the terms are selected from the data).")]
+StatisticOpt = Annotated[str, typer.Option(
+    "--statistic", help="adev (Allan), hdev (Hadamard: blind to a rate ramp) or mdev (modified Allan).")]
+OutliersOpt = Annotated[str, typer.Option(
+    "--outliers", help="Samples beyond 6 robust sigma: warn (default), clip (to 6 sigma) or replace (by the "
+                       "local median).")]
 
 
 @dataclass(frozen=True)
@@ -166,6 +173,12 @@ def parse_fit_taus(text: str):
         return (float(lo) if lo.strip() else None, float(hi) if hi.strip() else None)
     except ValueError:
         raise ConfigError(f"--fit-taus must look like MIN:MAX in seconds (e.g. '1:' or '0.1:300'), got {text!r}") from None
+
+
+def parse_terms(text: str):
+    """'' -> None (select from the data); 'n,k' -> ('N', 'K')."""
+    items = csv_list(text or "")
+    return tuple(t.upper() for t in items) if items else None
 
 
 def parse_taus(text: str):

@@ -20,8 +20,11 @@ def metrics_table(title, rows):
 
 
 def print_noise_notes(label, noise):
-    from ..report import not_estimable_notes, readout_text
+    """The fit statistic, fitted range, what was left out and why, and every unresolved term's reason."""
+    from ..report import noise_notes, readout_text
 
-    for note in not_estimable_notes(noise):
-        console.print(Text(f"  {label} {note}", style="dim"), highlight=False)
-    console.print(Text(f"  {label} slope read-outs (cross-check): {readout_text(noise)}"), highlight=False)
+    for i, note in enumerate(noise_notes(noise)):
+        style = "bold" if i == 0 else ("yellow" if note.startswith("fit poor") else "dim")
+        console.print(Text(f"  {label}: {note}", style=style), highlight=False)
+    console.print(Text(f"  {label}: slope read-outs (IEEE-952 cross-check, not the result): {readout_text(noise)}"),
+                  style="dim", highlight=False)

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from ._app import (EstOpt, FitTausOpt, OutOpt, TausOpt, app, console, csv_list, errors, parse_fit_taus,
+from ._app import (OutliersOpt, StatisticOpt, TermsOpt, parse_terms, EstOpt, FitTausOpt, OutOpt, TausOpt, app, console, csv_list, errors, parse_fit_taus,
                    parse_taus, progress, with_load_options)
 from ._tables import noise_table, print_noise_notes
 
@@ -18,7 +18,9 @@ def allan(
     load,
     estimator: EstOpt = "overlapping",
     taus: TausOpt = "octave",
-    terms: Annotated[str, typer.Option("--terms", help="Noise terms to fit, e.g. Q,N,B,K,R.")] = "Q,N,B,K,R",
+    terms: TermsOpt = "",
+    statistic: StatisticOpt = "adev",
+    outliers: OutliersOpt = "warn",
     fit_taus: FitTausOpt = ":",
     out: OutOpt = Path("out/allan"),
 ):
@@ -29,7 +31,7 @@ def allan(
     with errors():
         record = load.load()
         cfg = AnalysisConfig(taus=parse_taus(taus), estimator=estimator, fit_tau_s=parse_fit_taus(fit_taus),
-                             terms=tuple(t.upper() for t in csv_list(terms)))
+                             terms=parse_terms(terms), statistic=statistic, outliers=outliers)
         with progress("allan") as (allan_cb, _):
             results = run_allan(record, cfg, progress=allan_cb)
         console.print(noise_table(

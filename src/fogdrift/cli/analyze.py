@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import ConfigError
-from ._app import (EstOpt, FitTausOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, console,
+from ._app import (OutliersOpt, StatisticOpt, TermsOpt, parse_terms, EstOpt, FitTausOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, console,
                    csv_list, errors, parse_fit_taus, parse_level, parse_taus, progress, with_load_options)
 from ._tables import metrics_table, noise_table
 from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt
@@ -36,7 +36,9 @@ def analyze(
     model_rate: ModelRateOpt = 1.0,
     taus: TausOpt = "octave",
     estimator: EstOpt = "overlapping",
-    terms: Annotated[str, typer.Option("--terms", help="Noise terms to fit, e.g. Q,N,B,K,R.")] = "Q,N,B,K,R",
+    terms: TermsOpt = "",
+    statistic: StatisticOpt = "adev",
+    outliers: OutliersOpt = "warn",
     fit_taus: FitTausOpt = ":",
     train_fraction: Annotated[float, typer.Option("--train-fraction", help="Chronological training share.")] = 0.6,
     val_fraction: Annotated[float, typer.Option("--val-fraction", help="Validation share (early stopping).")] = 0.2,
@@ -62,7 +64,7 @@ def analyze(
         cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
                              training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
                              model_rate_hz=model_rate or None, taus=parse_taus(taus), estimator=estimator,
-                             terms=tuple(t.upper() for t in csv_list(terms)), latitude_deg=latitude,
+                             terms=parse_terms(terms), statistic=statistic, outliers=outliers, latitude_deg=latitude,
                              earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), train_fraction=train_fraction,
                              val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window)
         with progress("analyze") as (_, epoch_cb):

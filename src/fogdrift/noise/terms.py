@@ -24,8 +24,8 @@ from types import MappingProxyType
 
 import numpy as np
 
-from .errors import ConfigError
-from .units import B_FACTOR, URAD_PER_ARCSEC
+from ..errors import ConfigError
+from ..units import B_FACTOR, URAD_PER_ARCSEC
 
 __all__ = [
     "TermSpec",
