@@ -81,3 +81,7 @@ def analyze(
                     console.print("  " + line, highlight=False)
         path = write_report(result, record, out)
         console.print(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
+        # the self-describing bundle 'fogdrift compensate' applies to other logs
+        from ..bundle import write_bundle
+
+        console.print(f"bundle: {write_bundle(out / 'bundle', [ax.models for ax in result.axes], cfg, record).path}")
