@@ -27,6 +27,7 @@ is bounded by a segment plus a chunk (plus, while re-estimating the bias, the ca
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,6 +39,19 @@ __all__ = ["AxisPlan", "OutputBlock", "StreamCompensator", "segment_blocks"]
 
 #: The constant-bias-only compensator (no drift model), always available.
 BIAS_ONLY = "bias"
+
+
+def _block_means(x, nb: int, m: int) -> np.ndarray:
+    """Means of ``nb`` consecutive blocks of ``m`` rows, by sequential elementwise sums.
+
+    ``ndarray.mean(axis=1)`` may sum in an order that depends on the data's memory alignment (SIMD paths), which
+    would make the output depend on how the input was chunked; elementwise additions do not.
+    """
+    blocks = x[: nb * m].reshape(nb, m, x.shape[1])
+    acc = blocks[:, 0, :].copy()
+    for j in range(1, m):
+        acc += blocks[:, j, :]
+    return acc / m
 
 
 def segment_blocks(factor: int) -> int:
@@ -106,6 +120,9 @@ class StreamCompensator:
         ``"keep"`` or the length [s] of the window at the start of the log the bias is re-estimated on.
     keep_model_rate : bool
         Keep the raw modelling-rate block means (:attr:`block_means_dph`) for evaluations.
+    segment : int or None
+        Modelling intervals per segment; None: :func:`segment_blocks` of ``factor``.  The outputs depend on it
+        (the models' fixed-length histories restart at segment boundaries), never on the chunking of the input.
 
     Examples
     --------
@@ -131,6 +148,7 @@ class StreamCompensator:
     mode: str
     bias: object = "keep"
     keep_model_rate: bool = True
+    segment: int | None = None
     block_means_dph: list = field(default_factory=list, init=False)
     n_in: int = field(default=0, init=False)
     n_out: int = field(default=0, init=False)
@@ -150,7 +168,9 @@ class StreamCompensator:
                 raise ConfigError(f"bias must be 'keep' or a re-estimation window > 0 s; got {self.bias!r}; "
                                   "pass {opt:bias} keep or re-estimate:SECONDS")
             self.n_cal = max(1, int(round(seconds / self.model_dt_s)))
-        self.seg_blocks = segment_blocks(self.factor)
+        self.seg_blocks = segment_blocks(self.factor) if self.segment is None else int(self.segment)
+        if self.seg_blocks < 1:
+            raise ConfigError(f"segment must be >= 1 modelling interval; got {self.segment!r}")
         self.seg_native = self.seg_blocks * self.factor
         self._axes = []
         for plan in self.plans:
@@ -208,7 +228,7 @@ class StreamCompensator:
     def _segment(self, t, x, final: bool) -> list:
         m = self.factor
         nb = x.shape[0] // m
-        means = x[: nb * m].reshape(nb, m, self.n_axes).mean(axis=1)
+        means = _block_means(x, nb, m)
         if self.keep_model_rate:
             self.block_means_dph.append(means)
         seg = (t, x, means, self._n_blocks)
@@ -223,7 +243,7 @@ class StreamCompensator:
                     f"{self._n_blocks * self.model_dt_s:g} s (pass {{opt:bias}} keep or a shorter window)",
                     needed=self.n_cal, got=self._n_blocks)
             cal = np.concatenate([s[2] for s in self._held])[: self.n_cal]
-            level = cal.mean(axis=0)
+            level = [math.fsum(cal[:, k]) / self.n_cal for k in range(self.n_axes)]  # order-independent
             self.re_estimated_bias_dph = []
             for k, a in enumerate(self._axes):
                 earth = a.plan.bundle_axis.earth_rate_dph

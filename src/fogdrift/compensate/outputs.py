@@ -40,6 +40,8 @@ class CsvWriter:
     def close(self):
         self._fh.close()
 
+    abort = close
+
 
 class NpzWriter:
     """An ``.npz`` of known shapes written row block by row block (see the module docstring)."""
@@ -69,6 +71,13 @@ class NpzWriter:
         for name, a in arrays.items():
             self._files[name].write(np.ascontiguousarray(a, dtype="<f8").tobytes())
         self.n += t.shape[0]
+
+    def abort(self):
+        """Close and remove the temporary files (after an error)."""
+        for name, fh in self._files.items():
+            fh.close()
+            os.remove(os.path.join(self._dir, name + ".npy"))
+        os.rmdir(self._dir)
 
     def close(self):
         for fh in self._files.values():

@@ -118,14 +118,21 @@ class CausalPredictor:
         c = np.full(z.size, np.nan)
         first = min(z.size, max(0, (W - 1) - self._z_tail.size))  # index in z of the first full window
         if first < z.size:
-            view = np.lib.stride_tricks.sliding_window_view(full, W)
-            c[first:] = view[self._z_tail.size + first - (W - 1):] @ self.g
+            # c[k] = sum_i g[i] full[k0 + k + i], as W elementwise passes (a BLAS dot product's summation
+            # order may depend on memory alignment; this one does not)
+            k0 = self._z_tail.size + first - (W - 1)
+            n_out = z.size - first
+            acc = np.zeros(n_out)
+            for i in range(W):
+                acc += self.g[i] * full[k0 + i:k0 + i + n_out]
+            c[first:] = acc
         self._z_tail = full[-(W - 1):] if W > 1 else np.empty(0)
         y = c[first:]
         if extra:
             y = np.append(y, 0.0)  # the target slot of the sample after the log; its prediction uses y[:-1] only
         out = np.full(z.size + int(extra), np.nan)
-        if y.size:
+        # Elman.predict cannot take fewer samples than its lags in all (they would all be NaN anyway)
+        if y.size and self._c_tail.size + y.size > int(getattr(self.model, "lags", 0)):
             out[first:] = self.model.predict(y, history=self._c_tail if self._c_tail.size else None)
         finite = c[first:]
         self._c_tail = np.concatenate([self._c_tail, finite])[-self._hist:]

@@ -93,7 +93,7 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
                     accept_rate=False, columns=None, time_column="auto", rate_hz=None, time_unit=None,
                     chunk_samples=DEFAULT_CHUNK, formats=FORMATS, figures=True, heading=True, artefacts=False,
                     calib_s=300.0, step_s=300.0, horizons_s=(60.0, 600.0, 3600.0), max_model_rate_samples=1 << 23,
-                    progress=None) -> CompensationResult:
+                    segment=None, progress=None) -> CompensationResult:
     """Compensate the log ``path`` with ``bundle`` and write the results to ``out_dir``.
 
     Parameters
@@ -126,6 +126,9 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
         ``max_model_rate_samples`` samples at the modelling rate.
     calib_s, step_s, horizons_s
         Heading-error protocol (:func:`fogdrift.evaluation.heading.heading_errors`).
+    segment : int, optional
+        Processing segment in modelling intervals (default fixed by the block-average factor; see
+        :class:`~fogdrift.compensate.engine.StreamCompensator`).  Tests use short segments.
     progress : callable, optional
         ``progress(done_samples, total_samples)``.
 
@@ -146,7 +149,7 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
     match = match_log(source, b, apply_unit=apply_unit, axis_map=axis_map, accept_rate=accept_rate)
     plans = [AxisPlan(log_ax, b.axis(b_ax), name) for log_ax, b_ax in match.axes]
     engine = StreamCompensator(plans, factor=match.factor, model_dt_s=b.model_dt_s, wavelet=b.wavelet, mode=b.mode,
-                               bias=bias_mode,
+                               bias=bias_mode, segment=segment,
                                keep_model_rate=(heading or artefacts)
                                and source.n_samples // match.factor <= max_model_rate_samples)
     out = Path(out_dir)
@@ -176,9 +179,12 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
             if progress is not None:
                 progress(engine.n_in, source.n_samples)
         emit(engine.finish())
-    finally:
+    except BaseException:
         for w in writers:
-            w.close()
+            w.abort()
+        raise
+    for w in writers:
+        w.close()
 
     messages = list(match.notes)
     biases = engine.biases()
