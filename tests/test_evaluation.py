@@ -119,4 +119,21 @@ def test_evaluate_axis_gives_the_verdicts_headline_first(model_axis):
     assert headers[0] == "model" and [r[0] for r in rows] == ["constant bias", "AR(p)", "Kalman", "persistence"]
     text = " ".join(heading_verdict(ev["heading"]).lines)
     assert "constant bias leaves" in text and "origins" in text
+    assert "7 origin(s) are too few to judge" in text and "reduces the heading error" not in text
     assert [v.kind for v in compensation_verdicts(model_axis=ma)] == ["causal", "paper"]
+
+
+def test_analyze_heading_prints_the_evaluation_and_writes_a_bundle(bundled_path, tmp_path):
+    from typer.testing import CliRunner
+
+    from fogdrift.bundle import load_bundle
+    from fogdrift.cli import app
+
+    result = CliRunner().invoke(app, ["analyze", str(bundled_path), "--columns", "gz", "--models", "ar,persistence",
+                                      "--train-fraction", "0.4", "--val-fraction", "0.1", "--heading",
+                                      "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    out = result.output
+    assert "heading error after a 300-s calibration" in out and "surviving fraction" in out
+    assert out.index("heading error after") < out.index("paper's measure")
+    assert load_bundle(tmp_path / "bundle").axis_names == ("gz",)

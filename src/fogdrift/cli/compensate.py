@@ -57,7 +57,6 @@ def compensate(
     the heading-error table."""
     from ..compensate import compensate_file
     from ..errors import ConfigError
-    from ..evaluation import artefact_table, heading_table
 
     with errors():
         try:
@@ -74,15 +73,22 @@ def compensate(
                            f"(unit {s['unit']}, {1 / s['native_dt_s']:g} Hz, models at {1 / s['model_dt_s']:g} Hz)"))
         for line in result.messages:
             console.print(Text("  " + line), highlight=False)
-        for h in result.heading:
-            headers, rows = heading_table(h)
-            console.print(table(f"axis {h.axis}: heading error after a {h.calib_s:g}-s calibration "
-                                f"(RMS over origins every {h.step_s:g} s; ratio to constant bias)", headers, rows))
-        for a in result.artefacts:
-            headers, rows = artefact_table(a)
-            console.print(table(f"axis {a.axis}: surviving fraction of injected signals "
-                                f"(amplitude {a.amplitude_dph:.4g} deg/h)", headers, rows))
-        for v in result.verdicts:
-            for line in v.lines:
-                console.print(Text("  " + line), highlight=False)
+        print_evaluation(result.heading, result.artefacts, result.verdicts)
         console.print(Text(f"wrote {', '.join(str(p) for p in result.files.values())}"))
+
+
+def print_evaluation(headings, artefacts, verdicts):
+    """Heading-error tables, artefact tables, then the verdict lines (headline first)."""
+    from ..evaluation import artefact_table, heading_table
+
+    for h in headings:
+        headers, rows = heading_table(h)
+        console.print(table(f"axis {h.axis}: heading error after a {h.calib_s:g}-s calibration "
+                            f"(RMS over origins every {h.step_s:g} s; ratio to constant bias)", headers, rows))
+    for a in artefacts:
+        headers, rows = artefact_table(a)
+        console.print(table(f"axis {a.axis}: surviving fraction of injected signals "
+                            f"(amplitude {a.amplitude_dph:.4g} deg/h)", headers, rows))
+    for v in verdicts:
+        for line in v.lines:
+            console.print(Text("  " + line), highlight=False)

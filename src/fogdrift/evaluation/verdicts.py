@@ -54,14 +54,25 @@ def _f(x, digits=3) -> str:
 
 
 def _pct(ratio) -> str:
-    return "n/a" if ratio is None or not math.isfinite(ratio) else f"{100.0 * (ratio - 1.0):+.0f} %"
+    """Change of a ratio in per cent; ``x12`` style beyond 10 (a diverging forecast)."""
+    if ratio is None or not math.isfinite(ratio):
+        return "n/a"
+    if ratio >= 10:
+        return f"x{ratio:.3g}"
+    pct = round(100.0 * (ratio - 1.0))
+    return "±0 %" if pct == 0 else f"{pct:+d} %"
 
 
-def heading_verdict(result, *, material: float = MATERIAL) -> Verdict:
+#: Fewest origins on which a horizon's verdict says which model reduces the heading error.
+MIN_ORIGINS = 10
+
+
+def heading_verdict(result, *, material: float = MATERIAL, min_origins: int = MIN_ORIGINS) -> Verdict:
     """Per horizon: constant bias's RMS angle error, each model's change, and which models reduce it.
 
     A model *reduces* the heading error when its RMS is at least ``material`` (5 %) below constant bias's,
-    *worsens* it when at least 5 % above; in between the difference is not material.
+    *worsens* it when at least 5 % above; in between the difference is not material.  With fewer than
+    ``min_origins`` origins the numbers are shown but no model is said to reduce or worsen anything.
 
     Examples
     --------
@@ -96,6 +107,12 @@ def heading_verdict(result, *, material: float = MATERIAL) -> Verdict:
                 worse.append(label)
         lines.append(f"{result.axis}, {h:g} s after a {result.calib_s:g}-s calibration ({base.n_origins} origins): "
                      f"constant bias leaves {_f(base.rms_deg)} deg RMS; " + "; ".join(parts) + ".")
+        if base.n_origins < min_origins:
+            lines.append(f"{result.axis}, {h:g} s: {base.n_origins} origin(s) are too few to judge (need "
+                         f"{min_origins}; use a longer held-out record or a smaller origin step).")
+            data[str(h)] = {"reduces": [], "worsens": [], "constant_bias_rms_deg": base.rms_deg,
+                            "too_few_origins": True}
+            continue
         if better:
             best = ", ".join(f"{label} by {100 * (1 - ratio):.0f} %" for ratio, label in sorted(better))
             lines.append(f"{result.axis}, {h:g} s: reduces the heading error: {best}.")
