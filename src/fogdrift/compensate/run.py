@@ -7,8 +7,6 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from ..errors import ConfigError
 from .engine import BIAS_ONLY, AxisPlan, StreamCompensator
 from .outputs import AllanAccumulator, CsvWriter, NpzWriter, plot_before_after

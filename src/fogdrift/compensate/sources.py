@@ -130,9 +130,9 @@ def _open_npy(path: Path, columns, time_column, rate_hz, time_unit) -> LogSource
         r_idx = [_column_index(k, cols, "columns", path) for k in keys]
     if not r_idx or len(set(r_idx)) != len(r_idx) or t_idx in r_idx:
         raise ConfigError(f"{path}: choose distinct rate columns other than the time column; got columns={columns!r}")
-    t_scale = TIME_UNITS[time_unit] if time_unit else 1.0
     if time_unit and time_unit not in TIME_UNITS:
         raise ConfigError(f"unknown time unit {time_unit!r}; expected one of {list(TIME_UNITS)}")
+    t_scale = TIME_UNITS[time_unit] if time_unit else 1.0
 
     def read(lo, hi):
         if fortran:

@@ -163,7 +163,6 @@ def heading_errors(rate_dph, dt_s, models, *, causal_window: int, wavelet="db2",
     >>> row.n_origins, 0.008 < row.rms_deg < 0.018
     (66, True)
     """
-    from ..models.kalman import Kalman  # noqa: F401  (rate-input models expose forecast_with_uncertainty)
     from ..compensate.predictors import causal_weights
 
     r = np.asarray(rate_dph, dtype=np.float64)
