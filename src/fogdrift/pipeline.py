@@ -526,8 +526,11 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
     if fitted is None:
         for model_name in cfg.models:
             model = make_model(model_name, cfg, progress)
+            if "dt_s" in model.get_params():  # state-space models (Kalman) work in seconds
+                model.set_params(dt_s=dt_s)
             t0 = time.perf_counter()
-            model.fit(drift["train"], drift["val"])
+            fit_on = blocks if model.input_kind == "rate" else drift  # a Kalman filter sees the rate itself
+            model.fit(fit_on["train"], fit_on["val"])
             fit_s[model.label] = time.perf_counter() - t0
             models[model.label] = model
     else:
@@ -541,8 +544,11 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
     with warnings.catch_warnings(record=True) as log:
         warnings.simplefilter("always", FogdriftWarning)
         for label, model in models.items():
-            yhat = model.predict(drift["test"], history=history)
-            yhat_c = model.predict(causal_test, history=causal_hist)
+            if model.input_kind == "rate":  # causal by construction: the same estimate for both targets
+                yhat = yhat_c = model.predict(blocks["test"], history=rate[:e])
+            else:
+                yhat = model.predict(drift["test"], history=history)
+                yhat_c = model.predict(causal_test, history=causal_hist)
             predictions[label], causal_predictions[label] = yhat, yhat_c
             y, p, pp = drift["test"][skip:], yhat[skip:], persist_pred[skip:]
             metrics[label] = evaluate(y, p, y_train=drift["train"], yhat_persistence=pp,

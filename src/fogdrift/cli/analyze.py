@@ -46,6 +46,10 @@ def analyze(
         "--causal-window", help="Window [s] of the causal (real-time) drift of the practical compensation.")] = 128.0,
     gm_window: Annotated[int, typer.Option("--gm-window", help="Rolling window [samples] of the one-step GM(1,1).")]
     = 8,
+    heading: Annotated[bool, typer.Option(
+        "--heading/--no-heading", help="Also print the heading-error table (rolling 300-s calibrations, free-run "
+                                       "forecasts) and the filtering-artefact check of every model on the test "
+                                       "block, with the verdicts headline first.")] = False,
     out: OutOpt = Path("out/analyze"),
 ):
     """The whole method: Allan analysis, separation, drift models, compensation, Table 2 and an HTML report."""
@@ -81,5 +85,19 @@ def analyze(
                                             metrics_rows(ax.models)))
                 for line in verdict(ax.models):
                     console.print("  " + line, highlight=False)
+        if heading:  # compensation evidence on the test block (fogdrift.evaluation)
+            from ..evaluation import evaluate_axis
+            from .compensate import print_evaluation
+
+            for ax in result.axes:
+                ev = evaluate_axis(ax.models, cfg)
+                for note in ev["notes"]:
+                    console.print("  " + note, highlight=False)
+                print_evaluation([ev["heading"]] if ev["heading"] else [],
+                                 [ev["artefacts"]] if ev["artefacts"] else [], ev["verdicts"])
         path = write_report(result, record, out)
         console.print(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
+        # the self-describing bundle 'fogdrift compensate' applies to other logs
+        from ..bundle import write_bundle
+
+        console.print(f"bundle: {write_bundle(out / 'bundle', [ax.models for ax in result.axes], cfg, record).path}")

@@ -59,3 +59,7 @@ def model(
                 console.print("  " + line, highlight=False)
         write_model_outputs(results, out)
         console.print(f"wrote models, metrics.json and figures to {out}")
+        # the self-describing bundle 'fogdrift compensate' applies to other logs
+        from ..bundle import write_bundle
+
+        console.print(f"bundle: {write_bundle(out / 'bundle', results, cfg, record).path}")

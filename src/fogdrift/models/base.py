@@ -51,6 +51,10 @@ class DriftModel:
     label = "model"
     #: True when ``fit`` uses ``y_val`` (early stopping); False: ``y_val`` is accepted and ignored.
     uses_validation = False
+    #: What the model is fed when it compensates a gyro: ``"drift"`` (a separated drift series, the
+    #: paper's framing; the causal drift in real time) or ``"rate"`` (the bias-removed rate itself, e.g.
+    #: a Kalman filter whose noise model includes the white noise).
+    input_kind = "drift"
 
     @classmethod
     def _param_names(cls) -> list[str]:
