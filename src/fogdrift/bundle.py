@@ -210,7 +210,8 @@ def _allan_noise_model(x, dt_s) -> dict:
     return {
         "source": "training block at the modelling rate",
         "A": [float(a) for a in fit.A],
-        "A_cov": [[float(c) for c in row] for row in np.asarray(fit.A_cov)],
+        "selected": list(fit.selected),
+        "fit_quality": {"chi2_red": float(fit.chi2_red), "p_value": float(fit.p_value), "quality": fit.quality},
         "A_unit": "(deg/h)^2 with tau in s: sigma^2(tau) = sum_n A_n tau^n, n = -2..2",
         "tau_range_s": [float(fit.tau_min_s), float(fit.tau_max_s)],
         "terms": {k: t.to_dict() for k, t in fit.terms.items()},
