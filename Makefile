@@ -19,7 +19,7 @@ $(STAMP): pyproject.toml
 venv: $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/fogdrift analyze $(DATA) --out $(OUT)
+	$(BIN)/fogdrift analyze $(DATA) --unit deg/h --out $(OUT)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -q

@@ -25,12 +25,12 @@ def report_dir(bundled_path, tmp_path_factory):
     """Run `fogdrift analyze` once on gz, applying the models to a second recording (gx of the same file
     renamed to gz: real data the models were not fitted on)."""
     tmp = tmp_path_factory.mktemp("analyze")
-    rec = load(bundled_path)
+    rec = load(bundled_path, unit="deg/h")
     other = tmp / "other <b>&.csv"
     gx = np.asarray(rec.axis("gx"))
     t = np.arange(gx.size) * rec.dt_s
     np.savetxt(other, np.column_stack([t, gx]), delimiter=",", header="t_s,gz", comments="", fmt="%.6f")
-    result = runner.invoke(app, ["analyze", str(bundled_path), "--columns", "gz", "--apply-to", str(other),
+    result = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--apply-to", str(other),
                                  "--out", str(tmp / "out"), *FAST])
     assert result.exit_code == 0, result.output + repr(result.exception)
     return tmp / "out", result.output
