@@ -8,8 +8,10 @@ printed as "Exception ignored on calling ctypes callback function" and dropped, 
 
 So an interruption here is a **flag** that survives such a loss:
 
-* :func:`request` sets it; :class:`SigintGuard` installs a SIGINT handler that sets it and then raises
-  :class:`Interrupted` (a ``KeyboardInterrupt``) at once, except inside :func:`critical` sections;
+* :func:`request` sets it; :class:`SigintGuard` installs a SIGINT handler that sets it, and raises
+  :class:`Interrupted` (a ``KeyboardInterrupt``) at once unless a JAX/numba/llvmlite frame is on the main
+  thread's stack or a :func:`critical` section is running (there an exception could be dropped, or unwind
+  through a compiler and crash it);
 * :func:`check` and :func:`checkpoint` raise :class:`Interrupted` whenever the flag is set.  The library calls
   :func:`checkpoint` between stages, axes and models (:mod:`fogdrift.pipeline`); progress callbacks (Allan
   taus, training epochs) call :func:`check`, so a dropped interrupt is raised again within one step;
@@ -40,6 +42,7 @@ __all__ = [
     "requested",
     "reset",
     "stage_listener",
+    "FOREIGN_RUNTIMES",
 ]
 
 
@@ -128,9 +131,28 @@ def critical():
     check()
 
 
+#: Packages whose Python code runs inside compiled runtimes (tracing, lowering, compiling, object-cache
+#: callbacks): an exception raised in the middle of them can be dropped or leave the runtime broken (a crash at
+#: exit was seen when a KeyboardInterrupt unwound through XLA lowering), so the handler only sets the flag there.
+FOREIGN_RUNTIMES = ("jax", "jaxlib", "numba", "llvmlite", "optax")
+
+
+def _safe_to_raise(frame) -> bool:
+    """Raise at once unless a compiled runtime's Python frame is on the stack (see FOREIGN_RUNTIMES)."""
+    if frame is None:
+        return False
+    while frame is not None:
+        top = str(frame.f_globals.get("__name__", "")).partition(".")[0]
+        if top in FOREIGN_RUNTIMES:
+            return False
+        frame = frame.f_back
+    return True
+
+
 class SigintGuard:
-    """Context manager: SIGINT sets the interruption flag and raises :class:`Interrupted`; a watchdog calls
-    ``on_timeout()`` if the block is still running ``grace_s`` seconds after the first SIGINT.
+    """Context manager: SIGINT sets the interruption flag and raises :class:`Interrupted` where that is safe (see
+    the module docstring); a watchdog calls ``on_timeout()`` if the block is still running ``grace_s`` seconds
+    after the first SIGINT.
 
     Only effective in the main thread, and not when SIGINT is ignored on entry (a background job of a
     non-interactive shell: the shell asked for Ctrl-C not to reach it).  On exit the previous handler, wakeup
@@ -155,7 +177,7 @@ class SigintGuard:
     # -- the handler -------------------------------------------------------------------------------
     def _handler(self, signum, frame):
         request()
-        if _critical_depth == 0:
+        if _critical_depth == 0 and _safe_to_raise(frame):
             raise Interrupted()
 
     def _unraisable(self, unraisable):

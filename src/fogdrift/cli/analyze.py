@@ -8,10 +8,13 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import ConfigError
-from ._app import (EstOpt, FitTausOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, console,
-                   csv_list, errors, parse_fit_taus, parse_level, parse_taus, progress, with_load_options)
+from ._app import (EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app,
+                   check_model_rate, check_plausible, console, csv_list, echo_record, parse_fit_taus, parse_level,
+                   parse_taus, precheck, progress, run, say, with_load_options)
 from ._tables import metrics_table, noise_table
-from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt
+from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt, model_axes_text
+
+DEFAULT_OUT = Path("out/analyze")
 
 
 @app.command()
@@ -44,29 +47,44 @@ def analyze(
         "--causal-window", help="Window [s] of the causal (real-time) drift of the practical compensation.")] = 128.0,
     gm_window: Annotated[int, typer.Option("--gm-window", help="Rolling window [samples] of the one-step GM(1,1).")]
     = 8,
-    out: OutOpt = Path("out/analyze"),
+    out: OutOpt = DEFAULT_OUT,
+    json_out: JsonOpt = False,
 ):
     """The whole method: Allan analysis, separation, drift models, compensation, Table 2 and an HTML report."""
     from ..pipeline import AnalysisConfig, run_analysis
     from ..report import metrics_rows, noise_row, verdict, write_report
 
-    with errors():
-        record = load.load()
-        other = load.load(apply_to) if apply_to else None
+    with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to], json_out=json_out,
+             expect=("analysis.json", "report.html")) as r:
         earth = {}
         for item in earth_axis or []:
             name, sep, orient = item.partition("=")
             if not sep:
                 raise ConfigError(f"--earth-axis must look like AXIS=ORIENTATION (e.g. gz=up), got {item!r}")
             earth[name.strip()] = orient.strip()
+        term_list = tuple(t.upper() for t in (csv_list(terms) or []))
+        precheck(wavelet=wavelet, mode=mode, training=training, estimator=estimator, terms=term_list)
         cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
                              training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
                              model_rate_hz=model_rate or None, taus=parse_taus(taus), estimator=estimator,
-                             terms=tuple(t.upper() for t in csv_list(terms)), latitude_deg=latitude,
+                             terms=term_list, latitude_deg=latitude,
                              earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), train_fraction=train_fraction,
-                             val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window)
-        with progress("analyze") as (_, epoch_cb):
+                             val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window).validate()
+        if apply_to is not None and not apply_to.is_file():
+            raise ConfigError(f"--apply-to {apply_to}: no such file")
+        record = load.load()
+        check_model_rate(record, cfg.model_rate_hz)
+        echo_record(load, record)
+        check_plausible(record)
+        other = None
+        if apply_to:
+            other = load.load(apply_to)
+            check_model_rate(other, cfg.model_rate_hz)
+            echo_record(load, other, apply_to)
+            check_plausible(other)
+        with progress("analyze", record.axis_names) as (_, epoch_cb):
             result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb)
+        say(model_axes_text([ax.models for ax in result.axes], record))
         for res, title in ((result, load.file.name), (result.apply_to, apply_to.name if apply_to else "")):
             if res is None:
                 continue
@@ -74,10 +92,12 @@ def analyze(
                 console.print(noise_table(f"{title} axis {ax.name}: Table 2 (test block, {ax.models.dt_s:g} s "
                                           "samples; 95 % intervals)",
                                           [["original (whole record, native rate)"] + noise_row(ax.original.noise)]
-                                          + [[r.label] + noise_row(r.analysis.noise) for r in ax.table2]))
+                                          + [[row.label] + noise_row(row.analysis.noise) for row in ax.table2]))
                 console.print(metrics_table(f"{title} axis {ax.name}: one-step metrics on the test block",
                                             metrics_rows(ax.models)))
                 for line in verdict(ax.models):
-                    console.print("  " + line, highlight=False)
-        path = write_report(result, record, out)
-        console.print(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
+                    say("  " + line)
+        path = write_report(result, record, r.out.path)
+        r.wrote()
+        say(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
+        r.print_json(r.out.path / "analysis.json")
