@@ -19,6 +19,7 @@ $(STAMP): pyproject.toml
 venv: $(STAMP)
 
 demo: $(STAMP)
+	mkdir -p $(dir $(OUT))
 	$(BIN)/fogdrift analyze $(DATA) --unit deg/h --out $(OUT)
 
 test: $(STAMP)

@@ -10,7 +10,8 @@
   write, the files the previous run's manifest lists are removed (and the folders it created, when empty):
   the folder then holds the files of one run only, listed in its manifest with ``"complete": true`` once the
   run finished.  Files fogdrift did not write (not in a manifest) are never touched; nor are the run's inputs.
-  Leftover temporary files of a process that no longer runs are removed at the first write too.
+  Leftover temporary files of a process that no longer runs (in the folder and the subfolders the previous run
+  created) are removed at the first write too.
 
 An interrupted run (see :mod:`fogdrift.interrupt`) leaves only complete files; :meth:`OutputDir.summary` says
 which were written and which were not.
@@ -285,11 +286,13 @@ class OutputDir:
             if target is not None and target.is_dir() and not any(target.iterdir()):
                 with contextlib.suppress(OSError):
                     target.rmdir()
-        for stale in self.path.rglob(TMP_PREFIX + "*"):
-            m = _TMP.match(stale.name)
-            if m and stale.is_file() and not _pid_alive(int(m.group(1))):
-                with contextlib.suppress(OSError):
-                    stale.unlink()
+        folders = [self.path] + [d for d in (self._inside(r) for r in previous.get("dirs", [])) if d is not None]
+        for folder in folders:  # not recursive: --out may be a big folder of other things
+            for stale in (folder.glob(TMP_PREFIX + "*") if folder.is_dir() else ()):
+                m = _TMP.match(stale.name)
+                if m and stale.is_file() and not _pid_alive(int(m.group(1))):
+                    with contextlib.suppress(OSError):
+                        stale.unlink()
         self._opened = True
         self._write_manifest()
 
