@@ -24,13 +24,12 @@ from __future__ import annotations
 import contextlib
 import functools
 import inspect
-import json
 import os
 import sys
 import threading
 import typing
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -294,12 +293,11 @@ class Run:
     """What :func:`run` hands a command: the output folder and the --json switch."""
 
     out: OutputDir
-    json: bool = False
-    files: dict = field(default_factory=dict)
+    json_out: bool = False
 
     def print_json(self, path) -> None:
         """Under --json, print the JSON file the run wrote to stdout (the only thing on stdout)."""
-        if self.json:
+        if self.json_out:
             sys.stdout.write(Path(path).read_text(encoding="utf-8").rstrip("\n") + "\n")
             sys.stdout.flush()
 

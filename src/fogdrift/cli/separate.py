@@ -59,6 +59,6 @@ def separate(
             if s.level_scan:
                 say("  level scan: " + "; ".join(
                     f"L{d.level}: noise slope {d.noise_adev_slope:+.2f}" for d in s.level_scan))
-        files = write_separation_outputs(seps, r.out.path)
+        write_separation_outputs(seps, r.out.path)
         r.wrote()
         r.print_json(r.out.path / "separation.json")
