@@ -70,7 +70,7 @@ def test_training_input_is_described(fitted, tmp_path):
     np.save(path, np.asarray(rec.rate_dph))
     from fogdrift.io import load
 
-    loaded = load(path, rate_hz=10.0)
+    loaded = load(path, rate_hz=10.0, unit="deg/h")
     axes2 = run_models(loaded, AnalysisConfig(models=("persistence",)))
     b = write_bundle(tmp_path / "bundle", axes2, AnalysisConfig(models=("persistence",)), loaded)
     doc = json.loads((tmp_path / "bundle" / "manifest.json").read_text())
@@ -142,7 +142,7 @@ def test_modified_or_missing_model_files_are_refused(fitted, tmp_path):
 def test_model_command_writes_a_loadable_bundle(bundled_path, tmp_path):
     from fogdrift.cli import app
 
-    result = CliRunner().invoke(app, ["model", str(bundled_path), "--columns", "gz", "--models", "ar,persistence",
+    result = CliRunner().invoke(app, ["model", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models", "ar,persistence",
                                       "--out", str(tmp_path)])
     assert result.exit_code == 0, result.output
     b = load_bundle(tmp_path / "bundle")

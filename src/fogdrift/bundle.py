@@ -50,6 +50,7 @@ import numpy as np
 from . import __version__
 from ._util import json_default
 from .errors import ConfigError, FogdriftError, ModelFileError
+from .output import atomic_path
 
 __all__ = [
     "BUNDLE_FORMAT",
@@ -308,7 +309,9 @@ def save_bundle(bundle: Bundle, out_dir) -> Path:
         "axes": axes_doc,
     }
     text = json.dumps(_finite(json.loads(json.dumps(doc, default=json_default))), indent=2, allow_nan=False)
-    (out / MANIFEST).write_text(text)
+    # the manifest last and whole (temporary name, renamed): a bundle without one is incomplete, never half-read
+    with atomic_path(out / MANIFEST) as tmp:
+        tmp.write_text(text)
     return out
 
 

@@ -34,6 +34,7 @@ from typing import Callable
 import numpy as np
 
 from .errors import ConfigError, FogdriftWarning, InsufficientDataError
+from .interrupt import checkpoint  # a stop point between stages/axes/models; reports the stage to listeners
 from .io import file_sha256
 from .models import MODEL_NAMES  # registry order = report order
 from .models import build_model as make_model  # make_model(name, cfg, progress=None), old name kept for now
@@ -188,7 +189,8 @@ class SeparationAxis:
     """Lifting separation of one axis at the modelling rate.
 
     ``rate_dph`` is the (bias-removed) rate, ``drift_dph + noise_dph == rate_dph``; each of ``rows`` is
-    ``(label, AllanAxis)`` for original / drift / noise.
+    ``(label, AllanAxis)`` for original / drift / noise.  ``mean_removed_dph`` is the mean that
+    :func:`run_separation` subtracted before separating (None when the caller removed a bias itself).
     """
 
     name: str
@@ -199,12 +201,14 @@ class SeparationAxis:
     noise_dph: np.ndarray
     rows: list
     level_scan: list | None = None
+    mean_removed_dph: float | None = None
 
     def to_dict(self) -> dict:
         return {
             "name": self.name,
             "dt_s": self.dt_s,
             "level": self.level,
+            "mean_removed_dph": self.mean_removed_dph,
             "n_samples": int(self.rate_dph.size),
             "max_abs_reconstruction_error_dph": float(np.max(np.abs(self.drift_dph + self.noise_dph - self.rate_dph))),
             "rows": [{"label": label, **row.to_dict()} for label, row in self.rows],
@@ -456,8 +460,11 @@ def _check_earth_axes(record, cfg: AnalysisConfig) -> None:
 def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | None = None) -> list[AllanAxis]:
     """Allan variance and noise identification of every axis of a record at its native rate."""
     cfg = (cfg or AnalysisConfig()).validate()
-    return [analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True)
-            for name in record.axis_names]
+    out = []
+    for name in record.axis_names:
+        checkpoint("Allan variance", axis=name)
+        out.append(analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True))
+    return out
 
 
 def run_separation(record, cfg: AnalysisConfig | None = None) -> list[SeparationAxis]:
@@ -466,9 +473,12 @@ def run_separation(record, cfg: AnalysisConfig | None = None) -> list[Separation
     rec = _model_record(record, cfg)
     out = []
     for name in rec.axis_names:
+        checkpoint("separation", axis=name)
         x = np.asarray(rec.axis(name), dtype=np.float64)
         # A constant goes wholly into the drift; remove it so the drift shows the variation only.
-        out.append(_separation_axis(name, x - x.mean(), rec.dt_s, cfg))
+        sep = _separation_axis(name, x - x.mean(), rec.dt_s, cfg)
+        sep.mean_removed_dph = float(x.mean())
+        out.append(sep)
     return out
 
 
@@ -525,6 +535,7 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
     models, fit_s = {}, {}
     if fitted is None:
         for model_name in cfg.models:
+            checkpoint("fitting", axis=name, model=model_name)
             model = make_model(model_name, cfg, progress)
             if "dt_s" in model.get_params():  # state-space models (Kalman) work in seconds
                 model.set_params(dt_s=dt_s)
@@ -536,6 +547,7 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
     else:
         models = dict(fitted)
 
+    checkpoint("evaluating", axis=name)
     predictions, causal_predictions, metrics, causal_metrics, p0_meas = {}, {}, {}, {}, {}
     # Score only predictions whose inputs lie inside the test block: the first `lags` use history from the
     # validation block, whose drift was separated on its own and carries that block's end effect.
@@ -587,6 +599,7 @@ def run_models(record, cfg: AnalysisConfig | None = None, progress=None) -> list
     rec = _model_record(record, cfg)
     out = []
     for name in rec.axis_names:
+        checkpoint("separation", axis=name)
         rate, bias, earth = _prepared_axis(rec, name, cfg)
         lvl_cfg = _with_level(cfg, _resolved_level(rate, cfg, rec.dt_s)[0])
         out.append(_fit_axis_models(name, rate, rec.dt_s, lvl_cfg, bias, earth, progress))
@@ -595,6 +608,7 @@ def run_models(record, cfg: AnalysisConfig | None = None, progress=None) -> list
 
 def _table2(ma: ModelAxis, cfg: AnalysisConfig) -> list[CompensatedSignal]:
     """Allan analysis of original, drift and every compensated signal on the test block."""
+    checkpoint("Table 2", axis=ma.name)
     e, f = ma.split["test"]
     k = ma.score_from
     raw = ma.rate_dph[e + k:f]
@@ -631,9 +645,11 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
     rec_m = _model_record(record, cfg)
     axes = []
     for name in record.axis_names:
+        checkpoint("Allan variance (native rate)", axis=name)
         original = analyse_allan(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s, cfg)
         original.outliers = outlier_reports[name]
         original.noise.outliers = outlier_reports[name].to_dict()
+        checkpoint("separation", axis=name)
         rate, bias, earth = _prepared_axis(rec_m, name, cfg)
         sep = _separation_axis(name, rate, rec_m.dt_s, cfg)
         lvl_cfg = _with_level(cfg, sep.level)

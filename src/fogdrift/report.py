@@ -12,11 +12,13 @@ import base64
 import html
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 
 from ._util import json_default
+from .output import atomic_path
 
 __all__ = [
     "NOISE_HEADERS",
@@ -193,9 +195,9 @@ def _clean(obj):
 
 def write_json(obj, path) -> Path:
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     data = json.loads(json.dumps(obj, default=json_default))
-    path.write_text(json.dumps(_clean(data), indent=2, allow_nan=False))
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(_clean(data), indent=2, allow_nan=False))
     return path
 
 
@@ -210,10 +212,17 @@ def _plt():
 
 def _save(fig, path) -> Path:
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    _plt().close(fig)
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110, bbox_inches="tight")
+    finally:
+        _plt().close(fig)
     return path
+
+
+def _safe(name) -> str:
+    """An axis or model name as a file-name part (deterministic; no path separators)."""
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._") or "axis"
 
 
 # -------------------------------------------------------------------------------------------------------------
@@ -374,8 +383,7 @@ def _noise_csv_header():
 
 def _write_rows_csv(path, header, rows) -> Path:
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w") as fh:
+    with atomic_path(path) as tmp, open(tmp, "w") as fh:
         fh.write(",".join(header) + "\n")
         for row in rows:
             fh.write(",".join(str(c) for c in row) + "\n")
@@ -385,7 +393,6 @@ def _write_rows_csv(path, header, rows) -> Path:
 def write_allan_outputs(allan_axes, record, out_dir) -> dict:
     """``allan.json``, ``allan.csv`` (curve of every axis, with units) and ``allan.png``."""
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     write_json({"source": record.source, "record": record.metadata(),
                 "axes": [a.to_dict() for a in allan_axes]}, out / "allan.json")
     rows = []
@@ -408,37 +415,37 @@ def write_allan_outputs(allan_axes, record, out_dir) -> dict:
 def write_separation_outputs(seps, out_dir) -> dict:
     """Drift and noise series (CSV and NPZ), Fig. 5 and 6 per axis, the Q..R table (JSON and CSV)."""
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     arrays = {}
     for s in seps:
         arrays[f"{s.name}_input_dph"] = s.rate_dph
         arrays[f"{s.name}_drift_dph"] = s.drift_dph
         arrays[f"{s.name}_noise_dph"] = s.noise_dph
-    np.savez(out / "separation.npz", dt_s=np.array(seps[0].dt_s), **arrays)
+    with atomic_path(out / "separation.npz") as tmp:
+        np.savez(tmp, dt_s=np.array(seps[0].dt_s), **arrays)
     n = seps[0].rate_dph.size
     cols = ["t_s"] + list(arrays)
     data = np.column_stack([np.arange(n) * seps[0].dt_s] + [arrays[c] for c in cols[1:]])
-    np.savetxt(out / "separation.csv", data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+    with atomic_path(out / "separation.csv") as tmp:
+        np.savetxt(tmp, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
     rows = [_noise_csv_rows(f"{s.name}:{label}", aa) for s in seps for label, aa in s.rows]
     _write_rows_csv(out / "separation_table.csv", _noise_csv_header(), rows)
     write_json({"axes": [s.to_dict() for s in seps]}, out / "separation.json")
     files = {}
     for s in seps:
-        files[f"fig5_{s.name}"] = plot_separation(s, out / f"fig5_drift_noise_{s.name}.png")
-        files[f"fig6_{s.name}"] = plot_separation_allan(s, out / f"fig6_allan_{s.name}.png")
+        files[f"fig5_{s.name}"] = plot_separation(s, out / f"fig5_drift_noise_{_safe(s.name)}.png")
+        files[f"fig6_{s.name}"] = plot_separation_allan(s, out / f"fig6_allan_{_safe(s.name)}.png")
     return files
 
 
 def write_model_outputs(model_axes, out_dir) -> dict:
     """Saved models (JSON + NPZ), metrics JSON, Fig. 8 and 9 per axis."""
     out = Path(out_dir)
-    (out / "models").mkdir(parents=True, exist_ok=True)
     for ma in model_axes:
         for label, model in ma.fitted.items():
             safe = label.replace("(", "").replace(")", "").replace(",", "").replace(" ", "_").lower()
-            model.save(out / "models" / f"{ma.name}_{safe}")
-        plot_models(ma, out / f"fig8_models_{ma.name}.png")
-        plot_residuals(ma, out / f"fig9_residual_{ma.name}.png")
+            model.save(out / "models" / f"{_safe(ma.name)}_{_safe(safe)}")
+        plot_models(ma, out / f"fig8_models_{_safe(ma.name)}.png")
+        plot_residuals(ma, out / f"fig9_residual_{_safe(ma.name)}.png")
     write_json({"axes": [ma.to_dict() for ma in model_axes]}, out / "metrics.json")
     return {"dir": out}
 
@@ -516,12 +523,14 @@ def _analysis_section(result, fig_dir, title, fig_offset=0) -> str:
         parts.append("<h4>Metrics on the test block (target: causal drift)</h4>")
         parts.append(_table(METRICS_HEADERS, causal_metrics_rows(ma), "metrics"))
         parts.append('<div class="verdict"><p>' + "</p><p>".join(html.escape(v) for v in verdict(ma)) + "</p></div>")
+        # deterministic names: the figure number and the axis; the applied section's files start "apply_to_"
+        pre, name = ("apply_to_" if fig_offset else ""), _safe(ax.name)
         figs = [
-            plot_allan([ax.original], fig_dir / f"fig3_allan_{ax.name}_{fig_offset}.png", "Allan deviation (Fig. 3)"),
-            plot_separation(ax.separation, fig_dir / f"fig5_{ax.name}_{fig_offset}.png"),
-            plot_separation_allan(ax.separation, fig_dir / f"fig6_{ax.name}_{fig_offset}.png"),
-            plot_models(ma, fig_dir / f"fig8_{ax.name}_{fig_offset}.png", 8 + fig_offset),
-            plot_residuals(ma, fig_dir / f"fig9_{ax.name}_{fig_offset}.png", 9 + fig_offset),
+            plot_allan([ax.original], fig_dir / f"{pre}fig3_allan_{name}.png", "Allan deviation (Fig. 3)"),
+            plot_separation(ax.separation, fig_dir / f"{pre}fig5_drift_noise_{name}.png"),
+            plot_separation_allan(ax.separation, fig_dir / f"{pre}fig6_allan_{name}.png"),
+            plot_models(ma, fig_dir / f"{pre}fig{8 + fig_offset}_models_{name}.png", 8 + fig_offset),
+            plot_residuals(ma, fig_dir / f"{pre}fig{9 + fig_offset}_residual_{name}.png", 9 + fig_offset),
         ]
         parts += [_img(p) for p in figs]
     return "\n".join(parts)
@@ -531,7 +540,6 @@ def write_report(result, record, out_dir, apply_record=None) -> Path:
     """Write ``report.html`` (figures embedded as base64, nothing fetched) plus ``analysis.json``."""
     out = Path(out_dir)
     fig_dir = out / "figures"
-    fig_dir.mkdir(parents=True, exist_ok=True)
     write_json(result.to_dict(), out / "analysis.json")
     body = [f"<h1>fogdrift analysis of {html.escape(Path(result.source).name)}</h1>",
             '<p class="note">Rates in deg/h, τ in s. Method: Tang et al., Chinese J. Lasers 39(10) 2012, with the '
@@ -546,5 +554,6 @@ def write_report(result, record, out_dir, apply_record=None) -> Path:
     doc = (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>fogdrift report</title>"
            f"<style>{_CSS}</style></head><body>{''.join(body)}</body></html>")
     path = out / "report.html"
-    path.write_text(doc, encoding="utf-8")
+    with atomic_path(path) as tmp:
+        tmp.write_text(doc, encoding="utf-8")
     return path
