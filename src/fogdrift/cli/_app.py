@@ -123,12 +123,15 @@ class LoadOptions:
     time_column: str = "auto"
     gaps: str = "error"
 
-    def load(self, path=None):
-        """Load ``path`` (default: ``file``) with these options; ``--gaps longest`` keeps the longest segment."""
+    def load(self, path=None, *, unit=None, time_unit=None):
+        """Load ``path`` (default: ``file``) with these options; ``--gaps longest`` keeps the longest segment.
+
+        ``unit`` / ``time_unit`` override ``--unit`` / ``--time-unit`` (a second recording's own units)."""
         from ..io import load, load_segments
 
         path = self.file if path is None else path
-        kwargs = dict(columns=csv_list(self.columns), rate_hz=self.rate, unit=self.unit, time_unit=self.time_unit,
+        kwargs = dict(columns=csv_list(self.columns), rate_hz=self.rate, unit=unit or self.unit,
+                      time_unit=time_unit or self.time_unit,
                       time_column=None if self.time_column.lower() == "none" else self.time_column)
         if self.gaps == "error":
             return load(path, **kwargs)
