@@ -316,7 +316,10 @@ def _describe_excluded(ctx: _Context, start: int, sel) -> str:
     elif slope < -1.0:
         kind = f"a slope of {slope:+.2f}, steeper than quantization's -1: not an IEEE-952 term"
     else:
-        kind = f"a shape no IEEE-952 term describes (ADEV up to {100 * (ratio.max() - 1):+.0f} % off the model)"
+        dev = ratio[:-1] - 1.0 if start >= 1 else ratio - 1.0
+        k = int(np.argmax(np.abs(dev)))
+        kind = (f"a shape no IEEE-952 term describes: the ADEV is {'above' if dev[k] > 0 else 'below'} the model by up "
+                f"to {100 * abs(dev[k]):.2g} %, many times its statistical error there")
     return kind
 
 
@@ -589,14 +592,20 @@ def _classical_b(c: _Context, A, floor_refused: bool = False) -> dict:
     value = math.sqrt(var[k]) / B_FACTOR
     at_edge = k >= grid.size - 2
     lo = math.sqrt(c.y[j] * (c.y[j] / c.y_hi[j])) / B_FACTOR  # symmetric-in-log guess of the lower bound
+    rule = ("min of the fitted ADEV / 0.664 (IEEE Std 952-1997 C.2); an upper bound when the curve still falls at "
+            "the longest fitted tau")
+    jm = int(np.argmin(c.y))
     if at_edge:  # two valid upper bounds: the fitted curve's end and the measured minimum; keep the tighter
-        jm = int(np.argmin(c.y))
         if math.sqrt(c.y[jm]) / B_FACTOR < value:
             value, j, k = math.sqrt(c.y[jm]) / B_FACTOR, jm, None
+    elif not lo <= value <= math.sqrt(c.y_hi[j]) / B_FACTOR:
+        # the fitted curve misses the measured points at its minimum (a poor fit): read the measured curve
+        value, j, k = math.sqrt(c.y[jm]) / B_FACTOR, jm, None
+        lo = math.sqrt(c.y[j] * (c.y[j] / c.y_hi[j])) / B_FACTOR
+        rule = ("min of the measured ADEV / 0.664 (IEEE Std 952-1997 C.2): the fitted curve misses the measured "
+                "points at its minimum")
     return {
         "value": value, "unit": "deg/h", "tau_s": float(grid[k] if k is not None else c.tau[j]),
         "bound_only": bool(at_edge),
-        "lo95": None if at_edge else lo, "hi95": math.sqrt(c.y_hi[j]) / B_FACTOR,
-        "rule": "min of the fitted ADEV / 0.664 (IEEE Std 952-1997 C.2); an upper bound when the curve still "
-                "falls at the longest fitted tau",
+        "lo95": None if at_edge else lo, "hi95": math.sqrt(c.y_hi[j]) / B_FACTOR, "rule": rule,
     }
