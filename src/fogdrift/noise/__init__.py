@@ -27,6 +27,7 @@ from .identify import POOR_CHI2_RED, identify, thin_taus
 from .readouts import Readout, slope_readouts
 from .result import TERM_STATUSES, NoiseFit, NoiseTerm
 from .terms import (
+    DISPLAY_UNITS,
     TERM_HEADERS,
     TERM_TABLE,
     TERM_UNITS,
@@ -54,6 +55,7 @@ __all__ = [
     "TERMS",
     "TERM_UNITS",
     "TERM_HEADERS",
+    "DISPLAY_UNITS",
     "TERM_TABLE",
     "TermSpec",
     "term_spec",
