@@ -29,7 +29,7 @@ import time
 import jax
 import numpy as np
 
-from fogdrift.elman import Elman, GreyElman, fit_many
+from fogdrift.models.elman import Elman, GreyElman, fit_many
 from fogdrift.models import Persistence
 
 

@@ -16,6 +16,9 @@ The ``numpy`` column runs the same lifting steps with the NumPy reference kernel
 Usage::
 
     python bench/bench_lifting.py --sizes 1e6,1e7,1e8 [--wavelet db2] [--level 4]
+
+``--wavelet`` takes any name of ``fogdrift.lifting.wavelist()`` (haar, db2, db4); each has a
+PyWavelets counterpart of the same name (``LiftingScheme.pywt_name``).
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ from fogdrift import lifting
 
 def _pywt_separate(x, wavelet, level):
     n = x.shape[0]
+    wavelet = lifting.get_wavelet(wavelet).pywt_name
     c = pywt.wavedec(x, wavelet, mode="periodization", level=level)
     drift = pywt.waverec([c[0]] + [np.zeros_like(b) for b in c[1:]], wavelet, mode="periodization")[:n]
     noise = pywt.waverec([np.zeros_like(c[0])] + c[1:], wavelet, mode="periodization")[:n]
@@ -116,7 +120,7 @@ def _table(rows, backends):
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--sizes", default="1e6,1e7", help="comma-separated sample counts, e.g. 1e6,1e7,1e8")
-    p.add_argument("--wavelet", default="db2")
+    p.add_argument("--wavelet", default="db2", choices=lifting.wavelist())
     p.add_argument("--level", type=int, default=4)
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--backends", default="numba,numpy", help="lifting kernels to time")

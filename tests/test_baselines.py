@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from fogdrift.baselines import AR, ar_aic, ar_fit
+from fogdrift.models.ar import AR, ar_aic, ar_fit
 from fogdrift.errors import ConfigError, InsufficientDataError, NotFittedError
-from fogdrift.grey import GM11
+from fogdrift.models.grey import GM11
 from fogdrift.metrics import rmse
 from fogdrift.models import Persistence, load_model
 
@@ -99,6 +99,19 @@ def test_predict_and_forecast_by_hand():
     # a stationary AR forecast converges to its mean
     mu = c / (1 - phi.sum())
     assert model.forecast(400)[-1] == pytest.approx(mu, abs=1e-6)
+
+
+def test_persistence_by_definition():
+    """predict(y, history) == [history[-1], y[0], ..., y[-2]] exactly; forecasts repeat the last sample."""
+    rng = np.random.default_rng(11)
+    train, hist, y = rng.normal(size=50), rng.normal(size=30), rng.normal(size=20)
+    model = Persistence().fit(train)
+    assert model.predict(y, history=hist).tolist() == [hist[-1], *y[:-1]]
+    without = model.predict(y)
+    assert math.isnan(without[0]) and without[1:].tolist() == y[:-1].tolist()
+    assert model.predict(y[:1], history=hist).tolist() == [hist[-1]]
+    assert model.forecast(4).tolist() == [train[-1]] * 4
+    assert model.forecast(3, history=hist).tolist() == [hist[-1]] * 3
 
 
 def test_ar_errors_and_persistence(tmp_path):

@@ -1,4 +1,4 @@
-"""Tests of fogdrift.elman: Elman / grey-Elman networks (Tang et al. 2012, eqs. (11)-(13)).
+"""Tests of fogdrift.models.elman: Elman / grey-Elman networks (Tang et al. 2012, eqs. (11)-(13)).
 
 Independent checks used here:
 
@@ -7,7 +7,8 @@ Independent checks used here:
   digits; computed in float64).
 * Central finite differences (float64, step 1e-6) of the loss w.r.t. every weight, rel 1e-5,
   for full BPTT and for classic BP (gradient of a loss whose context sequence is frozen).
-* np.cumsum / np.diff for the AGO restore rules (method notes §3.1, §4.1, R13).
+* np.cumsum / np.diff for the AGO restore rules (method notes §3.1, §4.1, R13), and a NumPy
+  re-implementation of the grey-Elman free run, eq. (13).
 * A seeded synthetic drift with learnable structure, scored against persistence.
 """
 
@@ -19,7 +20,16 @@ import pytest
 jax = pytest.importorskip("jax")
 import jax.numpy as jnp  # noqa: E402
 
-from fogdrift.elman import Elman, GreyElman, elman_forward, elman_loss, fit_many, init_params  # noqa: E402
+from fogdrift.models.elman import (  # noqa: E402
+    Elman,
+    ElmanCell,
+    GreyElman,
+    elman_forward,
+    elman_loss,
+    fit_many,
+    init_params,
+)
+from fogdrift.models.training import RecurrentCell  # noqa: E402
 from fogdrift.errors import ConfigError, InsufficientDataError, NotFittedError  # noqa: E402
 from fogdrift.models import Persistence, load_model  # noqa: E402
 
@@ -195,26 +205,53 @@ def test_save_load_identical(tmp_path, drift, fitted):
         model.progress = None
 
 
-def test_changing_test_block_leaves_fit_unchanged(drift):
+@pytest.mark.parametrize("cls, kw", [(Elman, {}), (GreyElman, {"ago_frame": "global"})])
+def test_validation_block_drives_early_stopping_but_not_normalisation(drift, cls, kw):
+    """Fit on the same training block with two very different validation blocks: early stopping sees
+    the difference (so the check below is not vacuous), the z-score statistics, the training
+    length and the forecast start do not; they equal the statistics of y_train computed here."""
     y = drift[:1200]
     n_tr, n_va = 700, 250
-    kw = QUICK
-    a = Elman(**kw).fit(y[:n_tr], y[n_tr:n_tr + n_va])
-    y2 = y.copy()
-    y2[n_tr + n_va:] += np.random.default_rng(5).normal(0, 1.0, y.size - n_tr - n_va)
-    b = Elman(**kw).fit(y2[:n_tr], y2[n_tr:n_tr + n_va])
-    for key in a.params_:
-        np.testing.assert_array_equal(a.params_[key], b.params_[key])
-    assert (a.x_mean_, a.x_std_) == (b.x_mean_, b.x_std_)
-    # normalisation comes from the training part only: changing the held-out tail of y_train
-    # changes early stopping data but not the z-score statistics
-    n_fit = n_tr + n_va - round(0.2 * (n_tr + n_va))  # val_fraction 0.2 held out chronologically
-    c = GreyElman(**kw, ago_frame="global").fit(y[:n_tr + n_va])
-    d = GreyElman(**kw, ago_frame="global").fit(np.r_[y[:n_fit], y[n_fit:n_tr + n_va] * 3])
+    train, val = y[:n_tr], y[n_tr:n_tr + n_va]
+    a = cls(**QUICK, **kw).fit(train, val)
+    b = cls(**QUICK, **kw).fit(train, val * 3.0 + 1.0)
+    assert not np.array_equal(a.val_curve_, b.val_curve_)
+    assert (a.x_mean_, a.x_std_, a.n_train_) == (b.x_mean_, b.x_std_, b.n_train_)
+    assert a.x_mean_ == pytest.approx(np.mean(train), rel=1e-12)
+    assert a.x_std_ == pytest.approx(np.std(train), rel=1e-12)
+    assert a.n_train_ == n_tr
+    np.testing.assert_array_equal(a.history_, b.history_)
+    assert a.x1_last_ == b.x1_last_
+    if cls is GreyElman:
+        x1 = np.cumsum((train - np.mean(train)) / np.std(train))
+        assert (a.x1_mean_, a.x1_std_) == (b.x1_mean_, b.x1_std_)
+        assert a.x1_mean_ == pytest.approx(np.mean(x1), rel=1e-9)
+        assert a.x1_std_ == pytest.approx(np.std(x1), rel=1e-9)
+
+
+def test_held_out_tail_is_not_used_for_normalisation(drift):
+    """Without y_val, the last val_fraction of y_train is held out for early stopping; changing that
+    tail changes the stopping data but not the z-score statistics (training part only)."""
+    y = drift[:950]
+    n_fit = 950 - round(0.2 * 950)  # val_fraction 0.2 held out chronologically
+    c = GreyElman(**QUICK, ago_frame="global").fit(y)
+    d = GreyElman(**QUICK, ago_frame="global").fit(np.r_[y[:n_fit], y[n_fit:] * 3])
     assert c.n_train_ == n_fit
-    assert c.best_epoch_ != d.best_epoch_ or c.val_curve_[0] != d.val_curve_[0]  # the tail was used
+    assert not np.array_equal(c.val_curve_, d.val_curve_)  # the tail was used
     assert (c.x_mean_, c.x_std_, c.x1_mean_, c.x1_std_) == (d.x_mean_, d.x_std_, d.x1_mean_, d.x1_std_)
     assert c.x_mean_ == pytest.approx(np.mean(y[:n_fit]), rel=1e-12)
+
+
+def test_grey_global_predictions_never_use_the_future(drift):
+    """The paper-literal framing accumulates from the first history sample: still causal, so replacing
+    y[j:] leaves out[:j + 1] bit-identical (the contract test covers the default framing)."""
+    y = drift[:1000]
+    m = GreyElman(hidden=4, window=64, epochs=5, ago_frame="global").fit(y[:600])
+    hist, test = y[:700], y[700:]
+    base = m.predict(test, history=hist)
+    for j in (0, 5, 150):
+        changed = np.r_[test[:j], test[j:] * 5.0 + 2.0]
+        np.testing.assert_array_equal(m.predict(changed, history=hist)[: j + 1], base[: j + 1])
 
 
 def test_grey_global_restores_with_measured_previous_sum(drift):
@@ -230,9 +267,48 @@ def test_grey_global_restores_with_measured_previous_sum(drift):
     x1_hat = m.x1_mean_ + m.x1_std_ * np.asarray(out[:, 0], dtype=np.float64)
     expected = m.x_mean_ + m.x_std_ * (x1_hat - x1[p - 1:-1])
     np.testing.assert_allclose(m.predict(y)[p:], expected, rtol=0, atol=1e-4 * m.x_std_)
-    # free run follows eq. (13): x0*(t) = x1*(t) - x1*(t-1); its AGO is the predicted x1
-    fc = m.forecast(3, history=y)
-    assert np.all(np.isfinite(fc))
+
+
+def test_grey_global_free_run_follows_eq13(x64, drift):
+    """Free run of the paper-literal grey-Elman, recomputed here in NumPy float64 from the weights.
+
+    With n measured samples: the context is the hidden state after the history; step 1 predicts
+    x1_hat(n) from the measured x1(n-1..n-p) and restores with the *measured* x1(n-1),
+    x0_hat(n) = x1_hat(n) - x1(n-1) (method notes §4.1); step h > 1 feeds the predicted AGO values
+    back and restores with eq. (13), x0_hat(n+h-1) = x1_hat(n+h-1) - x1_hat(n+h-2), both predicted.
+    """
+    y = drift[:900]
+    m = GreyElman(hidden=4, window=64, epochs=5, ago_frame="global", dtype="float64").fit(y[:600])
+    hist = y[:750]
+    n, p, steps = hist.size, m.lags, 8
+    w = {k: np.asarray(v, dtype=np.float64) for k, v in m.params_.items()}
+    x1 = list(np.cumsum((hist - m.x_mean_) / m.x_std_))  # measured AGO (z units)
+
+    def cell(h, k):  # inputs x1(k-1), ..., x1(k-p), z-scored with the training-block AGO statistics
+        u = (np.array([x1[k - 1 - i] for i in range(p)]) - m.x1_mean_) / m.x1_std_
+        h = np.tanh(w["W_u"] @ u + w["W_c"] @ h + w["b_h"])
+        return h, m.x1_mean_ + m.x1_std_ * float(w["W_o"][0] @ h + w["b_o"][0])
+
+    h = np.zeros(m.hidden)
+    for k in range(p, n):  # context after the measured history
+        h, _ = cell(h, k)
+    x1_hat = []
+    for k in range(n, n + steps):
+        h, nxt = cell(h, k)
+        x1_hat.append(nxt)
+        x1.append(nxt)  # fed back: later inputs are predicted AGO values
+    x1_hat = np.array(x1_hat)
+    measured_prev = np.cumsum((hist - m.x_mean_) / m.x_std_)[-1]
+    x0_hat = np.r_[x1_hat[0] - measured_prev, x1_hat[1:] - x1_hat[:-1]]
+    expected = m.x_mean_ + m.x_std_ * x0_hat
+
+    fc = m.forecast(steps, history=hist)
+    np.testing.assert_allclose(fc, expected, rtol=0, atol=1e-9 * m.x_std_)
+    # step 1 is the one-step prediction of the next sample from the same measured history
+    assert fc[0] == pytest.approx(m.predict(y[n:n + 1], history=hist)[0], abs=1e-9 * m.x_std_)
+    # and the restore rules matter here: restoring step 2 with the measured x1(n-1) differs by far more
+    wrong = m.x_mean_ + m.x_std_ * (x1_hat[1] - measured_prev)
+    assert abs(wrong - expected[1]) > 1e3 * 1e-9 * m.x_std_
 
 
 def test_fit_many_equals_separate_fits(x64, drift):
@@ -296,17 +372,21 @@ def test_grey_global_frame_loses_to_persistence(drift):
 
 
 @pytest.mark.parametrize("activation", ["tanh", "logsig"])
-def test_windowed_training_kernel_equals_elman_forward(x64, activation):
-    """The batched kernel used for training computes, window by window, exactly eq. (11) as elman_forward."""
-    from fogdrift.elman import _window_pass
-
-    params = init_params(jax.random.key(5), 4, 6, dtype=jnp.float64)
+def test_cell_scans_equal_elman_forward(x64, activation):
+    """The batched fast path used for training (ElmanCell.scan), the generic scan of ElmanCell.step
+    (RecurrentCell.scan: vmap inside lax.scan, what a GRU/LSTM cell would get) and elman_forward
+    (eq. 11) compute the same outputs and final states, window by window."""
+    cell = ElmanCell(activation)
+    params = cell.init(jax.random.key(5), 4, 6, dtype=jnp.float64)
     rng = np.random.default_rng(5)
     n_win, width = 7, 9
-    u = rng.standard_normal((width, n_win, 4))
-    h0s = rng.standard_normal((n_win, 6)) * 0.3
-    out, h_end = _window_pass(params, jnp.asarray(u), jnp.asarray(h0s), activation, False)
+    u = jnp.asarray(rng.standard_normal((width, n_win, 4)))
+    h0s = jnp.asarray(rng.standard_normal((n_win, 6)) * 0.3)
+    h_fast, y_fast = cell.scan(params, h0s, u)
+    h_gen, y_gen = RecurrentCell.scan(cell, params, h0s, u)
+    assert y_fast.shape == y_gen.shape == (width, n_win, 1)
     for w in range(n_win):
-        ref, hid = elman_forward(params, jnp.asarray(u[:, w, :]), jnp.asarray(h0s[w]), activation)
-        np.testing.assert_allclose(np.asarray(out[:, w]), np.asarray(ref[:, 0]), rtol=1e-12, atol=1e-12)
-        np.testing.assert_allclose(np.asarray(h_end[w]), np.asarray(hid[-1]), rtol=1e-12, atol=1e-12)
+        ref, hid = elman_forward(params, u[:, w, :], h0s[w], activation)
+        for out, h_end in ((y_fast, h_fast), (y_gen, h_gen)):
+            np.testing.assert_allclose(np.asarray(out[:, w, 0]), np.asarray(ref[:, 0]), rtol=1e-12, atol=1e-12)
+            np.testing.assert_allclose(np.asarray(h_end[w]), np.asarray(hid[-1]), rtol=1e-12, atol=1e-12)

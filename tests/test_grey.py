@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from fogdrift.errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError, NotFittedError
-from fogdrift.grey import (
+from fogdrift.models.grey import (
     GM11,
     GM11Fit,
     ago,

@@ -42,6 +42,30 @@ def test_hand_values():
     assert p0_weighted(y, yh) == pytest.approx(85.0)
 
 
+def test_asymmetric_hand_values():
+    """Hand values chosen so that each plausible slip changes the number (comments give both)."""
+    y = np.array([2.0, 4.0, 8.0])
+    yh = np.array([1.0, 5.0, 6.0])  # errors -1, +1, -2; |e| = 1, 1, 2
+    # p0 = 100 (1 - mean(|e|/|y|)) = 100 (1 - (1/2 + 1/4 + 2/8)/3) = 100 (1 - 1/3) = 66.667 %
+    # (dividing by |yhat| instead: (1/1 + 1/5 + 2/6)/3 = 0.5111 -> 48.889 %)
+    assert p0(y, yh, offset_convention="as_measured") == pytest.approx(200.0 / 3.0, rel=1e-12)
+    # p0_w = 100 (1 - sum|e| / sum|y|) = 100 (1 - 4/14) = 71.4286 %  (sum|yhat| = 12 would give 66.667 %)
+    assert p0_weighted(y, yh) == pytest.approx(100.0 * (1.0 - 4.0 / 14.0), rel=1e-12)
+    # MASE = MAE / mean|diff(y_train)|: MAE = 4/3; diffs of [0, 1, 3, 2, 6] are 1, 2, 1, 4 -> mean 2; MASE = 2/3
+    # (sum/len(y_train) = 8/5 would give 0.8333; the test block's own diffs 2, 4 -> 3 would give 0.4444)
+    assert mase(y, yh, [0.0, 1.0, 3.0, 2.0, 6.0]) == pytest.approx(2.0 / 3.0, rel=1e-12)
+    # skill = 1 - RMSE/RMSE_p: persistence-like [0, 2, 4] has errors 2, 2, 4 -> RMSE_p = sqrt(24/3) = sqrt(8);
+    # RMSE = sqrt(6/3) = sqrt(2); skill = 1 - 1/2 = 0.5  (MSE ratio: 0.75; inverted ratio: -1)
+    assert skill(y, yh, [0.0, 2.0, 4.0]) == pytest.approx(0.5, rel=1e-12)
+    # evaluate() reports the same numbers for the same samples
+    r = evaluate(y, yh, y_train=np.array([0.0, 1.0, 3.0, 2.0, 6.0]), yhat_persistence=np.array([0.0, 2.0, 4.0]),
+                 offset_convention="as_measured")
+    assert (r.p0_pct, r.p0_weighted_pct, r.mase, r.skill) == pytest.approx(
+        (200.0 / 3.0, 100.0 * (1.0 - 4.0 / 14.0), 2.0 / 3.0, 0.5), rel=1e-12)
+    # persistence's p0 beside it: |e_p|/|y| = 2/2, 2/4, 4/8 -> mean 2/3 -> 33.333 %
+    assert r.p0_persistence_pct == pytest.approx(100.0 / 3.0, rel=1e-12)
+
+
 @settings(max_examples=50, deadline=None)
 @given(st.lists(st.floats(0.5, 1e3), min_size=1, max_size=40), st.sampled_from(OFFSET_CONVENTIONS))
 def test_metrics_zero_on_identical_inputs(values, convention):

@@ -26,10 +26,22 @@ __all__ = [
     "earth_rate_projection_dph",
     "AXIS_DIRECTIONS",
     "check_dt_s",
+    "TIME_UNITS",
+    "time_scale_to_s",
+    "URAD_PER_ARCSEC",
+    "B_FACTOR",
 ]
 
 #: WGS-84 Earth rotation rate 7.2921150e-5 rad/s expressed in deg/h (method notes §6).
 EARTH_RATE_DPH = 7.2921150e-5 * 180.0 / math.pi * 3600.0
+
+#: One arcsecond in microradians, 1e6 pi / (180 * 3600) = 4.8481368.  Note that 1 (deg/h) s = 1/3600 deg
+#: = 1 arcsec, so a quantization coefficient in the Allan-law units (rate deg/h, tau s) is in arcsec.
+URAD_PER_ARCSEC = 1e6 * math.pi / (180.0 * 3600.0)
+
+#: sqrt(2 ln 2 / pi) = 0.664282: the flat Allan deviation of flicker rate noise in units of the bias
+#: instability B (IEEE Std 952-1997 Annex C; method notes 2.2).  The read-off sigma_min = 0.6643 B.
+B_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)
 
 #: Multiply a rate in the key's unit by the value to get deg/h.
 RATE_UNITS: dict[str, float] = {
@@ -47,6 +59,34 @@ INCREMENT_UNITS: dict[str, float] = {
     "rad": 180.0 / math.pi * 3600.0,
     "arcsec": 1.0,
 }
+
+
+#: Multiply a time stamp in the key's unit by the value to get seconds (time columns, ``time_unit``).
+TIME_UNITS: dict[str, float] = {
+    "s": 1.0,
+    "ms": 1e-3,
+    "us": 1e-6,
+    "ns": 1e-9,
+}
+
+
+def time_scale_to_s(unit: str) -> float:
+    """Factor that converts a time stamp in ``unit`` to seconds.
+
+    Raises
+    ------
+    ConfigError
+        If ``unit`` is not a key of :data:`TIME_UNITS` (the message lists them).
+
+    Examples
+    --------
+    >>> time_scale_to_s("ms")
+    0.001
+    """
+    try:
+        return TIME_UNITS[unit]
+    except (KeyError, TypeError):
+        raise ConfigError(f"unknown time unit {unit!r}; expected one of {list(TIME_UNITS)}") from None
 
 
 def check_dt_s(dt_s, name: str = "dt_s") -> float:

@@ -15,6 +15,10 @@ Contract (scikit-learn shape, see ``docs`` and the style examples):
   and ``path.npz`` (arrays); :func:`load_model` reads them back without pickle.
 
 Series are 1-D float arrays of drift samples in deg/h at a fixed sample interval.
+
+Model files name their class (``"class": "GM11"``); :func:`load_model` finds the module of that
+class in the registry table (:mod:`fogdrift.models.registry`) and imports only that module, so
+loading a GM(1,1), AR or persistence model never imports JAX.
 """
 
 from __future__ import annotations
@@ -25,21 +29,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ._util import check_series, json_default
-from .errors import ConfigError, ModelFileError, NotFittedError
+from .._util import check_series, json_default
+from ..errors import ConfigError, ModelFileError, NotFittedError
+from ..output import atomic_path
+from .registry import class_for_file, file_class_names
 
-__all__ = ["DriftModel", "Persistence", "register_model", "load_model", "check_series", "MODEL_REGISTRY"]
+__all__ = ["DriftModel", "load_model", "check_series", "FORMAT_VERSION"]
 
+#: Version of the model-file layout (JSON keys and NPZ array names); unchanged since the first release.
 FORMAT_VERSION = 1
-
-#: Class name -> class, filled by :func:`register_model`; used by :func:`load_model`.
-MODEL_REGISTRY: dict[str, type] = {}
-
-
-def register_model(cls):
-    """Class decorator: make ``cls`` loadable by :func:`load_model` under its class name."""
-    MODEL_REGISTRY[cls.__name__] = cls
-    return cls
 
 
 class DriftModel:
@@ -50,8 +48,14 @@ class DriftModel:
     ``_set_state(meta, arrays)``; ``meta`` must be JSON-serialisable.
     """
 
-    #: Name shown in tables and reports.
+    #: Name shown in tables and reports (the registry row repeats it for CLI help).
     label = "model"
+    #: True when ``fit`` uses ``y_val`` (early stopping); False: ``y_val`` is accepted and ignored.
+    uses_validation = False
+    #: What the model is fed when it compensates a gyro: ``"drift"`` (a separated drift series, the
+    #: paper's framing; the causal drift in real time) or ``"rate"`` (the bias-removed rate itself, e.g.
+    #: a Kalman filter whose noise model includes the white noise).
+    input_kind = "drift"
 
     @classmethod
     def _param_names(cls) -> list[str]:
@@ -99,7 +103,6 @@ class DriftModel:
         base = Path(path)
         if base.suffix in (".json", ".npz"):
             base = base.with_suffix("")
-        base.parent.mkdir(parents=True, exist_ok=True)
         meta, arrays = self._get_state()
         doc = {
             "format": "fogdrift-model",
@@ -110,8 +113,11 @@ class DriftModel:
         }
         json_path = base.with_suffix(".json")
         npz_path = base.with_suffix(".npz")
-        json_path.write_text(json.dumps(doc, indent=2, default=json_default))
-        np.savez(npz_path, **{k: np.asarray(v) for k, v in arrays.items()})
+        # each file complete or absent (temporary name, renamed when written): fogdrift.output.atomic_path
+        with atomic_path(json_path) as tmp:
+            tmp.write_text(json.dumps(doc, indent=2, default=json_default))
+        with atomic_path(npz_path) as tmp:
+            np.savez(tmp, **{k: np.asarray(v) for k, v in arrays.items()})
         return json_path, npz_path
 
     @classmethod
@@ -124,7 +130,23 @@ class DriftModel:
 
 
 def load_model(path) -> DriftModel:
-    """Load any registered drift model from ``<path>.json`` + ``<path>.npz`` (no pickle)."""
+    """Load a drift model from ``<path>.json`` + ``<path>.npz`` (no pickle).
+
+    Parameters
+    ----------
+    path : str or Path
+        Base path as given to :meth:`DriftModel.save` (a ``.json`` or ``.npz`` suffix is dropped).
+
+    Returns
+    -------
+    DriftModel
+        A fitted model of the class named in the file; only that class's module is imported.
+
+    Raises
+    ------
+    ModelFileError
+        Missing or corrupt file, another format version, or a class the registry does not know.
+    """
     base = Path(path)
     if base.suffix in (".json", ".npz"):
         base = base.with_suffix("")
@@ -141,12 +163,10 @@ def load_model(path) -> DriftModel:
         raise ModelFileError(
             f"{json_path}: format version {doc.get('format_version')!r}; this fogdrift reads {FORMAT_VERSION}"
         )
-    cls = MODEL_REGISTRY.get(doc.get("class"))
+    cls = class_for_file(doc.get("class"))
     if cls is None:
-        _import_model_modules()
-        cls = MODEL_REGISTRY.get(doc.get("class"))
-    if cls is None:
-        raise ModelFileError(f"{json_path}: unknown model class {doc.get('class')!r}")
+        raise ModelFileError(f"{json_path}: unknown model class {doc.get('class')!r}; "
+                             f"expected one of {', '.join(file_class_names())}")
     try:
         with np.load(npz_path, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
@@ -157,60 +177,3 @@ def load_model(path) -> DriftModel:
     model = cls(**doc.get("params", {}))
     model._set_state(doc.get("state", {}), arrays)
     return model
-
-
-def _import_model_modules() -> None:
-    """Import the modules that register model classes (lazy: JAX only when needed)."""
-    import importlib
-
-    for name in ("fogdrift.grey", "fogdrift.baselines", "fogdrift.elman"):
-        try:
-            importlib.import_module(name)
-        except ImportError:  # pragma: no cover - optional module missing
-            pass
-
-
-@register_model
-class Persistence(DriftModel):
-    """Persistence ("repeat the last value") baseline: predicts y[k] = y[k-1].
-
-    For a smoothed drift target this is hard to beat one step ahead (method notes §5.2);
-    every metric table shows it beside the learned models.
-
-    Attributes
-    ----------
-    last_ : float
-        Last training sample [deg/h], start of free-run forecasts.
-    """
-
-    label = "persistence"
-
-    def __init__(self):
-        pass
-
-    def fit(self, y_train, y_val=None):
-        y = check_series(y_train, "y_train", min_length=1)
-        self.last_ = float(y[-1])
-        return self
-
-    def predict(self, y, *, history=None):
-        self._check_fitted()
-        y = check_series(y, "y")
-        out = np.empty_like(y)
-        out[1:] = y[:-1]
-        if history is not None and len(history):
-            out[0] = check_series(history, "history")[-1]
-        else:
-            out[0] = np.nan
-        return out
-
-    def forecast(self, h: int, *, history=None):
-        self._check_fitted()
-        start = self.last_ if history is None else float(check_series(history, "history", min_length=1)[-1])
-        return np.full(int(h), start)
-
-    def _get_state(self):
-        return {"last_": self.last_}, {}
-
-    def _set_state(self, meta, arrays):
-        self.last_ = float(meta["last_"])

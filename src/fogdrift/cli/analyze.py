@@ -1,0 +1,169 @@
+"""``fogdrift analyze``: the whole method on one recording, with an HTML report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ..errors import ConfigError
+from ._app import (EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutliersOpt, OutOpt,
+                   StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_model_rate, check_plausible, console,
+                   csv_list, echo_record, parse_fit_taus, parse_level, parse_taus, parse_terms, precheck, progress,
+                   run, say, with_load_options)
+from ._tables import metrics_table, noise_table
+from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt, model_axes_text
+
+DEFAULT_OUT = Path("out/analyze")
+
+
+@app.command()
+@with_load_options
+def analyze(
+    load,
+    latitude: Annotated[Optional[float], typer.Option("--latitude", help="Latitude [deg] for Earth-rate removal.")]
+    = None,
+    earth_axis: Annotated[Optional[list[str]], typer.Option(
+        "--earth-axis", help="AXIS=ORIENTATION (up, down, north, south, east, west), repeatable.")] = None,
+    apply_to: Annotated[Optional[Path], typer.Option("--apply-to", help="Second recording: apply the fitted "
+                                                     "models unchanged to it (axes matched by name; its bias is "
+                                                     "re-estimated on its own training share, and said so).")] = None,
+    apply_unit: Annotated[Optional[str], typer.Option(
+        "--apply-unit", help="Rate unit of the --apply-to recording (default: --unit, or its header's).")] = None,
+    apply_time_unit: Annotated[Optional[str], typer.Option(
+        "--apply-time-unit", help="Time unit of the --apply-to recording (default: --time-unit, or its header's).")]
+    = None,
+    models: ModelsOpt = ALL_MODELS,
+    hidden: HiddenOpt = 16,
+    lags: LagsOpt = 4,
+    epochs: EpochsOpt = 2000,
+    seed: SeedOpt = 0,
+    training: TrainingOpt = "bptt",
+    wavelet: WaveletOpt = "db2",
+    level: LevelOpt = "4",
+    mode: ModeOpt = "symmetric",
+    model_rate: ModelRateOpt = 1.0,
+    taus: TausOpt = "octave",
+    estimator: EstOpt = "overlapping",
+    terms: TermsOpt = "",
+    statistic: StatisticOpt = "adev",
+    outliers: OutliersOpt = "warn",
+    fit_taus: FitTausOpt = ":",
+    train_fraction: Annotated[float, typer.Option("--train-fraction", help="Chronological training share.")] = 0.6,
+    val_fraction: Annotated[float, typer.Option("--val-fraction", help="Validation share (early stopping).")] = 0.2,
+    causal_window: Annotated[float, typer.Option(
+        "--causal-window", help="Window [s] of the causal (real-time) drift of the practical compensation.")] = 128.0,
+    gm_window: Annotated[int, typer.Option("--gm-window", help="Rolling window [samples] of the one-step GM(1,1).")]
+    = 8,
+    heading: Annotated[bool, typer.Option(
+        "--heading/--no-heading", help="Also print the heading-error table (rolling 300-s calibrations, free-run "
+                                       "forecasts) and the filtering-artefact check of every model on the test "
+                                       "block, with the verdicts headline first.")] = False,
+    out: OutOpt = DEFAULT_OUT,
+    json_out: JsonOpt = False,
+):
+    """The whole method: Allan analysis, separation, drift models, compensation, Table 2 and an HTML report."""
+    from ..pipeline import AnalysisConfig, run_analysis
+    from ..report import metrics_rows, noise_row, verdict, write_report
+
+    with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to], json_out=json_out,
+             expect=("analysis.json", "report.html")) as r:
+        earth = {}
+        for item in earth_axis or []:
+            name, sep, orient = item.partition("=")
+            if not sep:
+                raise ConfigError(f"--earth-axis must look like AXIS=ORIENTATION (e.g. gz=up), got {item!r}")
+            earth[name.strip()] = orient.strip()
+        term_list = parse_terms(terms)
+        precheck(wavelet=wavelet, mode=mode, training=training, estimator=estimator, terms=term_list)
+        cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
+                             training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
+                             model_rate_hz=model_rate or None, taus=parse_taus(taus), estimator=estimator,
+                             terms=term_list, statistic=statistic, outliers=outliers, latitude_deg=latitude,
+                             earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), train_fraction=train_fraction,
+                             val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window).validate()
+        if apply_to is not None and not apply_to.is_file():
+            raise ConfigError(f"--apply-to {apply_to}: no such file")
+        record = load.load()
+        check_model_rate(record, cfg.model_rate_hz)
+        echo_record(load, record)
+        check_plausible(record)
+        other = None
+        if apply_to:
+            other = load.load(apply_to, unit=apply_unit, time_unit=apply_time_unit)
+            other = _match_axes(record, other, apply_to)
+            check_model_rate(other, cfg.model_rate_hz)
+            echo_record(load, other, apply_to)
+            check_plausible(other)
+        elif apply_unit or apply_time_unit:
+            raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
+        with progress("analyze", record.axis_names) as (_, epoch_cb):
+            result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb)
+        say(model_axes_text([ax.models for ax in result.axes], record))
+        if result.apply_to is not None:
+            say(apply_note(result, apply_to))
+        for res, title in ((result, load.file.name), (result.apply_to, apply_to.name if apply_to else "")):
+            if res is None:
+                continue
+            for ax in res.axes:
+                console.print(noise_table(f"{title} axis {ax.name}: Table 2 (test block, {ax.models.dt_s:g} s "
+                                          "samples; 95 % intervals)",
+                                          [["original (whole record, native rate)"] + noise_row(ax.original.noise)]
+                                          + [[row.label] + noise_row(row.analysis.noise) for row in ax.table2]))
+                console.print(metrics_table(f"{title} axis {ax.name}: one-step metrics on the test block",
+                                            metrics_rows(ax.models)))
+                for line in verdict(ax.models):
+                    say("  " + line)
+        if heading:  # compensation evidence on the test block (fogdrift.evaluation)
+            from ..evaluation import evaluate_axis
+            from .compensate import print_evaluation
+
+            for ax in result.axes:
+                ev = evaluate_axis(ax.models, cfg)
+                for note in ev["notes"]:
+                    say("  " + note)
+                print_evaluation([ev["heading"]] if ev["heading"] else [],
+                                 [ev["artefacts"]] if ev["artefacts"] else [], ev["verdicts"])
+        path = write_report(result, record, r.out.path)
+        # the self-describing bundle 'fogdrift compensate' applies to other logs
+        from ..bundle import write_bundle
+
+        bundle = write_bundle(r.out.path / "bundle", [ax.models for ax in result.axes], cfg, record)
+        # the compensated test block (what each model's causal compensation gives; loadable by fogdrift.io.load)
+        from ..compensate.test_block import write_compensated_test_block
+
+        comp = write_compensated_test_block([ax.models for ax in result.axes], r.out.path, t0_s=record.t0_s)
+        r.wrote()
+        say(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
+        say(f"bundle: {bundle.path}")
+        say(f"compensated test block: {', '.join(p.name for p in comp)} (modelling rate, deg/h)")
+        r.print_json(r.out.path / "analysis.json")
+
+
+def _match_axes(record, other, path):
+    """The --apply-to recording's axes matched to the fitted ones BY NAME; refuses axes without a model."""
+    fitted = list(record.axis_names)
+    extra = [a for a in other.axis_names if a not in fitted]
+    if extra:
+        raise ConfigError(f"--apply-to {path}: axes {extra} have no fitted model (the fitted recording has "
+                          f"{fitted}); axes are matched by name: select matching ones with --columns")
+    missing = [a for a in fitted if a not in other.axis_names]
+    if missing:
+        say(f"--apply-to {path.name}: axes {missing} are not in this recording: not applied there", style="yellow")
+    return other
+
+
+def apply_note(result, path) -> str:
+    """One line saying what --apply-to re-estimated and what it kept."""
+    cfg = result.config
+    parts = []
+    fitted = {a.name: a.models for a in result.axes}
+    for ax in result.apply_to.axes:
+        ma, src = ax.models, fitted.get(ax.name)
+        e, f = ma.split["train"]
+        parts.append(f"{ax.name} {ma.bias_dph:+.4g} deg/h on its first {(f - e) * ma.dt_s:g} s "
+                     f"(fitted recording: {src.bias_dph:+.4g} deg/h)" if src is not None else ax.name)
+    return (f"--apply-to {path.name}: models applied unchanged (axes by name); bias re-estimated on its own "
+            f"training share ({cfg.train_fraction:g}): " + "; ".join(parts)
+            + "; Earth rate, wavelet, level and modelling rate as for the fitted recording")

@@ -1,0 +1,621 @@
+"""Loading a gyro log into :class:`~fogdrift.io.GyroRecord` objects, for every format.
+
+The reader (chosen by :mod:`fogdrift.io.registry`) turns the file into named numeric columns;
+this module does what is the same for all formats: it chooses the rate and time columns,
+checks the values (finite), the time (increasing, matching ``dt_s``/``rate_hz``, gaps),
+resolves units (given, or declared by the file), converts to deg/h and builds the records.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import units
+from ..errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
+from ._checks import (
+    check_path,
+    first_nonfinite,
+    parse_unit,
+    positive_float,
+    split_keys,
+    take_columns,
+    to_dph,
+    unit_scale,
+    valid_units,
+)
+from .hashing import file_sha256
+from .readers.base import Table, split_unit_label
+from .record import GyroRecord
+from .registry import reader_by_name, select_reader
+
+__all__ = ["load", "load_segments", "time_unit_of_name", "TIME_COLUMN_NAMES", "GAP_FACTOR", "DT_TOLERANCE"]
+
+#: Column names (compared case-insensitively) that ``time_column="auto"`` takes as time; so does one of the
+#: first, third or last with a time-unit suffix (``t_ms``, ``time_us``, ``timestamp_ns``).
+TIME_COLUMN_NAMES = ("t", "t_s", "time", "time_s", "timestamp")
+#: A time step larger than ``GAP_FACTOR`` sample intervals is a gap.
+GAP_FACTOR = 1.5
+#: Largest relative disagreement allowed between the time column and ``dt_s``/``rate_hz``.
+DT_TOLERANCE = 0.01
+
+
+def load(
+    path,
+    *,
+    columns=None,
+    time_column="auto",
+    dt_s=None,
+    rate_hz=None,
+    unit=None,
+    time_unit=None,
+    delimiter=None,
+    gaps="error",
+    min_samples=2,
+    format=None,
+    reader_options=None,
+) -> GyroRecord:
+    """Load a gyro log into a :class:`~fogdrift.io.GyroRecord` in deg/h.
+
+    Parameters
+    ----------
+    path : str or Path
+        Text (CSV/TXT, optionally gzip), ``.npy`` or ``.npz`` file; the format is detected
+        from the first bytes, then the extension (see :mod:`fogdrift.io.registry`).
+    columns : None, int, str or sequence of int/str
+        Rate columns: names or 0-based indices (ints or digit strings; a string may list
+        several separated by commas, e.g. ``"gx,gz"`` or ``"1,2"``).  Default: every column
+        except the time column.  Header-less text and arrays name columns ``col0, col1, ...``.
+        A header cell ``gz[deg/s]`` names the column ``gz``.
+    time_column : "auto", None, int or str
+        ``"auto"`` uses the format's own time vector if it has one, else a column named t,
+        t_s, time, time_s or timestamp (any case) if there is one; ``None`` means no time
+        column.
+    dt_s, rate_hz : float, optional
+        Sample interval in s, or sample rate in Hz.  Required without a time column; with
+        one, they must agree with its median step within 1 % and then take precedence.
+    unit : str, optional
+        Unit of the numbers: a rate unit from :data:`fogdrift.units.RATE_UNITS`
+        (``"deg/h"``, ``"deg/s"``, ``"rad/s"``, ``"rad/h"``, ``"arcsec/s"``) or an angle increment
+        per sample ``"inc:deg"``, ``"inc:rad"``, ``"inc:arcsec"``.  Default: the unit the
+        file declares for the rate columns (``gz[deg/s]``); a file that declares none needs
+        ``unit`` (ConfigError otherwise: a unit is never guessed).  A given unit takes
+        precedence over a declared one (a note records the difference).
+    time_unit : {"s", "ms", "us", "ns"}, optional
+        Unit of the time column (:data:`fogdrift.units.TIME_UNITS`).  Default: the unit the
+        header declares for it, in brackets (``t[ms]``) or by a name suffix (``t_s``,
+        ``time_ms``); a time column that declares none needs ``time_unit``.  Not needed
+        without a time column or for a format's own time stamps (always in s).
+    delimiter : None or str
+        Text only.  ``None`` detects it from the first non-comment lines (tab, comma,
+        semicolon, else whitespace); or one of ``","``, ``";"``, ``"\\t"``, ``" "``
+        (whitespace) or the words comma, semicolon, tab, whitespace.
+    gaps : {"error", "split"}
+        A time step > 1.5 sample intervals is a gap.  ``"error"`` raises, naming the line,
+        time and size of the first gap; ``"split"`` returns the longest gap-free segment with
+        a :class:`~fogdrift.errors.FogdriftWarning` (use :func:`load_segments` to get all).
+    min_samples : int
+        Fewest samples accepted (>= 1).
+    format : str, optional
+        Force a reader by its name in :data:`fogdrift.io.registry.READERS` (``"text"``,
+        ``"npy"``, ``"npz"``) instead of detecting it.
+    reader_options : mapping, optional
+        Options for the reader, e.g. ``{"delimiter": ";"}`` for text; each reader lists
+        the ones it accepts in its registry line.
+
+    Returns
+    -------
+    GyroRecord
+        ``rate_dph`` is a read-only view; for a float64 ``.npy`` in deg/h it is a view of the
+        memory map (no copy).  ``sha256`` is the hash of the file's bytes, computed while
+        they were read.
+
+    Raises
+    ------
+    ConfigError
+        Invalid option (unit, time_unit, dt_s/rate_hz, delimiter, gaps, min_samples,
+        format, reader_options), a column selected twice, no way to know the sample
+        interval, or a rate unit / time unit neither given nor declared by the file.
+    DataFormatError
+        Missing/empty/unknown-format file, header only, non-numeric cell, NaN/inf (also
+        after conversion to deg/h), ragged row, unsorted or duplicate time, gap, unknown
+        column, time column contradicting dt_s/rate_hz, unknown or mixed declared units.
+    InsufficientDataError
+        Fewer than ``min_samples`` samples.
+
+    Notes
+    -----
+    Text is parsed by :func:`numpy.loadtxt`; only if that fails is the file re-read line by
+    line to report the exact line and column.  The interval from a time column is the
+    median step rounded to 10 significant digits (removes the float noise of decimal time
+    stamps: steps of 0.01 s stay 0.01 s).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp(); p = os.path.join(d, "g.csv")
+    >>> with open(p, "w") as fh:
+    ...     _ = fh.write("t_s,gx,gy\\n0.00,1,2\\n0.01,3,4\\n0.02,5,6\\n")
+    >>> rec = load(p, columns="gy", unit="deg/h")
+    >>> rec.dt_s, rec.axis_names, rec.rate_dph[:, 0].tolist()
+    (0.01, ('gy',), [2.0, 4.0, 6.0])
+
+    Units declared in the header are used when no ``unit`` is given:
+
+    >>> with open(p, "w") as fh:
+    ...     _ = fh.write("t[ms],gz[deg/s]\\n0,0.001\\n10,0.002\\n20,0.003\\n")
+    >>> rec = load(p)
+    >>> rec.dt_s, rec.input_unit, rec.rate_dph[:, 0].round(9).tolist()
+    (0.01, 'deg/s', [3.6, 7.2, 10.8])
+
+    A unit is never guessed: without ``unit`` a file that declares none is refused.
+
+    >>> with open(p, "w") as fh:
+    ...     _ = fh.write("t_s,gz\\n0,1\\n0.01,2\\n")
+    >>> load(p)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.ConfigError: ...g.csv: no rate unit: the file declares none for gz; pass unit= (deg/h, ...
+    """
+    if gaps not in ("error", "split"):
+        raise ConfigError(f"gaps must be 'error' or 'split'; got {gaps!r}")
+    opts = _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
+                    reader_options)
+    records = _load_records(path, opts)
+    if len(records) == 1:
+        return records[0]
+    best = max(records, key=lambda r: r.n_samples)
+    warnings.warn(
+        f"{path}: data have {len(records)} gap-free segments; returning the longest "
+        f"({best.n_samples} of {sum(r.n_samples for r in records)} samples, {best.notes[-1]}); "
+        "use load_segments() to get all",
+        FogdriftWarning,
+        stacklevel=2,
+    )
+    return best
+
+
+def load_segments(
+    path,
+    *,
+    columns=None,
+    time_column="auto",
+    dt_s=None,
+    rate_hz=None,
+    unit=None,
+    time_unit=None,
+    delimiter=None,
+    gaps="split",
+    min_samples=2,
+    format=None,
+    reader_options=None,
+) -> list[GyroRecord]:
+    """Load a gyro log split at time gaps into gap-free :class:`~fogdrift.io.GyroRecord` segments.
+
+    Takes the keyword arguments of :func:`load`; ``gaps`` defaults to ``"split"`` here
+    (``"error"`` raises at the first gap as in :func:`load`).  Each segment's ``t0_s`` is
+    its first time stamp and its last note reads
+    ``"segment k of m: samples a-b (lines c-d)"`` (sample indices are 0-based data rows of
+    the file; lines are physical lines, text only).  Segments shorter than ``min_samples``
+    are dropped with a :class:`~fogdrift.errors.FogdriftWarning`.
+
+    Returns
+    -------
+    list of GyroRecord
+        In time order; a single element when the data have no gap.  All share the file's
+        ``sha256``.
+
+    Raises
+    ------
+    ConfigError, DataFormatError
+        As :func:`load`.
+    InsufficientDataError
+        If no segment has ``min_samples`` samples.
+    """
+    if gaps not in ("error", "split"):
+        raise ConfigError(f"gaps must be 'error' or 'split'; got {gaps!r}")
+    opts = _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
+                    reader_options)
+    return _load_records(path, opts)
+
+
+# --------------------------------------------------------------------------------------------
+# Options
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class _Options:
+    columns: object
+    time_column: object
+    dt_s: float | None          # from dt_s or rate_hz
+    unit: str | None
+    time_unit: str | None
+    split: bool
+    min_samples: int
+    format: str | None
+    reader_options: dict
+
+
+def _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
+             reader_options) -> _Options:
+    """Validate every option before the file is touched."""
+    if unit is not None:
+        parse_unit(unit)
+    if time_unit is not None and time_unit not in units.TIME_UNITS:
+        raise ConfigError(f"unknown time unit {time_unit!r}; expected one of {list(units.TIME_UNITS)}")
+    if isinstance(min_samples, bool) or not isinstance(min_samples, (int, np.integer)) or min_samples < 1:
+        raise ConfigError(f"min_samples must be an integer >= 1; got {min_samples!r}")
+    if format is not None:
+        reader_by_name(format)
+    if reader_options is None:
+        ropts = {}
+    elif isinstance(reader_options, Mapping):
+        ropts = dict(reader_options)
+    else:
+        raise ConfigError(f"reader_options must be a mapping of option names to values; got {reader_options!r}")
+    if delimiter is not None:
+        if "delimiter" in ropts:
+            raise ConfigError("delimiter given twice; expected it as delimiter= or in reader_options, not both")
+        ropts["delimiter"] = delimiter
+    return _Options(columns=columns, time_column=time_column, dt_s=_interval_option(dt_s, rate_hz), unit=unit,
+                    time_unit=time_unit, split=gaps == "split", min_samples=int(min_samples), format=format,
+                    reader_options=ropts)
+
+
+def _interval_option(dt_s, rate_hz):
+    dt = None if dt_s is None else positive_float(dt_s, "dt_s")
+    fs = None if rate_hz is None else positive_float(rate_hz, "rate_hz")
+    if dt is not None and fs is not None and abs(dt * fs - 1.0) > 1e-6:
+        raise ConfigError(
+            f"dt_s and rate_hz disagree; expected dt_s = 1/rate_hz, got dt_s={dt_s!r}, rate_hz={rate_hz!r}"
+        )
+    if dt is not None:
+        return dt
+    return None if fs is None else 1.0 / fs
+
+
+# --------------------------------------------------------------------------------------------
+# Loading
+# --------------------------------------------------------------------------------------------
+def _open(path, opts: _Options) -> Table:
+    p = check_path(path, allow_dir=True)
+    spec = reader_by_name(opts.format) if opts.format else select_reader(p)
+    ropts = dict(opts.reader_options)
+    if "delimiter" in ropts and "delimiter" not in spec.options:
+        del ropts["delimiter"]  # the top-level text option is ignored for other formats
+    return spec.open_table(p, ropts)
+
+
+def _load_records(path, opts: _Options) -> list[GyroRecord]:
+    table = _open(path, opts)
+    p = table.path
+    t_idx, r_idx, table_time = _resolve_columns(table, opts.columns, opts.time_column)
+    if t_idx is None and not table_time and opts.dt_s is None:
+        raise ConfigError(
+            f"{p}: cannot tell the sample interval: no time column (none named {' / '.join(TIME_COLUMN_NAMES)}; "
+            "name one with {opt:time_column}) and no sample rate given; pass the sample rate in Hz as {opt:rate_hz}"
+        )
+    notes = []
+    kind_u, base_u, unit = _rate_unit(table, r_idx, opts.unit, notes)
+    t_scale = _time_scale(table, t_idx, opts.time_unit, notes)
+
+    # values: finite in every used column
+    used = [j for j in [t_idx, *r_idx] if j is not None]
+    data = table.read(used)
+    n = data.shape[0]
+    if n == 0:
+        if table.header_line:
+            raise DataFormatError(
+                f"no data rows after the header on line {table.header_line}; expected at least one "
+                "numeric row, got only the header", path=p,
+            )
+        raise DataFormatError("no data; expected at least one sample, got an empty table", path=p)
+    bad = first_nonfinite(data, used)
+    if bad is not None:
+        i, j = bad
+        raise table.error(
+            f"non-finite value{table.at(i)}; expected a finite number, got {float(data[i, j])!r}", row=i, col=j
+        )
+
+    # sample interval and segments
+    notes.insert(0, table.describe(n))
+    t = _time_vector(table, data, t_idx, table_time, t_scale)
+    if t is not None:
+        tname = "the file's time stamps" if t_idx is None else f"time column {table.names[t_idx]!r}"
+        if n < 2 and opts.dt_s is None:
+            raise InsufficientDataError(
+                f"{n} sample; expected at least 2 to take the sample interval from {tname}", needed=2, got=n, path=p,
+            )
+        dt, seg_bounds, gap_info = _check_time(table, t, t_idx, opts.dt_s, opts.split)
+        if opts.dt_s is None:
+            notes.insert(1, f"dt_s {dt:.10g} from the median step of {tname}")
+        else:
+            notes.insert(1, f"dt_s {dt:.10g} from dt_s/rate_hz ({tname} agrees within 1 %)")
+    else:
+        dt, seg_bounds, gap_info = opts.dt_s, [(0, n)], []
+        notes.insert(1, f"dt_s {dt:.10g} from dt_s/rate_hz (no time column)")
+    scale = unit_scale(kind_u, base_u, dt)
+    if scale != 1.0:
+        notes.append(f"input unit {unit!r} scaled by {scale:.10g} to deg/h")
+    return _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, opts.min_samples)
+
+
+def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, min_samples):
+    p = table.path
+    n = data.shape[0]
+    m = len(seg_bounds)
+    if m == 1 and n < min_samples:
+        raise InsufficientDataError(
+            f"{n} samples; expected at least {min_samples}", needed=min_samples, got=n, path=p
+        )
+    names = tuple(table.names[j] for j in r_idx)
+    declared = tuple(table.units[j] for j in r_idx)
+    sha256 = table.sha256
+    if sha256 is None and p.is_file():
+        sha256 = file_sha256(p)  # only for a reader that did not hash what it read
+    records, dropped = [], []
+    for k, (a, b) in enumerate(seg_bounds, start=1):
+        seg_notes = list(notes)
+        if m > 1:
+            where = f"samples {a}-{b - 1}"
+            if table.line_of(a) is not None:
+                where += f" (lines {table.line_of(a)}-{table.line_of(b - 1)})"
+            if k > 1:
+                where += f", after a gap of {gap_info[k - 2]:.6g} s"
+            seg_notes.append(f"segment {k} of {m}: {where}")
+            if b - a < min_samples:
+                dropped.append(f"segment {k} ({where}, {b - a} samples)")
+                continue
+        raw = take_columns(data[a:b], r_idx)
+        rate = to_dph(raw, scale)
+        if scale != 1.0:
+            bad = first_nonfinite(rate)
+            if bad is not None:
+                i, j = bad
+                raise table.error(
+                    f"value{table.at(a + i)} overflows in deg/h; expected |value| * {scale:.6g} below "
+                    f"{np.finfo(np.float64).max:.3g}, got {float(raw[i, j])!r} {unit}", row=a + i, col=r_idx[j],
+                )
+        records.append(GyroRecord(
+            rate_dph=rate, dt_s=dt, axis_names=names, source=str(p), input_unit=unit, scale_to_dph=scale,
+            t0_s=float(t[a]) if t is not None else 0.0, notes=tuple(seg_notes), sha256=sha256,
+            declared_units=declared,
+        ))
+    if dropped:
+        if not records:
+            longest = max(b - a for a, b in seg_bounds)
+            raise InsufficientDataError(
+                f"all {m} gap-free segments are shorter than {min_samples} samples; longest has {longest}",
+                needed=min_samples, got=longest, path=p,
+            )
+        warnings.warn(
+            f"{p}: dropped {len(dropped)} segment(s) shorter than {min_samples} samples: " + "; ".join(dropped),
+            FogdriftWarning, stacklevel=4,
+        )
+    return records
+
+
+# --------------------------------------------------------------------------------------------
+# Columns and units
+# --------------------------------------------------------------------------------------------
+def _resolve_columns(table: Table, columns, time_column):
+    """(time column index or None, rate column indices, use the table's own time vector)."""
+    names = table.names
+    ncol = len(names)
+
+    def resolve(key, option):
+        if isinstance(key, (int, np.integer)) and not isinstance(key, bool):
+            if -ncol <= int(key) < ncol:
+                return int(key) % ncol
+        elif isinstance(key, str):
+            for k in dict.fromkeys((key.strip(), split_unit_label(key)[0])):
+                hits = [j for j, a in enumerate(names) if a == k]
+                if not hits and k.isdigit() and int(k) < ncol:
+                    return int(k)
+                if not hits:
+                    hits = [j for j, a in enumerate(names) if a.lower() == k.lower()]
+                if len(hits) == 1:
+                    return hits[0]
+                if len(hits) > 1:
+                    raise DataFormatError(
+                        f"column name {key!r} is ambiguous; expected a unique name or an index, "
+                        f"got columns {hits}", path=table.path, column=key,
+                    )
+        raise DataFormatError(
+            f"unknown column {key!r}; expected one of {names} or an index 0..{ncol - 1} "
+            f"in {{opt:{option}}}, got {key!r}", path=table.path, column=key,
+        )
+
+    table_time = False
+    if time_column is None:
+        t_idx = None
+    elif isinstance(time_column, str) and time_column.strip().lower() == "auto":
+        t_idx = None
+        if table.time_s is not None:
+            table_time = True
+        elif table.named:
+            t_idx = next((j for j, a in enumerate(names) if _is_time_name(a)), None)
+    else:
+        t_idx = resolve(time_column, "time_column")
+
+    if columns is None:
+        r_idx = [j for j in range(ncol) if j != t_idx]
+    else:
+        r_idx = [resolve(k, "columns") for k in split_keys(columns, "columns")]
+        if len(set(r_idx)) != len(r_idx):
+            raise ConfigError(f"the same column is selected twice; expected distinct columns, got {columns!r}")
+        if t_idx is not None and t_idx in r_idx:
+            raise ConfigError(
+                f"column {names[t_idx]!r} is the time column; expected rate columns only, got {columns!r} "
+                "(to read it as rate data, pass {opt:time_column} none)"
+            )
+    if not r_idx:
+        raise DataFormatError(
+            f"no rate columns; expected at least one column besides the time column, got {names}",
+            path=table.path,
+        )
+    return t_idx, r_idx, table_time
+
+
+def _header_error(table: Table, message: str, col: int) -> DataFormatError:
+    return DataFormatError(message, path=table.path, line=table.header_line or None, column=table.label(col))
+
+
+def _rate_unit(table: Table, r_idx, unit, notes: list):
+    """(kind, base, unit string) for the rate columns: the given unit, else the declared one; never a guess."""
+    declared = {j: table.units[j] for j in r_idx}
+    if unit is not None:
+        kind, base = parse_unit(unit)
+        other = {table.names[j]: u for j, u in declared.items() if u is not None and u.strip() != unit.strip()}
+        if other:
+            notes.append(f"the file declares {other}; unit {unit!r} given takes precedence")
+        return kind, base, unit
+    kinds = set(declared.values())
+    if kinds == {None}:
+        cols = [table.names[j] for j in r_idx]
+        raise ConfigError(
+            f"{table.path}: no rate unit: the file declares none for {', '.join(cols)}; pass {{opt:unit}} "
+            f"({', '.join(valid_units())}), or declare it in the header as {cols[0]}[deg/s] (units are never guessed)"
+        )
+    first = declared[r_idx[0]]
+    odd = next(j for j in r_idx if declared[j] != first) if len(kinds) > 1 else None
+    if odd is not None:
+        listing = {table.names[j]: u for j, u in declared.items()}
+        raise _header_error(
+            table, f"rate columns declare different units; expected one unit for all rate columns (choose them "
+                   f"with {{opt:columns}} or pass {{opt:unit}}), got {listing}", odd,
+        )
+    try:
+        kind, base = parse_unit(first)
+    except ConfigError:
+        raise _header_error(
+            table, f"unknown unit {first!r} declared in the header; expected one of {valid_units()} "
+                   f"(or pass {{opt:unit}}), got {first!r}", r_idx[0],
+        ) from None
+    notes.append(f"unit {first!r} declared in the file")
+    return kind, base, first
+
+
+def _is_time_name(name: str) -> bool:
+    low = name.strip().lower()
+    return low in TIME_COLUMN_NAMES or (time_unit_of_name(low) is not None
+                                        and low.rpartition("_")[0] in ("t", "time", "timestamp"))
+
+
+def time_unit_of_name(name: str) -> str | None:
+    """The time unit a column name declares by its suffix (``t_s``, ``time_ms``, ``stamp_us``), else None.
+
+    Examples
+    --------
+    >>> time_unit_of_name("t_s"), time_unit_of_name("Time_MS"), time_unit_of_name("time"), time_unit_of_name("gz_s2")
+    ('s', 'ms', None, None)
+    """
+    stem, sep, suffix = name.strip().rpartition("_")
+    suffix = suffix.lower()
+    return suffix if sep and stem and suffix in units.TIME_UNITS else None
+
+
+def _time_scale(table: Table, t_idx, time_unit, notes: list) -> float:
+    """Factor from the time column's unit to s: the given time_unit, else the declared one; never a guess.
+
+    A column declares its unit in brackets (``t[ms]``) or by a suffix of its name (``t_s``, ``time_ms``).
+    """
+    if t_idx is None:
+        return 1.0
+    declared = table.units[t_idx]
+    name = table.names[t_idx]
+    if time_unit is not None:
+        if declared is not None and declared.strip() != time_unit:
+            notes.append(f"the file declares time unit {declared!r}; time_unit {time_unit!r} given takes precedence")
+        unit = time_unit
+    elif declared is not None:
+        unit = declared.strip()
+        if unit not in units.TIME_UNITS:
+            raise _header_error(
+                table, f"unknown time unit {unit!r} declared in the header; expected one of "
+                       f"{list(units.TIME_UNITS)} (or pass {{opt:time_unit}}), got {unit!r}", t_idx,
+            )
+    elif time_unit_of_name(name) is not None:
+        unit = time_unit_of_name(name)
+    else:
+        raise ConfigError(
+            f"{table.path}: time column {name!r} declares no unit; pass {{opt:time_unit}} "
+            f"({', '.join(units.TIME_UNITS)}), or name it {name}[s] or {name}_s in the header, or leave it out "
+            "with {opt:time_column} none and give the sample rate as {opt:rate_hz} (units are never guessed)"
+        )
+    notes.append(f"time column {name!r} in {unit}")
+    return units.time_scale_to_s(unit)
+
+
+# --------------------------------------------------------------------------------------------
+# Time
+# --------------------------------------------------------------------------------------------
+def _time_vector(table: Table, data, t_idx, table_time: bool, t_scale: float):
+    """Time in s (float64), or None without time."""
+    if t_idx is not None:
+        t = np.asarray(data[:, t_idx], dtype=np.float64)
+        return t if t_scale == 1.0 else t * t_scale
+    if not table_time:
+        return None
+    t = np.asarray(table.time_s, dtype=np.float64)
+    if t.shape != (data.shape[0],):
+        raise DataFormatError(
+            f"time vector has shape {t.shape}; expected ({data.shape[0]},), one time per row", path=table.path
+        )
+    bad = first_nonfinite(t.reshape(-1, 1))
+    if bad is not None:
+        raise table.error(f"non-finite time{table.at(bad[0])}; expected a finite number, got {float(t[bad[0]])!r}",
+                          row=bad[0])
+    return t
+
+
+def _check_time(table: Table, t: np.ndarray, t_idx, dt_user, split: bool):
+    """Validate the time vector; return (dt_s, [(start, stop) segments], [gap sizes in s])."""
+    n = t.shape[0]
+    if n < 2:
+        return dt_user, [(0, n)], []
+    with np.errstate(over="ignore", invalid="ignore"):
+        steps = np.diff(t)
+    nonpos = ~(steps > 0)
+    if nonpos.any():
+        i = int(np.argmax(nonpos)) + 1
+        if steps[i - 1] == 0:
+            msg = (f"duplicate timestamp{table.at(i)}; expected strictly increasing time, "
+                   f"got {float(t[i])!r} s again (as on {table.row_ref(i - 1)})")
+        else:
+            msg = (f"time goes backwards{table.at(i)}; expected strictly increasing time, "
+                   f"got {float(t[i])!r} s after {float(t[i - 1])!r} s on {table.row_ref(i - 1)}")
+        raise table.error(msg, row=i, col=t_idx)
+    dt_time = float(f"{float(np.median(steps)):.10g}")
+    if not (np.isfinite(dt_time) and dt_time > 0):
+        raise table.error(
+            f"time steps overflow; expected a finite median step between time stamps, got {dt_time!r} s", col=t_idx
+        )
+    if dt_user is None:
+        dt = dt_time
+    else:
+        rel = abs(dt_time - dt_user) / dt_user
+        if rel > DT_TOLERANCE:
+            raise table.error(
+                f"time column disagrees with the given sample interval (omit {{opt:rate_hz}} to take it from the "
+                f"time column); expected a median step within 1 % of {dt_user:.10g} s ({1 / dt_user:.10g} Hz), "
+                f"got {dt_time:.10g} s ({rel:.1%} off)", col=t_idx,
+            )
+        dt = dt_user
+    gap_rows = np.flatnonzero(steps > GAP_FACTOR * dt) + 1
+    if gap_rows.size == 0:
+        return dt, [(0, n)], []
+    if not split:
+        i = int(gap_rows[0])
+        g = float(steps[i - 1])
+        raise table.error(
+            f"gap in time{table.at(i)} of {g:.6g} s ({g / dt:.4g} sample intervals) between t={float(t[i - 1])!r} s "
+            f"and t={float(t[i])!r} s ({gap_rows.size} gap(s) in total; set {{opt:gaps}} to use the gap-free "
+            f"segments); expected steps of at most {GAP_FACTOR} x {dt:.10g} s, got {g:.6g} s",
+            row=i, col=t_idx,
+        )
+    starts = [0, *gap_rows.tolist()]
+    stops = [*gap_rows.tolist(), n]
+    return dt, list(zip(starts, stops)), [float(steps[i - 1]) for i in gap_rows]

@@ -1,0 +1,179 @@
+"""The reader interface: :class:`Table`, what every format module hands to :func:`fogdrift.io.load`.
+
+A reader module defines one function::
+
+    def open_table(path: Path, **options) -> Table
+
+``options`` are the reader options its registry line declares (``delimiter`` for text; later
+``dataset``, ``topic``, ``layout``...).  ``open_table`` reads as little as it needs to name the
+columns (a header, an array header); :meth:`Table.read` delivers the numbers.  Everything
+else (choosing columns, time checks, gaps, units, the record) is :mod:`fogdrift.io.load`'s job
+and the same for every format.
+"""
+
+from __future__ import annotations
+
+import re
+import zipfile
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import DataFormatError
+
+__all__ = ["Table", "split_unit_label", "numeric_column", "describe_exception", "PARSER_ERRORS"]
+
+#: What third-party parsers (numpy.load, zipfile, gzip) raise on corrupt bytes; readers turn
+#: these into a DataFormatError naming the file.  RuntimeError covers zipfile's "encrypted"
+#: and NotImplementedError ("compression method not supported"); OverflowError and
+#: MemoryError come from absurd shapes in array headers.
+PARSER_ERRORS = (ValueError, TypeError, KeyError, OSError, EOFError, OverflowError, MemoryError, RuntimeError,
+                 zlib.error, zipfile.BadZipFile)
+
+_UNIT_LABEL = re.compile(r"^(?P<name>.*?)\s*\[\s*(?P<unit>[^\[\]]*?)\s*\]$")
+
+
+def split_unit_label(label: str) -> tuple[str, str | None]:
+    """Split a column label ``name[unit]`` into ``(name, unit)``; ``(label, None)`` without brackets.
+
+    The convention for files that carry units in their column names (text headers):
+    ``gz[deg/s]``, ``t[ms]``, ``gyro x [rad/s]``.  Spaces around the brackets are dropped;
+    empty brackets declare no unit.
+
+    Examples
+    --------
+    >>> split_unit_label("gz[deg/s]")
+    ('gz', 'deg/s')
+    >>> split_unit_label("gyro x [inc:arcsec]")
+    ('gyro x', 'inc:arcsec')
+    >>> split_unit_label("time_s")
+    ('time_s', None)
+    """
+    label = label.strip()
+    m = _UNIT_LABEL.match(label)
+    if m is None:
+        return label, None
+    return m.group("name"), (m.group("unit") or None)
+
+
+def describe_exception(exc: BaseException) -> str:
+    """``"<Type>: <message>"`` of a parser's exception on one line (for ``got ...`` in messages)."""
+    return " ".join(f"{type(exc).__name__}: {exc}".split())
+
+
+def numeric_column(arr: np.ndarray, path, what: str, column=None) -> np.ndarray:
+    """``arr`` as float64 (a copy only if it is not float64 already); DataFormatError for non-numeric dtypes."""
+    if arr.dtype.kind not in "biuf":
+        raise DataFormatError(
+            f"{what} has dtype {arr.dtype}; expected a real numeric dtype, got {arr.dtype}", path=path, column=column
+        )
+    if arr.dtype != np.float64:
+        arr = np.asarray(arr, dtype=np.float64)
+    return arr
+
+
+class Table:
+    """Named numeric columns read from one file, and how to locate a sample in it.
+
+    Parameters
+    ----------
+    path : Path
+        The file (or directory, for directory formats).
+    names : sequence of str
+        One unique name per column.
+    named : bool
+        True if the names come from the file (header, array keys); False for generated
+        names ``col0, col1, ...``.
+    units : sequence of (str or None), optional
+        Unit each column declares in the file, as written (None: not declared).  Rate units
+        are checked by :func:`fogdrift.io.load` only for the columns it uses.
+    data : ndarray, shape (n_rows, n_columns), optional
+        The numbers, if the reader has them at open time (arrays).  Keep it a view of a
+        memory map when the file allows: :func:`fogdrift.io.load` copies only the columns
+        it converts.
+    time_s : ndarray, shape (n_rows,), optional
+        Time in s that the format itself provides (message stamps, start time + rate), when
+        time is not one of the columns.  ``time_column="auto"`` uses it.
+    sha256 : str, optional
+        Hex SHA-256 of the file bytes, set by the reader once it has read them all.
+    format : str, optional
+        Format name for messages and notes (default: the class attribute, ``"table"``).
+
+    Notes
+    -----
+    Subclasses override :meth:`read` (parse on demand, e.g. only the used columns of a text
+    file), :meth:`line_of` (text: physical line of a data row), :meth:`label` and
+    :meth:`describe`.  ``row_kind`` names a row in messages ("sample"; "message" for a bag).
+    """
+
+    format = "table"
+    row_kind = "sample"
+    #: Physical line of a header that names the columns (text), 0 if none: locates unit errors.
+    header_line = 0
+
+    def __init__(self, path, *, names, named=True, units=None, data=None, time_s=None, sha256=None, format=None):
+        if format is not None:
+            self.format = str(format)
+        self.path = Path(path)
+        self.names = [str(n) for n in names]
+        self.named = bool(named)
+        self.units = list(units) if units is not None else [None] * len(self.names)
+        self.data = data
+        self.time_s = time_s
+        self.sha256 = sha256
+        if len(self.units) != len(self.names):
+            raise ValueError(f"reader bug: {len(self.units)} units for {len(self.names)} columns")
+        dup = next((a for j, a in enumerate(self.names) if a in self.names[:j]), None)
+        if dup is not None:
+            raise DataFormatError(
+                f"duplicate column name; expected unique names, got {dup!r} twice", path=self.path, column=dup
+            )
+
+    # -- the numbers ---------------------------------------------------------------------------
+    def read(self, used) -> np.ndarray:
+        """All rows as a 2-D array ``(n_rows, n_columns)``; the columns in ``used`` are valid numbers.
+
+        Parameters
+        ----------
+        used : sequence of int
+            Columns the caller will use (time and rate columns).  Cells of other columns
+            may be NaN if they do not parse.  NaN/inf in used columns are returned as they
+            are (the caller locates them).
+
+        Raises
+        ------
+        DataFormatError
+            If a used cell is not a number (located by line/column or sample index).
+        """
+        return self.data
+
+    # -- locating ------------------------------------------------------------------------------
+    def line_of(self, row: int) -> int | None:
+        """Physical line of data row ``row`` (text formats), else None."""
+        return None
+
+    def label(self, col: int):
+        """Column label for error locations (the name; header-less text: the 1-based field number)."""
+        return self.names[col]
+
+    def at(self, row: int) -> str:
+        """Phrase that locates ``row`` inside a message: ``" at sample 12"``, or "" where a line number does."""
+        return "" if self.line_of(row) is not None else f" at {self.row_kind} {row}"
+
+    def row_ref(self, row: int) -> str:
+        """``"line 7"`` or ``"sample 6"``: a row named in the middle of a message."""
+        line = self.line_of(row)
+        return f"line {line}" if line is not None else f"{self.row_kind} {row}"
+
+    def error(self, message: str, row: int | None = None, col: int | None = None) -> DataFormatError:
+        """DataFormatError at ``row`` (data row index) and ``col`` (column index) of this table."""
+        return DataFormatError(
+            message, path=self.path,
+            line=None if row is None else self.line_of(row),
+            column=None if col is None else self.label(col),
+        )
+
+    def describe(self, n_rows: int) -> str:
+        """One line for the record's notes, e.g. ``"npy array, 1000 samples x 3 columns"``."""
+        return f"{self.format} array, {n_rows} {self.row_kind}s x {len(self.names)} columns"

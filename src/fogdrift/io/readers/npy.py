@@ -1,0 +1,44 @@
+"""NumPy ``.npy`` reader: 1-D (one axis) or 2-D (samples x columns), memory-mapped.
+
+The array is opened with ``mmap_mode="r"``: a float64 array is handed on as a view of the
+memory map, never copied (other dtypes are converted to float64).  The file's SHA-256 is
+computed by reading it once in chunks (the memory map itself reads nothing up front).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import DataFormatError
+from ..hashing import file_sha256
+from .base import PARSER_ERRORS, Table, describe_exception, numeric_column
+
+__all__ = ["open_table"]
+
+
+def open_table(path: Path) -> Table:
+    """Memory-map a ``.npy`` array; columns are named ``col0, col1, ...``.
+
+    Raises
+    ------
+    DataFormatError
+        Unreadable file, object/string/complex dtype, or more than 2 dimensions.
+    """
+    p = Path(path)
+    try:
+        arr = np.load(p, mmap_mode="r", allow_pickle=False)
+    except PARSER_ERRORS as exc:
+        raise DataFormatError(
+            f"unreadable .npy file; expected a numeric NumPy array, got {describe_exception(exc)}", path=p
+        ) from exc
+    if arr.ndim not in (1, 2):
+        raise DataFormatError(
+            f"array has shape {arr.shape}; expected 1-D (one axis) or 2-D (samples x columns)", path=p
+        )
+    arr = numeric_column(arr, p, "array")
+    if arr.ndim == 1:
+        arr = arr.reshape(-1, 1)
+    return Table(p, names=[f"col{j}" for j in range(arr.shape[1])], named=False, data=arr,
+                 sha256=file_sha256(p), format="npy")

@@ -1,0 +1,550 @@
+"""The in-memory gyro record: :class:`GyroRecord`, block averaging and the modelling-rate rule.
+
+A record is uniformly sampled, in deg/h, with time in s.  Sample ``k`` covers
+``[t0_s + k dt_s, t0_s + (k+1) dt_s)``, so ``duration_s = n_samples * dt_s`` and block averages
+keep ``t0_s``.  Nothing here reads files (see :mod:`fogdrift.io.load`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ConfigError, DataFormatError, InsufficientDataError
+from ._checks import first_nonfinite, int_arg, parse_unit, positive_float, split_keys, take_columns, to_dph, unit_scale
+
+__all__ = ["GyroRecord", "block_average", "from_array", "decimation_factor"]
+
+#: Relative tolerance for "target interval is an integer multiple of dt_s" in :meth:`GyroRecord.block_average`.
+_MULTIPLE_RTOL = 1e-6
+#: Relative tolerance for "the native rate is an integer multiple of the model rate" (:func:`decimation_factor`).
+RATE_RTOL = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class GyroRecord:
+    """A uniformly sampled multi-axis gyro record in deg/h.
+
+    Parameters
+    ----------
+    rate_dph : ndarray, shape (n_samples, n_axes), float64
+        Angular rate in deg/h.  Stored as a read-only view (possibly of a memory map): copy
+        it before modifying.
+    dt_s : float
+        Sample interval in s (> 0).
+    axis_names : tuple of str
+        One unique name per column of ``rate_dph``.
+    source : str
+        File path, or ``"<array>"``.
+    input_unit : str
+        Unit of the input numbers as given (``"deg/s"``, ``"inc:arcsec"`` ...).
+    scale_to_dph : float
+        Factor that was applied to the input numbers to get deg/h.
+    t0_s : float, optional
+        Time of the first sample in s.
+    notes : tuple of str, optional
+        Provenance ("segment 2 of 3: samples ...", "block-averaged x100 ...").
+    sha256 : str or None, optional
+        Hex SHA-256 of the input file's bytes, recorded while the file was read (None for
+        arrays).
+    declared_units : tuple of (str or None), optional
+        Unit each axis declared in the file (``gz[deg/s]`` header cells), None where the
+        file declares none.  Default: None for every axis.
+    block_average_factor : int, optional
+        Product of the block-averaging factors applied since loading (1 = native rate).
+
+    Notes
+    -----
+    Sample ``k`` covers ``[t0_s + k dt_s, t0_s + (k + 1) dt_s)``; ``duration_s`` is
+    ``n_samples * dt_s``.  Records compare by identity (they hold arrays).
+    """
+
+    rate_dph: np.ndarray
+    dt_s: float
+    axis_names: tuple[str, ...]
+    source: str
+    input_unit: str
+    scale_to_dph: float
+    t0_s: float = 0.0
+    notes: tuple[str, ...] = ()
+    sha256: str | None = None
+    declared_units: tuple[str | None, ...] = ()
+    block_average_factor: int = 1
+
+    def __post_init__(self):
+        r = self.rate_dph
+        if not isinstance(r, np.ndarray) or r.ndim != 2 or r.dtype != np.float64:
+            raise ConfigError(
+                "rate_dph must be a float64 array of shape (n_samples, n_axes); got "
+                f"{type(r).__name__} {getattr(r, 'dtype', '')} {getattr(r, 'shape', '')}".rstrip()
+            )
+        if r.flags.writeable:
+            r = r.view()
+            r.flags.writeable = False
+            object.__setattr__(self, "rate_dph", r)
+        names = tuple(str(a) for a in self.axis_names)
+        if len(names) != r.shape[1]:
+            raise ConfigError(f"axis_names must name the {r.shape[1]} columns of rate_dph; got {names!r}")
+        if len(set(names)) != len(names):
+            raise ConfigError(f"axis_names must be unique; got {names!r}")
+        object.__setattr__(self, "axis_names", names)
+        declared = tuple(None if u is None else str(u) for u in self.declared_units) or (None,) * len(names)
+        if len(declared) != len(names):
+            raise ConfigError(f"declared_units must give one unit (or None) per axis {names!r}; got {declared!r}")
+        object.__setattr__(self, "declared_units", declared)
+        object.__setattr__(self, "dt_s", positive_float(self.dt_s, "dt_s"))
+        object.__setattr__(self, "t0_s", float(self.t0_s))
+        object.__setattr__(self, "scale_to_dph", float(self.scale_to_dph))
+        object.__setattr__(self, "source", str(self.source))
+        object.__setattr__(self, "notes", tuple(str(n) for n in self.notes))
+        object.__setattr__(self, "sha256", None if self.sha256 is None else str(self.sha256))
+        factor = int_arg(self.block_average_factor, "block_average_factor")
+        if factor < 1:
+            raise ConfigError(f"block_average_factor must be an integer >= 1; got {factor}")
+        object.__setattr__(self, "block_average_factor", factor)
+
+    # -- sizes ---------------------------------------------------------------------------------
+    @property
+    def n_samples(self) -> int:
+        """Number of samples."""
+        return int(self.rate_dph.shape[0])
+
+    @property
+    def n_axes(self) -> int:
+        """Number of axes (columns)."""
+        return int(self.rate_dph.shape[1])
+
+    @property
+    def fs_hz(self) -> float:
+        """Sample rate in Hz (``1 / dt_s``)."""
+        return 1.0 / self.dt_s
+
+    @property
+    def native_fs_hz(self) -> float:
+        """Sample rate of the loaded data before block averaging, in Hz."""
+        return self.block_average_factor / self.dt_s
+
+    @property
+    def duration_s(self) -> float:
+        """Record length in s, ``n_samples * dt_s``."""
+        return self.n_samples * self.dt_s
+
+    # -- axes and ranges -----------------------------------------------------------------------
+    def _axis_index(self, key) -> int:
+        n = self.n_axes
+        if isinstance(key, (int, np.integer)) and not isinstance(key, bool):
+            if -n <= int(key) < n:
+                return int(key) % n
+        elif isinstance(key, str):
+            k = key.strip()
+            if k in self.axis_names:
+                return self.axis_names.index(k)
+            if k.isdigit() and int(k) < n:
+                return int(k)
+            folded = [i for i, a in enumerate(self.axis_names) if a.lower() == k.lower()]
+            if len(folded) == 1:
+                return folded[0]
+        raise ConfigError(
+            f"unknown axis {key!r}; expected one of {list(self.axis_names)} or an index 0..{n - 1}"
+        )
+
+    def axis(self, key) -> np.ndarray:
+        """Rate of one axis in deg/h, shape (n_samples,), a read-only view.
+
+        Parameters
+        ----------
+        key : int or str
+            Axis name, or 0-based index (negative counts from the end).
+
+        Raises
+        ------
+        ConfigError
+            If ``key`` names no axis.
+        """
+        return self.rate_dph[:, self._axis_index(key)]
+
+    def select(self, keys) -> "GyroRecord":
+        """Record with a subset of the axes, in the order given.
+
+        Parameters
+        ----------
+        keys : int, str or sequence of int/str
+            Axis names or 0-based indices; a string may list several separated by commas.
+
+        Raises
+        ------
+        ConfigError
+            If a key is unknown, repeated, or no key is given.
+        """
+        idx = [self._axis_index(k) for k in split_keys(keys, "keys")]
+        if len(set(idx)) != len(idx):
+            raise ConfigError(f"keys select an axis twice; expected distinct axes, got {keys!r}")
+        return dataclasses.replace(
+            self, rate_dph=take_columns(self.rate_dph, idx), axis_names=tuple(self.axis_names[i] for i in idx),
+            declared_units=tuple(self.declared_units[i] for i in idx),
+        )
+
+    def slice(self, start: int, stop: int) -> "GyroRecord":
+        """Record of samples ``start .. stop-1`` (Python semantics for negative values).
+
+        ``t0_s`` becomes ``t0_s + start * dt_s``; a note records the range.
+
+        Raises
+        ------
+        ConfigError
+            If the range is empty or outside ``0 .. n_samples``.
+        """
+        n = self.n_samples
+        lo, hi = int_arg(start, "start"), int_arg(stop, "stop")
+        lo = lo + n if lo < 0 else lo
+        hi = hi + n if hi < 0 else hi
+        if not 0 <= lo < hi <= n:
+            raise ConfigError(
+                f"slice({start!r}, {stop!r}) is empty or out of range; expected 0 <= start < stop <= {n}"
+            )
+        note = f"slice: samples {lo}-{hi - 1} of {n}"
+        return dataclasses.replace(
+            self, rate_dph=self.rate_dph[lo:hi], t0_s=self.t0_s + lo * self.dt_s, notes=self.notes + (note,)
+        )
+
+    # -- averaging -----------------------------------------------------------------------------
+    def block_average(self, dt_s: float) -> "GyroRecord":
+        """Average non-overlapping blocks to the longer sample interval ``dt_s`` (s).
+
+        Parameters
+        ----------
+        dt_s : float
+            Target interval in s; must be an integer multiple ``m`` of ``self.dt_s`` within
+            1e-6 relative.  The result has ``dt_s = m * self.dt_s``; the incomplete last
+            block is dropped.
+
+        Raises
+        ------
+        ConfigError
+            If ``dt_s`` is not a positive integer multiple (the message suggests the nearest).
+        InsufficientDataError
+            If the record is shorter than one block.
+
+        See Also
+        --------
+        to_rate : the same by a target rate in Hz, with the stricter modelling-rate rule.
+
+        Notes
+        -----
+        ``y_j = (1/m) sum_{k=0}^{m-1} x_{jm+k}``: for rate samples that are averages over their
+        interval (integrating gyros, angle increments) this is exactly the average rate over
+        the longer interval, so ``t0_s`` is unchanged.
+        """
+        target = positive_float(dt_s, "dt_s")
+        ratio = target / self.dt_s
+        m = int(round(ratio))
+        if m < 1 or abs(m * self.dt_s - target) > _MULTIPLE_RTOL * target:
+            near = sorted({max(1, math.floor(ratio)), max(1, math.ceil(ratio))})
+            hint = " or ".join(f"{k * self.dt_s:.10g} s (x{k})" for k in near)
+            raise ConfigError(
+                f"block-average interval dt_s={dt_s!r} is not an integer multiple of the sample "
+                f"interval {self.dt_s:.10g} s; expected e.g. {hint}, got {ratio:.6g} x dt_s"
+            )
+        return self._averaged(m)
+
+    def to_rate(self, rate_hz: float) -> "GyroRecord":
+        """The record block-averaged to the modelling rate ``rate_hz`` (Hz), by an integer factor only.
+
+        Parameters
+        ----------
+        rate_hz : float
+            Target rate in Hz; ``fs_hz / rate_hz`` must be an integer ``m`` within 1e-9
+            relative (see :func:`decimation_factor`).
+
+        Returns
+        -------
+        GyroRecord
+            ``self`` when ``rate_hz`` equals ``fs_hz``; otherwise blocks of ``m`` samples
+            averaged (the incomplete last block dropped), ``dt_s = m * self.dt_s``, ``fs_hz``
+            the effective rate and ``block_average_factor`` multiplied by ``m``.
+
+        Raises
+        ------
+        ConfigError
+            If ``rate_hz`` is not ``fs_hz`` divided by an integer (the message names the
+            nearest valid rates above and below) or is above ``fs_hz``.
+        InsufficientDataError
+            If the record is shorter than one block.
+
+        Examples
+        --------
+        >>> rec = from_array(np.arange(8.0), dt_s=0.01)
+        >>> low = rec.to_rate(25.0)
+        >>> low.fs_hz, low.block_average_factor, low.rate_dph[:, 0].tolist()
+        (25.0, 4, [1.5, 5.5])
+        >>> rec.to_rate(100.0) is rec
+        True
+        """
+        return self._averaged(decimation_factor(self.dt_s, rate_hz))
+
+    def _averaged(self, m: int) -> "GyroRecord":
+        if m == 1:
+            return self
+        n = self.n_samples
+        if n < m:
+            raise InsufficientDataError(
+                f"block average to {m * self.dt_s:.10g} s needs {m} samples for one block; got {n}",
+                needed=m, got=n, path=self.source,
+            )
+        avg = block_average(self.rate_dph, m)
+        dropped = n - avg.shape[0] * m
+        note = f"block-averaged x{m} ({self.dt_s:.10g} s -> {m * self.dt_s:.10g} s), dropped {dropped} trailing samples"
+        return dataclasses.replace(self, rate_dph=avg, dt_s=m * self.dt_s, notes=self.notes + (note,),
+                                   block_average_factor=self.block_average_factor * m)
+
+    def metadata(self) -> dict:
+        """JSON-serialisable description (no arrays): every field but the data, plus sizes.
+
+        Returns
+        -------
+        dict
+            ``source, sha256, input_unit, declared_units (list), scale_to_dph, rate_unit
+            ("deg/h"), dt_s, fs_hz, native_fs_hz, block_average_factor, t0_s, n_samples,
+            n_axes, duration_s, axis_names (list), notes (list)``.  ``fs_hz`` is the
+            effective rate after block averaging; ``native_fs_hz`` the rate as loaded.
+        """
+        return {
+            "source": self.source,
+            "sha256": self.sha256,
+            "input_unit": self.input_unit,
+            "declared_units": list(self.declared_units),
+            "scale_to_dph": self.scale_to_dph,
+            "rate_unit": "deg/h",
+            "dt_s": self.dt_s,
+            "fs_hz": self.fs_hz,
+            "native_fs_hz": self.native_fs_hz,
+            "block_average_factor": self.block_average_factor,
+            "t0_s": self.t0_s,
+            "n_samples": self.n_samples,
+            "n_axes": self.n_axes,
+            "duration_s": self.duration_s,
+            "axis_names": list(self.axis_names),
+            "notes": list(self.notes),
+        }
+
+    def __repr__(self) -> str:
+        return (
+            f"GyroRecord(n_samples={self.n_samples}, axes={list(self.axis_names)}, dt_s={self.dt_s:.10g}, "
+            f"t0_s={self.t0_s:.10g}, input_unit={self.input_unit!r}, source={self.source!r})"
+        )
+
+
+# --------------------------------------------------------------------------------------------
+# Functions
+# --------------------------------------------------------------------------------------------
+def block_average(x, factor: int) -> np.ndarray:
+    """Average non-overlapping blocks of ``factor`` samples along axis 0.
+
+    Parameters
+    ----------
+    x : array_like, shape (n_samples, ...)
+        Samples (any unit).
+    factor : int
+        Block length m >= 1.
+
+    Returns
+    -------
+    ndarray, shape (n_samples // factor, ...), float64
+        ``y_j = (1/m) sum_{k=0}^{m-1} x_{jm+k}``; the incomplete last block is dropped.
+
+    Raises
+    ------
+    ConfigError
+        If ``factor`` is not an integer >= 1 or ``x`` is 0-D.
+    InsufficientDataError
+        If ``x`` has fewer than ``factor`` samples.
+
+    Notes
+    -----
+    Works on memory maps without a full copy: the kept rows are reshaped (a view) to
+    ``(n_blocks, m, ...)`` and reduced along the block axis.
+
+    Examples
+    --------
+    >>> block_average([1.0, 2.0, 3.0, 4.0, 5.0], 2)
+    array([1.5, 3.5])
+    """
+    if isinstance(factor, bool) or not isinstance(factor, (int, np.integer)) or factor < 1:
+        raise ConfigError(f"factor must be an integer >= 1; got {factor!r}")
+    arr = np.asarray(x)
+    if arr.ndim == 0:
+        raise ConfigError("x must have at least one dimension (samples along axis 0); got a scalar")
+    m = int(factor)
+    n = arr.shape[0]
+    nb = n // m
+    if nb == 0:
+        raise InsufficientDataError(
+            f"block average needs {m} samples for one block; got {n}", needed=m, got=n
+        )
+    blocks = arr[: nb * m].reshape((nb, m) + arr.shape[1:])
+    return blocks.mean(axis=1, dtype=np.float64)
+
+
+def decimation_factor(native_dt_s: float, rate_hz: float) -> int:
+    """Integer block-average factor that takes a record sampled every ``native_dt_s`` to ``rate_hz``.
+
+    The modelling-rate rule: a record is only ever block-averaged by an integer factor, so
+    ``rate_hz`` must be the native rate ``1 / native_dt_s`` divided by an integer ``m``
+    (within 1e-9 relative).  Non-integer resampling would mix noise between samples and
+    change the Allan variance at short tau.
+
+    Parameters
+    ----------
+    native_dt_s : float
+        Sample interval of the record in s.
+    rate_hz : float
+        Wanted rate in Hz.
+
+    Returns
+    -------
+    int
+        ``m >= 1`` with ``rate_hz = 1 / (m * native_dt_s)``; 1 when the rates are equal.
+
+    Raises
+    ------
+    ConfigError
+        If ``rate_hz`` is not finite and > 0, is above the native rate, or does not divide
+        it by an integer; the message names the nearest valid rates and the option
+        ``{opt:model_rate_hz}``.
+
+    Examples
+    --------
+    >>> decimation_factor(0.01, 3.125)
+    32
+    >>> decimation_factor(0.01, 3.0)
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.ConfigError: model rate 3 Hz does not divide the native 100 Hz by an integer; nearest valid rates: 3.03 Hz (/33), 2.941 Hz (/34); pass model_rate_hz=
+    """
+    dt = positive_float(native_dt_s, "native_dt_s")
+    try:
+        fs = float(rate_hz)
+    except (TypeError, ValueError):
+        fs = math.nan
+    if isinstance(rate_hz, bool) or not (math.isfinite(fs) and fs > 0):
+        raise ConfigError(f"model rate must be a finite number of Hz > 0, got {rate_hz!r}; pass {{opt:model_rate_hz}}")
+    native = 1.0 / dt
+    ratio = native / fs
+    m = round(ratio)
+    if m >= 1 and abs(ratio - m) <= RATE_RTOL * ratio:
+        return int(m)
+    if ratio < 1:
+        valid = [native / k for k in (1, 2, 3)]
+        shown = _distinct(fs, *valid)
+        listing = ", ".join(f"{s} Hz (/{k})" for k, s in enumerate(shown[1:], start=1))
+        raise ConfigError(
+            f"model rate {shown[0]} Hz is above the native {native:.10g} Hz; expected the native rate divided "
+            f"by an integer (block averaging cannot raise the rate): {listing} ...; pass {{opt:model_rate_hz}}"
+        )
+    lo = math.floor(ratio)
+    req, above, below = _distinct(fs, native / lo, native / (lo + 1))
+    raise ConfigError(
+        f"model rate {req} Hz does not divide the native {native:.10g} Hz by an integer; nearest valid rates: "
+        f"{above} Hz (/{lo}), {below} Hz (/{lo + 1}); pass {{opt:model_rate_hz}}"
+    )
+
+
+def _distinct(*values: float) -> list[str]:
+    """The values printed with the fewest significant digits (>= 4) that tell them apart."""
+    for digits in range(4, 18):
+        shown = [f"{v:.{digits}g}" for v in values]
+        if len(set(shown)) == len(set(values)):
+            return shown
+    return [repr(v) for v in values]
+
+
+def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -> GyroRecord:
+    """Wrap an array of rates (or angle increments) as a :class:`GyroRecord`.
+
+    Parameters
+    ----------
+    rate : array_like, shape (n_samples,) or (n_samples, n_axes)
+        Rates in ``unit``.  A float64 deg/h array is not copied (the record holds a
+        read-only view of it).
+    dt_s : float
+        Sample interval in s (> 0).
+    unit : str
+        Rate unit from :data:`fogdrift.units.RATE_UNITS` or ``"inc:<angle>"`` for an angle
+        increment per sample (``"inc:deg"``, ``"inc:rad"``, ``"inc:arcsec"``).
+    axis_names : sequence of str, optional
+        Default ``("axis0", "axis1", ...)``.
+    source : str
+        Where the numbers came from (used in messages).
+
+    Returns
+    -------
+    GyroRecord
+        ``sha256`` is None (no file).
+
+    Raises
+    ------
+    ConfigError
+        Bad ``dt_s``, ``unit`` or ``axis_names``.
+    DataFormatError
+        Non-numeric data, wrong number of dimensions, or a NaN/inf value (the message gives
+        the sample index; ``column`` is the axis name), also after conversion to deg/h.
+    InsufficientDataError
+        Zero samples.
+
+    Examples
+    --------
+    >>> rec = from_array([0.1, 0.1, 0.2], dt_s=0.01, unit="inc:arcsec")
+    >>> rec.rate_dph[:, 0]
+    array([10., 10., 20.])
+    """
+    dt = positive_float(dt_s, "dt_s")
+    kind, base = parse_unit(unit)
+    try:
+        arr = np.asarray(rate)
+        if arr.dtype.kind not in "biuf":
+            arr = np.asarray(rate, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise DataFormatError(
+            f"rate is not numeric; expected an array of numbers, got {type(rate).__name__}", path=source
+        ) from exc
+    if arr.ndim == 1:
+        arr = arr.reshape(-1, 1)
+    if arr.ndim != 2:
+        raise DataFormatError(
+            f"rate has shape {arr.shape}; expected (n_samples,) or (n_samples, n_axes)", path=source
+        )
+    if axis_names is None:
+        names = [f"axis{j}" for j in range(arr.shape[1])]
+    else:
+        names = [axis_names] if isinstance(axis_names, str) else [str(a) for a in axis_names]
+        if len(names) != arr.shape[1] or len(set(names)) != len(names):
+            raise ConfigError(
+                f"axis_names must be {arr.shape[1]} unique names (one per column); got {axis_names!r}"
+            )
+    n = arr.shape[0]
+    if n == 0:
+        raise InsufficientDataError("rate has 0 samples; expected at least 1", needed=1, got=0, path=source)
+    bad = first_nonfinite(arr)
+    if bad is not None:
+        i, j = bad
+        raise DataFormatError(
+            f"non-finite value at sample {i}; expected a finite number, got {float(arr[i, j])!r}",
+            path=source, column=names[j],
+        )
+    scale = unit_scale(kind, base, dt)
+    rate_dph = to_dph(arr, scale)
+    if scale != 1.0:
+        bad = first_nonfinite(rate_dph)
+        if bad is not None:
+            i, j = bad
+            raise DataFormatError(
+                f"value at sample {i} overflows in deg/h; expected |value| * {scale:.6g} below "
+                f"{np.finfo(np.float64).max:.3g}, got {float(arr[i, j])!r} {unit}", path=source, column=names[j],
+            )
+    return GyroRecord(
+        rate_dph=rate_dph, dt_s=dt, axis_names=tuple(names), source=str(source),
+        input_unit=unit, scale_to_dph=scale,
+    )

@@ -1,0 +1,173 @@
+"""The model registry: one table serves the builder, load_model and CLI help; lazy imports; old model files.
+
+Independent checks: the constructor signatures of the classes (inspect), hand-written model files in
+the layout fogdrift wrote before the models moved into ``fogdrift.models`` (format version 1), AR
+predictions by hand, and fresh interpreters (subprocess) for what gets imported.
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import subprocess
+import sys
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+import fogdrift.models as models
+from fogdrift.errors import ConfigError, ModelFileError
+from fogdrift.models import MODEL_NAMES, MODELS, DriftModel, build_model, describe_models, load_model, model_spec
+from fogdrift.pipeline import AnalysisConfig
+
+
+def test_names_order_and_uniqueness():
+    known = ["grey-elman", "elman", "gm11", "ar", "persistence"]  # report order (new rows may be added)
+    assert [name for name in MODEL_NAMES if name in known] == known
+    assert len({s.cls for s in MODELS}) == len(MODELS)
+    assert all(s.name == s.name.lower().strip() for s in MODELS)
+
+
+@pytest.mark.parametrize("spec", MODELS, ids=lambda s: s.name)
+def test_each_row_matches_its_class(spec):
+    cls = spec.load()
+    assert issubclass(cls, DriftModel) and cls.__name__ == spec.cls
+    assert cls.label == spec.label
+    assert spec.description and "\n" not in spec.description
+    params = set(inspect.signature(cls.__init__).parameters) - {"self"}
+    assert {k for k, _ in spec.settings} <= params
+    assert {k for k, _ in spec.fixed} <= params
+    assert all(hasattr(AnalysisConfig(), attr) for _, attr in spec.settings)
+    assert getattr(models, spec.cls) is cls  # lazy package attribute
+
+
+def test_build_model_from_analysis_settings():
+    cfg = AnalysisConfig(lags=3, hidden=5, epochs=7, seed=2, activation="logsig", training="bp", gm_window=10)
+
+    def progress(*args):
+        pass
+
+    got = {name: build_model(name, cfg, progress=progress) for name in MODEL_NAMES}
+    for name in ("grey-elman", "elman"):
+        p = got[name].get_params()
+        assert (p["lags"], p["hidden"], p["epochs"], p["seed"], p["activation"], p["training"]) == (
+            3, 5, 7, 2, "logsig", "bp")
+        assert p["progress"] is progress
+    assert type(got["grey-elman"]).__name__ == "GreyElman" and type(got["elman"]).__name__ == "Elman"
+    assert got["gm11"].get_params() == {"mode": "rolling", "window": 10, "shift": "auto", "shift_margin": 1.0}
+    assert got["ar"].get_params() == {"order": 3, "max_order": 12}
+    assert got["persistence"].get_params() == {}
+    # a mapping works as settings; None gives the class defaults (plus the fixed keywords)
+    assert build_model("ar", {"lags": 6}).order == 6
+    assert build_model("gm11").get_params()["window"] == 8
+
+
+def test_pipeline_uses_the_registry():
+    import fogdrift.pipeline as pipeline
+
+    assert pipeline.MODEL_NAMES is MODEL_NAMES
+    assert pipeline.make_model is build_model
+    assert AnalysisConfig().models == MODEL_NAMES
+
+
+def test_names_are_case_insensitive_and_unknown_names_are_errors():
+    assert model_spec(" GM11 ").name == "gm11"
+    assert type(build_model("Persistence")).__name__ == "Persistence"
+    for bad in ("lstm", "", "gm-11", None, 3):
+        with pytest.raises(ConfigError) as info:
+            build_model(bad, AnalysisConfig())
+        msg = str(info.value)
+        assert all(name in msg for name in MODEL_NAMES), msg
+        assert "models=" in msg and "--models" in info.value.render({"models": "--models"})
+    with pytest.raises(ConfigError, match="gm_window"):
+        build_model("gm11", SimpleNamespace(lags=3))
+
+
+def test_describe_models_lists_every_row_in_order():
+    lines = describe_models().splitlines()
+    assert [line.split(":")[0] for line in lines] == list(MODEL_NAMES)
+
+
+def test_old_module_paths_are_aliases():
+    import fogdrift.baselines
+    import fogdrift.grey
+    import fogdrift.models.ar
+    import fogdrift.models.grey
+
+    assert fogdrift.grey.GM11 is fogdrift.models.grey.GM11 and fogdrift.grey.gm11_fit is fogdrift.models.grey.gm11_fit
+    assert fogdrift.baselines.AR is fogdrift.models.ar.AR
+    with pytest.raises(AttributeError):
+        models.NoSuchModel  # noqa: B018
+
+
+# -- model files ------------------------------------------------------------------------------------
+def _write(base, doc, arrays):
+    base.with_suffix(".json").write_text(json.dumps(doc, indent=2))
+    np.savez(base.with_suffix(".npz"), **arrays)
+
+
+def test_files_written_before_the_move_still_load(tmp_path):
+    """Format version 1 as fogdrift wrote it when the classes lived in fogdrift.baselines / fogdrift.grey /
+    fogdrift.models: the file names only the class, so the move changes nothing."""
+    head = {"format": "fogdrift-model", "format_version": 1}
+    _write(tmp_path / "ar", {**head, "class": "AR", "params": {"order": 2, "max_order": 12},
+                             "state": {"order_": 2, "intercept_": 0.1, "sigma_": 0.01, "n_train_": 100}},
+           {"coef_": np.array([0.5, 0.25]), "aic_": np.empty(0), "last_": np.array([1.0, 2.0])})
+    _write(tmp_path / "pers", {**head, "class": "Persistence", "params": {}, "state": {"last_": 0.15}}, {})
+    _write(tmp_path / "gm", {**head, "class": "GM11",
+                             "params": {"mode": "whole", "window": 8, "shift": 0.0, "shift_margin": 1.0},
+                             "state": {"shift_": 0.0, "a_": 0.0, "b_": 0.3, "x0_first_": 0.25, "n_train_": 10,
+                                       "C_": 0.2, "P_": 1.0, "grade_": "good", "mre_pct_": 1.0,
+                                       "class_ratio_pass_": True}},
+           {"last_window_": np.array([0.3, 0.3, 0.3, 0.3])})
+    ar = load_model(tmp_path / "ar")
+    assert type(ar).__module__ == "fogdrift.models.ar"
+    # by hand: 0.1 + 0.5 * y[k-1] + 0.25 * y[k-2]
+    assert ar.forecast(2).tolist() == pytest.approx([0.1 + 0.5 * 2.0 + 0.25 * 1.0, 0.1 + 0.5 * 1.35 + 0.25 * 2.0])
+    assert ar.predict(np.array([3.0]), history=np.array([1.0, 2.0])).tolist() == pytest.approx([1.35])
+    assert load_model(tmp_path / "pers").forecast(2).tolist() == [0.15, 0.15]
+    # a = 0: the GM(1,1) time response is the constant b
+    assert load_model(tmp_path / "gm").forecast(3).tolist() == pytest.approx([0.3, 0.3, 0.3])
+    _write(tmp_path / "odd", {**head, "class": "LSTM", "params": {}, "state": {}}, {})
+    with pytest.raises(ModelFileError, match="unknown model class 'LSTM'.*GM11"):
+        load_model(tmp_path / "odd")
+
+
+def _imports_after(code: str) -> set:
+    """Modules a fresh interpreter has imported after running ``code`` (printed as JSON)."""
+    script = code + "\nimport json, sys\nprint(json.dumps(sorted(sys.modules)))\n"
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True, timeout=300)
+    return set(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def test_loading_linear_models_does_not_import_jax(tmp_path):
+    """GM(1,1), AR and persistence files load (and predict) without JAX; a grey-Elman file does import it,
+    which shows the check can fail."""
+    from fogdrift.models.ar import AR
+    from fogdrift.models.grey import GM11
+    from fogdrift.models.persistence import Persistence
+
+    y = np.sin(0.05 * np.arange(300)) + 2.0
+    paths = []
+    for name, model in (("gm", GM11()), ("ar", AR(order=3)), ("pers", Persistence())):
+        model.fit(y[:200]).save(tmp_path / name)
+        paths.append(str(tmp_path / name))
+    code = ("import numpy as np\nfrom fogdrift.models import load_model, build_model\n"
+            f"for p in {paths!r}:\n    m = load_model(p)\n    m.predict(np.ones(20) * 2.0, history=np.ones(20))\n"
+            "for n in ('gm11', 'ar', 'persistence'):\n    build_model(n)\n")
+    mods = _imports_after(code)
+    assert "jax" not in mods and "fogdrift.models.elman" not in mods and "fogdrift.models.training" not in mods
+    assert {"fogdrift.models.grey", "fogdrift.models.ar"} <= mods
+
+    pytest.importorskip("jax")
+    from fogdrift.models.elman import GreyElman
+
+    GreyElman(hidden=2, epochs=2, window=32).fit(y[:200]).save(tmp_path / "ge")
+    assert "jax" in _imports_after(f"from fogdrift.models import load_model\nload_model({str(tmp_path / 'ge')!r})")
+
+
+def test_importing_the_package_and_the_pipeline_imports_no_model_module():
+    mods = _imports_after("import fogdrift.models, fogdrift.pipeline\nfogdrift.models.MODEL_NAMES")
+    assert "jax" not in mods
+    assert not {"fogdrift.models.grey", "fogdrift.models.ar", "fogdrift.models.elman"} & mods
