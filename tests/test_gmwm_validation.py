@@ -32,6 +32,9 @@ import pytest
 
 from fogdrift.gmwm import gmwm_fit, haar_wvar, parse_model, select_model, simulate_latent
 
+# 30/100-seed simulations (~65 s on one core): run in the full suite, not in -m "not slow"
+pytestmark = pytest.mark.slow
+
 N, DT = 2**18, 0.01
 
 
