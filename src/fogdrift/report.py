@@ -507,6 +507,10 @@ def _analysis_section(result, fig_dir, title, fig_offset=0) -> str:
     for ax in result.axes:
         parts.append(f"<h3>Axis {html.escape(ax.name)}</h3>")
         parts.append("<h4>Noise coefficients of the original output (whole record, native rate)</h4>")
+        if getattr(ax, "gmwm", None) is not None:  # analyze --noise-method gmwm: the GMWM table first
+            from .report_gmwm import gmwm_noise_html
+
+            parts.append(gmwm_noise_html(ax.gmwm))
         parts.append(_table(("signal",) + NOISE_HEADERS, [["original"] + noise_row(ax.original.noise)], "allan"))
         notes = noise_notes(ax.original.noise)
         parts.append('<ul class="note">' + "".join(f"<li>{html.escape(n)}</li>" for n in notes) + "</ul>")

@@ -50,7 +50,7 @@ def _fmt(x, digits=4):
     return fmt(x, digits)
 
 
-def _print_gmwm(title, axes):
+def print_gmwm(title, axes):
     """Per axis: IEEE table, candidates (WIC, why rejected), excluded scales, J with its caveat."""
     from ..gmwm.analysis import J_CAVEAT, ieee_rows
 
@@ -129,7 +129,7 @@ def noise(
                 axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=model, levels=scales, robust=robust)
                         for name in record.axis_names]
             source, meta = str(record.source), record.metadata()
-        _print_gmwm((curve or load.file).name, axes)
+        print_gmwm((curve or load.file).name, axes)
         files = write_gmwm_outputs(axes, r.out.path, source=source, record=meta)
         r.wrote()
         r.print_json(files["json"])
