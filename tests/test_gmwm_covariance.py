@@ -1,4 +1,4 @@
-"""Covariance of WV and AVAR estimates (fogdrift.gmwm.covariance).
+"""Covariance of WV estimates (fogdrift.gmwm.covariance), and of AVAR estimates (fogdrift.noise.covariance, its one home).
 
 Independent references: (1) exact time-domain sums ``int |H_a H_b|^2 S^2 = sum_k c_k^2`` with ``c``
 the convolution of the two filters (and of the RW/AR(1) impulse responses); (2) the exact
@@ -24,9 +24,10 @@ from fogdrift.allan import allan_variance
 from fogdrift.errors import ConfigError
 from fogdrift.gmwm import haar_wvar, parse_model, simulate_latent
 from fogdrift.gmwm.covariance import (
-    avar_covariance, filter_gram, ieee_sdf, model_wvar_covariance, wvar_covariance,
+    filter_gram, model_wvar_covariance, wvar_covariance,
 )
 from fogdrift.gmwm.processes import PROCESSES
+from fogdrift.noise.covariance import estimator_covariance
 
 MC_MODEL = "WN+RW+GM"
 MC_THETA = [1.0, 1e-6, -math.log(0.995), 2.5e-4]
@@ -134,10 +135,12 @@ def test_wv_covariance_against_monte_carlo(monte_carlo):
     assert np.all(eta_sd[4:] > 1.1 * nus.std(axis=0, ddof=1)[4:])
 
 
-def test_avar_covariance_at_non_octave_m_against_monte_carlo(monte_carlo):
+def test_allan_covariance_of_fogdrift_noise_at_non_octave_m_against_monte_carlo(monte_carlo):
+    """The AVAR covariance has one home, fogdrift.noise.covariance; checked here on a latent model it never sees
+    (WN+RW+GM) at non-octave m."""
     _, avs, _, _, m = monte_carlo
     sdf = parse_model(MC_MODEL).sdf(MC_THETA)
-    V = avar_covariance(m, MC_N, sdf)
+    V = estimator_covariance(m, MC_N, sdf)
     assert_allclose(avs.mean(axis=0), parse_model(MC_MODEL).avar(MC_THETA, m), rtol=0.05)
     ratio = avs.std(axis=0, ddof=1) / np.sqrt(np.diag(V))
     assert np.all(np.abs(ratio - 1.0) < 0.25)
@@ -154,23 +157,9 @@ def test_nonparametric_variance_is_unbiased_on_average(monte_carlo):
     assert abs(np.mean(np.log(ratio[:10]))) < 0.15
 
 
-def test_ieee_sdf_and_flicker_cutoff():
-    dt, n = 0.01, 2**16
-    s = ieee_sdf(dt, arw_dprh=0.1)
-    sigma2 = (60 * 0.1) ** 2 / dt
-    assert_allclose(avar_covariance([1], n, s)[0, 0] * (n - 1), 3.0 * sigma2**2, rtol=1e-5)  # Var AVAR(1) = 3 s^4/M
-    # flicker below the inverse record length: negligible up to m = N/64, a few % at m = N/6.5
-    m = [1, 4, 50, 1000, 10000]
-    a = avar_covariance(m, n, ieee_sdf(dt, arw_dprh=0.01, bias_instability_dph=0.5, record_s=n * dt))
-    b = avar_covariance(m, n, ieee_sdf(dt, arw_dprh=0.01, bias_instability_dph=0.5, record_s=100 * n * dt))
-    assert np.max(np.abs(a[:4, :4] / b[:4, :4] - 1.0)) < 1e-3
-    assert 0.01 < abs(a[4, 4] / b[4, 4] - 1.0) < 0.1
-    with pytest.raises(ConfigError, match="record_s"):
-        ieee_sdf(dt, bias_instability_dph=0.5)
+def test_filter_gram_refuses_m_below_one():
     with pytest.raises(ConfigError):
-        avar_covariance([n], n, s)
-    with pytest.raises(ConfigError):
-        filter_gram([0, 1], s)
+        filter_gram([0, 1], lambda f: np.ones_like(f))
 
 
 def test_psd_and_cache_reuse():

@@ -6,13 +6,15 @@ Modules (one concept each):
   published curves (:func:`from_curve`).
 * :mod:`~fogdrift.gmwm.processes` - the latent processes (WN, QN, RW, DR, FLICKER, GM) as a
   registry: theoretical WV, SDF, IEEE mapping; composite models (:func:`parse_model`).
-* :mod:`~fogdrift.gmwm.covariance` - model-based covariance of WV and of overlapping AVAR
-  estimates at any averaging factors.
+* :mod:`~fogdrift.gmwm.covariance` - model-based covariance of WV estimates (that of Allan-family
+  estimates is :mod:`fogdrift.noise.covariance`).
 * :mod:`~fogdrift.gmwm.estimator` - the GMWM fit (:func:`gmwm_fit`, :class:`GMWM`).
 * :mod:`~fogdrift.gmwm.selection` - WIC model selection with sanity checks and automatic
   exclusion of short scales no candidate explains.
 * :mod:`~fogdrift.gmwm.ieee` - IEEE-952 quantities (N, K, R, Q, B, GM T_c / sigma) with CIs.
 * :mod:`~fogdrift.gmwm.simulate` - simulator of the latent processes.
+* :mod:`~fogdrift.gmwm.analysis` - one axis end to end (log or published curve), as the CLI and
+  the pipeline use it.
 
 Units: rates in deg/h (so WVs in (deg/h)^2), time and scales in s.
 
@@ -25,7 +27,7 @@ Examples
 ('WN+RW', 1.0)
 """
 
-from .covariance import avar_covariance, filter_gram, ieee_sdf, model_wvar_covariance, wvar_covariance
+from .covariance import filter_gram, model_wvar_covariance, wvar_covariance
 from .estimator import GMWM, GMWMFit, gmwm_fit
 from .ieee import BiasInstability, IEEEResult, IEEEValue, to_ieee
 from .processes import PROCESSES, LatentModel, Process, ar1_wv, flicker_wv_factor, parse_model
@@ -36,7 +38,7 @@ from .wvar import WvarResult, from_curve, haar_wvar
 __all__ = [
     "WvarResult", "haar_wvar", "from_curve",
     "Process", "PROCESSES", "LatentModel", "parse_model", "ar1_wv", "flicker_wv_factor",
-    "filter_gram", "wvar_covariance", "model_wvar_covariance", "avar_covariance", "ieee_sdf",
+    "filter_gram", "wvar_covariance", "model_wvar_covariance",
     "GMWM", "GMWMFit", "gmwm_fit",
     "DEFAULT_CANDIDATES", "CandidateScore", "ExcludedScale", "SelectionResult", "select_model",
     "IEEEValue", "BiasInstability", "IEEEResult", "to_ieee",

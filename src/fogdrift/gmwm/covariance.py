@@ -1,4 +1,4 @@
-"""Covariance of wavelet-variance and Allan-variance estimates (model-based and nonparametric).
+"""Covariance of wavelet-variance estimates (model-based and nonparametric).
 
 For a Gaussian stationary-increment process with two-sided SDF ``S(f)`` (``|f| <= 1/2``,
 cycles per sample) the estimates of the Haar WV at half-widths ``m_a``, ``m_b`` have, for
@@ -10,9 +10,10 @@ large ``M`` ([PW2000]_ §8.3; [GMWM]_ §1(b))::
 with ``M = N - 2m + 1`` coefficients.  (The record of the longer filter is a subset of
 the other's, so the number of coefficient pairs at each lag is the smaller ``M``; hence
 ``max`` in the denominator, not the geometric mean; checked by Monte Carlo in the tests.)
-The overlapping Allan variance at any averaging factor ``m`` uses the Allan filter,
-``2 G_m``, and the same number of terms, so ``Cov(AVAR_a, AVAR_b) = 4 x`` the WV formula
-at the same ``m``.
+The covariance of Allan-family estimates (AVAR/HVAR/MVAR at any averaging factor) has its
+one home in :mod:`fogdrift.noise.covariance` (cell-averaged quadrature); against the Monte
+Carlo of ``tests/test_gmwm_covariance.py`` (WN+RW+GM, N = 2^16, 200 records, m = 1..3000) it
+agreed with the Filon version removed from here to 1e-4 in the standard deviations.
 
 Quadrature.  ``I_ab = int_0^{1/2} G_a G_b S^2 df`` is evaluated on geometric panels
 ``[f_L, f_R]`` (ratio 1.05 by default) from ``f_min = 1e-3 / max(m)`` to 1/2 plus a
@@ -25,8 +26,8 @@ the quadratic interpolant (nodes f_L, f_C, f_R) of the smooth remainder
 ever resolves the fastest oscillation, so the cost is independent of N.  Everything but
 ``S`` is precomputed once per set of ``m`` (``n_pairs x 3 P`` weights, ``P`` about 450 panels
 for ``m`` up to 2^21): the first evaluation for the 22 octave scales of ``10^7`` samples
-takes about 0.07 s and every further one (another SDF) about 1 ms; 50 arbitrary Allan ``m``
-take about 0.7 s, then about 5 ms (2 vCPU Xeon, see ``bench/bench_gmwm.py``).  The
+takes about 0.07 s and every further one (another SDF) about 1 ms (2 vCPU Xeon, see
+``bench/bench_gmwm.py``).  The
 "uniform grid of 2^(J+3) points" of [GMWM]_ would need 3e7 points and a (J x 3e7) matrix
 for J = 22.  Relative accuracy: 5e-6 (default ratio 1.05), 1e-8 (ratio 1.01) against exact
 time-domain sums for WN, RW and AR(1) (tests).
@@ -54,15 +55,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ConfigError
-from ..units import check_dt_s
 from .processes import PROCESSES, parse_model
 
 __all__ = [
     "filter_gram",
     "wvar_covariance",
     "model_wvar_covariance",
-    "avar_covariance",
-    "ieee_sdf",
 ]
 
 _X_SLOW = 0.25  # a filter is "slow" on a panel if f_R m < this
@@ -313,120 +311,3 @@ def model_wvar_covariance(model, theta, tau_samples, n_coef, **quad) -> np.ndarr
             nu = PROCESSES[key].wv(th[sl], tau)
             V = V + g2 * np.outer(nu, nu) / np.maximum.outer(M, M)
     return V
-
-
-def avar_covariance(m, n_samples, sdf, **quad) -> np.ndarray:
-    """Covariance of overlapping Allan-variance estimates at arbitrary averaging factors ``m``.
-
-    Parameters
-    ----------
-    m : array_like of int, shape (n_m,)
-        Averaging factors (cluster sizes) ``>= 1``, any integers (not only octaves),
-        with ``2 m <= n_samples``.
-    n_samples : int
-        Number of rate samples N; the estimate at ``m`` averages ``N - 2m + 1`` terms.
-    sdf : callable
-        Two-sided SDF ``f -> S(f)`` of the rate in rate^2 per cycle/sample (e.g.
-        :func:`ieee_sdf` or ``LatentModel.sdf(theta)``).
-
-    Returns
-    -------
-    ndarray, shape (n_m, n_m)
-        ``Cov(AVAR_a, AVAR_b) ~ 16 I_ab / max(M_a, M_b)`` in rate^4: the Allan filter's
-        squared gain is ``2 sin^4(pi f m) / (m^2 sin^2(pi f))`` (twice the Haar one).
-
-    Examples
-    --------
-    White noise: ``Var(AVAR(1)) ~ 3 / N`` for unit variance (AVAR(1) = 1).
-
-    >>> v = avar_covariance([1, 3], 10**6, lambda f: np.ones_like(f))
-    >>> round(float(v[0, 0]) * (10**6 - 1), 5)
-    3.0
-    """
-    mm = np.asarray(m, dtype=np.float64).ravel()
-    try:
-        n = int(n_samples)
-    except (TypeError, ValueError):
-        raise ConfigError(f"n_samples must be an integer, got {n_samples!r}") from None
-    if np.any(2 * mm > n):
-        raise ConfigError(f"every m must satisfy 2 m <= n_samples = {n}")
-    _, M = _check_counts(mm, n - 2 * mm + 1)
-    gram = filter_gram(mm, sdf, **quad)
-    return 16.0 * gram / np.maximum.outer(M, M)
-
-
-def ieee_sdf(dt_s, *, q_urad=0.0, arw_dprh=0.0, bias_instability_dph=0.0, rrw_dphrh=0.0, record_s=None):
-    """Two-sided per-sample SDF (deg/h)^2 per cycle/sample from IEEE-952 coefficients.
-
-    Parameters (the keywords of :func:`fogdrift.simulate.simulate`)
-    ----------
-    dt_s : float
-        Sample interval in s.
-    q_urad : float
-        Quantization Q in microradians: ``q2 = (Q / dt)^2`` with Q in arcsec = (deg/h) s,
-        SDF ``4 q2 sin^2(pi f)`` (AVAR ``3 Q^2 / tau^2``).
-    arw_dprh : float
-        Angle random walk N in deg/sqrt(h): white, ``sigma2 = (60 N)^2 / dt``.
-    bias_instability_dph : float
-        B in deg/h: flicker ``B^2 / (2 pi max(|f|, f_low))`` (flat WV ``0.2206 B^2``,
-        AVAR ``0.4413 B^2``), flattened below ``f_low = dt_s / record_s`` cycles/sample,
-        i.e. below the inverse record length.  The WV/AVAR integrals converge without a
-        cutoff; the covariances change by less than 1e-3 with it for ``m <= N/64`` but by a
-        few per cent at ``m ~ N/6`` (the longest clusters see the assumed low-frequency
-        content; tested).
-    rrw_dphrh : float
-        Rate random walk K in deg/h/sqrt(h): discrete random walk with step variance
-        ``gamma2 = (K / 60)^2 dt``, SDF ``gamma2 / (4 sin^2(pi f))``.
-    record_s : float, optional
-        Record length in s; required when ``bias_instability_dph > 0``.
-
-    Rate ramp R is deterministic and adds nothing to the SDF.
-
-    Returns
-    -------
-    callable
-        ``sdf(f)`` for arrays of ``f`` in (0, 1/2].
-
-    Examples
-    --------
-    >>> s = ieee_sdf(0.01, arw_dprh=0.1)
-    >>> float(s(np.array([0.25]))[0])    # (60 * 0.1)^2 / 0.01
-    3600.0
-    """
-    dt = check_dt_s(dt_s)
-    vals = {}
-    for name, v in (("q_urad", q_urad), ("arw_dprh", arw_dprh),
-                    ("bias_instability_dph", bias_instability_dph), ("rrw_dphrh", rrw_dphrh)):
-        try:
-            x = float(v)
-        except (TypeError, ValueError):
-            raise ConfigError(f"{name} must be a number >= 0, got {v!r}") from None
-        if not (x >= 0 and math.isfinite(x)):
-            raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
-        vals[name] = x
-    q_arcsec = vals["q_urad"] / (1e6 * math.pi / 648000.0)
-    q2 = (q_arcsec / dt) ** 2
-    sigma2 = (60.0 * vals["arw_dprh"]) ** 2 / dt
-    b2 = vals["bias_instability_dph"] ** 2
-    gamma2 = (vals["rrw_dphrh"] / 60.0) ** 2 * dt
-    f_low = 0.0
-    if b2 > 0:
-        if record_s is None:
-            raise ConfigError("a flicker (bias instability) SDF needs the record length; pass {opt:record_s}")
-        rec = check_dt_s(record_s, "record_s")
-        f_low = dt / rec
-
-    def sdf(f):
-        f = np.abs(np.asarray(f, dtype=np.float64))
-        s = np.sin(np.pi * f) ** 2
-        out = np.full(f.shape, sigma2)
-        if q2:
-            out = out + 4.0 * q2 * s
-        if gamma2:
-            with np.errstate(divide="ignore"):
-                out = out + gamma2 / (4.0 * s)
-        if b2:
-            out = out + b2 / (2.0 * np.pi * np.maximum(f, f_low))
-        return out
-
-    return sdf

@@ -25,6 +25,7 @@ import math
 import numpy as np
 from scipy.signal import lfilter
 
+from .._util import check_count
 from ..errors import ConfigError
 from .processes import parse_model
 
@@ -72,12 +73,7 @@ def simulate_latent(model, theta, n_samples, *, seed) -> np.ndarray:
     th = np.asarray(theta, dtype=np.float64)
     if th.shape != (mdl.n_params,) or not np.all(np.isfinite(th)) or np.any(th <= 0):
         raise ConfigError(f"theta must be {mdl.n_params} finite values > 0 {mdl.param_names}, got {theta!r}")
-    try:
-        n = int(n_samples)
-    except (TypeError, ValueError):
-        raise ConfigError(f"n_samples must be an integer >= 2, got {n_samples!r}") from None
-    if n != n_samples or n < 2:
-        raise ConfigError(f"n_samples must be an integer >= 2, got {n_samples!r}")
+    n = check_count(n_samples)
     try:
         ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     except (TypeError, ValueError):
