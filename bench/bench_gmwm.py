@@ -4,6 +4,8 @@ Part 1 - WV of 1e8 samples (default; ``--wv-size``) against ``fogdrift.allan.all
 (exact overlapping estimator) at the matching octave averaging factors ``m = 2^(j-1)``, on the
 same seeded white + random-walk data, timed one after the other in the same process.  The numba
 kernels of allan_variance are warmed up first.  Both results are compared: ``nu2_j = AVAR(m)/2``.
+The classical WV is computed through ``allan_variance`` (one home for the second-difference
+sums), so the ratio shows the WV's own overhead (input checks, eta3 intervals).
 
 Part 2 - ``select_model`` with the default candidate set on 1e7 simulated samples (WN + RW + GM,
 dt = 0.01 s), with the time split into: the WV pyramid, the covariance quadrature (building the

@@ -64,6 +64,17 @@ def test_r5_wv_is_half_the_overlapping_allan_variance():
     assert_allclose(r.allan_tau_s, av.tau_s)
 
 
+def test_classical_wv_via_allan_equals_the_mean_square_of_the_pyramid_coefficients():
+    """The classical path (AVAR/2 by fogdrift.allan) against the mean of W^2 of the pyramid (which the next test
+    checks against PyWavelets); odd length, a random walk and a large offset, to exercise the phase summation."""
+    rng = np.random.default_rng(11)
+    x = 500.0 + rng.standard_normal(2**15 + 37) + np.cumsum(1e-2 * rng.standard_normal(2**15 + 37))
+    r = haar_wvar(x, 0.1)
+    ref = [float(np.mean(w * w)) for _, w in haar_coefficients(x - x.mean(), len(r))]
+    assert_allclose(r.nu2_dph2, ref, rtol=1e-10)
+    assert_allclose(haar_wvar(x, 0.1, nonparametric_var=True).nu2_dph2, ref, rtol=1e-12)
+
+
 def test_pyramid_equals_pywavelets_swt_non_boundary_coefficients():
     x = np.random.default_rng(7).standard_normal(1024)
     swt = pywt.swt(x, "haar", level=6, trim_approx=False)  # [(cA6, cD6), ..., (cA1, cD1)]
