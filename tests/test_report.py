@@ -56,7 +56,8 @@ def test_report_is_self_contained_and_escaped(report_dir):
     assert "http://" not in page and "https://" not in page and "<script" not in page
     assert "other <b>&" not in page and "other &lt;b&gt;&amp;" in page
     assert page.count("data:image/png;base64,") >= 12  # figs 1, 2 + 5 per axis section + 5 applied
-    for needle in ("Table 2", "Metrics on the test block", "persistence"):
+    for needle in ("Table 2", "Paper&#x27;s measure", "persistence", "Heading error after a", "Filtering-artefact check",
+                   "What this record cannot support", "Glossary"):
         assert needle in page
 
 
