@@ -91,7 +91,9 @@ def _b_min(noise) -> str:
     if b.get("value") is None:
         return "–"
     if b.get("bound_only"):
-        return f"< {_fmt(b['value'], 3)} (curve still falling)"
+        why = "fitted floor above the measured curve" if "measured curve" in b.get("rule", "") else \
+            "curve still falling"
+        return f"< {_fmt(b['value'], 3)} ({why})"
     return f"{_fmt(b['value'], 3)} at τ = {_fmt(b.get('tau_s'), 3)} s"
 
 
