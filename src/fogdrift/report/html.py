@@ -42,7 +42,8 @@ h3{margin-top:1.4em}h4{margin:1.2em 0 0.3em}
 table{border-collapse:collapse;margin:0.5em 0 0.8em;font-size:0.86em}
 th,td{border:1px solid #c4c4c4;padding:3px 7px;text-align:right;vertical-align:top;overflow-wrap:anywhere}
 th{background:#eee}td:first-child,th:first-child{text-align:left}
-table.kv td{text-align:left}table.kv td:first-child{white-space:nowrap;color:#444}
+table.kv td{text-align:left}table.limits td{text-align:left}table.heading td:nth-child(-n+2),table.heading th:nth-child(-n+2){white-space:nowrap;
+ overflow-wrap:normal}table.heading td:nth-child(2){text-align:left}table.limits td:first-child{white-space:nowrap}table.kv td:first-child{white-space:nowrap;color:#444}
 table.settings td{text-align:left}table.settings tr.group th{text-align:left;background:#dde6ef}
 table.settings td:first-child{width:28%}
 td.good{background:#d8f0dc}td.bad{background:#f9dcd9}td.flag{background:#fde7c2;font-weight:600}

@@ -118,6 +118,7 @@ def verdict_items(result, *, evaluated: bool = True) -> list:
 def _term_limits(result) -> list:
     """Rows ``[axis, term, status, 95 % bound, reason]`` of every term that is not resolved."""
     from ..noise import TERM_TABLE
+    from ..noise.terms import DISPLAY_UNITS
 
     rows = []
     for ax in result.axes:
@@ -127,7 +128,7 @@ def _term_limits(result) -> list:
                 continue
             status = {"not_estimable": "not estimable (n/e)", "absent": "not in the model",
                       "unresolved": "in the model, interval reaches 0"}.get(t.status, t.status)
-            bound = "–" if t.hi95 is None else f"< {_fmt(t.hi95, 3)} {t.unit}"
+            bound = "–" if t.hi95 is None else f"< {_fmt(t.hi95, 3)} {DISPLAY_UNITS.get(name, t.unit)}"
             rows.append([ax.name, f"{name} ({TERM_TABLE[name].long_name})", status, bound, t.reason or "–"])
     return rows
 
