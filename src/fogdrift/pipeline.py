@@ -290,6 +290,7 @@ class AnalysisAxis:
     separation: SeparationAxis  # whole record at the modelling rate (figures 5, 6)
     models: ModelAxis
     table2: list  # CompensatedSignal rows, test block at the modelling rate
+    evaluation: object = None  # fogdrift.evaluation.AxisEvaluation, set by evaluation.evaluate_analysis
     gmwm: object = None  # fogdrift.gmwm.analysis.GmwmAxis of the native-rate record (noise_method "gmwm")
 
     def to_dict(self) -> dict:
@@ -300,6 +301,7 @@ class AnalysisAxis:
             "separation": self.separation.to_dict(),
             "models": self.models.to_dict(),
             "table2": [row.to_dict() for row in self.table2],
+            "evaluation": None if self.evaluation is None else self.evaluation.to_dict(),
         }
 
 
@@ -670,7 +672,7 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
         lvl_cfg = _with_level(cfg, sep.level)
         ma = _fit_axis_models(name, rate, rec_m.dt_s, lvl_cfg, bias, earth, progress,
                               fitted=None if fitted_from is None else _fitted_models_for(name, fitted_from))
-        axes.append(AnalysisAxis(name, original, sep, ma, _table2(ma, lvl_cfg), gmwm))
+        axes.append(AnalysisAxis(name, original, sep, ma, _table2(ma, lvl_cfg), gmwm=gmwm))
     result = AnalysisResult(
         config=cfg,
         source=source or record.source,

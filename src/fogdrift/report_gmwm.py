@@ -4,21 +4,20 @@
   :func:`fogdrift.output.atomic_path`, so inside a run's :class:`~fogdrift.output.OutputDir`).
 * :func:`gmwm_noise_html` - the HTML noise table of the analysis report (``analyze --noise-method gmwm``).
 
-Self-contained on purpose (it imports nothing private from :mod:`fogdrift.report`).
+It uses only public names of :mod:`fogdrift.report` (``write_json``).
 """
 
 from __future__ import annotations
 
 import html
-import json
 import math
-import re
 from pathlib import Path
 
 import numpy as np
 
 from .gmwm.analysis import J_CAVEAT, GmwmAxis, ieee_rows
 from .output import atomic_path
+from .report import write_json
 
 __all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
 
@@ -28,20 +27,6 @@ def fmt(x, digits=4) -> str:
     if x is None or not math.isfinite(float(x)):
         return "–"
     return f"{float(x):.{digits}g}"
-
-
-def _clean(obj):
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    return obj
-
-
-def _safe(name) -> str:
-    return re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._") or "axis"
 
 
 def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
@@ -91,8 +76,7 @@ def write_gmwm_outputs(axes: list[GmwmAxis], out_dir, *, source: str, record: di
            "units": {"rate": "deg/h", "wvar": "(deg/h)^2", "scale": "s"},
            "axes": [a.to_dict() for a in axes]}
     paths = {"json": out / "noise.json", "csv": out / "wvar.csv", "png": out / "noise.png"}
-    with atomic_path(paths["json"]) as tmp:
-        tmp.write_text(json.dumps(_clean(doc), indent=2, allow_nan=False), encoding="utf-8")
+    write_json(doc, paths["json"])
     with atomic_path(paths["csv"]) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         fh.write("axis,level,scale_s,wvar_dph2,ci_lo95_dph2,ci_hi95_dph2,used,model_wvar_dph2\n")
         for a in axes:
