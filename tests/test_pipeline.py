@@ -250,3 +250,142 @@ def test_verdict_sentences_on_constructed_metrics():
     assert lines[4] == "Lowest RMSE among learned models on the test block: good."
     assert verdict(SimpleNamespace(metrics={"persistence": _axis().metrics["persistence"]})) == [
         "Only the persistence baseline was run."]
+
+
+# ---------------------------------------------------------------------------------------------------------
+# found unasserted by the mutation run (docs/testing.md): the causal path, as-measured p0, block-size
+# check, rate-input models, the factory call, config validation boundaries
+
+
+def test_causal_path_window_wavelet_mode_and_history(spy):
+    from fogdrift.lifting import causal_drift
+
+    rec, x = _record(n=800, dt_s=0.5)
+    cfg = _cfg(wavelet="haar", mode="periodization", causal_window_s=40.0)
+    (ma,) = run_models(rec, cfg)
+    rate = x - x[:480].mean()
+    # window = causal_window_s / dt = 80 samples (haar level 2 reach 4 is shorter; training block 480 longer)
+    causal = causal_drift(rate, 80, wavelet="haar", level=2, mode="periodization")
+    np.testing.assert_array_equal(ma.causal_drift_dph, causal)
+    for block, (lo, hi) in ma.split.items():
+        np.testing.assert_array_equal(ma.drift_blocks[block],
+                                      separate(rate[lo:hi], "haar", 2, mode="periodization")[0])
+    calls = [c for c in spy.calls if c[0] == "predict"]
+    assert len(calls) == 2
+    np.testing.assert_array_equal(calls[1][1], causal[640:800])
+    np.testing.assert_array_equal(calls[1][2], causal[:640][np.isfinite(causal[:640])])
+    # causal metrics: the spy is perfect -> 0; persistence on the causal drift from its own history
+    lags = cfg.lags
+    m = ma.causal_metrics["spy"]
+    assert m.rmse_dph == 0.0 and m.n == 160 - lags
+    expected = np.sqrt(np.mean(np.diff(causal[640 + lags - 1:800]) ** 2))
+    np.testing.assert_allclose(m.rmse_persistence_dph, expected, rtol=1e-12)
+    np.testing.assert_array_equal(ma.causal_predictions["spy"], causal[640:800])
+
+
+def test_p0_as_measured_adds_bias_and_earth_rate_back(spy):
+    b0, lat = 40.0, 30.0
+    earth = W_IE_DPH * math.sin(math.radians(lat))
+    _, x = _record()
+    rec = from_array(x + b0 + earth, dt_s=1.0, unit="deg/h", axis_names=("gz",))
+    (ma,) = run_models(rec, _cfg(latitude_deg=lat, earth_axes={"gz": "up"}))
+    lags, offset = 3, ma.bias_dph + earth
+    y = ma.drift_blocks["test"][lags:] + offset
+    pp = np.r_[ma.drift_blocks["val"][-1], ma.drift_blocks["test"][:-1]][lags:] + offset
+    model_p0, persistence_p0 = ma.p0_as_measured["spy"]
+    assert model_p0 == 100.0  # perfect predictions
+    np.testing.assert_allclose(persistence_p0, 100.0 * (1.0 - np.mean(np.abs(y - pp) / np.abs(y))), rtol=1e-12)
+    assert persistence_p0 < 100.0
+
+
+@pytest.mark.parametrize("n, block, ok", [(60, None, True), (40, "val", False)])
+def test_block_size_check_at_the_boundary(spy, n, block, ok):
+    from fogdrift.errors import InsufficientDataError
+
+    rec, _ = _record(n=n)
+    # need = max((4 - 1) * 2**2, lags + 2) = 12: n = 60 gives blocks 36/12/12 (exactly enough), n = 40 -> 24/8/8
+    if ok:
+        (ma,) = run_models(rec, _cfg())
+        assert ma.split["test"] == [48, 60]
+        return
+    with pytest.raises(InsufficientDataError) as err:
+        run_models(rec, _cfg())
+    assert (err.value.needed, err.value.got) == (12, 8) and f"the {block} block has 8 samples" in str(err.value)
+
+
+def test_rate_input_models_see_the_rate_blocks(monkeypatch):
+    model = Spy()
+    model.input_kind = "rate"
+    monkeypatch.setattr(pipeline, "make_model", lambda name, cfg, progress=None: model)
+    rec, x = _record()
+    (ma,) = run_models(rec, _cfg())
+    rate = x - x[:240].mean()
+    fit = [c for c in model.calls if c[0] == "fit"][0]
+    np.testing.assert_array_equal(fit[1], rate[:240])
+    np.testing.assert_array_equal(fit[2], rate[240:320])
+    pred = [c for c in model.calls if c[0] == "predict"]
+    assert len(pred) == 1  # causal by construction: one prediction serves both targets
+    np.testing.assert_array_equal(pred[0][1], rate[320:400])
+    np.testing.assert_array_equal(pred[0][2], rate[:320])
+    assert ma.causal_predictions["spy"] is ma.predictions["spy"]
+
+
+def test_factory_receives_name_settings_and_progress_and_records_fit_time(monkeypatch):
+    seen = []
+
+    def factory(name, cfg, progress=None):
+        seen.append((name, cfg.level, cfg.lags, progress))
+        return Spy()
+
+    def progress(*args):
+        pass
+
+    monkeypatch.setattr(pipeline, "make_model", factory)
+    rec, _ = _record()
+    (ma,) = run_models(rec, _cfg(models=("ar",), level="auto"), progress=progress)
+    from fogdrift.lifting import choose_level, level_scan
+
+    rate = np.asarray(ma.rate_dph)
+    level = int(choose_level(level_scan(rate, 1.0, wavelet="db2", mode="symmetric")))
+    assert seen == [("ar", level, 3, progress)]
+    assert ma.name == "gz" and list(ma.fit_seconds) == ["spy"] and 0.0 <= ma.fit_seconds["spy"] < 60.0
+    assert any(note.startswith("p0 is unstable near zero") for note in ma.notes)  # the drift crosses zero
+
+
+def test_earth_rate_only_for_the_named_axis(spy):
+    rng = np.random.default_rng(5)
+    data = rng.standard_normal((400, 2)) + [1.0, 2.0]
+    rec = from_array(data, dt_s=1.0, unit="deg/h", axis_names=("gx", "gz"))
+    gx, gz = run_models(rec, _cfg(latitude_deg=45.0, earth_axes={"gz": "up"}))
+    assert gx.earth_rate_dph == 0.0
+    assert gz.earth_rate_dph == pytest.approx(W_IE_DPH * math.sqrt(0.5), rel=1e-12)
+    with pytest.raises(ConfigError, match=r"Earth-rate axis \['gy'\] not in the record; its axes are \['gx', 'gz'\]"):
+        run_models(rec, _cfg(latitude_deg=45.0, earth_axes={"gy": "up"}))
+
+
+@pytest.mark.parametrize("kw, ok", [
+    (dict(train_fraction=0.0), False), (dict(train_fraction=1.0), False), (dict(train_fraction=0.5), True),
+    (dict(val_fraction=0.0), True), (dict(val_fraction=1.0), False), (dict(val_fraction=-0.1), False),
+    (dict(train_fraction=0.6, val_fraction=0.4), False), (dict(train_fraction=0.6, val_fraction=0.39), True),
+    (dict(train_fraction=0.9, val_fraction=0.05), True),
+    (dict(model_rate_hz=0.0), False), (dict(model_rate_hz=0.5), True), (dict(model_rate_hz=None), True),
+    (dict(lags=0), False), (dict(lags=1), True), (dict(hidden=0), False), (dict(hidden=1), True),
+    (dict(epochs=0), False), (dict(epochs=1), True),
+    (dict(causal_window_s=0.0), False), (dict(causal_window_s=0.5), True),
+    (dict(latitude_deg=-90.0, earth_axes={"gz": "up"}), True), (dict(latitude_deg=90.0, earth_axes={"gz": "up"}), True),
+    (dict(latitude_deg=-90.5, earth_axes={"gz": "up"}), False), (dict(latitude_deg=90.5, earth_axes={"gz": "up"}), False),
+    (dict(latitude_deg=10.0), False),
+])
+def test_config_validation_boundaries(kw, ok):
+    cfg = AnalysisConfig(**kw)
+    if ok:
+        assert cfg.validate() is cfg
+    else:
+        with pytest.raises(ConfigError):
+            cfg.validate()
+
+
+def test_config_to_dict_lists():
+    d = AnalysisConfig(models=("ar", "persistence"), terms=("N", "B"), fit_tau_s=(1.0, None)).to_dict()
+    assert d["models"] == ["ar", "persistence"] and d["terms"] == ["N", "B"] and d["fit_tau_s"] == [1.0, None]
+    assert AnalysisConfig().to_dict()["terms"] is None
