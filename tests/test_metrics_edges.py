@@ -10,12 +10,19 @@ from __future__ import annotations
 
 import math
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from fogdrift.errors import DataFormatError, FogdriftWarning, InsufficientDataError
 from fogdrift.metrics import evaluate, mase, p0, p0_ago, skill
+
+# mutmut's trampolines add stack frames, so "the warning points at the caller" cannot hold under mutation
+# testing; the normal suite checks it (stacklevel mutants are listed as tool-equivalent in docs/testing.md)
+import fogdrift.metrics  # noqa: E402
+
+CALLER_LINE_CHECKED = "mutants" not in Path(fogdrift.metrics.__file__).parts
 
 Y = np.array([2.0, 4.0, 8.0])
 YH = np.array([1.0, 5.0, 6.0])
@@ -73,7 +80,7 @@ def test_demeaned_warning_threshold(mean, std_scale, convention, warns):
     demeaned = [w for w in log if "was the series demeaned" in str(w.message)]
     assert len(demeaned) == int(warns)
     assert all(w.category is FogdriftWarning for w in log)
-    assert all(w.filename == __file__ for w in demeaned)  # points at the caller of evaluate()
+    assert not CALLER_LINE_CHECKED or all(w.filename == __file__ for w in demeaned)  # the caller's line
 
 
 def test_warnings_are_fogdrift_warnings_at_the_callers_line():
@@ -88,7 +95,8 @@ def test_warnings_are_fogdrift_warnings_at_the_callers_line():
     assert math.isnan(r.p0_pct) and math.isnan(r.mase) and math.isnan(r.skill)
     assert len(log) >= 6
     assert all(w.category is FogdriftWarning for w in log), [w.category for w in log]
-    assert all(w.filename == __file__ for w in log), [(w.filename, str(w.message)) for w in log]
+    assert not CALLER_LINE_CHECKED or all(w.filename == __file__ for w in log), [(w.filename, str(w.message))
+                                                                                for w in log]
 
 
 def test_to_dict_keeps_values_and_maps_nan_to_none():
