@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed
 OUT    ?= out/demo
 DATA   := data/psins_lasergyro_rlg/psins_lasergyro_rlg.csv.gz
 
-.PHONY: demo test bench venv clean
+.PHONY: demo test bench venv clean mutation
 
 $(STAMP): pyproject.toml
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "need $(PYTHON) (set PYTHON=...)"; exit 1; }
@@ -24,6 +24,14 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -q
+
+# Mutation testing (mutmut, config in pyproject.toml [tool.mutmut]; docs/testing.md). Not part of `make test`.
+# One module: make mutation MUTANTS='fogdrift.metrics.*'   (names as `mutmut results` prints them)
+MUTANTS ?=
+mutation: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[test,mutation]'
+	$(BIN)/mutmut run --max-children 2 $(MUTANTS)
+	$(BIN)/mutmut results
 
 bench: $(STAMP)
 	$(BIN)/python bench/run_all.py

@@ -89,14 +89,14 @@ def test_describe_models_lists_every_row_in_order():
     assert [line.split(":")[0] for line in lines] == list(MODEL_NAMES)
 
 
-def test_old_module_paths_are_aliases():
-    import fogdrift.baselines
-    import fogdrift.grey
-    import fogdrift.models.ar
-    import fogdrift.models.grey
+def test_removed_alias_modules_are_gone_and_unknown_attributes_raise():
+    # fogdrift.grey and fogdrift.baselines were compatibility aliases of fogdrift.models.grey / .ar;
+    # nothing imported them any more, so they were removed (issue 8). fogdrift.elman stays while the
+    # README's example imports it.
+    import importlib.util
 
-    assert fogdrift.grey.GM11 is fogdrift.models.grey.GM11 and fogdrift.grey.gm11_fit is fogdrift.models.grey.gm11_fit
-    assert fogdrift.baselines.AR is fogdrift.models.ar.AR
+    assert importlib.util.find_spec("fogdrift.grey") is None
+    assert importlib.util.find_spec("fogdrift.baselines") is None
     with pytest.raises(AttributeError):
         models.NoSuchModel  # noqa: B018
 

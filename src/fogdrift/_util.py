@@ -4,32 +4,77 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import ConfigError, DataFormatError
+from .errors import DataFormatError, InsufficientDataError
 
 
-def check_series(y, name: str = "y", *, min_length: int = 1) -> np.ndarray:
-    """Return ``y`` as a 1-D float64 array, or raise a clear error.
+def check_series(y, name: str = "y", *, min_length: int = 1, allow_2d: bool = False, needed_by: str = "",
+                 hint: str = "") -> np.ndarray:
+    """Return ``y`` as a C-contiguous float64 array of samples, or raise a clear error.
+
+    The one series validator of the package (models, metrics and the lifting transform call it), so that
+    the same fault gives the same message everywhere.
+
+    Parameters
+    ----------
+    y : array_like
+        The series, shape ``(n_samples,)`` (or ``(n_samples, n_axes)`` with ``allow_2d``).
+    name : str
+        Name used in the messages (the argument name the caller documents).
+    min_length : int
+        Fewest samples accepted (``0`` accepts an empty series).
+    allow_2d : bool
+        Accept ``(n_samples, n_axes)`` as well.
+    needed_by : str
+        What needs ``min_length`` samples, e.g. ``"this model"``; named in the too-short message.
+    hint : str
+        Appended to the non-finite message, e.g. how to drop warm-up NaN.
+
+    Returns
+    -------
+    numpy.ndarray
+        float64, C-contiguous, same shape.
 
     Raises
     ------
     DataFormatError
-        If ``y`` is not numeric, not 1-D, or holds NaN/inf (the message gives the first bad index).
-    ConfigError
-        If ``y`` is shorter than ``min_length``.
+        Not numeric, wrong number of dimensions, or NaN/inf (the message gives the first bad index).
+    InsufficientDataError
+        Fewer than ``min_length`` samples.
+
+    Examples
+    --------
+    >>> check_series([1, 2, 3]).tolist()
+    [1.0, 2.0, 3.0]
+    >>> check_series([[1.0, 2.0]], "x")
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.DataFormatError: x must be a 1-D series of shape (n_samples,); got shape (1, 2)
+    >>> check_series([0.0, float("nan")], "y_test")
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.DataFormatError: y_test[1] is nan; expected finite values
+    >>> check_series([1.0], "y_train", min_length=3, needed_by="this model")
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.InsufficientDataError: y_train has 1 samples; this model needs at least 3
     """
     try:
         arr = np.asarray(y, dtype=np.float64)
     except (TypeError, ValueError):
-        raise DataFormatError(f"{name} must be a numeric 1-D array, got {type(y).__name__}") from None
-    if arr.ndim != 1:
-        raise DataFormatError(f"{name} must be a 1-D series; expected shape (n_samples,), got {arr.shape}")
+        raise DataFormatError(f"{name} must be a numeric series; got {type(y).__name__}") from None
+    if arr.ndim == 0 or arr.ndim > (2 if allow_2d else 1):
+        want = "1-D (n_samples,) or 2-D (n_samples, n_axes)" if allow_2d else "a 1-D series of shape (n_samples,)"
+        raise DataFormatError(f"{name} must be {want}; got shape {arr.shape}")
     bad = ~np.isfinite(arr)
     if bad.any():
-        i = int(np.argmax(bad))
-        raise DataFormatError(f"{name}[{i}] is {arr[i]!r}; expected finite values")
-    if arr.size < min_length:
-        raise ConfigError(f"{name} has {arr.size} samples; this model needs at least {min_length}")
-    return arr
+        idx = np.unravel_index(int(np.argmax(bad)), arr.shape)
+        where = ", ".join(str(int(i)) for i in idx)
+        raise DataFormatError(f"{name}[{where}] is {float(arr[idx])!r}; expected finite values{hint}")
+    n = int(arr.shape[0])
+    if n < min_length:
+        who = f"{needed_by} needs" if needed_by else "expected"
+        raise InsufficientDataError(f"{name} has {n} samples; {who} at least {min_length}", needed=min_length, got=n)
+    return np.ascontiguousarray(arr)
 
 
 def check_count(value, name: str = "n_samples", minimum: int = 2) -> int:

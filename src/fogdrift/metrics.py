@@ -18,6 +18,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
+from ._util import check_series
 
 __all__ = [
     "OFFSET_CONVENTIONS",
@@ -41,20 +42,13 @@ P0_GUARD_RATIO = 0.1
 
 
 def _pair(y, yhat, names=("y", "yhat")) -> tuple[np.ndarray, np.ndarray]:
-    a = np.asarray(y, dtype=np.float64)
-    b = np.asarray(yhat, dtype=np.float64)
-    for arr, name in zip((a, b), names):
-        if arr.ndim != 1:
-            raise DataFormatError(f"{name} must be a 1-D series; got shape {arr.shape}")
-        bad = ~np.isfinite(arr)
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise DataFormatError(f"{name}[{i}] is {arr[i]!r}; expected finite values (drop warm-up NaN first, "
-                                  "or use evaluate())")
+    """Two finite 1-D series of the same length, at least 1 sample (the package's one series validator)."""
+    hint = " (drop warm-up NaN first, or use evaluate())"
+    a = check_series(y, names[0], min_length=0, hint=hint)
+    b = check_series(yhat, names[1], min_length=0, hint=hint)
     if a.size != b.size:
         raise DataFormatError(f"{names[0]} and {names[1]} must have the same length; got {a.size} and {b.size}")
-    if a.size == 0:
-        raise InsufficientDataError(f"{names[0]} is empty; expected at least 1 sample", needed=1, got=0)
+    a = check_series(a, names[0], min_length=1)
     return a, b
 
 

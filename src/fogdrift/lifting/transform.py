@@ -39,7 +39,8 @@ import numbers
 
 import numpy as np
 
-from ..errors import ConfigError, DataFormatError, InsufficientDataError
+from ..errors import ConfigError, DataFormatError
+from .._util import check_series
 from ._kernels import _merge, _split, _step, _step_arrays
 from .schemes import LiftingScheme, get_wavelet
 
@@ -165,28 +166,8 @@ def _band_lengths(n: int, level: int, periodic: bool) -> list[int]:
 
 
 def _as_signal(x, name="x", allow_2d=False) -> np.ndarray:
-    try:
-        arr = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise DataFormatError(f"{name} must be numeric; got {type(x).__name__}") from exc
-    if arr.ndim == 0 or arr.ndim > (2 if allow_2d else 1):
-        want = "1-D (n,) or 2-D (n, n_axes)" if allow_2d else "1-D (n,)"
-        raise DataFormatError(f"{name} must be {want}; got shape {arr.shape}")
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        idx = np.unravel_index(int(np.argmax(bad)), arr.shape)
-        where = idx[0] if arr.ndim == 1 else idx
-        raise DataFormatError(
-            f"{name}[{', '.join(str(int(i)) for i in np.atleast_1d(where))}] is "
-            f"{arr[idx]!r}; expected finite values"
-        )
-    if arr.shape[0] < 2:
-        raise InsufficientDataError(
-            f"{name} has {arr.shape[0]} samples; a wavelet level needs at least 2",
-            needed=2,
-            got=int(arr.shape[0]),
-        )
-    return np.ascontiguousarray(arr)
+    """The lifting transform's input check: the package's one series validator, at least 2 samples."""
+    return check_series(x, name, min_length=2, allow_2d=allow_2d, needed_by="a wavelet level")
 
 
 def _check_level(level, n, scheme, mode) -> int:

@@ -1,0 +1,31 @@
+"""Argument boundaries of ``fogdrift.allan.ci.edf_simple`` (found unasserted by the mutation run).
+
+``n_phase >= 3`` and ``1 <= m <= (n_phase - 1) / 2``, integers: each boundary accepted, one step beyond
+refused; the value at the smallest case by hand (white FM, SP 1065 Table 5).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from fogdrift.allan.ci import edf_simple
+from fogdrift.errors import ConfigError
+
+
+def test_smallest_valid_case_by_hand():
+    # white FM, N = 3, m = 1: [3 (N-1)/(2m) - 2 (N-2)/N] 4m^2/(4m^2+5) = (3 - 2/3) * 4/9 = 28/27
+    assert edf_simple(3, 1, 0) == pytest.approx(28.0 / 27.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("n_phase, m", [(3, 1), (5, 2), (9, 4), (10, 4)])
+def test_boundaries_accepted(n_phase, m):
+    assert edf_simple(n_phase, m, 0) > 0
+
+
+@pytest.mark.parametrize("n_phase, m, what", [
+    (2, 1, "n_phase"), (2.5, 1, "n_phase"), (5, 3, "m must be"), (9, 5, "m must be"), (10, 5, "m must be"),
+    (9, 0, "m must be"), (9, 1.5, "m must be"),
+])
+def test_boundaries_refused(n_phase, m, what):
+    with pytest.raises(ConfigError, match=what):
+        edf_simple(n_phase, m, 0)
