@@ -38,5 +38,10 @@ def allan(
             [[a.name] + noise_row(a.noise) for a in results]))
         for a in results:
             print_noise_notes(a.name, a.noise)
+        temp = record.metadata()["temperature"]
+        if temp is not None:
+            from ..temperature import summary_line
+
+            console.print("  " + summary_line(temp), highlight=False)
         files = write_allan_outputs(results, record, out)
         console.print(f"wrote {files['json']}, {files['csv']}, {files['png']}")
