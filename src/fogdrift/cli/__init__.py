@@ -1,4 +1,4 @@
-"""Command-line interface: ``fogdrift allan | separate | model | analyze``.
+"""Command-line interface: ``fogdrift allan | separate | model | analyze | batch``.
 
 One module per command; :mod:`fogdrift.cli._app` holds the typer application, the shared load options and the
 error edge.  Commands only declare options, call the library (:mod:`fogdrift.pipeline`) and the renderer
@@ -9,7 +9,7 @@ exit 2.
 
 from __future__ import annotations
 
-from . import allan, analyze, model, separate  # noqa: F401  (register the commands)
+from . import allan, analyze, batch, model, separate  # noqa: F401  (register the commands)
 from ._app import app
 
 __all__ = ["app", "main"]

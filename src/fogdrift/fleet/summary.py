@@ -1,0 +1,96 @@
+"""The fleet summary table: its columns as data, and ``summary.parquet`` written and read with pyarrow.
+
+One row per file x axis (a file that failed is one row with ``status = "error"`` and its message).  The
+schema is fixed (every column present, nullable) so that DuckDB and pandas see the same columns whether a
+batch succeeded, partly failed or was cached::
+
+    duckdb -c "SELECT file, axis, N_dprh, N_lo95_dprh, N_hi95_dprh FROM 'out/summary.parquet' WHERE status <> 'error'"
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..io.readers.base import require
+from .commands import TERMS
+
+__all__ = ["COLUMNS", "UNITS", "write_summary", "read_summary", "schema"]
+
+#: (column, type, unit or meaning).  Types: str, int, float, bool.
+COLUMNS: tuple = (
+    ("file", "str", "input path relative to the batch's common folder"),
+    ("path", "str", "absolute input path"),
+    ("sha256", "str", "SHA-256 of the input file (of its files, for a ROS 2 bag directory)"),
+    ("command", "str", "batch command"),
+    ("axis", "str", "axis name (null when the file failed before its axes were known)"),
+    ("status", "str", "ok, cached (unchanged file and settings: not recomputed) or error"),
+    ("error", "str", "the error message when status is error"),
+    ("warnings", "str", "warnings raised while processing, '; '-separated"),
+    ("out_dir", "str", "folder of the file's outputs, relative to the batch folder"),
+    ("n_samples", "int", "samples analysed"),
+    ("duration_s", "float", "s"),
+    ("rate_hz", "float", "Hz, sample rate analysed"),
+    ("input_unit", "str", "unit of the input numbers"),
+    ("t0_s", "float", "s, time of the first sample"),
+    ("temperature_min_c", "float", "deg C"),
+    ("temperature_max_c", "float", "deg C"),
+    ("temperature_range_c", "float", "deg C"),
+    ("temperature_change_c", "float", "deg C, end minus start of the log"),
+    ("temperature_slope_c_per_h", "float", "deg C/h, least-squares slope"),
+    *[c for name, unit in TERMS for c in (
+        (f"{name}_{unit}", "float", f"{name} estimate"),
+        (f"{name}_lo95_{unit}", "float", f"{name} 95 % lower bound"),
+        (f"{name}_hi95_{unit}", "float", f"{name} 95 % upper bound"),
+        (f"{name}_estimable", "bool", f"{name} estimable from this record"),
+    )],
+    ("noise_model", "str", "terms whose 95 % interval excludes zero, e.g. N+B+K"),
+    ("fitted_terms", "str", "terms fitted"),
+    ("fit_method", "str", "noise-fit method"),
+    ("fit_chi2_red", "float", "reduced chi-squared of the noise fit"),
+    ("fit_n_points", "int", "taus in the noise fit"),
+    ("fit_tau_min_s", "float", "s"),
+    ("fit_tau_max_s", "float", "s"),
+    ("verdict", "str", "analyze: which drift model beat persistence on the test block"),
+    ("wall_s", "float", "s, processing time of the file (0 when cached)"),
+    ("settings_sha256", "str", "SHA-256 of the command and its settings (re-runs skip unchanged files)"),
+)
+
+#: Unit (or meaning) of every column.
+UNITS = {name: unit for name, _, unit in COLUMNS}
+
+
+def schema():
+    """The pyarrow schema of :data:`COLUMNS` (every column nullable)."""
+    pa = require("pyarrow", "fleet", "writing the batch summary (Parquet)")
+    types = {"str": pa.string(), "int": pa.int64(), "float": pa.float64(), "bool": pa.bool_()}
+    return pa.schema([pa.field(name, types[kind], nullable=True, metadata={"unit": unit})
+                      for name, kind, unit in COLUMNS])
+
+
+def write_summary(rows: list[dict], path) -> Path:
+    """Write rows (dicts; missing keys are null, unknown keys are an error) as a Parquet file.
+
+    Raises
+    ------
+    KeyError
+        A row has a key that is not a column (a bug in a command's row function).
+    """
+    pa = require("pyarrow", "fleet", "writing the batch summary (Parquet)")
+    pq = require("pyarrow.parquet", "fleet", "writing the batch summary (Parquet)")
+    sch = schema()
+    names = set(sch.names)
+    for row in rows:
+        extra = set(row) - names
+        if extra:
+            raise KeyError(f"summary row has unknown columns {sorted(extra)}")
+    table = pa.Table.from_pylist([{n: row.get(n) for n in sch.names} for row in rows], schema=sch)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    pq.write_table(table, path)
+    return path
+
+
+def read_summary(path) -> list[dict]:
+    """Rows of a ``summary.parquet`` as dicts (pyarrow, no pandas needed)."""
+    pq = require("pyarrow.parquet", "fleet", "reading the batch summary (Parquet)")
+    return pq.read_table(Path(path)).to_pylist()
