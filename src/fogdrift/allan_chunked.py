@@ -12,8 +12,8 @@ binary, HDF5) in three streaming passes:
 2. the block totals of ``y - mu`` (blocks of 65536 samples, four interleaved accumulators) and their
    Neumaier-compensated running offsets, as the in-memory angle kernel computes them;
 3. for each chunk of start indices ``k``, the angle ``theta`` of the windows the cluster sizes need,
-   rebuilt from the block offsets and a cumulative sum inside each block (so every ``theta_k`` equals the
-   in-memory value), and the sums of ``(theta_{k+2m} - 2 theta_{k+m} + theta_k)^2`` per block of 65536
+   rebuilt by a compiled kernel from the block offsets and a running sum inside each block (so every
+   ``theta_k`` equals the in-memory value), and the sums of ``(theta_{k+2m} - 2 theta_{k+m} + theta_k)^2`` per block of 65536
    start indices, added in block order as the in-memory estimator adds them.
 
 Small cluster sizes (``2m <= chunk_samples``) are served from one window per chunk; each larger ``m``
@@ -52,8 +52,25 @@ _PW_BLOCK = 128     # NumPy's pairwise-summation leaf size: recursion splits onl
 # ----------------------------------------------------------------------------------------
 # numba kernels (compiled lazily, cached on disk)
 # ----------------------------------------------------------------------------------------
-def _totals_py(y, mu, out, block):  # pragma: no cover - runs compiled
-    """out[ib] = sum of y - mu over block ib, four interleaved accumulators (as the in-memory phase kernel)."""
+def _theta_py(y, scale, mu, offsets, blk0, out, block):  # pragma: no cover - runs compiled
+    """out[i + 1] = theta at sample i + 1 of the window: block offset + running sum of y * scale - mu in the block.
+
+    ``y`` starts at block ``blk0``; the same additions in the same order as the in-memory phase kernel.
+    """
+    n = y.size
+    nb = (n + block - 1) // block
+    for ib in prange(nb):
+        lo = ib * block
+        hi = min(n, lo + block)
+        base = offsets[blk0 + ib]
+        run = 0.0
+        for i in range(lo, hi):
+            run += y[i] * scale - mu
+            out[i + 1] = base + run
+
+
+def _totals_py(y, scale, mu, out, block):  # pragma: no cover - runs compiled
+    """out[ib] = sum of y * scale - mu over block ib, four interleaved accumulators (as the in-memory kernel)."""
     n = y.size
     nb = (n + block - 1) // block
     for ib in prange(nb):
@@ -65,13 +82,13 @@ def _totals_py(y, mu, out, block):  # pragma: no cover - runs compiled
         a3 = 0.0
         i = lo
         while i + 3 < hi:
-            a0 += y[i] - mu
-            a1 += y[i + 1] - mu
-            a2 += y[i + 2] - mu
-            a3 += y[i + 3] - mu
+            a0 += y[i] * scale - mu
+            a1 += y[i + 1] * scale - mu
+            a2 += y[i + 2] * scale - mu
+            a3 += y[i + 3] * scale - mu
             i += 4
         while i < hi:
-            a0 += y[i] - mu
+            a0 += y[i] * scale - mu
             i += 1
         out[ib] = (a0 + a1) + (a2 + a3)
 
@@ -107,6 +124,7 @@ def _kernels():
 
         globals()["prange"] = numba.prange
         _KERNELS["totals"] = numba.njit(cache=True, parallel=True)(_totals_py)
+        _KERNELS["theta"] = numba.njit(cache=True, parallel=True)(_theta_py)
         _KERNELS["sums"] = numba.njit(cache=True, parallel=True)(_block_sums_py)
     return _KERNELS
 
@@ -134,12 +152,10 @@ class _Phase:
         """theta[a:b] (indices of the N + 1 phase points)."""
         lo_i, hi_i = max(a - 1, 0), b - 1           # theta_{i+1} needs y[block start .. i]
         ya = (lo_i // BLOCK) * BLOCK
-        nb = -(-(hi_i - ya) // BLOCK)
-        buf = np.zeros(nb * BLOCK + 1)               # buf[0]: theta_0 = 0 when a == 0
-        np.subtract(self.source.read(ya, hi_i), self.mu, out=buf[1: 1 + hi_i - ya])
-        blocks = buf[1:].reshape(nb, BLOCK)
-        np.cumsum(blocks, axis=1, out=blocks)
-        blocks += self.offsets[ya // BLOCK: ya // BLOCK + nb, None]
+        y = self.source.raw(ya, hi_i)
+        buf = np.empty(y.size + 1)
+        buf[0] = 0.0                                 # theta_0, used when a == 0
+        _kernels()["theta"](y, self.source.scale_to_dph, self.mu, self.offsets, ya // BLOCK, buf, BLOCK)
         return buf[a - ya: b - ya]                   # buf[t + 1] = theta[ya + t + 1]
 
     def points(self, idx) -> np.ndarray:
@@ -167,9 +183,9 @@ def _mean_and_offsets(source, leaf: int, progress):
     kern = _kernels()["totals"]
     step = max(BLOCK, (leaf // BLOCK) * BLOCK)
     for a in range(0, n, step):
-        y = source.read(a, min(n, a + step))
+        y = source.raw(a, min(n, a + step))
         part = np.empty(-(-y.size // BLOCK))
-        kern(y, mu, part, BLOCK)
+        kern(y, source.scale_to_dph, mu, part, BLOCK)
         totals[a // BLOCK: a // BLOCK + part.size] = part
     offsets = np.empty(nb + 1)
     s = c = 0.0

@@ -52,14 +52,22 @@ class ChunkSource:
     _read: Callable = field(repr=False, default=None)
     check: Callable | None = field(repr=False, default=None)   # check(start, stop) on the streaming pass
 
-    def read(self, start: int, stop: int) -> np.ndarray:
-        """Samples ``start .. stop-1`` in deg/h (float64, a new array)."""
+    def raw(self, start: int, stop: int) -> np.ndarray:
+        """Samples ``start .. stop-1`` as stored (after a raw binary scale factor), before ``scale_to_dph``.
+
+        ``raw(a, b) * scale_to_dph`` (in float64) is :meth:`read`; compiled consumers multiply as they go
+        and save the float64 copy.
+        """
         start, stop = int(start), int(stop)
         if not 0 <= start <= stop <= self.n_samples:
             raise ConfigError(f"window [{start}, {stop}) outside 0..{self.n_samples}")
         if stop == start:
             return np.empty(0)
-        x = np.asarray(self._read(start, stop), dtype=np.float64)
+        return np.ascontiguousarray(self._read(start, stop))
+
+    def read(self, start: int, stop: int) -> np.ndarray:
+        """Samples ``start .. stop-1`` in deg/h (float64, a new array)."""
+        x = np.asarray(self.raw(start, stop), dtype=np.float64)
         if self.scale_to_dph != 1.0:
             x = np.multiply(x, self.scale_to_dph, dtype=np.float64)
         return x
