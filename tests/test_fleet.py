@@ -149,3 +149,18 @@ def test_bad_settings_fail_before_any_work(tmp_path):
     with pytest.raises(ConfigError, match=r"is a folder; pass glob="):
         run_batch([tmp_path], tmp_path / "o")
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.slow
+def test_analyze_batch_rows_carry_the_verdict(tmp_path):
+    rng = np.random.default_rng(14)
+    n = 40_000                                                      # 4000 s at 10 Hz
+    drift = np.cumsum(rng.normal(scale=0.05, size=n))
+    f = _csv(tmp_path / "a.csv", drift + rng.normal(size=n), dt=0.1)
+    settings = {"analysis": {"models": ["ar", "persistence"], "model_rate_hz": 1.0, "level": 2}}
+    res = run_batch([f], tmp_path / "o", command="analyze", settings=settings, scheduler="serial")
+    row = res.rows[0]
+    assert row["status"] == "ok", row["error"]
+    assert row["verdict"].startswith("AR(p) ") and "persistence one step ahead" in row["verdict"]
+    assert (tmp_path / "o" / "a.csv" / "report.html").is_file()
+    assert json.loads((tmp_path / "o" / "a.csv" / "analysis.json").read_text())["sha256"] == row["sha256"]

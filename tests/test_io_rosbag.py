@@ -83,7 +83,10 @@ def rng():
 
 
 @pytest.mark.parametrize("ros, storage", [(1, None), (2, "sqlite3"), (2, "mcap")])
-def test_bag_values_stamps_and_units(tmp_path, rng, ros, storage):
+def test_bag_values_stamps_and_units(tmp_path, rng, ros, storage, monkeypatch):
+    import fogdrift.io.readers.rosbag as rosbag_reader
+
+    monkeypatch.setattr(rosbag_reader, "_BATCH", 64)           # several decoding batches
     n = 400
     w = rng.normal(scale=1e-3, size=(n, 3))
     stamps = T0_NS + np.arange(n, dtype=np.int64) * 5_000_000          # 200 Hz

@@ -108,7 +108,11 @@ def _pick_imu(reader, topic, p):
     return imu[0], [c for c in conns if c.topic == imu[0]]
 
 
-def _decode_imu(raws: list, is_ros2: bool, p: Path):
+#: Messages decoded at a time (their bytes are joined into one buffer).
+_BATCH = 1 << 16
+
+
+def _decode_imu(raws: list, is_ros2: bool, p: Path, first: int = 0):
     """(stamp ns int64, angular velocity (n, 3) float64) from serialised Imu messages, vectorised.
 
     ROS 2 (CDR): 4-byte encapsulation header, then stamp (int32 sec, uint32 nanosec), frame_id
@@ -125,14 +129,14 @@ def _decode_imu(raws: list, is_ros2: bool, p: Path):
     short = lengths < 16
     if short.any():
         i = int(np.argmax(short))
-        raise DataFormatError(f"Imu message {i} is truncated; expected at least 16 bytes, got {int(lengths[i])}",
-                              path=p)
+        raise DataFormatError(f"Imu message {first + i} is truncated; expected at least 16 bytes, got "
+                              f"{int(lengths[i])}", path=p)
     if is_ros2:
         enc = buf[starts + 1]
         if np.any(enc != enc[0]) or enc[0] not in (0, 1):
             i = int(np.argmax(enc != enc[0])) if np.any(enc != enc[0]) else 0
-            raise DataFormatError(f"Imu message {i} has CDR encapsulation {int(enc[i])}; expected plain CDR (0 big- "
-                                  "or 1 little-endian) in every message", path=p)
+            raise DataFormatError(f"Imu message {first + i} has CDR encapsulation {int(enc[i])}; expected plain CDR "
+                                  "(0 big- or 1 little-endian) in every message", path=p)
         order = "<" if enc[0] == 1 else ">"
     else:
         order = "<"
@@ -154,15 +158,16 @@ def _decode_imu(raws: list, is_ros2: bool, p: Path):
     if short.any():
         i = int(np.argmax(short))
         raise DataFormatError(
-            f"Imu message {i} is truncated or not a sensor_msgs/Imu; expected {int(need[i])} bytes for its "
+            f"Imu message {first + i} is truncated or not a sensor_msgs/Imu; expected {int(need[i])} bytes for its "
             f"{int(flen[i])}-byte frame_id, got {int(lengths[i])}", path=p,
         )
     av = gather(starts + av_off, 24, "f8").astype(np.float64)
     return sec * 1_000_000_000 + nsec, av
 
 
-def _check_against_deserializer(reader, conn, raws, av, stamps, p):
-    for i in sorted({0, len(raws) - 1}):
+def _check_against_deserializer(reader, conn, raws: dict, av, stamps, p):
+    """The first and last messages through rosbags' deserialiser must equal the bulk decoding."""
+    for i in sorted(raws):
         msg = reader.deserialize(raws[i], conn.msgtype)
         ref = (msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z)
         st = msg.header.stamp
@@ -222,15 +227,26 @@ def open_table(path: Path, *, topic=None, stamp="header", temperature=None) -> T
         with highlevel.AnyReader([p], default_typestore=typesys.get_typestore(typesys.Stores.ROS2_HUMBLE)) as reader:
             is_ros2 = bool(reader.is2)
             name, conns = _pick_imu(reader, None if topic is None else str(topic).strip(), p)
+            parts, first_raw, last_raw = [], None, None
             for _conn, t_ns, raw in reader.messages(connections=conns):
                 raws.append(bytes(raw))
                 bag_ns.append(t_ns)
                 n_read += 1
-            if not raws:
+                if len(raws) == _BATCH:               # decode in batches: memory ~ the output arrays
+                    first_raw = raws[0] if first_raw is None else first_raw
+                    parts.append(_decode_imu(raws, is_ros2, p, n_read - len(raws)))
+                    last_raw, raws = raws[-1], []
+            if raws:
+                first_raw = raws[0] if first_raw is None else first_raw
+                parts.append(_decode_imu(raws, is_ros2, p, n_read - len(raws)))
+                last_raw = raws[-1]
+            if not parts:
                 raise DataFormatError(f"Imu topic {name!r} has no messages; expected at least one", path=p,
                                       column=name)
-            stamps, av = _decode_imu(raws, is_ros2, p)
-            _check_against_deserializer(reader, conns[0], raws, av, stamps, p)
+            stamps = np.concatenate([q[0] for q in parts])
+            av = np.concatenate([q[1] for q in parts])
+            del parts
+            _check_against_deserializer(reader, conns[0], {0: first_raw, n_read - 1: last_raw}, av, stamps, p)
             temp = None
             if temperature is not None:
                 temp = _temperature(reader, list(reader.connections), str(temperature).strip(), stamp, p)
