@@ -17,8 +17,9 @@ binary, HDF5) in three streaming passes:
    start indices, added in block order as the in-memory estimator adds them.
 
 Small cluster sizes (``2m <= chunk_samples``) are served from one window per chunk; each larger ``m``
-reads two more windows (at ``k + m`` and ``k + 2m``), so the file is read about ``3 + 2 n_large`` times
-(``n_large`` taus above ``chunk_samples / 2``), sequentially.  Non-overlapping sums with strides above
+reads two more windows (at ``k + m`` and ``k + 2m``; on an octave grid the window at ``k + 2m`` is the next
+tau's window at ``k + m`` and is reused), so the file is read about ``4 + n_large`` times (``n_large`` taus
+above ``chunk_samples / 2``), sequentially.  Non-overlapping sums with strides above
 1.5 blocks read only the points they need.  EDF and chi-squared bounds follow
 :func:`fogdrift.allan.allan_variance` (simple EDF, SP 1065 Table 5; alpha from the local slope).
 
@@ -218,6 +219,7 @@ def _second_difference_sums(phase: _Phase, m: np.ndarray, strides: np.ndarray, c
     for ci, k0 in enumerate(range(0, k_end_all, chunk)):
         k1 = min(k0 + chunk, k_end_all)
         base = phase.window(k0, min(n_phase, k1 + ext))      # theta for every small m of this chunk
+        cache = {}                                   # window start -> theta window (octave grids: 2 m_j = m_j+1)
         for j in range(m.size):
             mj, s = int(m[j]), int(strides[j])
             kmax = min(k1, n_phase - 2 * mj)
@@ -241,13 +243,17 @@ def _second_difference_sums(phase: _Phase, m: np.ndarray, strides: np.ndarray, c
                 bb = base[kstart - k0 + mj: kstart - k0 + mj + L]
                 a = base[kstart - k0 + 2 * mj: kstart - k0 + 2 * mj + L]
             else:
-                bb = phase.window(kstart + mj, kstart + mj + L)
-                a = phase.window(kstart + 2 * mj, kstart + 2 * mj + L)
+                start_b, start_a = kstart + mj, kstart + 2 * mj
+                hit = cache.get(start_b)
+                bb = hit[:L] if hit is not None and hit.size >= L else phase.window(start_b, start_b + L)
+                cache.clear()                        # keep at most the window the next m can reuse
+                a = phase.window(start_a, start_a + L)
+                cache[start_a] = a
             kern(a, bb, c, kstart, s, BLOCK, out)
             del a, bb, c                             # free the windows before the next m reads its own
             first = kstart // BLOCK
             parts[j] += [(first + q, float(v)) for q, v in enumerate(out)]
-        del base
+        del base, cache
         if progress is not None:
             progress("sums", ci + 1, n_chunks)
     sums = np.empty(m.size)
