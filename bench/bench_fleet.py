@@ -7,6 +7,8 @@ three axes (white + random-walk rate noise, deg/h), then runs in the same proces
   (numba's own threads still parallelise the Allan kernel inside each file);
 * ``dask``   - ``run_batch(..., workers=N)``: a local cluster of N worker processes (default: the cores),
   each single-threaded, cluster start-up included;
+* ``running`` - the same on a cluster started (and warmed up on two files) beforehand, as with
+  ``--scheduler``: the compute alone;
 
 into separate output folders (no skipping), checks that both summaries hold the same numbers, and prints
 the wall times and the speed-up with the machine's description and load.
@@ -79,16 +81,33 @@ def main() -> int:
     t0 = time.perf_counter()
     dask = run_batch(files, root / "dask", workers=args.workers)
     t_dask = time.perf_counter() - t0
+    # the same on a cluster started beforehand (as with --scheduler): the compute without the start-up
+    from distributed import LocalCluster
+
+    from fogdrift.fleet.runner import _worker_env
+
+    t0 = time.perf_counter()
+    with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None, env=_worker_env(args.workers)) as cluster:
+        t_start = time.perf_counter() - t0
+        run_batch(files[:2], root / "warm2", scheduler=cluster.scheduler_address, page=False)   # workers' numba
+        t0 = time.perf_counter()
+        run_batch(files, root / "dask2", scheduler=cluster.scheduler_address)
+        t_running = time.perf_counter() - t0
     key = [(r["file"], r["axis"]) for r in serial.rows]
     same = all(a["N_dprh"] == b["N_dprh"] and a["file"] == b["file"] for a, b in zip(serial.rows, dask.rows))
     print("\n| run | files | wall [s] | per file [s] |\n| --- | --- | --- | --- |")
     print(f"| serial loop (in process) | {len(files)} | {t_serial:.1f} | {t_serial / len(files):.2f} |")
     print(f"| {dask.scheduler} (start-up included) | {len(files)} | {t_dask:.1f} | {t_dask / len(files):.2f} |")
-    print(f"\nspeed-up serial / dask: {t_serial / t_dask:.2f}x (target >= 1.7x on 2 cores); "
+    print(f"| running cluster of {args.workers} workers (started in {t_start:.1f} s, warmed up) | {len(files)} | "
+          f"{t_running:.1f} | {t_running / len(files):.2f} |")
+    print(f"\nspeed-up serial / dask: {t_serial / t_dask:.2f}x with start-up, {t_serial / t_running:.2f}x on a running "
+          f"cluster (target >= 1.7x on 2 cores); "
           f"same N in both summaries: {same} ({len(key)} rows); load after: {os.getloadavg()}")
     if args.json:
         Path(args.json).write_text(json.dumps({"machine": _machine(), "serial_s": t_serial, "dask_s": t_dask,
-                                               "speedup": t_serial / t_dask, "same": same}, indent=1))
+                                               "dask_running_s": t_running, "speedup": t_serial / t_dask,
+                                               "speedup_running": t_serial / t_running, "same": same}, indent=1))
     shutil.rmtree(root, ignore_errors=True)
     return 0
 
