@@ -19,7 +19,8 @@ $(STAMP): pyproject.toml
 venv: $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/fogdrift analyze $(DATA) --out $(OUT)
+	mkdir -p $(dir $(OUT))
+	$(BIN)/fogdrift analyze $(DATA) --unit deg/h --out $(OUT)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -q

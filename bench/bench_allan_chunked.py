@@ -47,12 +47,12 @@ from fogdrift.io.chunked import open_source
 # warm-up (numba compilation or cache load) on a small file, excluded from the timing
 small = np.random.default_rng(0).normal(size=300_000).astype(np.float32)
 np.save(path + ".warm.npy", small)
-allan_variance_chunked(open_source(path + ".warm.npy", rate_hz=100.0), chunk_samples=65536)
+allan_variance_chunked(open_source(path + ".warm.npy", rate_hz=100.0, unit="deg/h"), chunk_samples=65536)
 allan_variance(small, 0.01)
 base = vm_hwm_mb()
 t0 = time.perf_counter()
 if mode == "chunked":
-    r = allan_variance_chunked(open_source(path, rate_hz=100.0))
+    r = allan_variance_chunked(open_source(path, rate_hz=100.0, unit="deg/h"))
 else:
     y = np.load(path, mmap_mode="r")[:n]
     y = np.array(y)            # loaded into memory (float32, as the file)

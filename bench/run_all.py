@@ -28,6 +28,7 @@ def main() -> int:
         ["bench_allan.py", "--sizes", sizes, "--taus", "100", "--json", str(out / "allan.json")],
         ["bench_lifting.py", "--sizes", sizes, "--json", str(out / "lifting.json")],
         ["bench_elman.py", "--json", str(out / "elman.json")],
+        ["bench_compensate.py", "--sizes", sizes, "--json", str(out / "compensate.json")],
     ]
     status = 0
     for job in jobs:

@@ -30,4 +30,4 @@ def bundled_path() -> Path:
 def bundled_record():
     from fogdrift.io import load
 
-    return load(BUNDLED)
+    return load(BUNDLED, unit="deg/h")  # the file declares no unit (data/README.md: deg/h)

@@ -1,8 +1,24 @@
-"""Allan variance engine: reference values (method notes section 7: R8, R9, R11, R17),
-agreement with allantools (``oadev``/``adev``, ``data_type='freq'``) to 1e-9 relative,
+"""Allan family engine: reference values (method notes section 7: R8, R9, R11, R17),
+agreement with allantools (``oadev``/``adev``/``ohdev``/``hdev``/``mdev``, ``data_type='freq'``)
+to 1e-9 relative, the published NBS14 values of the Allan, Hadamard and modified Allan
+deviations, the compiled operators against a plain evaluation of the statistics table,
 numerical robustness against a large offset, EDF/bounds, the fast estimator and validation.
+(EDF formulas in detail: ``test_allan_ci.py``.)
 
-R17 is the NBS14 10-point set from NIST SP 1065 (Riley), as reproduced by Stable32/allantools.
+NBS14 reference values (Riley's test suite for frequency-stability software; the numbers were
+taken from the NBS14 tables of NIST SP 1065 (pp. 107-108) and of W. J. Riley, "The Calculation
+of Time Domain Frequency Stability" (Tables II and III), as quoted in the test suites of
+allantools and allantoolkit -- the documents themselves were not available to this project):
+
+* 10-point frequency set (R17): ADEV and overlapping ADEV (method notes R17); MDEV 91.22945,
+  74.78849 and overlapping HDEV 70.80607, 85.61487 at tau = 1, 2 (SP 1065); non-overlapping
+  HDEV 70.80608, 116.7980 (Riley, Table II).
+* 1000-point set (generator n_{i+1} = 16807 n_i mod 2147483647, n_0 = 1234567890, value
+  n_i / 2147483647): at tau = 1, 10, 100 ADEV 2.922319e-01, 9.965736e-02, 3.897804e-02;
+  overlapping ADEV ..., 9.159953e-02, 3.241343e-02; MDEV ..., 6.172376e-02, 2.170921e-02;
+  overlapping HDEV 2.943883e-01, 9.581083e-02, 3.237638e-02 (SP 1065); non-overlapping HDEV
+  ..., 1.052754e-01, 3.910860e-02 (Riley, Table III).  All published to 7 significant
+  digits, so compared at 1e-6 relative.
 """
 
 from __future__ import annotations
@@ -14,7 +30,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from fogdrift.allan import FAST_M0, AllanResult, allan_variance, edf_simple, tau_grid
+from fogdrift.allan import FAST_M0, STATISTICS, AllanResult, allan_variance, edf_simple, tau_grid
+from fogdrift.allan._kernels import OPERATORS, operator_sums, phase_dph_samples
 from fogdrift.errors import ConfigError, DataFormatError, InsufficientDataError
 
 R8 = [1.0, 3.0, 2.0, 5.0, 4.0, 4.0, 6.0, 3.0]
@@ -54,6 +71,88 @@ def test_r17_nbs14_published_values():
     assert_allclose(oadev, [91.22945, 85.95287], rtol=1e-6)
 
 
+def _nbs14_1000() -> np.ndarray:
+    n, out = 1234567890, []
+    for _ in range(1000):
+        out.append(n / 2147483647)
+        n = (16807 * n) % 2147483647
+    return np.array(out)
+
+
+@pytest.mark.parametrize(
+    "statistic, estimator, expected",
+    [
+        ("mdev", "overlapping", [91.22945, 74.78849]),
+        ("hdev", "overlapping", [70.80607, 85.61487]),
+        ("hdev", "non-overlapping", [70.80608, 116.7980]),
+    ],
+)
+def test_nbs14_10_point_hadamard_and_modified(statistic, estimator, expected):
+    r = allan_variance(NBS14_FREQ, 1.0, taus=[1, 2], statistic=statistic, estimator=estimator)
+    assert r.statistic == statistic
+    assert_allclose(r.dev_dph, expected, rtol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "statistic, estimator, expected",
+    [
+        ("adev", "non-overlapping", [2.922319e-01, 9.965736e-02, 3.897804e-02]),
+        ("adev", "overlapping", [2.922319e-01, 9.159953e-02, 3.241343e-02]),
+        ("mdev", "overlapping", [2.922319e-01, 6.172376e-02, 2.170921e-02]),
+        ("hdev", "overlapping", [2.943883e-01, 9.581083e-02, 3.237638e-02]),
+        ("hdev", "non-overlapping", [2.943883e-01, 1.052754e-01, 3.910860e-02]),
+    ],
+)
+def test_nbs14_1000_point_published_values(statistic, estimator, expected):
+    r = allan_variance(_nbs14_1000(), 1.0, taus=[1, 10, 100], statistic=statistic, estimator=estimator)
+    assert_allclose(r.dev_dph, expected, rtol=1e-6)
+
+
+def test_r8_hadamard_and_modified_by_hand():
+    """R8 by hand: HVAR(1) = (9 + 16 + 16 + 1 + 4 + 25) / (6 * 6) = 71/36 (the squared second
+    differences of y); MVAR(1) = AVAR(1) = 2; MVAR(2) from SP 1065 eq. 14 with explicit loops."""
+    y = np.array(R8)
+    h = allan_variance(R8, 1.0, taus=[1], statistic="hdev")
+    assert_allclose(h.var_dph2, [71.0 / 36.0], rtol=1e-13)
+    assert_array_equal(h.n_terms, [6])
+    x = np.concatenate(([0.0], np.cumsum(y)))  # phase, 9 points
+    m, n_terms, acc = 2, len(x) - 3 * 2 + 1, 0.0
+    for j in range(n_terms):
+        acc += sum(x[i + 2 * m] - 2 * x[i + m] + x[i] for i in range(j, j + m)) ** 2
+    mod = allan_variance(R8, 1.0, taus=[1, 2], statistic="mdev")
+    assert_allclose(mod.var_dph2, [2.0, acc / (2 * m**2 * m**2 * n_terms)], rtol=1e-13)
+    assert_array_equal(mod.n_terms, [7, n_terms])  # N + 2 - 3m
+
+
+@pytest.mark.parametrize("key", list(OPERATORS))
+def test_compiled_operators_match_the_table(key):
+    """Each compiled kernel evaluates exactly the operator of its table entry (plain numpy here)."""
+    coefs, window = key
+    assert any(tuple(s.coefficients) == coefs and s.windowed == window for s in STATISTICS.values())
+    rng = np.random.default_rng(4)
+    y = rng.normal(size=5003) + 0.01 * np.cumsum(rng.normal(size=5003))
+    p = phase_dph_samples(y)
+    ms = np.array([1, 2, 3, 7, 64, 500, 1500])
+    for stride_kind in (("one", "m") if not window else ("one",)):
+        strides = np.ones_like(ms) if stride_kind == "one" else ms.copy()
+        got = operator_sums(p, ms, strides, coefs, window)
+        for m, s, g in zip(ms, strides, got):
+            q = np.convolve(p, np.ones(m), mode="valid") if window else p  # window sums W_k
+            span = (len(coefs) - 1) * m
+            k = np.arange(0, q.size - span, s)
+            d = sum(c * q[k + l * m] for l, c in enumerate(coefs))
+            assert g == pytest.approx(np.sum(d * d), rel=1e-10)
+
+
+@pytest.mark.parametrize("statistic", ["hdev", "mdev"])
+def test_family_ramp_and_constant(statistic):
+    """A rate ramp: HVAR = 0 (the third difference of a quadratic angle vanishes), MVAR = r^2 tau^2 / 2."""
+    y = 0.5 * np.arange(300.0) + 7.0
+    r = allan_variance(y, 1.0, taus=[1.0, 4.0, 16.0], statistic=statistic)
+    expected = [0.0, 0.0, 0.0] if statistic == "hdev" else [0.125, 2.0, 32.0]
+    assert_allclose(r.var_dph2, expected, rtol=1e-12, atol=1e-11)
+
+
 # --- allantools agreement ---------------------------------------------------------------
 @pytest.mark.parametrize("n", [9, 100, 1001, 12345, 100_003])
 @pytest.mark.parametrize("grid", ["octave", "decade", 40])
@@ -75,6 +174,36 @@ def test_all_grid_matches_allantools():
     taus, dev, _, _ = allantools.oadev(y, rate=1.0, data_type="freq", taus=r.tau_s)
     assert_array_equal(taus, r.tau_s[:-1])  # allantools stops at m < N/2
     assert_allclose(r.adev_dph[:-1], dev, rtol=1e-9)
+
+
+@pytest.mark.parametrize("n", [10, 101, 1000, 12345, 100_003])
+@pytest.mark.parametrize("grid", ["octave", "decade", 40])
+def test_hadamard_and_modified_match_allantools(n, grid):
+    rng = np.random.default_rng(n + 1)
+    y = 3.0 * rng.normal(size=n) + 0.01 * np.cumsum(rng.normal(size=n)) + 50.0
+    for statistic, est, func in (("hdev", "overlapping", allantools.ohdev),
+                                 ("hdev", "non-overlapping", allantools.hdev),
+                                 ("mdev", "overlapping", allantools.mdev)):
+        r = allan_variance(y, 0.01, taus=grid, estimator=est, statistic=statistic)
+        taus, dev, _, ns = func(y, rate=100.0, data_type="freq", taus=r.tau_s)
+        keep = np.isin(np.rint(r.tau_s * 100), np.rint(np.asarray(taus) * 100))  # allantools drops m >= N/2 etc.
+        assert keep.sum() >= min(len(r), 3)
+        assert_allclose(taus, r.tau_s[keep], rtol=1e-12)
+        assert_allclose(r.dev_dph[keep], dev, rtol=1e-9)
+        assert_array_equal(r.n_terms[keep], ns)
+
+
+@pytest.mark.parametrize("statistic", ["hdev", "mdev"])
+def test_family_large_offset_does_not_cancel(statistic):
+    rng = np.random.default_rng(12)
+    noise = rng.normal(size=1_000_000)
+    a = allan_variance(noise, 0.01, taus=40, statistic=statistic)
+    b = allan_variance(noise + 1.0e4, 0.01, taus=40, statistic=statistic)
+    assert_allclose(b.var_dph2, a.var_dph2, rtol=1e-9)
+    # white rate noise: HVAR = 1/m; MVAR = (1 + 1/m^2)/(2m) (noise_terms laws)
+    m = a.m[:5].astype(float)
+    law = 1.0 / m if statistic == "hdev" else (1.0 + 1.0 / m**2) / (2.0 * m)
+    assert_allclose(a.var_dph2[:5] / law, 1.0, rtol=0.03)
 
 
 def test_large_offset_does_not_cancel():
@@ -204,6 +333,57 @@ def test_validation_errors():
         allan_variance(np.zeros(10), 1.0, noise_alpha=[0, 0, 0, 0, 0])
     with pytest.raises(InsufficientDataError):
         allan_variance([1.0], 1.0)
+
+
+@pytest.mark.parametrize(
+    "statistic, estimator",
+    [("mdev", "non-overlapping"), ("mdev", "fast"), ("hdev", "fast"), ("tdev", "overlapping")],
+)
+def test_unsupported_statistic_or_sampling_is_a_config_error(statistic, estimator):
+    with pytest.raises(ConfigError, match="statistic|estimator") as err:
+        allan_variance(np.zeros(100), 1.0, statistic=statistic, estimator=estimator)
+    if statistic != "tdev":
+        assert "estimator=" in str(err.value) and "--estimator" in err.value.render({"estimator": "--estimator"})
+
+
+def test_statistics_table_states_samplings_and_sources():
+    assert set(STATISTICS) == {"adev", "hdev", "mdev"}
+    assert STATISTICS["adev"].samplings == ("overlapping", "non-overlapping", "fast")
+    assert STATISTICS["hdev"].samplings == ("overlapping", "non-overlapping")
+    assert STATISTICS["mdev"].samplings == ("overlapping",)
+    assert [STATISTICS[k].norm for k in ("adev", "hdev", "mdev")] == [2.0, 6.0, 2.0]
+    for s in STATISTICS.values():
+        assert "SP 1065" in s.equation and "p." in s.equation and s.edf_source
+
+
+def test_tau_grid_per_statistic():
+    assert tau_grid(10, 1.0, "all", max_fraction=0.5).tolist() == [1, 2, 3, 4, 5]
+    assert tau_grid(10, 1.0, "all", max_fraction=0.5, statistic="hdev").tolist() == [1, 2, 3]
+    assert tau_grid(11, 1.0, "all", max_fraction=0.5, statistic="mdev").tolist() == [1, 2, 3, 4]
+    assert tau_grid(10, 1.0, [3.0], statistic="hdev").tolist() == [3]
+    with pytest.raises(ConfigError, match="Hadamard"):
+        tau_grid(10, 1.0, [4.0], statistic="hdev")
+    with pytest.raises(InsufficientDataError):
+        tau_grid(2, 1.0, statistic="hdev")
+
+
+def test_result_names_per_statistic(tmp_path):
+    y = np.random.default_rng(8).normal(size=2000)
+    a = allan_variance(y, 0.5, taus=[0.5, 1.0])
+    assert a.statistic == "adev"
+    assert a.avar_dph2 is a.var_dph2 and a.adev_dph is a.dev_dph and a.adev_hi95_dph is a.dev_hi95_dph
+    h = allan_variance(y, 0.5, taus=[0.5, 1.0], statistic="hdev")
+    with pytest.raises(AttributeError, match="Hadamard"):
+        _ = h.adev_dph
+    d = json.loads(json.dumps(h.to_dict()))
+    assert d["statistic"] == "hdev" and "hdev_dph" in d and "hvar_dph2" in d and "adev_dph" not in d
+    assert_allclose(d["hdev_lo95_dph"], h.dev_lo95_dph, rtol=1e-15)
+    path = tmp_path / "hdev.csv"
+    h.to_csv(path)
+    text = path.read_text().splitlines()
+    assert "statistic=hdev" in text[0]
+    assert text[2] == ",".join(h.column_names()) and text[2].startswith("tau_s,m,hvar_dph2,hdev_dph,hdev_lo68_dph")
+    assert allan_variance(y, 0.5, taus=[1.0], statistic="mdev").column_names()[2:4] == ("mvar_dph2", "mdev_dph")
 
 
 def test_result_serialisation_and_progress(tmp_path):

@@ -42,7 +42,7 @@ def _series(n, seed):
 def test_npy_many_chunks_equals_in_memory(tmp_path, estimator, taus):
     y = _series(600_001, 1)                                    # m up to 150000: windows beyond the chunk
     np.save(tmp_path / "y.npy", y)
-    src = open_source(tmp_path / "y.npy", rate_hz=100.0)
+    src = open_source(tmp_path / "y.npy", rate_hz=100.0, unit="deg/h")
     got = allan_variance_chunked(src, taus=taus, estimator=estimator, chunk_samples=65536)
     _same(got, allan_variance(y, 0.01, taus=taus, estimator=estimator))
 
@@ -56,7 +56,7 @@ def test_npy_2d_columns_float32_and_fortran_order(tmp_path):
         ref = allan_variance(load(tmp_path / name, rate_hz=10.0, columns=1, unit="deg/s").axis(0), 0.1)
         _same(allan_variance_chunked(src, chunk_samples=65536), ref)
     with pytest.raises(ConfigError, match=r"3 columns; choose one with columns="):
-        open_source(tmp_path / "c.npy", rate_hz=10.0)
+        open_source(tmp_path / "c.npy", rate_hz=10.0, unit="deg/s")
 
 
 def test_raw_binary_with_scale_increments_and_sequence(tmp_path):
@@ -75,7 +75,7 @@ def test_raw_binary_with_scale_increments_and_sequence(tmp_path):
     _same(allan_variance_chunked(src, chunk_samples=65536), allan_variance(ref.axis(0), ref.dt_s))
     rec["seq"][250_000:] += 3                                   # three records lost
     p.write_bytes(b"H" * 24 + rec.tobytes())
-    src = open_source(p, column="gz", layout=layout, header_bytes=24, rate_hz=200.0)
+    src = open_source(p, column="gz", layout=layout, header_bytes=24, rate_hz=200.0, unit="inc:arcsec")
     with pytest.raises(DataFormatError, match=r"log\.bin:seq: sequence counter jumps from 53391 to 53395 at "
                                               r"record 250000"):
         allan_variance_chunked(src, chunk_samples=65536)
@@ -88,17 +88,21 @@ def test_hdf5_dataset_and_compound(tmp_path):
     rows["gz"] = y
     with h5py.File(tmp_path / "a.h5", "w") as f:
         f.create_dataset("imu/rate", data=np.column_stack([y, -y]), chunks=(10_000, 2), compression="gzip")
-        f.create_dataset("imu/records", data=rows)
-    src = open_source(tmp_path / "a.h5", dataset="/imu/rate", column=1, rate_hz=50.0)
+        f.create_dataset("imu/records", data=rows).attrs["units"] = ["s", "deg/h"]
+    with pytest.raises(ConfigError, match=r"a\.h5: no rate unit: HDF5 dataset /imu/rate declares none; pass unit="):
+        open_source(tmp_path / "a.h5", dataset="/imu/rate", column=1, rate_hz=50.0)
+    src = open_source(tmp_path / "a.h5", dataset="/imu/rate", column=1, rate_hz=50.0, unit="deg/h")
     _same(allan_variance_chunked(src, chunk_samples=65536), allan_variance(-y, 0.02))
-    src = open_source(tmp_path / "a.h5", dataset="/imu/records", column="gz", rate_hz=50.0)
+    src = open_source(tmp_path / "a.h5", dataset="/imu/records", column="gz", rate_hz=50.0)   # declared deg/h
     _same(allan_variance_chunked(src, chunk_samples=65536), allan_variance(rows["gz"], 0.02))
+    src = open_source(tmp_path / "a.h5", dataset="/imu/records", column="gz", rate_hz=50.0, unit="deg/s")
+    _same(allan_variance_chunked(src, chunk_samples=65536), allan_variance(rows["gz"].astype(np.float64) * 3600.0, 0.02))
 
 
 def test_memory_is_bounded_by_the_chunk(tmp_path):
     n = 2_000_000
     np.save(tmp_path / "big.npy", _series(n, 5).astype(np.float32))
-    src = open_source(tmp_path / "big.npy", rate_hz=100.0)
+    src = open_source(tmp_path / "big.npy", rate_hz=100.0, unit="deg/h")
     allan_variance_chunked(src, chunk_samples=65536)           # compile outside the measurement
     tracemalloc.start()
     allan_variance_chunked(src, chunk_samples=65536)
@@ -112,21 +116,25 @@ def test_errors_are_located(tmp_path):
     y[70_000] = np.nan
     np.save(tmp_path / "nan.npy", y)
     with pytest.raises(DataFormatError, match=r"nan\.npy:col0: non-finite value at sample 70000"):
-        allan_variance_chunked(open_source(tmp_path / "nan.npy", rate_hz=1.0), chunk_samples=65536)
+        allan_variance_chunked(open_source(tmp_path / "nan.npy", rate_hz=1.0, unit="deg/h"), chunk_samples=65536)
+    with pytest.raises(ConfigError, match=r"nan\.npy: no rate unit: npy float64 \(100000,\) declares none; pass unit="):
+        open_source(tmp_path / "nan.npy", rate_hz=1.0)
     with pytest.raises(ConfigError, match=r"needs the sample rate; pass rate_hz="):
-        open_source(tmp_path / "nan.npy")
+        open_source(tmp_path / "nan.npy", unit="deg/h")
     (tmp_path / "a.csv").write_text("t,x\n0,1\n1,2\n")
     with pytest.raises(ConfigError, match=r"supports \.npy, raw binary \(pass layout=\) and HDF5; got a text file"):
-        open_source(tmp_path / "a.csv", rate_hz=1.0)
+        open_source(tmp_path / "a.csv", rate_hz=1.0, unit="deg/h")
     with pytest.raises(ConfigError, match="estimator must be one of"):
-        allan_variance_chunked(open_source(tmp_path / "nan.npy", rate_hz=1.0), estimator="fast")
+        allan_variance_chunked(open_source(tmp_path / "nan.npy", rate_hz=1.0, unit="deg/h"), estimator="fast")
+    with pytest.raises(ConfigError, match="noise_alpha must be"):
+        allan_variance_chunked(open_source(tmp_path / "nan.npy", rate_hz=1.0, unit="deg/h"), noise_alpha="x")
 
 
 def test_haar_wavelet_variance_against_pywavelets(tmp_path):
     pywt = pytest.importorskip("pywt")
     y = _series(2 ** 17, 7)                                    # pywt.swt needs a multiple of 2^level
     np.save(tmp_path / "y.npy", y)
-    wv = haar_wavelet_variance_chunked(open_source(tmp_path / "y.npy", rate_hz=10.0), levels=8,
+    wv = haar_wavelet_variance_chunked(open_source(tmp_path / "y.npy", rate_hz=10.0, unit="deg/h"), levels=8,
                                        chunk_samples=65536)
     n = y.size
     ref = []

@@ -28,7 +28,7 @@ def test_python_m_help():
 
 
 def test_allan_on_bundled_recording(bundled_path, tmp_path):
-    out = _ok(runner.invoke(app, ["allan", str(bundled_path), "--out", str(tmp_path)]))
+    out = _ok(runner.invoke(app, ["allan", str(bundled_path), "--unit", "deg/h", "--out", str(tmp_path)]))
     for unit in ("µrad", "deg/√h", "deg/h^1.5", "deg/h²"):
         assert unit in out
     for axis in ("gx", "gy", "gz"):
@@ -56,7 +56,7 @@ def test_allan_on_bundled_recording(bundled_path, tmp_path):
 def test_bad_input_is_one_clear_line(tmp_path, content, fragment):
     path = tmp_path / "bad.csv"
     path.write_text(content)
-    result = runner.invoke(app, ["allan", str(path), "--out", str(tmp_path / "o")])
+    result = runner.invoke(app, ["allan", str(path), "--unit", "deg/h", "--out", str(tmp_path / "o")])
     assert result.exit_code == 1
     assert fragment in result.output
     assert "Traceback" not in result.output
@@ -66,12 +66,12 @@ def test_bad_input_is_one_clear_line(tmp_path, content, fragment):
 def test_unknown_unit_and_level_are_config_errors(bundled_path, tmp_path):
     result = runner.invoke(app, ["allan", str(bundled_path), "--unit", "furlongs", "--out", str(tmp_path)])
     assert result.exit_code == 1 and "furlongs" in result.output
-    result = runner.invoke(app, ["separate", str(bundled_path), "--level", "x", "--out", str(tmp_path)])
+    result = runner.invoke(app, ["separate", str(bundled_path), "--unit", "deg/h", "--level", "x", "--out", str(tmp_path)])
     assert result.exit_code == 1 and "--level" in result.output
 
 
 def test_separate_writes_series_figures_and_table(bundled_path, tmp_path):
-    out = _ok(runner.invoke(app, ["separate", str(bundled_path), "--columns", "gz", "--out", str(tmp_path)]))
+    out = _ok(runner.invoke(app, ["separate", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--out", str(tmp_path)]))
     assert "drift" in out and "noise" in out
     with np.load(tmp_path / "separation.npz") as z:
         x, d, n = z["gz_input_dph"], z["gz_drift_dph"], z["gz_noise_dph"]
@@ -82,7 +82,7 @@ def test_separate_writes_series_figures_and_table(bundled_path, tmp_path):
 
 
 def test_model_command_small(bundled_path, tmp_path):
-    out = _ok(runner.invoke(app, ["model", str(bundled_path), "--columns", "gz", "--models", "ar,gm11,persistence",
+    out = _ok(runner.invoke(app, ["model", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models", "ar,gm11,persistence",
                                   "--out", str(tmp_path)]))
     assert "persistence" in out and "RMSE [deg/h]" in out
     doc = json.loads((tmp_path / "metrics.json").read_text())

@@ -26,7 +26,8 @@ def test_allan_reports_temperature_range_and_drift(tmp_path):
     lines = ["t_s,gz,temp"] + [f"{i / 10:.1f},{float(v)!r},{20 + i / 1000:.3f}" for i, v in enumerate(rng.normal(size=n))]
     p = tmp_path / "log.csv"
     p.write_text("\n".join(lines) + "\n")
-    out = _ok(runner.invoke(app, ["allan", str(p), "--temperature", "temp", "--out", str(tmp_path / "o")]))
+    out = _ok(runner.invoke(app, ["allan", str(p), "--unit", "deg/h", "--temperature", "temp",
+                                   "--out", str(tmp_path / "o")]))
     assert "temperature 20.00 to 24.00 deg C (range 4.00), drift +3.96 deg C" in out
     doc = json.loads((tmp_path / "o" / "allan.json").read_text())
     t = doc["record"]["temperature"]

@@ -32,7 +32,7 @@ runner = CliRunner()
 
 def _csv(path: Path, x, dt=0.01):
     t = np.arange(len(x)) * dt
-    path.write_text("t_s,gz\n" + "".join(f"{a:.2f},{float(b)!r}\n" for a, b in zip(t, x)))
+    path.write_text("t_s,gz[deg/h]\n" + "".join(f"{a:.2f},{float(b)!r}\n" for a, b in zip(t, x)))
     return path
 
 
@@ -78,7 +78,7 @@ def test_failures_are_rows_and_reruns_skip_only_unchanged(tmp_path):
     d.mkdir()
     for k in range(3):
         _csv(d / f"unit{k}.csv", rng.normal(size=4000))
-    (d / "broken.csv").write_text("t_s,gz\n0.00,1.0\n0.01,nan\n0.02,2.0\n")
+    (d / "broken.csv").write_text("t_s,gz[deg/h]\n0.00,1.0\n0.01,nan\n0.02,2.0\n")
     (d / "notes.txt").write_text("not a log\n")
     out = tmp_path / "out"
     settings = {"load": {"unit": "deg/h"}}
@@ -113,8 +113,10 @@ def test_unexpected_exception_is_a_row_not_cached(tmp_path, monkeypatch):
     assert not (tmp_path / "o" / "a.csv" / "batch.json").exists()
 
 
-def test_existing_cluster_by_address(tmp_path):
+def test_existing_cluster_by_address(tmp_path, monkeypatch):
     from distributed import LocalCluster
+
+    from fogdrift.fleet import runner
 
     rng = np.random.default_rng(12)
     files = [_csv(tmp_path / f"g{k}.csv", rng.normal(size=3000)) for k in range(2)]
@@ -122,6 +124,7 @@ def test_existing_cluster_by_address(tmp_path):
                       protocol="tcp://", host="127.0.0.1") as cluster:
         res = run_batch(files, tmp_path / "o", scheduler=cluster.scheduler_address, page=False)
     assert res.scheduler.startswith("Dask cluster at tcp://") and res.n_ok == 2
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 1.0)            # nothing listens on port 9
     with pytest.raises(ConfigError, match="cannot reach the Dask scheduler"):
         run_batch(files, tmp_path / "o2", scheduler="tcp://127.0.0.1:9", page=False)
 

@@ -18,9 +18,25 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from fogdrift.errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
-from fogdrift.io import GyroRecord, block_average, file_sha256, from_array, load, load_segments
+from fogdrift.io import GyroRecord, block_average, file_sha256, from_array
+from fogdrift.io import load as io_load
+from fogdrift.io import load_segments as io_load_segments
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "psins_lasergyro_rlg" / "psins_lasergyro_rlg.csv.gz"
+
+
+def load(path, **kw):
+    """:func:`fogdrift.io.load` in deg/h and s unless the test gives units (a unit is never guessed; these
+    tests are about formats, time, errors and records; tests/test_io_units.py tests the unit rules)."""
+    kw.setdefault("unit", "deg/h")
+    kw.setdefault("time_unit", "s")
+    return io_load(path, **kw)
+
+
+def load_segments(path, **kw):
+    kw.setdefault("unit", "deg/h")
+    kw.setdefault("time_unit", "s")
+    return io_load_segments(path, **kw)
 
 
 def write(tmp_path: Path, name: str, text: str) -> Path:

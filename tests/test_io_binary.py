@@ -109,6 +109,6 @@ def test_float_time_field_is_a_time_column(tmp_path):
     r["gz"] = np.arange(50)
     p = tmp_path / "t.raw"
     r.tofile(p)
-    rec = load(p, unit="deg/h", reader_options={"layout": "<f8 t, <f4 gz"})
+    rec = load(p, unit="deg/h", time_unit="s", reader_options={"layout": "<f8 t, <f4 gz"})
     assert rec.dt_s == 0.25 and rec.t0_s == 10.0
     assert_array_equal(rec.rate_dph[:, 0], np.arange(50))

@@ -20,7 +20,8 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from fogdrift.errors import ConfigError, DataFormatError
-from fogdrift.io import from_array, load, load_segments, registry
+from fogdrift.io import from_array, load_segments, registry
+from fogdrift.io import load as io_load
 from fogdrift.io.readers.base import Table
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "psins_lasergyro_rlg" / "psins_lasergyro_rlg.csv.gz"
@@ -33,6 +34,13 @@ LOAD_MODULE = sys.modules["fogdrift.io.load"]  # the attribute fogdrift.io.load 
 @pytest.fixture
 def rng():
     return np.random.default_rng(20240612)
+
+
+def load(path, **kw):
+    """:func:`fogdrift.io.load` in deg/h and s unless the test gives units (the unit tests call ``io_load``)."""
+    kw.setdefault("unit", "deg/h")
+    kw.setdefault("time_unit", "s")
+    return io_load(path, **kw)
 
 
 def sha(p: Path) -> str:
@@ -88,7 +96,7 @@ def test_array_sha256(tmp_path, no_second_read, rng):
 def test_sha256_survives_segments_and_record_operations(tmp_path):
     t = np.r_[np.arange(5) * 0.1, 2.0 + np.arange(6) * 0.1]
     p = write(tmp_path, "g.csv", "t,x,y\n" + "".join(f"{v:.1f},{k},{-k}\n" for k, v in enumerate(t)))
-    segs = load_segments(p)
+    segs = load_segments(p, unit="deg/h", time_unit="s")
     assert [s.sha256 for s in segs] == [sha(p)] * 2
     r = segs[1]
     assert r.slice(1, 4).sha256 == r.select("y").sha256 == r.block_average(0.2).sha256 == sha(p)
@@ -189,25 +197,25 @@ def test_plugged_in_reader_gets_time_units_and_locations(tmp_path, gyrobin, rng)
     t = 100.0 + np.arange(40) * 0.005
     w = rng.normal(size=(2, 40))
     p = gyrobin(tmp_path / "a.raw", t, w)  # selected by its magic bytes
-    rec = load(p)
+    rec = io_load(p)
     assert rec.axis_names == ("wx", "wy") and rec.t0_s == 100.0
     assert rec.dt_s == pytest.approx(0.005, rel=1e-12)
     assert_allclose(rec.rate_dph, w.T * 3600.0, rtol=1e-15)  # declared deg/s
     assert rec.input_unit == "deg/s" and rec.declared_units == ("deg/s", "deg/s")
     assert rec.sha256 == sha(p)
     assert rec.notes[0] == "gyrobin array, 40 records x 2 columns"
-    assert_allclose(load(p, reader_options={"scale": 2.0}).rate_dph, w.T * 7200.0, rtol=1e-15)
-    assert load(p, time_column=None, rate_hz=10.0).dt_s == 0.1
+    assert_allclose(io_load(p, reader_options={"scale": 2.0}).rate_dph, w.T * 7200.0, rtol=1e-15)
+    assert io_load(p, time_column=None, rate_hz=10.0).dt_s == 0.1
     t_bad = t.copy()
     t_bad[7] = t_bad[5]
     with pytest.raises(DataFormatError) as ei:
-        load(gyrobin(tmp_path / "b.gyb", t_bad, w))
+        io_load(gyrobin(tmp_path / "b.gyb", t_bad, w))
     assert str(ei.value) == (f"{tmp_path / 'b.gyb'}: time goes backwards at record 7; expected strictly increasing "
                              f"time, got {float(t[5])!r} s after {float(t[6])!r} s on record 6")
     w_bad = w.copy()
     w_bad[1, 12] = np.inf
     with pytest.raises(DataFormatError, match=r"b\.gyb:wy: non-finite value at record 12; expected a finite number"):
-        load(gyrobin(tmp_path / "b.gyb", t, w_bad))
+        io_load(gyrobin(tmp_path / "b.gyb", t, w_bad))
 
 
 # ------------------------------------------------------------------------------------------
@@ -215,72 +223,72 @@ def test_plugged_in_reader_gets_time_units_and_locations(tmp_path, gyrobin, rng)
 # ------------------------------------------------------------------------------------------
 def test_declared_rate_unit_used_when_none_given(tmp_path):
     p = write(tmp_path, "u.csv", "t_s,gx[deg/s],gy [deg/s]\n0,0.001,-0.5\n0.01,0.002,0.25\n0.02,0.003,1\n")
-    rec = load(p)
+    rec = io_load(p)
     assert rec.axis_names == ("gx", "gy") and rec.input_unit == "deg/s"
     assert_allclose(rec.rate_dph, [[3.6, -1800.0], [7.2, 900.0], [10.8, 3600.0]], rtol=1e-14)
     assert rec.declared_units == ("deg/s", "deg/s")
     assert rec.metadata()["declared_units"] == ["deg/s", "deg/s"]
     assert "unit 'deg/s' declared in the file" in rec.notes
     # a given unit wins (no behaviour change), and the record says so
-    given = load(p, unit="deg/h")
+    given = io_load(p, unit="deg/h")
     assert_array_equal(given.rate_dph, [[0.001, -0.5], [0.002, 0.25], [0.003, 1.0]])
     assert "the file declares {'gx': 'deg/s', 'gy': 'deg/s'}; unit 'deg/h' given takes precedence" in given.notes
     # columns can be named with or without the unit
-    assert load(p, columns="gy[deg/s]").axis_names == load(p, columns="GY").axis_names == ("gy",)
+    assert io_load(p, columns="gy[deg/s]").axis_names == io_load(p, columns="GY").axis_names == ("gy",)
 
 
 def test_declared_increment_unit_uses_the_interval(tmp_path):
-    p = write(tmp_path, "i.csv", "t,dtheta[inc:arcsec]\n0,0.1\n0.01,0.2\n")
-    rec = load(p)
+    p = write(tmp_path, "i.csv", "t_s,dtheta[inc:arcsec]\n0,0.1\n0.01,0.2\n")
+    rec = io_load(p)
     assert_allclose(rec.rate_dph[:, 0], [10.0, 20.0], rtol=1e-14)  # 0.1 arcsec per 10 ms = 10 deg/h
 
 
 def test_mixed_or_unknown_declared_units(tmp_path):
     p = write(tmp_path, "m.csv", "# units\nt,gx[deg/s],gy[rad/s],temp[degC]\n0,1,2,20\n1,1,2,21\n")
     with pytest.raises(DataFormatError) as ei:
-        load(p, columns="gx,gy")
+        io_load(p, columns="gx,gy")
     assert str(ei.value) == (
         f"{p}:2:gy: rate columns declare different units; expected one unit for all rate columns (choose them "
         "with columns= or pass unit=), got {'gx': 'deg/s', 'gy': 'rad/s'}"
     )
     assert "(choose them with --columns or pass --unit)" in ei.value.render(CLI_FLAGS)
     with pytest.raises(DataFormatError) as ei:
-        load(p, columns="temp")
+        io_load(p, columns="temp")
     assert str(ei.value) == (
         f"{p}:2:temp: unknown unit 'degC' declared in the header; expected one of ['deg/h', 'deg/s', 'rad/s', "
         "'rad/h', 'arcsec/s', 'inc:deg', 'inc:rad', 'inc:arcsec'] (or pass unit=), got 'degC'"
     )
-    assert load(p, columns="temp", unit="deg/h").n_samples == 2  # a given unit needs no declared one
-    assert_allclose(load(p, columns="gy").rate_dph[:, 0], 2 * 180 / np.pi * 3600, rtol=1e-14)
+    assert io_load(p, columns="temp", unit="deg/h", time_unit="s").n_samples == 2  # a given unit needs no declared one
+    assert_allclose(io_load(p, columns="gy", time_unit="s").rate_dph[:, 0], 2 * 180 / np.pi * 3600, rtol=1e-14)
     # a column without a declared unit next to one with a unit is ambiguous too
     q = write(tmp_path, "n.csv", "t,gx[deg/s],gy\n0,1,2\n1,1,2\n")
     with pytest.raises(DataFormatError, match=r"n\.csv:1:gy: rate columns declare different units"):
-        load(q)
+        io_load(q)
 
 
 @pytest.mark.parametrize("unit, factor", [("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9)])
 def test_declared_and_given_time_units(tmp_path, unit, factor):
     steps = np.arange(4) * 10.0  # 10 time units per sample
     body = "".join(f"{v:g},{k}\n" for k, v in enumerate(steps + 5.0))
-    declared = load(write(tmp_path, "d.csv", f"t[{unit}],x\n" + body))
-    given = load(write(tmp_path, "g.csv", "t,x\n" + body), time_unit=unit)
+    declared = io_load(write(tmp_path, "d.csv", f"t[{unit}],x\n" + body), unit="deg/h")
+    given = io_load(write(tmp_path, "g.csv", "t,x[deg/h]\n" + body), time_unit=unit)
     for rec in (declared, given):
         assert rec.dt_s == pytest.approx(10 * factor, rel=1e-12) and rec.t0_s == pytest.approx(5 * factor, rel=1e-12)
-        assert f"time column in {unit}" in rec.notes
-    over = load(write(tmp_path, "o.csv", f"t[{unit}],x\n" + body), time_unit="s")
+        assert f"time column 't' in {unit}" in rec.notes
+    over = io_load(write(tmp_path, "o.csv", f"t[{unit}],x\n" + body), time_unit="s", unit="deg/h")
     assert over.dt_s == 10.0
     assert f"the file declares time unit '{unit}'; time_unit 's' given takes precedence" in over.notes
 
 
 def test_time_unit_errors(tmp_path):
-    p = write(tmp_path, "t.csv", "t[min],x\n0,1\n1,2\n")
+    p = write(tmp_path, "t.csv", "t[min],x[deg/h]\n0,1\n1,2\n")
     with pytest.raises(DataFormatError) as ei:
-        load(p)
+        io_load(p)
     assert str(ei.value) == (f"{p}:1:t: unknown time unit 'min' declared in the header; expected one of "
                              "['s', 'ms', 'us', 'ns'] (or pass time_unit=), got 'min'")
-    assert load(p, time_unit="s").dt_s == 1.0
+    assert io_load(p, time_unit="s").dt_s == 1.0
     with pytest.raises(ConfigError, match=r"unknown time unit 'h'; expected one of \['s', 'ms', 'us', 'ns'\]"):
-        load(p, time_unit="h")
+        io_load(p, time_unit="h")
 
 
 # ------------------------------------------------------------------------------------------

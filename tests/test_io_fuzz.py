@@ -27,11 +27,15 @@ from fogdrift.io import GyroRecord, load, load_segments
 # 150 examples per property in the default profile (the explore profile raises it to 1000)
 FUZZ = settings(max_examples=max(150, settings.default.max_examples))
 
-OPTIONS = st.sampled_from([
+_BASE_OPTIONS = st.sampled_from([
     {}, {"dt_s": 0.01}, {"gaps": "split"}, {"columns": "gx"}, {"columns": [0]}, {"time_column": None, "rate_hz": 100.0},
     {"unit": "deg/s"}, {"unit": "inc:arcsec", "dt_s": 0.01}, {"time_unit": "ms"}, {"delimiter": ";"},
     {"time_column": 0}, {"min_samples": 1, "dt_s": 1e-3},
 ])
+# A unit is never guessed: mostly give both (to reach the deep checks), sometimes rely on the file's declarations.
+_UNITS = st.sampled_from([{"unit": "deg/h", "time_unit": "s"}, {"unit": "deg/h", "time_unit": "s"},
+                          {"unit": "deg/h"}, {"time_unit": "s"}, {}])
+OPTIONS = st.tuples(_UNITS, _BASE_OPTIONS).map(lambda pair: {**pair[0], **pair[1]})
 
 
 def check_load(path, options, segments=False):
@@ -180,7 +184,7 @@ def test_valid_text_round_trip(tmp_path_factory, table, delim, header, decimal_c
     raw = ("\ufeff" if bom else "").encode() + (eol.join(lines) + eol).encode()
     p = tmp_path_factory.mktemp("valid") / ("v.txt.gz" if gz else "v.txt")
     p.write_bytes(gzip.compress(raw, mtime=0) if gz else raw)
-    out = check_load(p, {"time_column": 0})
+    out = check_load(p, {"time_column": 0, "unit": "deg/h", "time_unit": "s"})
     if isinstance(out, FogdriftError):
         # the only accepted failure: a decimal comma that the first data row does not show
         assert decimal_comma and isinstance(out, DataFormatError) and "decimal comma" in str(out), str(out)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from fogdrift.errors import DataFormatError
+from fogdrift.errors import ConfigError, DataFormatError
 from fogdrift.io import load
 
 h5py = pytest.importorskip("h5py")
@@ -64,7 +64,9 @@ def test_hdf5_contiguous_float64_is_memory_mapped(tmp_path, rng):
     p = tmp_path / "a.hdf5"
     with h5py.File(p, "w") as f:
         f.create_dataset("data/rate", data=x)
-    rec = load(p, rate_hz=100.0)
+    with pytest.raises(ConfigError, match=r"a\.hdf5: dataset /data/rate has no 'units' attribute.*unit=.*deg/s"):
+        load(p, rate_hz=100.0)                  # units are never guessed
+    rec = load(p, rate_hz=100.0, unit="deg/h")
     assert rec.axis_names == ("col0", "col1")
     assert_array_equal(rec.rate_dph, x)
     base = rec.rate_dph
@@ -95,7 +97,7 @@ def test_hdf5_dataset_choice_errors_list_candidates(tmp_path):
         load(p, rate_hz=1.0)
     with pytest.raises(DataFormatError, match=r"two\.h5:/nope: no dataset or group '/nope'.*/b/y"):
         load(p, rate_hz=1.0, reader_options={"dataset": "/nope"})
-    assert load(p, rate_hz=1.0, reader_options={"dataset": "b"}).axis_names == ("y",)
+    assert load(p, rate_hz=1.0, unit="deg/h", reader_options={"dataset": "b"}).axis_names == ("y",)
 
 
 def test_hdf5_units_attribute_of_wrong_length_is_located(tmp_path):
@@ -146,7 +148,9 @@ def test_mat_v5_struct_matrix_and_vectors(tmp_path, rng):
     gx, gz = rng.normal(size=n), rng.normal(size=n)
     p = tmp_path / "s.mat"
     sio.savemat(p, {"imu": {"t": t, "gx": gx, "gz": gz, "temp": 25 + 0 * t}, "note": "static test"})
-    rec = load(p, unit="deg/s", temperature="temp")
+    with pytest.raises(ConfigError, match=r"s\.mat: time column 't' declares no unit; pass time_unit="):
+        load(p, unit="deg/s", temperature="temp")
+    rec = load(p, unit="deg/s", time_unit="s", temperature="temp")
     assert rec.axis_names == ("gx", "gz") and rec.dt_s == 0.02
     assert_allclose(rec.rate_dph, np.column_stack([gx, gz]) * 3600.0, rtol=1e-15)
     assert_array_equal(rec.temperature_c, 25.0)
@@ -154,13 +158,15 @@ def test_mat_v5_struct_matrix_and_vectors(tmp_path, rng):
 
     m = rng.normal(size=(3, n))                      # channels in rows, as MATLAB users often store them
     sio.savemat(tmp_path / "m.mat", {"data": m, "fs": 50.0})
-    rec = load(tmp_path / "m.mat", reader_options={"variable": "data"}, rate_hz=50.0)
+    with pytest.raises(ConfigError, match=r"m\.mat: MATLAB files carry no units; pass unit= \(deg/h, deg/s"):
+        load(tmp_path / "m.mat", reader_options={"variable": "data"}, rate_hz=50.0)
+    rec = load(tmp_path / "m.mat", reader_options={"variable": "data"}, rate_hz=50.0, unit="deg/h")
     assert rec.axis_names == ("col0", "col1", "col2")
     assert_array_equal(rec.rate_dph, m.T)
     assert any("read as 300 samples of 3 channels" in s for s in rec.notes)
 
     sio.savemat(tmp_path / "v.mat", {"t": t, "gy": gx})   # top-level vectors: named columns
-    rec = load(tmp_path / "v.mat")
+    rec = load(tmp_path / "v.mat", unit="deg/h", time_unit="s")
     assert rec.axis_names == ("gy",) and rec.dt_s == 0.02
 
 
@@ -172,7 +178,7 @@ def test_mat_variable_errors(tmp_path, rng):
         load(p, rate_hz=1.0)
     with pytest.raises(DataFormatError, match=r"two\.mat:c: no variable 'c' in the file"):
         load(p, rate_hz=1.0, reader_options={"variable": "c"})
-    assert load(p, rate_hz=1.0, reader_options={"variable": "b"}).axis_names == ("x",)
+    assert load(p, rate_hz=1.0, unit="deg/h", reader_options={"variable": "b"}).axis_names == ("x",)
 
 
 def _write_v73(path: Path, variables: dict):
@@ -198,10 +204,10 @@ def test_mat_v73_through_h5py(tmp_path, rng):
     data = rng.normal(size=(n, 3))
     p = tmp_path / "big.mat"
     _write_v73(p, {"gyro": data, "imu": {"gx": data[:, 0], "t": np.arange(n) * 0.1}})
-    rec = load(p, reader_options={"variable": "gyro"}, rate_hz=10.0)
+    rec = load(p, reader_options={"variable": "gyro"}, rate_hz=10.0, unit="deg/h")
     assert_array_equal(rec.rate_dph, data)
     assert "MATLAB v7.3 file" in rec.notes
-    rec = load(p, reader_options={"variable": "imu"})
+    rec = load(p, reader_options={"variable": "imu"}, unit="deg/h", time_unit="s")
     assert rec.axis_names == ("gx",) and rec.dt_s == 0.1
     assert_array_equal(rec.rate_dph[:, 0], data[:, 0])
     assert rec.sha256 == sha(p)

@@ -28,6 +28,8 @@ TEST_PARAMS = {
     "GM11": [{"mode": "rolling", "window": 6}, {"mode": "whole", "shift": 0.5}],
     "Elman": [_ELMAN_FAST],
     "GreyElman": [_ELMAN_FAST],
+    "Kalman": [{}, {"components": [{"kind": "white", "arw_dprh": 1e-4},
+                                   {"kind": "gauss_markov", "tc_s": 30.0, "sigma_dph": 0.05}]}],
 }
 FAST_OVERRIDES = {"lags": 2, "hidden": 3, "epochs": 15, "patience": 5, "seed": 0}
 

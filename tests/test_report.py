@@ -25,12 +25,12 @@ def report_dir(bundled_path, tmp_path_factory):
     """Run `fogdrift analyze` once on gz, applying the models to a second recording (gx of the same file
     renamed to gz: real data the models were not fitted on)."""
     tmp = tmp_path_factory.mktemp("analyze")
-    rec = load(bundled_path)
+    rec = load(bundled_path, unit="deg/h")
     other = tmp / "other <b>&.csv"
     gx = np.asarray(rec.axis("gx"))
     t = np.arange(gx.size) * rec.dt_s
     np.savetxt(other, np.column_stack([t, gx]), delimiter=",", header="t_s,gz", comments="", fmt="%.6f")
-    result = runner.invoke(app, ["analyze", str(bundled_path), "--columns", "gz", "--apply-to", str(other),
+    result = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--apply-to", str(other),
                                  "--out", str(tmp / "out"), *FAST])
     assert result.exit_code == 0, result.output + repr(result.exception)
     return tmp / "out", result.output
@@ -113,3 +113,16 @@ def test_pipeline_blocks_do_not_leak(bundled_record):
         for key in sa[1]:
             np.testing.assert_array_equal(sa[1][key], sb[1][key])
     assert a.axes[0].models.bias_dph == b.axes[0].models.bias_dph
+
+
+def test_report_files_have_deterministic_names(report_dir):
+    """Figure names carry the figure number and the axis; the applied section's start "apply_to_" (no _0/_2)."""
+    out, _ = report_dir
+    figs = sorted(p.name for p in (out / "figures").iterdir())
+    assert figs == sorted(["fig1_signal.png", "fig2_spectrum.png", "fig3_allan_gz.png", "fig5_drift_noise_gz.png",
+                           "fig6_allan_gz.png", "fig8_models_gz.png", "fig9_residual_gz.png",
+                           "apply_to_fig3_allan_gz.png", "apply_to_fig5_drift_noise_gz.png",
+                           "apply_to_fig6_allan_gz.png", "apply_to_fig10_models_gz.png",
+                           "apply_to_fig11_residual_gz.png"])
+    manifest = json.loads((out / ".fogdrift-manifest.json").read_text())
+    assert manifest["complete"] and "report.html" in manifest["files"]

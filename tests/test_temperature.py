@@ -18,7 +18,7 @@ from fogdrift.temperature import summary_line, temperature_summary
 from fogdrift.temperature_plot import plot_rate_and_temperature
 
 
-def _csv(tmp_path, temp, t=None, header="t_s,gx,gy,temp"):
+def _csv(tmp_path, temp, t=None, header="t_s,gx[deg/h],gy[deg/h],temp"):
     n = len(temp)
     t = np.arange(n) * 0.1 if t is None else t
     rows = [f"{t[i]:.1f},{i},{-i},{float(temp[i])!r}" for i in range(n)]
@@ -38,7 +38,8 @@ def test_csv_temperature_column_kept_through_record_operations(tmp_path):
     assert_array_equal(rec.select("gy").temperature_c, temp)
     assert_allclose(rec.to_rate(2.5).temperature_c, temp[:100].reshape(25, 4).mean(axis=1))
     assert rec.to_rate(2.5).metadata()["temperature"]["n_samples"] == 25
-    assert load(p).temperature_c is None and load(p).metadata()["temperature"] is None
+    plain = load(p, columns="gx,gy")
+    assert plain.temperature_c is None and plain.metadata()["temperature"] is None
     with pytest.raises(ConfigError, match=r"column 'temp' is the temperature column"):
         load(p, temperature="temp", columns="gx,temp")
     with pytest.raises(DataFormatError, match=r"unknown column 'tmp'.*in temperature="):
@@ -46,9 +47,9 @@ def test_csv_temperature_column_kept_through_record_operations(tmp_path):
 
 
 def test_declared_kelvin_is_converted_and_other_units_refused(tmp_path):
-    p = _csv(tmp_path, 300.0 + np.zeros(10), header="t_s,gx,gy,temp[K]")
+    p = _csv(tmp_path, 300.0 + np.zeros(10), header="t_s,gx[deg/h],gy[deg/h],temp[K]")
     assert_allclose(load(p, temperature="temp").temperature_c, 26.85)
-    p = _csv(tmp_path, np.zeros(10), header="t_s,gx,gy,temp[degF]")
+    p = _csv(tmp_path, np.zeros(10), header="t_s,gx[deg/h],gy[deg/h],temp[degF]")
     with pytest.raises(DataFormatError, match=r"log\.csv:1:temp: unknown temperature unit 'degF'"):
         load(p, temperature="temp")
 
@@ -83,4 +84,4 @@ def test_plot_rate_and_temperature(tmp_path):
     png = plot_rate_and_temperature(rec, tmp_path / "t.png")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 5_000
     with pytest.raises(ConfigError, match=r"carries no temperature; load it with temperature="):
-        plot_rate_and_temperature(load(_csv(tmp_path, temp)), tmp_path / "u.png")
+        plot_rate_and_temperature(load(_csv(tmp_path, temp), columns="gx,gy"), tmp_path / "u.png")

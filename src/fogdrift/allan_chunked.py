@@ -20,8 +20,8 @@ Small cluster sizes (``2m <= chunk_samples``) are served from one window per chu
 reads two more windows (at ``k + m`` and ``k + 2m``; on an octave grid the window at ``k + 2m`` is the next
 tau's window at ``k + m`` and is reused), so the file is read about ``4 + n_large`` times (``n_large`` taus
 above ``chunk_samples / 2``), sequentially.  Non-overlapping sums with strides above
-1.5 blocks read only the points they need.  EDF and chi-squared bounds follow
-:func:`fogdrift.allan.allan_variance` (simple EDF, SP 1065 Table 5; alpha from the local slope).
+1.5 blocks read only the points they need.  EDF and chi-squared bounds are computed by the same
+functions as in :func:`fogdrift.allan.allan_variance` (simple EDF, SP 1065 Table 5).
 
 The Haar wavelet variance of the MODWT at scale ``tau_j = 2^(j-1) dt`` is half the overlapping Allan
 variance at ``m = 2^(j-1)`` (the same second differences over the same ``N - 2m + 1`` positions;
@@ -30,7 +30,6 @@ Percival & Walden 2000, sec. 8.6): :func:`haar_wavelet_variance_chunked` reuses 
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Callable
@@ -46,7 +45,6 @@ __all__ = ["allan_variance_chunked", "haar_wavelet_variance_chunked", "HaarWavel
 BLOCK = 65536
 #: Default chunk of start indices (a multiple of BLOCK).
 DEFAULT_CHUNK = 1 << 21
-_P68 = math.erf(1.0 / math.sqrt(2.0))
 _PW_BLOCK = 128     # NumPy's pairwise-summation leaf size: recursion splits only above it
 
 
@@ -271,74 +269,50 @@ def _second_difference_sums(phase: _Phase, m: np.ndarray, strides: np.ndarray, c
 # ----------------------------------------------------------------------------------------
 # result
 # ----------------------------------------------------------------------------------------
-def _alpha_from_slope(tau_s, avar) -> np.ndarray:
-    """Per-tau IEEE-952 alpha from the local log-log ADEV slope (the rule of fogdrift.allan.allan_variance)."""
-    alpha = np.zeros(tau_s.size, dtype=np.int64)
-    ok = avar > 0
-    if ok.sum() < 2:
-        return alpha
-    lt = np.log(tau_s[ok])
-    ls = 0.5 * np.log(avar[ok])
-    slope = np.empty(lt.size)
-    for i in range(lt.size):
-        sel = np.abs(lt - lt[i]) <= math.log(2.0) * (1 + 1e-9)
-        if sel.sum() < 2:
-            j = np.argsort(np.abs(lt - lt[i]))[:3] if lt.size >= 3 else np.arange(lt.size)
-            sel = np.zeros(lt.size, bool)
-            sel[j] = True
-        x = lt[sel] - lt[sel].mean()
-        slope[i] = np.dot(x, ls[sel] - ls[sel].mean()) / np.dot(x, x)
-    a = np.where(slope < -0.75, 2, np.where(slope < -0.25, 0, np.where(slope < 0.25, -1, -2)))
-    alpha[ok] = a
-    if not ok.all():
-        idx = np.flatnonzero(ok)
-        for i in np.flatnonzero(~ok):
-            alpha[i] = alpha[idx[np.argmin(np.abs(idx - i))]]
-    return alpha
+def _result(sums, n, m, strides, estimator, noise_alpha, dt):
+    """The AllanResult of the Allan statistic from the per-tau sums of squared second differences.
+
+    The EDF rule, alpha choice and chi-squared bounds are those of :func:`fogdrift.allan.allan_variance`
+    (its ``_edf_rule``, :func:`~fogdrift.allan.ci.resolve_alpha`, :func:`~fogdrift.allan.chi2_bounds`),
+    called with the same arguments, so the result equals the in-memory one field by field.
+    """
+    from .allan import IEEE952_ALPHAS, P68, AllanResult, chi2_bounds, get_statistic
+    from .allan.ci import resolve_alpha
+    from .allan.core import _edf_rule
+
+    stat = get_statistic("adev")
+    n_terms = stat.n_terms(n, m, strides)
+    var = stat.variance(sums, m, n_terms)
+    tau_s = m * dt
+    edf_of, _, base = _edf_rule(stat, estimator, n, m, strides)
+    alphas, rule = resolve_alpha(noise_alpha, tau_s, var, slopes=stat.dev_slopes, candidates=IEEE952_ALPHAS)
+    if isinstance(alphas, str):  # conservative
+        cands = np.array([[edf_of(i, a) for a in IEEE952_ALPHAS] for i in range(m.size)]).reshape(m.size, -1)
+        pick = np.argmin(cands, axis=1)
+        alphas = np.asarray(IEEE952_ALPHAS, dtype=np.int64)[pick]
+        edf = cands[np.arange(m.size), pick]
+    else:
+        edf = np.array([edf_of(i, a) for i, a in enumerate(alphas)], dtype=np.float64)
+    edf = np.clip(np.nan_to_num(edf, nan=1.0, posinf=float(n_terms.max())), 1.0, np.maximum(n_terms, 1))
+    lo68, hi68 = chi2_bounds(var, edf, P68)
+    lo95, hi95 = chi2_bounds(var, edf, 0.95)
+    return AllanResult(
+        tau_s=tau_s.astype(np.float64), m=m.astype(np.int64), var_dph2=var, dev_dph=np.sqrt(var),
+        n_terms=n_terms.astype(np.int64), edf=edf, dev_lo68_dph=np.sqrt(lo68), dev_hi68_dph=np.sqrt(hi68),
+        dev_lo95_dph=np.sqrt(lo95), dev_hi95_dph=np.sqrt(hi95), noise_alpha=np.asarray(alphas, dtype=np.int64),
+        estimator=estimator, edf_rule=base + "; " + rule, dt_s=float(dt), n_samples=int(n), statistic=stat.name,
+    )
 
 
-def _edf(n_phase: int, m: int, alpha: int) -> float:
-    from .allan import edf_simple
-
-    if n_phase < 3 or 2 * m > n_phase - 1:
-        return 1.0
-    return edf_simple(n_phase, m, alpha)
+_ESTIMATORS = ("overlapping", "non-overlapping")
 
 
-_RULES = {
-    "overlapping": "simple EDF (Howe-Allan-Barnes, SP 1065 Table 5) with N+1 phase points",
-    "non-overlapping": "simple EDF (SP 1065 Table 5) of the K+1 cluster-mean phase points at m=1",
-}
+def _prepare(source, taus, estimator, max_fraction, chunk_samples, noise_alpha=None):
+    from .allan import IEEE952_ALPHAS, get_statistic, tau_grid
+    from .allan.ci import resolve_alpha
 
-
-def _result(m, avar, n_terms, edf, alphas, rule, estimator, dt, n):
-    """An AllanResult with the fields its dataclass has (the allan package renames avar/adev to var/dev)."""
-    from scipy.special import chdtri
-
-    from .allan import AllanResult
-
-    bounds = {}
-    for label, p_conf in (("68", _P68), ("95", 0.95)):
-        q = 1.0 - p_conf
-        bounds[label] = (np.sqrt(avar * edf / chdtri(edf, q / 2.0)), np.sqrt(avar * edf / chdtri(edf, 1.0 - q / 2.0)))
-    values = {
-        "tau_s": (m * dt).astype(np.float64), "m": m.astype(np.int64), "n_terms": n_terms.astype(np.int64),
-        "edf": edf, "noise_alpha": np.asarray(alphas, dtype=np.int64), "estimator": estimator, "edf_rule": rule,
-        "dt_s": dt, "n_samples": int(n), "avar_dph2": avar, "var_dph2": avar, "adev_dph": np.sqrt(avar),
-        "dev_dph": np.sqrt(avar), "statistic": "adev",
-    }
-    for stat in ("adev", "dev"):
-        for label in ("68", "95"):
-            values[f"{stat}_lo{label}_dph"], values[f"{stat}_hi{label}_dph"] = bounds[label]
-    names = {f.name for f in dataclasses.fields(AllanResult) if f.init}
-    return AllanResult(**{k: v for k, v in values.items() if k in names})
-
-
-def _prepare(source, taus, estimator, max_fraction, chunk_samples):
-    from .allan import tau_grid
-
-    if estimator not in _RULES:
-        raise ConfigError(f"estimator must be one of {list(_RULES)} out of core; got {estimator!r}")
+    if estimator not in _ESTIMATORS:
+        raise ConfigError(f"estimator must be one of {list(_ESTIMATORS)} out of core; got {estimator!r}")
     n = int(source.n_samples)
     if n < 2:
         raise InsufficientDataError(f"an Allan variance needs at least 2 rate samples, got {n}", needed=2, got=n)
@@ -346,6 +320,9 @@ def _prepare(source, taus, estimator, max_fraction, chunk_samples):
         raise ConfigError(f"chunk_samples must be an integer >= 1; got {chunk_samples!r}")
     chunk = max(BLOCK, -(-int(chunk_samples) // BLOCK) * BLOCK)
     m = tau_grid(n, source.dt_s, taus, max_fraction=max_fraction)
+    if noise_alpha is not None:  # refused before the file is read (the real choice needs the variances)
+        resolve_alpha(noise_alpha, m * source.dt_s, np.ones(m.size), slopes=get_statistic("adev").dev_slopes,
+                      candidates=IEEE952_ALPHAS)
     strides = m.copy() if estimator == "non-overlapping" else np.ones_like(m)
     return n, chunk, m, strides
 
@@ -362,8 +339,8 @@ def allan_variance_chunked(source, *, taus="octave", estimator="overlapping", no
         Tau grid as for :func:`fogdrift.allan.allan_variance` (``"octave"``, ``"decade"``, an int, taus in s).
     estimator : {"overlapping", "non-overlapping"}
         The fast estimator is in-memory only.
-    noise_alpha : "auto" or int
-        Power-law alpha of the EDF: from the local slope (as in memory) or fixed.
+    noise_alpha : "auto", "conservative", int or array_like
+        Power-law alpha of the EDF, as for :func:`fogdrift.allan.allan_variance`.
     max_fraction : float
         Largest m of named grids as a fraction of N.
     chunk_samples : int
@@ -392,36 +369,15 @@ def allan_variance_chunked(source, *, taus="octave", estimator="overlapping", no
     >>> p = os.path.join(tempfile.mkdtemp(), "x.npy")
     >>> y = np.random.default_rng(1).normal(size=200_000).astype(np.float32)
     >>> np.save(p, y)
-    >>> src = open_source(p, rate_hz=100.0)
+    >>> src = open_source(p, rate_hz=100.0, unit="deg/h")
     >>> r = allan_variance_chunked(src, chunk_samples=65536)
     >>> bool(np.array_equal(r.avar_dph2, allan_variance(y, 0.01).avar_dph2))
     True
     """
-    n, chunk, m, strides = _prepare(source, taus, estimator, max_fraction, chunk_samples)
+    n, chunk, m, strides = _prepare(source, taus, estimator, max_fraction, chunk_samples, noise_alpha)
     mu, offsets = _mean_and_offsets(source, chunk, progress)
     sums = _second_difference_sums(_Phase(source, mu, offsets), m, strides, chunk, progress)
-    n_phase = n + 1
-    n_terms = (n_phase - 2 * m - 1) // strides + 1
-    avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)
-    tau_s = m * source.dt_s
-    if estimator == "overlapping":
-        edf_n, edf_m = np.full(m.size, n_phase), m
-    else:
-        edf_n, edf_m = n // m + 1, np.ones_like(m)
-    if isinstance(noise_alpha, str):
-        if noise_alpha != "auto":
-            raise ConfigError(f"noise_alpha must be 'auto' or an int out of core; got {noise_alpha!r}")
-        alphas = _alpha_from_slope(tau_s, avar)
-        rule = _RULES[estimator] + ("; alpha per tau from the local log-log ADEV slope mu (taus within x2): "
-                                    "mu<-0.75 -> +2, <-0.25 -> 0, <0.25 -> -1, else -2")
-    else:
-        if int(noise_alpha) not in (2, 1, 0, -1, -2):
-            raise ConfigError(f"noise_alpha values must be in (2, 1, 0, -1, -2), got {noise_alpha!r}")
-        alphas = np.full(m.size, int(noise_alpha), dtype=np.int64)
-        rule = _RULES[estimator] + "; alpha given by the caller"
-    edf = np.array([_edf(int(a), int(b), int(c)) for a, b, c in zip(edf_n, edf_m, alphas)])
-    edf = np.clip(np.nan_to_num(edf, nan=1.0, posinf=float(n_terms.max())), 1.0, np.maximum(n_terms, 1))
-    return _result(m, avar, n_terms, edf, alphas, rule, estimator, source.dt_s, n)
+    return _result(sums, n, m, strides, estimator, noise_alpha, source.dt_s)
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,7 @@ from typing import Callable
 import numpy as np
 
 from .errors import ConfigError, FogdriftWarning, InsufficientDataError
+from .interrupt import checkpoint  # a stop point between stages/axes/models; reports the stage to listeners
 from .io import file_sha256
 from .models import MODEL_NAMES  # registry order = report order
 from .models import build_model as make_model  # make_model(name, cfg, progress=None), old name kept for now
@@ -86,8 +87,12 @@ class AnalysisConfig:
         Tau grid of the Allan analyses (``"octave"``, ``"decade"``, ``"all"`` or a number of log-spaced taus).
     estimator : str
         Allan estimator (``"overlapping"``, ``"non-overlapping"`` or ``"fast"``).
-    terms : tuple of str
-        Noise terms fitted (subset of Q, N, B, K, R).
+    statistic : str
+        Allan-family statistic of the noise analyses (``"adev"``, ``"hdev"`` or ``"mdev"``).
+    terms : tuple of str or None
+        ``None`` (default): the noise model is selected from the data; a tuple fixes the terms fitted.
+    outliers : str
+        ``"warn"`` (report samples beyond 6 robust sigma), ``"clip"`` or ``"replace"`` them before the analyses.
     fit_tau_s : tuple of (float or None, float or None)
         Tau range [s] of the noise fit (None = no limit), e.g. to leave out a vibration bump that the
         IEEE-952 model does not describe.
@@ -112,8 +117,10 @@ class AnalysisConfig:
     causal_window_s: float = 128.0
     taus: str = "octave"
     estimator: str = "overlapping"
-    terms: tuple = ("Q", "N", "B", "K", "R")
+    statistic: str = "adev"
+    terms: tuple | None = None
     fit_tau_s: tuple = (None, None)
+    outliers: str = "warn"
 
     def validate(self) -> "AnalysisConfig":
         if not 0 < self.train_fraction < 1 or not 0 <= self.val_fraction < 1:
@@ -130,6 +137,13 @@ class AnalysisConfig:
             raise ConfigError(f"no drift model given; pass {{opt:models}} with one or more of {list(MODEL_NAMES)}")
         # canonical registry names (any case accepted); an unknown name is an error, never a fallback
         self.models = tuple(dict.fromkeys(model_spec(m).name for m in self.models))
+        from .allan import STATISTICS
+        from .outliers import OUTLIER_ACTIONS
+
+        if self.statistic not in STATISTICS:
+            raise ConfigError(f"statistic must be one of {tuple(STATISTICS)}, got {self.statistic!r} ({{opt:statistic}})")
+        if self.outliers not in OUTLIER_ACTIONS:
+            raise ConfigError(f"outliers must be one of {OUTLIER_ACTIONS}, got {self.outliers!r} ({{opt:outliers}})")
         if self.model_rate_hz is not None and not self.model_rate_hz > 0:
             raise ConfigError(f"model_rate_hz must be > 0 Hz or None; got {self.model_rate_hz!r}")
         if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
@@ -146,7 +160,7 @@ class AnalysisConfig:
     def to_dict(self) -> dict:
         d = asdict(self)
         d["models"] = list(self.models)
-        d["terms"] = list(self.terms)
+        d["terms"] = None if self.terms is None else list(self.terms)
         d["fit_tau_s"] = list(self.fit_tau_s)
         return d
 
@@ -157,14 +171,17 @@ class AnalysisConfig:
 
 @dataclass
 class AllanAxis:
-    """Allan analysis of one axis. ``allan`` is an AllanResult, ``noise`` a NoiseFit."""
+    """Allan analysis of one axis. ``allan`` is an AllanResult, ``noise`` a NoiseFit, ``outliers`` an
+    OutlierReport of the rate that was analysed (None when not checked)."""
 
     name: str
     allan: object
     noise: object
+    outliers: object = None
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict()}
+        return {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict(),
+                "outliers": None if self.outliers is None else self.outliers.to_dict()}
 
 
 @dataclass
@@ -172,7 +189,8 @@ class SeparationAxis:
     """Lifting separation of one axis at the modelling rate.
 
     ``rate_dph`` is the (bias-removed) rate, ``drift_dph + noise_dph == rate_dph``; each of ``rows`` is
-    ``(label, AllanAxis)`` for original / drift / noise.
+    ``(label, AllanAxis)`` for original / drift / noise.  ``mean_removed_dph`` is the mean that
+    :func:`run_separation` subtracted before separating (None when the caller removed a bias itself).
     """
 
     name: str
@@ -183,12 +201,14 @@ class SeparationAxis:
     noise_dph: np.ndarray
     rows: list
     level_scan: list | None = None
+    mean_removed_dph: float | None = None
 
     def to_dict(self) -> dict:
         return {
             "name": self.name,
             "dt_s": self.dt_s,
             "level": self.level,
+            "mean_removed_dph": self.mean_removed_dph,
             "n_samples": int(self.rate_dph.size),
             "max_abs_reconstruction_error_dph": float(np.max(np.abs(self.drift_dph + self.noise_dph - self.rate_dph))),
             "rows": [{"label": label, **row.to_dict()} for label, row in self.rows],
@@ -343,15 +363,47 @@ def library_versions() -> dict:
     return out
 
 
-def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None) -> AllanAxis:
-    """Allan variance + noise fit of one 1-D rate series."""
+def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False) -> AllanAxis:
+    """Allan-family variance and noise identification of one 1-D rate series.
+
+    The curve is computed on the configured grid (``cfg.taus``) for display; the noise fit always uses an octave
+    grid of the same data, so its numbers do not depend on the display grid.  With ``check_outliers`` the rate is
+    checked for samples beyond 6 robust sigma and, if ``cfg.outliers`` says so, clipped or replaced first.
+    """
     from .allan import allan_variance
     from .noise import fit_noise
 
-    res = allan_variance(rate_dph, dt_s, taus=cfg.taus, estimator=cfg.estimator, progress=progress)
+    outliers = None
+    if check_outliers:
+        from .outliers import treat_outliers
+
+        rate_dph, outliers = treat_outliers(rate_dph, cfg.outliers)
+    res = allan_variance(rate_dph, dt_s, taus=cfg.taus, estimator=cfg.estimator, statistic=cfg.statistic,
+                         progress=progress)
+    fit_curve = res if cfg.taus == "octave" else allan_variance(rate_dph, dt_s, taus="octave",
+                                                                estimator=cfg.estimator, statistic=cfg.statistic)
     lo, hi = cfg.fit_tau_s
-    tau_range = None if lo is None and hi is None else (lo or 0.0, hi or np.inf)
-    return AllanAxis(name=name, allan=res, noise=fit_noise(res, terms=tuple(cfg.terms), tau_range_s=tau_range))
+    tau_range = None if lo is None and hi is None else (lo, hi)
+    noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range)
+    if outliers is not None:
+        noise.outliers = outliers.to_dict()
+    return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers)
+
+
+def _treated_record(record, cfg: AnalysisConfig):
+    """The record with outliers clipped or replaced per ``cfg.outliers`` (unchanged for "warn"), and the reports."""
+    import dataclasses
+
+    from .outliers import treat_outliers
+
+    data = np.array(record.rate_dph, dtype=np.float64)
+    reports = {}
+    for k, name in enumerate(record.axis_names):
+        data[:, k], reports[name] = treat_outliers(data[:, k], cfg.outliers)
+    if cfg.outliers == "warn" or not any(r.count for r in reports.values()):
+        return record, reports
+    note = f"outliers {cfg.outliers}: " + ", ".join(f"{n} {r.count}" for n, r in reports.items())
+    return dataclasses.replace(record, rate_dph=data, notes=tuple(record.notes) + (note,)), reports
 
 
 def _model_record(record, cfg: AnalysisConfig):
@@ -408,7 +460,11 @@ def _check_earth_axes(record, cfg: AnalysisConfig) -> None:
 def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | None = None) -> list[AllanAxis]:
     """Allan variance and noise identification of every axis of a record at its native rate."""
     cfg = (cfg or AnalysisConfig()).validate()
-    return [analyse_allan(name, record.axis(name), record.dt_s, cfg, progress) for name in record.axis_names]
+    out = []
+    for name in record.axis_names:
+        checkpoint("Allan variance", axis=name)
+        out.append(analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True))
+    return out
 
 
 def run_separation(record, cfg: AnalysisConfig | None = None) -> list[SeparationAxis]:
@@ -417,9 +473,12 @@ def run_separation(record, cfg: AnalysisConfig | None = None) -> list[Separation
     rec = _model_record(record, cfg)
     out = []
     for name in rec.axis_names:
+        checkpoint("separation", axis=name)
         x = np.asarray(rec.axis(name), dtype=np.float64)
         # A constant goes wholly into the drift; remove it so the drift shows the variation only.
-        out.append(_separation_axis(name, x - x.mean(), rec.dt_s, cfg))
+        sep = _separation_axis(name, x - x.mean(), rec.dt_s, cfg)
+        sep.mean_removed_dph = float(x.mean())
+        out.append(sep)
     return out
 
 
@@ -476,14 +535,19 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
     models, fit_s = {}, {}
     if fitted is None:
         for model_name in cfg.models:
+            checkpoint("fitting", axis=name, model=model_name)
             model = make_model(model_name, cfg, progress)
+            if "dt_s" in model.get_params():  # state-space models (Kalman) work in seconds
+                model.set_params(dt_s=dt_s)
             t0 = time.perf_counter()
-            model.fit(drift["train"], drift["val"])
+            fit_on = blocks if model.input_kind == "rate" else drift  # a Kalman filter sees the rate itself
+            model.fit(fit_on["train"], fit_on["val"])
             fit_s[model.label] = time.perf_counter() - t0
             models[model.label] = model
     else:
         models = dict(fitted)
 
+    checkpoint("evaluating", axis=name)
     predictions, causal_predictions, metrics, causal_metrics, p0_meas = {}, {}, {}, {}, {}
     # Score only predictions whose inputs lie inside the test block: the first `lags` use history from the
     # validation block, whose drift was separated on its own and carries that block's end effect.
@@ -492,8 +556,11 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
     with warnings.catch_warnings(record=True) as log:
         warnings.simplefilter("always", FogdriftWarning)
         for label, model in models.items():
-            yhat = model.predict(drift["test"], history=history)
-            yhat_c = model.predict(causal_test, history=causal_hist)
+            if model.input_kind == "rate":  # causal by construction: the same estimate for both targets
+                yhat = yhat_c = model.predict(blocks["test"], history=rate[:e])
+            else:
+                yhat = model.predict(drift["test"], history=history)
+                yhat_c = model.predict(causal_test, history=causal_hist)
             predictions[label], causal_predictions[label] = yhat, yhat_c
             y, p, pp = drift["test"][skip:], yhat[skip:], persist_pred[skip:]
             metrics[label] = evaluate(y, p, y_train=drift["train"], yhat_persistence=pp,
@@ -532,6 +599,7 @@ def run_models(record, cfg: AnalysisConfig | None = None, progress=None) -> list
     rec = _model_record(record, cfg)
     out = []
     for name in rec.axis_names:
+        checkpoint("separation", axis=name)
         rate, bias, earth = _prepared_axis(rec, name, cfg)
         lvl_cfg = _with_level(cfg, _resolved_level(rate, cfg, rec.dt_s)[0])
         out.append(_fit_axis_models(name, rate, rec.dt_s, lvl_cfg, bias, earth, progress))
@@ -540,6 +608,7 @@ def run_models(record, cfg: AnalysisConfig | None = None, progress=None) -> list
 
 def _table2(ma: ModelAxis, cfg: AnalysisConfig) -> list[CompensatedSignal]:
     """Allan analysis of original, drift and every compensated signal on the test block."""
+    checkpoint("Table 2", axis=ma.name)
     e, f = ma.split["test"]
     k = ma.score_from
     raw = ma.rate_dph[e + k:f]
@@ -572,10 +641,15 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
     t_start = time.perf_counter()
     cfg = (cfg or AnalysisConfig()).validate()
     _check_earth_axes(record, cfg)
+    record, outlier_reports = _treated_record(record, cfg)
     rec_m = _model_record(record, cfg)
     axes = []
     for name in record.axis_names:
+        checkpoint("Allan variance (native rate)", axis=name)
         original = analyse_allan(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s, cfg)
+        original.outliers = outlier_reports[name]
+        original.noise.outliers = outlier_reports[name].to_dict()
+        checkpoint("separation", axis=name)
         rate, bias, earth = _prepared_axis(rec_m, name, cfg)
         sep = _separation_axis(name, rate, rec_m.dt_s, cfg)
         lvl_cfg = _with_level(cfg, sep.level)

@@ -12,11 +12,13 @@ import base64
 import html
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 
 from ._util import json_default
+from .output import atomic_path
 
 __all__ = [
     "NOISE_HEADERS",
@@ -61,9 +63,12 @@ def _fmt(x, digits=4) -> str:
 
 
 def term_text(term) -> str:
-    """``value [lo95, hi95]`` or ``n/e`` with the reason, for one NoiseTerm."""
-    if not term.estimable or term.value is None:
-        return "n/e" if term.hi95 is None else f"n/e (< {_fmt(term.hi95, 3)})"
+    """``value [lo95, hi95]`` for a term in the model; ``- (< hi95)`` for one that is not; ``n/e`` when the data
+    cannot support a number (the reason is in the notes)."""
+    if term.value is None:
+        if term.status == "not_estimable":
+            return "n/e" if term.hi95 is None else f"n/e (< {_fmt(term.hi95, 3)})"
+        return "–" if term.hi95 is None else f"– (< {_fmt(term.hi95, 3)})"
     text = _fmt(term.value)
     if term.lo95 is not None and term.hi95 is not None:
         text += f" [{_fmt(term.lo95, 3)}, {_fmt(term.hi95, 3)}]"
@@ -71,30 +76,52 @@ def term_text(term) -> str:
 
 
 def noise_row(noise) -> list[str]:
-    """Five cells Q, N, B, K, R of a NoiseFit (95 % intervals in brackets; n/e = not estimable)."""
+    """Five cells Q, N, B, K, R of a NoiseFit (95 % intervals in brackets; – = not in the model, with its upper
+    bound; n/e = not estimable)."""
     return [term_text(noise.terms[name]) for name in ("Q", "N", "B", "K", "R")]
 
 
-_READOUT_LABELS = {
-    "Q_urad@tau=sqrt3s": ("Q at τ=√3 s on the -1 line", "µrad"),
-    "N_dprh@tau=1h": ("N at τ=1 h on the -1/2 line", "deg/√h"),
-    "B_dph@min": ("B from the minimum", "deg/h"),
-    "K_dphrh@tau=3h": ("K at τ=3 h on the +1/2 line", "deg/h^1.5"),
-    "R_dph2@tau=sqrt2h": ("R at τ=√2 h on the +1 line", "deg/h²"),
-}
+def fit_summary(noise) -> str:
+    """One line: the selected model, the fit statistic and p-value, the fitted tau range."""
+    return (f"model {'+'.join(noise.selected) or '(none)'} selected from {len(noise.candidates)} candidates; "
+            f"chi2_red {_fmt(noise.chi2_red, 3)} on {noise.dof} dof (p = {noise.p_value:.2g}, fit {noise.quality}); "
+            f"fitted tau {_fmt(noise.tau_min_s, 3)} .. {_fmt(noise.tau_max_s, 3)} s")
 
 
 def readout_text(noise) -> str:
-    """The classic IEEE-952 slope read-outs, with units ('–' where the curve shows no such slope)."""
-    parts = []
-    for key, (label, unit) in _READOUT_LABELS.items():
-        value = noise.readouts.get(key)
-        parts.append(f"{label}: {'–' if value is None else _fmt(value) + ' ' + unit}")
-    return "; ".join(parts)
+    """The classic IEEE-952 slope read-outs, labelled as a cross-check (with where each was read)."""
+    parts = [ro.text() for ro in noise.readouts.values() if ro.value is not None]
+    return "; ".join(parts) if parts else "no term's slope is visible in the curve"
+
+
+def noise_notes(noise) -> list[str]:
+    """Everything a reader needs beside the table, in words: fit quality, what was left out and why, the
+    classical bias instability, each term that is not resolved and why, outliers."""
+    out = [fit_summary(noise)]
+    for e in noise.excluded:
+        out.append(f"left out tau {_fmt(e['tau_min_s'], 3)} .. {_fmt(e['tau_max_s'], 3)} s: {e['reason']}")
+    out += list(noise.notes)
+    b = noise.b_min or {}
+    if b.get("value") is not None:
+        if b.get("bound_only"):
+            out.append(f"bias instability (IEEE reading at the ADEV minimum): the fitted curve still falls at the "
+                       f"longest tau, so B_min < {_fmt(b['value'], 3)} deg/h")
+        else:
+            out.append(f"bias instability (IEEE reading, min of the fitted ADEV / 0.664): B_min = {_fmt(b['value'], 3)} "
+                       f"deg/h at tau = {_fmt(b['tau_s'], 3)} s")
+    for t in noise.terms.values():
+        if t.reason and t.status != "resolved":
+            out.append(f"{t.name}: {t.reason}")
+    if noise.outliers and noise.outliers.get("count"):
+        o = noise.outliers
+        out.append(f"outliers: {o['count']} samples ({100 * o['fraction']:.3g} %) beyond {o['threshold_sigma']:g} "
+                   f"robust sigma, action: {o['action']}")
+    return out
 
 
 def not_estimable_notes(noise) -> list[str]:
-    return [f"{t.name}: {t.reason}" for t in noise.terms.values() if not t.estimable and t.reason]
+    """Kept for callers of the earlier API: the notes of :func:`noise_notes`."""
+    return noise_notes(noise)
 
 
 def metrics_rows(model_axis) -> list[list[str]]:
@@ -168,9 +195,9 @@ def _clean(obj):
 
 def write_json(obj, path) -> Path:
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     data = json.loads(json.dumps(obj, default=json_default))
-    path.write_text(json.dumps(_clean(data), indent=2, allow_nan=False))
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(_clean(data), indent=2, allow_nan=False))
     return path
 
 
@@ -185,37 +212,53 @@ def _plt():
 
 def _save(fig, path) -> Path:
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    _plt().close(fig)
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110, bbox_inches="tight")
+    finally:
+        _plt().close(fig)
     return path
+
+
+def _safe(name) -> str:
+    """An axis or model name as a file-name part (deterministic; no path separators)."""
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._") or "axis"
 
 
 # -------------------------------------------------------------------------------------------------------------
 # figures
 
 
-def plot_allan(axes_list, path, title="Allan deviation") -> Path:
-    """Fig. 3: log-log ADEV with 68 % error bars, the fitted curve and each fitted term's asymptote."""
+def plot_allan(axes_list, path, title=None) -> Path:
+    """Fig. 3: log-log deviation with 68 % error bars, the fitted curve over the fitted range (points used marked,
+    left-out taus shaded), each selected term's asymptote, and the fit statistic."""
     plt = _plt()
     n = len(axes_list)
-    fig, axs = plt.subplots(1, n, figsize=(5.2 * n, 4.2), squeeze=False)
+    fig, axs = plt.subplots(1, n, figsize=(5.6 * n, 4.6), squeeze=False)
     for ax, aa in zip(axs[0], axes_list):
         r, fit = aa.allan, aa.noise
-        yerr = np.vstack([r.adev_dph - r.adev_lo68_dph, r.adev_hi68_dph - r.adev_dph])
-        ax.errorbar(r.tau_s, r.adev_dph, yerr=yerr, fmt="o", ms=3, color="k", lw=0.8, label="ADEV (68 % CI)")
-        tau = np.logspace(np.log10(r.tau_s[0]), np.log10(r.tau_s[-1]), 200)
-        ax.loglog(tau, fit.model_adev_dph(tau), "r-", lw=1.5, label="fit")
+        label = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}.get(getattr(r, "statistic", "adev"), "deviation")
+        yerr = np.vstack([r.dev_dph - r.dev_lo68_dph, r.dev_hi68_dph - r.dev_dph])
+        ax.errorbar(r.tau_s, r.dev_dph, yerr=yerr, fmt="o", ms=3, color="k", lw=0.8, mfc="white",
+                    label=f"{label} (68 % CI)")
+        used = np.isin(np.round(r.tau_s, 12), np.round(fit.fit_tau_s, 12))
+        ax.plot(r.tau_s[used], r.dev_dph[used], "o", ms=4.5, color="k", zorder=4, label="fitted points")
+        for e in fit.excluded:
+            ax.axvspan(e["tau_min_s"] / 1.2, e["tau_max_s"] * 1.2, color="0.85", zorder=0, label="left out")
+        tau = np.logspace(np.log10(fit.tau_min_s), np.log10(fit.tau_max_s), 200)
+        ax.loglog(tau, fit.model_dev_dph(tau), "r-", lw=1.6, label=f"fit {'+'.join(fit.selected)}")
         for name, style in zip(("Q", "N", "B", "K", "R"), ("--", "-.", ":", "--", "-.")):
-            if name in fit.fitted_terms and fit.terms[name].value:
-                ax.loglog(tau, fit.term_adev_dph(name, tau), style, lw=0.9, label=name)
-        lo = np.nanmin(r.adev_lo68_dph[r.adev_lo68_dph > 0]) if np.any(r.adev_lo68_dph > 0) else np.nanmin(r.adev_dph)
-        ax.set_ylim(lo / 3, np.nanmax(r.adev_hi68_dph) * 3)
+            if name in fit.selected and fit.terms[name].value:
+                ax.loglog(tau, fit.term_dev_dph(name, tau), style, lw=0.9, label=name)
+        pos = r.dev_lo68_dph > 0
+        lo = np.nanmin(r.dev_lo68_dph[pos]) if np.any(pos) else np.nanmin(r.dev_dph)
+        ax.set_ylim(lo / 3, np.nanmax(r.dev_hi68_dph) * 3)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("τ [s]")
-        ax.set_ylabel("σ(τ) [deg/h]")
-        ax.set_title(f"{title}: {aa.name}")
+        ax.set_ylabel(f"{label} σ(τ) [deg/h]")
+        ax.set_title(f"{title or label}: {aa.name}\nχ²_red {fit.chi2_red:.3g}, p = {fit.p_value:.2g} ({fit.quality})",
+                     fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     return _save(fig, path)
@@ -279,8 +322,8 @@ def plot_separation_allan(sep, path) -> Path:
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     for (label, aa), color in zip(sep.rows, ("k", "C3", "C0")):
         r = aa.allan
-        yerr = np.vstack([r.adev_dph - r.adev_lo68_dph, r.adev_hi68_dph - r.adev_dph])
-        ax.errorbar(r.tau_s, r.adev_dph, yerr=yerr, fmt="o-", ms=3, lw=0.8, color=color, label=label)
+        yerr = np.vstack([r.dev_dph - r.dev_lo68_dph, r.dev_hi68_dph - r.dev_dph])
+        ax.errorbar(r.tau_s, r.dev_dph, yerr=yerr, fmt="o-", ms=3, lw=0.8, color=color, label=label)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("τ [s]")
@@ -330,16 +373,17 @@ def _noise_csv_rows(label, aa):
 
 
 def _noise_csv_header():
+    from .noise import TERM_TABLE
+
     head = ["signal"]
-    for name, unit in zip(("Q", "N", "B", "K", "R"), ("urad", "deg/sqrt(h)", "deg/h", "deg/h^1.5", "deg/h^2")):
-        head += [f"{name}_{unit}", f"{name}_lo95_{unit}", f"{name}_hi95_{unit}"]
+    for name, spec in TERM_TABLE.items():
+        head += [f"{name}{spec.suffix}", f"{name}_lo95{spec.suffix}", f"{name}_hi95{spec.suffix}"]
     return head
 
 
 def _write_rows_csv(path, header, rows) -> Path:
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w") as fh:
+    with atomic_path(path) as tmp, open(tmp, "w") as fh:
         fh.write(",".join(header) + "\n")
         for row in rows:
             fh.write(",".join(str(c) for c in row) + "\n")
@@ -349,20 +393,21 @@ def _write_rows_csv(path, header, rows) -> Path:
 def write_allan_outputs(allan_axes, record, out_dir) -> dict:
     """``allan.json``, ``allan.csv`` (curve of every axis, with units) and ``allan.png``."""
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     write_json({"source": record.source, "record": record.metadata(),
                 "axes": [a.to_dict() for a in allan_axes]}, out / "allan.json")
     rows = []
     for a in allan_axes:
         r = a.allan
         for i in range(r.tau_s.size):
-            rows.append([a.name, repr(float(r.tau_s[i])), int(r.m[i]), repr(float(r.adev_dph[i])),
-                         repr(float(r.avar_dph2[i])), int(r.n_terms[i]), repr(float(r.edf[i])),
-                         repr(float(r.adev_lo68_dph[i])), repr(float(r.adev_hi68_dph[i])),
-                         repr(float(r.adev_lo95_dph[i])), repr(float(r.adev_hi95_dph[i]))])
+            rows.append([a.name, repr(float(r.tau_s[i])), int(r.m[i]), repr(float(r.dev_dph[i])),
+                         repr(float(r.var_dph2[i])), int(r.n_terms[i]), repr(float(r.edf[i])),
+                         repr(float(r.dev_lo68_dph[i])), repr(float(r.dev_hi68_dph[i])),
+                         repr(float(r.dev_lo95_dph[i])), repr(float(r.dev_hi95_dph[i]))])
+    dev = {"adev": "adev", "hdev": "hdev", "mdev": "mdev"}.get(getattr(allan_axes[0].allan, "statistic", "adev"), "dev")
+    var = {"adev": "avar", "hdev": "hvar", "mdev": "mvar"}.get(dev, "var")
     _write_rows_csv(out / "allan.csv",
-                    ["axis", "tau_s", "m", "adev_dph", "avar_dph2", "n_terms", "edf", "adev_lo68_dph",
-                     "adev_hi68_dph", "adev_lo95_dph", "adev_hi95_dph"], rows)
+                    ["axis", "tau_s", "m", f"{dev}_dph", f"{var}_dph2", "n_terms", "edf", f"{dev}_lo68_dph",
+                     f"{dev}_hi68_dph", f"{dev}_lo95_dph", f"{dev}_hi95_dph"], rows)
     plot_allan(allan_axes, out / "allan.png")
     return {"json": out / "allan.json", "csv": out / "allan.csv", "png": out / "allan.png"}
 
@@ -370,37 +415,37 @@ def write_allan_outputs(allan_axes, record, out_dir) -> dict:
 def write_separation_outputs(seps, out_dir) -> dict:
     """Drift and noise series (CSV and NPZ), Fig. 5 and 6 per axis, the Q..R table (JSON and CSV)."""
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     arrays = {}
     for s in seps:
         arrays[f"{s.name}_input_dph"] = s.rate_dph
         arrays[f"{s.name}_drift_dph"] = s.drift_dph
         arrays[f"{s.name}_noise_dph"] = s.noise_dph
-    np.savez(out / "separation.npz", dt_s=np.array(seps[0].dt_s), **arrays)
+    with atomic_path(out / "separation.npz") as tmp:
+        np.savez(tmp, dt_s=np.array(seps[0].dt_s), **arrays)
     n = seps[0].rate_dph.size
     cols = ["t_s"] + list(arrays)
     data = np.column_stack([np.arange(n) * seps[0].dt_s] + [arrays[c] for c in cols[1:]])
-    np.savetxt(out / "separation.csv", data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+    with atomic_path(out / "separation.csv") as tmp:
+        np.savetxt(tmp, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
     rows = [_noise_csv_rows(f"{s.name}:{label}", aa) for s in seps for label, aa in s.rows]
     _write_rows_csv(out / "separation_table.csv", _noise_csv_header(), rows)
     write_json({"axes": [s.to_dict() for s in seps]}, out / "separation.json")
     files = {}
     for s in seps:
-        files[f"fig5_{s.name}"] = plot_separation(s, out / f"fig5_drift_noise_{s.name}.png")
-        files[f"fig6_{s.name}"] = plot_separation_allan(s, out / f"fig6_allan_{s.name}.png")
+        files[f"fig5_{s.name}"] = plot_separation(s, out / f"fig5_drift_noise_{_safe(s.name)}.png")
+        files[f"fig6_{s.name}"] = plot_separation_allan(s, out / f"fig6_allan_{_safe(s.name)}.png")
     return files
 
 
 def write_model_outputs(model_axes, out_dir) -> dict:
     """Saved models (JSON + NPZ), metrics JSON, Fig. 8 and 9 per axis."""
     out = Path(out_dir)
-    (out / "models").mkdir(parents=True, exist_ok=True)
     for ma in model_axes:
         for label, model in ma.fitted.items():
             safe = label.replace("(", "").replace(")", "").replace(",", "").replace(" ", "_").lower()
-            model.save(out / "models" / f"{ma.name}_{safe}")
-        plot_models(ma, out / f"fig8_models_{ma.name}.png")
-        plot_residuals(ma, out / f"fig9_residual_{ma.name}.png")
+            model.save(out / "models" / f"{_safe(ma.name)}_{_safe(safe)}")
+        plot_models(ma, out / f"fig8_models_{_safe(ma.name)}.png")
+        plot_residuals(ma, out / f"fig9_residual_{_safe(ma.name)}.png")
     write_json({"axes": [ma.to_dict() for ma in model_axes]}, out / "metrics.json")
     return {"dir": out}
 
@@ -460,9 +505,10 @@ def _analysis_section(result, fig_dir, title, fig_offset=0) -> str:
         parts.append(f"<h3>Axis {html.escape(ax.name)}</h3>")
         parts.append("<h4>Noise coefficients of the original output (whole record, native rate)</h4>")
         parts.append(_table(("signal",) + NOISE_HEADERS, [["original"] + noise_row(ax.original.noise)], "allan"))
-        notes = not_estimable_notes(ax.original.noise)
-        if notes:
-            parts.append('<p class="note">n/e = not estimable: ' + html.escape("; ".join(notes)) + "</p>")
+        notes = noise_notes(ax.original.noise)
+        parts.append('<ul class="note">' + "".join(f"<li>{html.escape(n)}</li>" for n in notes) + "</ul>")
+        parts.append('<p class="note">In the table: value [95 % interval]; “– (&lt; x)”: the term is not in the '
+                     "selected model and x is its 95 % upper bound; “n/e”: not estimable (reason above).</p>")
         parts.append('<p class="note">Slope read-outs (cross-check): '
                      + html.escape(readout_text(ax.original.noise)) + "</p>")
         parts.append("<h4>Table 2: noise coefficients before and after compensation (test block, modelling rate)</h4>")
@@ -477,12 +523,14 @@ def _analysis_section(result, fig_dir, title, fig_offset=0) -> str:
         parts.append("<h4>Metrics on the test block (target: causal drift)</h4>")
         parts.append(_table(METRICS_HEADERS, causal_metrics_rows(ma), "metrics"))
         parts.append('<div class="verdict"><p>' + "</p><p>".join(html.escape(v) for v in verdict(ma)) + "</p></div>")
+        # deterministic names: the figure number and the axis; the applied section's files start "apply_to_"
+        pre, name = ("apply_to_" if fig_offset else ""), _safe(ax.name)
         figs = [
-            plot_allan([ax.original], fig_dir / f"fig3_allan_{ax.name}_{fig_offset}.png", "Allan deviation (Fig. 3)"),
-            plot_separation(ax.separation, fig_dir / f"fig5_{ax.name}_{fig_offset}.png"),
-            plot_separation_allan(ax.separation, fig_dir / f"fig6_{ax.name}_{fig_offset}.png"),
-            plot_models(ma, fig_dir / f"fig8_{ax.name}_{fig_offset}.png", 8 + fig_offset),
-            plot_residuals(ma, fig_dir / f"fig9_{ax.name}_{fig_offset}.png", 9 + fig_offset),
+            plot_allan([ax.original], fig_dir / f"{pre}fig3_allan_{name}.png", "Allan deviation (Fig. 3)"),
+            plot_separation(ax.separation, fig_dir / f"{pre}fig5_drift_noise_{name}.png"),
+            plot_separation_allan(ax.separation, fig_dir / f"{pre}fig6_allan_{name}.png"),
+            plot_models(ma, fig_dir / f"{pre}fig{8 + fig_offset}_models_{name}.png", 8 + fig_offset),
+            plot_residuals(ma, fig_dir / f"{pre}fig{9 + fig_offset}_residual_{name}.png", 9 + fig_offset),
         ]
         parts += [_img(p) for p in figs]
     return "\n".join(parts)
@@ -492,7 +540,6 @@ def write_report(result, record, out_dir, apply_record=None) -> Path:
     """Write ``report.html`` (figures embedded as base64, nothing fetched) plus ``analysis.json``."""
     out = Path(out_dir)
     fig_dir = out / "figures"
-    fig_dir.mkdir(parents=True, exist_ok=True)
     write_json(result.to_dict(), out / "analysis.json")
     body = [f"<h1>fogdrift analysis of {html.escape(Path(result.source).name)}</h1>",
             '<p class="note">Rates in deg/h, τ in s. Method: Tang et al., Chinese J. Lasers 39(10) 2012, with the '
@@ -507,5 +554,6 @@ def write_report(result, record, out_dir, apply_record=None) -> Path:
     doc = (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>fogdrift report</title>"
            f"<style>{_CSS}</style></head><body>{''.join(body)}</body></html>")
     path = out / "report.html"
-    path.write_text(doc, encoding="utf-8")
+    with atomic_path(path) as tmp:
+        tmp.write_text(doc, encoding="utf-8")
     return path

@@ -32,15 +32,10 @@ import math
 import numpy as np
 
 from .errors import ConfigError
-from .units import check_dt_s, earth_rate_projection_dph
+from .units import B_FACTOR as B_FLAT_FACTOR  # the flat ADEV of flicker rate noise in units of B
+from .units import URAD_PER_ARCSEC, check_dt_s, earth_rate_projection_dph
 
 __all__ = ["simulate", "URAD_PER_ARCSEC", "B_FLAT_FACTOR"]
-
-#: One arcsecond in microradians: 1e6 pi / (180 * 3600).
-URAD_PER_ARCSEC = 1e6 * math.pi / (180.0 * 3600.0)
-
-#: Flat Allan-deviation level of flicker rate noise in units of B: sqrt(2 ln 2 / pi).
-B_FLAT_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)
 
 
 def _nonneg(name, value) -> float:

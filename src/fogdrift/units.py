@@ -28,12 +28,22 @@ __all__ = [
     "check_dt_s",
     "TIME_UNITS",
     "time_scale_to_s",
+    "URAD_PER_ARCSEC",
+    "B_FACTOR",
     "TEMPERATURE_UNITS",
     "temperature_offset_to_c",
 ]
 
 #: WGS-84 Earth rotation rate 7.2921150e-5 rad/s expressed in deg/h (method notes §6).
 EARTH_RATE_DPH = 7.2921150e-5 * 180.0 / math.pi * 3600.0
+
+#: One arcsecond in microradians, 1e6 pi / (180 * 3600) = 4.8481368.  Note that 1 (deg/h) s = 1/3600 deg
+#: = 1 arcsec, so a quantization coefficient in the Allan-law units (rate deg/h, tau s) is in arcsec.
+URAD_PER_ARCSEC = 1e6 * math.pi / (180.0 * 3600.0)
+
+#: sqrt(2 ln 2 / pi) = 0.664282: the flat Allan deviation of flicker rate noise in units of the bias
+#: instability B (IEEE Std 952-1997 Annex C; method notes 2.2).  The read-off sigma_min = 0.6643 B.
+B_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)
 
 #: Multiply a rate in the key's unit by the value to get deg/h.
 RATE_UNITS: dict[str, float] = {

@@ -1,9 +1,22 @@
-"""The typer application, shared options and the edge where errors become one line.
+"""The typer application, shared options and the edge where errors, warnings and Ctrl-C become one line.
 
 Commands live one per module in :mod:`fogdrift.cli` (``allan``, ``separate``, ``model``, ``analyze``, ...); each
 only declares options, calls the library and prints.  Options every command that reads a gyro log shares are
 declared once (:data:`LOAD_PARAMS`) and added to a command by :func:`with_load_options`, which hands the command a
 :class:`LoadOptions` instead of seven loose arguments.
+
+A command's body runs inside :func:`run`, which
+
+* checks ``--out`` before any work (:class:`fogdrift.output.OutputDir`: every file written under a temporary name
+  and renamed when complete; the previous run's files in that folder replaced, never others);
+* prints a :class:`~fogdrift.errors.FogdriftError` as one line with settings spelled as CLI flags and exits 1;
+* prints each :class:`~fogdrift.errors.FogdriftWarning` as one ``warning:`` line;
+* on Ctrl-C (:mod:`fogdrift.interrupt`) prints one line saying what was and was not written and exits 130;
+* with ``--json``, keeps stdout for the result JSON alone (human lines go to stderr, tables are not printed).
+
+Console output: tables fit the terminal (columns folded into several tables when too wide, never truncated with
+an ellipsis); lines and notes are printed without hard wrapping (a pipe gets whole lines).  Off a terminal the
+width is ``COLUMNS`` if set, else 220.
 """
 
 from __future__ import annotations
@@ -11,20 +24,25 @@ from __future__ import annotations
 import contextlib
 import functools
 import inspect
+import os
 import sys
+import threading
 import typing
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
-from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.console import Console, Group
+from rich.progress import BarColumn, Progress, ProgressColumn, TextColumn, TimeElapsedColumn
 from rich.table import Table
 from rich.text import Text
 
 from .. import __version__
-from ..errors import ConfigError, FogdriftError
+from .. import interrupt
+from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
+from ..output import OutputDir
 
 app = typer.Typer(
     add_completion=False,
@@ -33,10 +51,12 @@ app = typer.Typer(
     context_settings={"help_option_names": ["-h", "--help"]},
     help="Characterise, separate, model and compensate optical-gyro drift (rates in deg/h, tau in s).",
 )
-# Tables are wide: when output goes to a file or pipe (logs, CI), do not wrap them at rich's 80 columns.
-console = Console(width=None if sys.stdout.isatty() else 220)
-err_console = Console(stderr=True, width=None if sys.stderr.isatty() else 220)
-_state = {"traceback": False}
+# stdout (tables, the result) and stderr (progress, warnings, errors); widths are set per run by _configure().
+console = Console(highlight=False)
+err_console = Console(stderr=True, highlight=False)
+_state = {"traceback": False, "json": False, "finish": threading.Lock()}
+#: Width off a terminal when COLUMNS is not set: logs and CI keep whole table rows.
+PIPE_WIDTH = 220
 
 #: Library parameter -> CLI flag, for error messages written with ``{opt:NAME}`` (see :mod:`fogdrift.errors`).
 FLAGS = {
@@ -46,6 +66,8 @@ FLAGS = {
     "tau_range_s": "--fit-taus", "taus": "--taus", "estimator": "--estimator", "statistic": "--statistic",
     "models": "--models", "latitude_deg": "--latitude", "earth_axes": "--earth-axis", "outliers": "--outliers",
     "lags": "--lags", "hidden": "--hidden", "epochs": "--epochs", "training": "--training", "seed": "--seed",
+    "apply_unit": "--apply-unit", "axis_map": "--axis-map", "accept_rate": "--accept-rate", "bias": "--bias",
+    "model": "--model", "chunk_samples": "--chunk", "out": "--out",
     # reader options (fogdrift.io.registry.READERS) and the temperature column
     "temperature": "--temperature", "topic": "--topic", "stamp": "--stamp", "dataset": "--dataset",
     "variable": "--variable", "gain": "--gain", "layout": "--layout", "scale": "--scale",
@@ -73,7 +95,11 @@ def _main(
 
 
 # -- shared option types --------------------------------------------------------------------------------------
-OutOpt = Annotated[Path, typer.Option("--out", help="Output directory.")]
+OutOpt = Annotated[Path, typer.Option("--out", help="Output folder: a new folder in an existing one, or a folder a "
+                                                    "fogdrift run wrote before (its files are replaced; files "
+                                                    "fogdrift did not write are kept).")]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print the result JSON to stdout and nothing else (human "
+                                                      "output goes to stderr; the files are still written).")]
 ModelRateOpt = Annotated[float, typer.Option(
     "--model-rate", help="Modelling rate [Hz]: block-average to it before separation/modelling; it must divide the "
                          "native rate by an integer (0 = native).")]
@@ -84,6 +110,13 @@ TausOpt = Annotated[str, typer.Option("--taus", help="Tau grid: octave, decade, 
 FitTausOpt = Annotated[str, typer.Option("--fit-taus", help="Tau range of the noise fit MIN:MAX [s], "
                                                             "either side may be empty, e.g. '1:'.")]
 EstOpt = Annotated[str, typer.Option("--estimator", help="overlapping, non-overlapping or fast.")]
+TermsOpt = Annotated[str, typer.Option(
+    "--terms", help="Fix the noise model, e.g. N,K (default: the terms are selected from the data).")]
+StatisticOpt = Annotated[str, typer.Option(
+    "--statistic", help="adev (Allan), hdev (Hadamard: blind to a rate ramp) or mdev (modified Allan).")]
+OutliersOpt = Annotated[str, typer.Option(
+    "--outliers", help="Samples beyond 6 robust sigma: warn (default), clip (to 6 sigma) or replace (by the "
+                       "local median).")]
 
 
 @dataclass(frozen=True)
@@ -143,9 +176,11 @@ LOAD_PARAMS = (
     ("rate", Annotated[Optional[float], typer.Option("--rate", help="Sample rate [Hz] (if the file has no time column).")], None),
     ("unit", Annotated[Optional[str], typer.Option(
         "--unit", help="Input unit: deg/h, deg/s, rad/s, rad/h, arcsec/s, or angle increments inc:deg, inc:rad, "
-                       "inc:arcsec (default: the unit the header declares, e.g. 'gz[deg/s]').")], None),
+                       "inc:arcsec.  Required unless the header declares it (e.g. 'gz[deg/s]'): never guessed.")],
+     None),
     ("time_unit", Annotated[Optional[str], typer.Option(
-        "--time-unit", help="Unit of the time column: s, ms, us or ns (default: declared in the header, else s).")], None),
+        "--time-unit", help="Unit of the time column: s, ms, us or ns.  Required for a time column unless the header "
+                            "declares it ('t[ms]', or a name suffix as in 't_s', 'time_ms'): never guessed.")], None),
     ("columns", Annotated[Optional[str], typer.Option("--columns", help="Comma-separated column names or 0-based indices.")], None),
     ("time_column", Annotated[str, typer.Option("--time-column", help="Time column name/index, 'auto' or 'none'.")], "auto"),
     ("gaps", Annotated[str, typer.Option("--gaps", help="Time gaps > 1.5 intervals: 'error' or 'longest' segment.")], "error"),
@@ -215,17 +250,55 @@ def parse_fit_taus(text: str):
         raise ConfigError(f"--fit-taus must look like MIN:MAX in seconds (e.g. '1:' or '0.1:300'), got {text!r}") from None
 
 
+def parse_terms(text: str):
+    """'' -> None (select from the data); 'n,k' -> ('N', 'K')."""
+    items = csv_list(text or "")
+    return tuple(t.upper() for t in items) if items else None
+
+
 def parse_taus(text: str):
     return int(text) if text.isdigit() else text
 
 
-# -- errors and progress ---------------------------------------------------------------------------------------
+# -- consoles -----------------------------------------------------------------------------------------------
+def _configure(json_mode: bool = False) -> None:
+    """Set the consoles for one run: widths (terminal, else COLUMNS, else PIPE_WIDTH) and the --json mode."""
+    for con, stream in ((console, sys.stdout), (err_console, sys.stderr)):
+        try:
+            tty = stream.isatty()
+        except (AttributeError, ValueError):
+            tty = False
+        if not tty:
+            cols = os.environ.get("COLUMNS", "")
+            con.width = int(cols) if cols.isdigit() and int(cols) > 20 else PIPE_WIDTH
+    _state["json"] = bool(json_mode)
+    console.quiet = bool(json_mode)
+
+
+def human() -> Console:
+    """The console for human lines: stdout, or stderr under --json (stdout is the JSON's alone)."""
+    return err_console if _state["json"] else console
+
+
+def say(text: str, style: str | None = None) -> None:
+    """One human line, never hard-wrapped (a pipe gets it whole)."""
+    human().print(Text(text, style=style or ""), soft_wrap=True)
+
+
+def warn(text: str) -> None:
+    """One ``warning:`` line on stderr."""
+    err_console.print(Text("warning: ", style="bold yellow") + Text(text), soft_wrap=True)
+
+
+# -- errors, warnings, Ctrl-C ---------------------------------------------------------------------------------
 @contextlib.contextmanager
 def errors():
     """Print a FogdriftError as one red line (options spelled as CLI flags) and exit 1."""
     try:
         yield
     except FogdriftError as exc:
+        if interrupt.requested():
+            raise
         if _state["traceback"]:
             raise
         err_console.print(Text("error: ", style="bold red") + Text(exc.render(FLAGS)), highlight=False,
@@ -234,27 +307,261 @@ def errors():
 
 
 @contextlib.contextmanager
-def progress(description: str):
-    """Yield (allan_cb, epoch_cb) callbacks that drive one rich progress bar."""
-    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
-                  TimeElapsedColumn(), console=err_console, transient=True) as bar:
-        task = bar.add_task(description, total=None)
+def _warning_lines():
+    """FogdriftWarnings as one ``warning:`` line each (settings spelled as flags); other warnings as usual."""
+    previous = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, FogdriftWarning):
+            warn(render_options(str(message), FLAGS))
+        else:
+            previous(message, category, filename, lineno, file, line)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("default", FogdriftWarning)
+        warnings.showwarning = show
+        yield
+
+
+def _interrupted(out: OutputDir | None):
+    """Ctrl-C: one line saying what was and was not written, exit 130 (the watchdog may already be at it)."""
+    if not _state["finish"].acquire(blocking=False):
+        raise typer.Exit(code=130)  # fogdrift.cli.main's watchdog prints the line and ends the process
+    summary = out.summary() if out is not None else "nothing was written"
+    err_console.print(Text("interrupted: ", style="bold red") + Text(summary), highlight=False, soft_wrap=True)
+    raise typer.Exit(code=130)
+
+
+def emergency_exit() -> None:
+    """The SIGINT watchdog's action when the main thread did not stop in time (fogdrift.cli.main): remove
+    unfinished temporary files, print the one line, end the process with 130.  Runs in another thread."""
+    from ..output import active
+
+    if _state["finish"].acquire(timeout=0.3):
+        out = active()
+        if out is not None:
+            out.abort(timeout=0.2)
+        summary = out.summary() if out is not None else "nothing was written"
+        tty = sys.stderr.isatty()
+        text = ("\r\x1b[2K" if tty else "") + f"interrupted: {summary}\n" + ("\x1b[?25h" if tty else "")
+        with contextlib.suppress(OSError):
+            os.write(2, text.encode("utf-8", "replace"))
+    os._exit(130)
+
+
+@dataclass
+class Run:
+    """What :func:`run` hands a command: the output folder and the --json switch."""
+
+    out: OutputDir
+    json_out: bool = False
+
+    def print_json(self, path) -> None:
+        """Under --json, print the JSON file the run wrote to stdout (the only thing on stdout)."""
+        if self.json_out:
+            sys.stdout.write(Path(path).read_text(encoding="utf-8").rstrip("\n") + "\n")
+            sys.stdout.flush()
+
+    def wrote(self) -> None:
+        """One human line: the files this run wrote."""
+        w = self.out.written
+        shown = ", ".join(w) if len(w) <= 6 else ", ".join(w[:6]) + f" and {len(w) - 6} more"
+        removed = f"; the earlier run's {len(self.out.removed)} file(s) there replaced" if self.out.removed else ""
+        say(f"wrote {len(w)} file(s) to {self.out.path}: {shown}{removed}")
+
+
+@contextlib.contextmanager
+def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool = False, expect=(),
+        out_class=OutputDir):
+    """The frame of every command (see the module docstring): yields a :class:`Run`.
+
+    ``--out`` is validated first, so a bad folder is refused before the file is read or anything computed.
+    ``out_class``: an :class:`~fogdrift.output.OutputDir` subclass whose ``summary()`` says more on Ctrl-C
+    (``batch``: which files' folders are finished).
+    """
+    _configure(json_out)
+    _state["finish"] = threading.Lock()
+    outdir = None
+    with errors(), _warning_lines():
+        outdir = out_class(out, command=command, create_parents=Path(out) == Path(default_out),
+                           protect=[p for p in inputs if p is not None])
+        outdir.expect(*expect)
+        try:
+            with outdir:
+                yield Run(outdir, bool(json_out))
+        except BaseException as exc:
+            if isinstance(exc, typer.Exit) and not interrupt.requested():
+                raise
+            if interrupt.requested() or isinstance(exc, KeyboardInterrupt):
+                _interrupted(outdir)
+            raise
+
+
+# -- what was read --------------------------------------------------------------------------------------------
+def echo_record(load: "LoadOptions", record, path=None) -> None:
+    """One line: the file, samples, axes, duration, the sample rate and where it came from, the units and theirs."""
+    import re
+
+    path = Path(path or load.file)
+    notes = list(getattr(record, "notes", ()))
+    time_note = next((m for m in (re.match(r"time column '(.*)' in (\w+)$", n) for n in notes) if m), None)
+    if load.rate is not None:
+        rate_src = "from --rate"
+    elif time_note is not None:
+        rate_src = f"from time column '{time_note.group(1)}'"
+    else:
+        rate_src = "from the file's time stamps"
+    units = f"rate {record.input_unit} ({'--unit' if load.unit else 'declared in the header'})"
+    if time_note is not None:
+        units += f", time {time_note.group(2)} ({'--time-unit' if load.time_unit else 'declared in the header'})"
+    say(f"{path.name}: {record.n_samples} samples x {record.n_axes} {'axis' if record.n_axes == 1 else 'axes'} ({', '.join(record.axis_names)}), "
+        f"{record.duration_s:.6g} s at {record.fs_hz:.6g} Hz (dt {record.dt_s:.6g} s {rate_src}); units: {units}; "
+        "rates converted to deg/h")
+
+
+def check_plausible(record) -> None:
+    """Warn (one line each) when the record is implausible for any gyro: a wrong --unit or --time-unit."""
+    from ..plausibility import check_record
+
+    for finding in check_record(record):
+        warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
+
+
+def check_model_rate(record, model_rate_hz) -> None:
+    """A modelling rate that does not divide the native rate by an integer is refused before any work."""
+    if model_rate_hz:
+        from ..io import decimation_factor
+
+        decimation_factor(record.dt_s, model_rate_hz)
+
+
+def precheck(*, wavelet=None, mode=None, training=None, estimator=None, terms=None) -> None:
+    """Refuse bad option values before the file is read (the library would refuse them only later)."""
+    if wavelet is not None:
+        from ..lifting import get_wavelet
+
+        get_wavelet(wavelet)
+    if mode is not None:
+        from ..lifting import MODES
+
+        if mode not in MODES:
+            raise ConfigError(f"{{opt:mode}} must be one of {list(MODES)}; got {mode!r}")
+    if training is not None and training not in ("bptt", "bp"):
+        raise ConfigError(f"{{opt:training}} must be 'bptt' or 'bp'; got {training!r}")
+    if estimator is not None:
+        from .. import allan
+
+        known = getattr(allan, "ESTIMATORS", None)
+        if known is not None and estimator not in known:
+            raise ConfigError(f"{{opt:estimator}} must be one of {list(known)}; got {estimator!r}")
+    if terms is not None:
+        bad = [t for t in terms if t not in ("Q", "N", "B", "K", "R")]
+        if bad or not terms:
+            raise ConfigError(f"{{opt:terms}} must list noise terms among Q, N, B, K, R; got {','.join(terms)!r}")
+
+
+# -- progress ---------------------------------------------------------------------------------------------------
+class _Counter(ProgressColumn):
+    """``done/total unit`` when the total is known, nothing otherwise (no "0/None")."""
+
+    def render(self, task):
+        if task.total is None:
+            return Text("")
+        return Text(f"{int(task.completed)}/{int(task.total)} {task.fields.get('unit', '')}".rstrip())
+
+
+def progress_label(description: str, axes, stage: str = "", axis=None, model=None, extra: str = "") -> str:
+    """``analyze · axis gz (1/3) · fitting elman · loss ...``: what the progress bar says."""
+    parts = [description]
+    if axis is not None:
+        k = f" ({list(axes).index(axis) + 1}/{len(axes)})" if axis in axes else ""
+        parts.append(f"axis {axis}{k}")
+    if stage:
+        parts.append(stage + (f" {model}" if model else ""))
+    if extra:
+        parts.append(extra)
+    return " · ".join(parts)
+
+
+@contextlib.contextmanager
+def progress(description: str, axes=()):
+    """Yield (allan_cb, epoch_cb) callbacks that drive one rich progress bar on stderr.
+
+    The bar names the stage, the axis (k/n of ``axes``) and the model that :func:`fogdrift.interrupt.checkpoint`
+    announces (:func:`progress_label`); it shows a count only when the total is known (taus, epochs).  Every
+    callback and checkpoint is a point where Ctrl-C stops the run.
+    """
+    axes = list(axes)
+    where = {"stage": "", "axis": None, "model": None}
+
+    with Progress(TextColumn("{task.description}"), BarColumn(), _Counter(), TimeElapsedColumn(),
+                  console=err_console, transient=True) as bar:
+        task = bar.add_task(description, total=None, unit="")
+
+        def on_stage(stage, axis, model):
+            where.update(stage=stage, axis=axis, model=model)
+            bar.update(task, description=progress_label(description, axes, **where), total=None, completed=0,
+                       unit="")
 
         def allan_cb(done, total):
-            bar.update(task, description=f"{description}: Allan", completed=done, total=total)
+            interrupt.check()
+            if not where["stage"]:
+                where["stage"] = "Allan variance"
+            bar.update(task, description=progress_label(description, axes, **where), completed=done, total=total,
+                       unit="taus")
 
         def epoch_cb(epoch, n_epochs, train_loss, val_loss):
-            bar.update(task, description=f"{description}: epoch, loss {train_loss:.3g} / val {val_loss:.3g}",
-                       completed=epoch, total=n_epochs)
+            interrupt.check()
+            bar.update(task, description=progress_label(description, axes, **where,
+                                                        extra=f"loss {train_loss:.3g} / val {val_loss:.3g}"),
+                       completed=epoch, total=n_epochs, unit="epochs")
 
-        yield allan_cb, epoch_cb
+        with interrupt.stage_listener(on_stage):
+            yield allan_cb, epoch_cb
 
 
+# -- tables -----------------------------------------------------------------------------------------------------
 def table(title, headers, rows) -> Table:
-    """A rich table of plain text (units such as [deg/h] must not be read as rich markup)."""
+    """A rich table of plain text (units such as [deg/h] must not be read as rich markup); cells fold, never
+    end in an ellipsis."""
     out = Table(title=Text(title), title_justify="left")
     for i, h in enumerate(headers):
-        out.add_column(Text(h), justify="left" if i == 0 else "right")
+        out.add_column(Text(h), justify="left" if i == 0 else "right", overflow="fold")
     for row in rows:
         out.add_row(*(Text(str(c)) for c in row))
     return out
+
+
+def column_groups(headers, rows, width: int) -> list[list[int]]:
+    """Split columns 1.. into groups that fit ``width`` with column 0 repeated in each (rich's box: 3 characters
+    per column plus 1).  A column too wide on its own gets a group of its own (its cells fold)."""
+    cells = [[str(h)] + [str(r[j]) for r in rows] for j, h in enumerate(headers)]
+    natural = [max(len(line) for c in col for line in c.splitlines() or [""]) + 3 for col in cells]
+    first = natural[0] + 1
+    groups, current, used = [], [], first
+    for j in range(1, len(headers)):
+        if current and used + natural[j] > width:
+            groups.append(current)
+            current, used = [], first
+        current.append(j)
+        used += natural[j]
+    if current:
+        groups.append(current)
+    return groups or [[]]
+
+
+def fitted_table(title, headers, rows) -> Group:
+    """A table that fits the console as one renderable: too many columns are folded into several tables
+    ("continued"), each repeating the first column."""
+    groups = column_groups(headers, rows, console.width)
+    parts = []
+    for k, group in enumerate(groups):
+        cols = [0] + group
+        part = title if k == 0 else f"{title} (continued, {k + 1}/{len(groups)})"
+        parts.append(table(part, [headers[j] for j in cols], [[row[j] for j in cols] for row in rows]))
+    return Group(*parts)
+
+
+def print_table(title, headers, rows) -> None:
+    """Print :func:`fitted_table` on stdout (nothing under --json)."""
+    console.print(fitted_table(title, headers, rows))

@@ -1,27 +1,35 @@
-"""Rich tables the commands share (rows come from :mod:`fogdrift.report`, which owns the formatting)."""
+"""Tables and notes the commands share (rows come from :mod:`fogdrift.report`, which owns the formatting)."""
 
 from __future__ import annotations
 
-from rich.text import Text
-
-from ._app import console, table
+from ._app import fitted_table, say
 
 
 def noise_table(title, rows):
+    """A Q, N, B, K, R table that fits the terminal (a rich renderable: ``console.print(noise_table(...))``)."""
     from ..report import NOISE_HEADERS
 
-    return table(title, ("signal",) + NOISE_HEADERS, rows)
+    return fitted_table(title, ("signal",) + NOISE_HEADERS, rows)
 
 
 def metrics_table(title, rows):
+    """A metrics table that fits the terminal (a rich renderable)."""
     from ..report import METRICS_HEADERS
 
-    return table(title, METRICS_HEADERS, rows)
+    return fitted_table(title, METRICS_HEADERS, rows)
 
 
-def print_noise_notes(label, noise):
-    from ..report import not_estimable_notes, readout_text
+def print_noise_notes(label, noise, outliers=None, dt_s=None):
+    """The fit statistic, fitted range, what was left out and why, every unresolved term's reason, the
+    outlier summary (the detailed one when ``outliers`` is given) and the slope read-outs as a labelled
+    cross-check; one whole line each (never hard-wrapped)."""
+    from ..report import noise_notes, readout_text
 
-    for note in not_estimable_notes(noise):
-        console.print(Text(f"  {label} {note}", style="dim"), highlight=False)
-    console.print(Text(f"  {label} slope read-outs (cross-check): {readout_text(noise)}"), highlight=False)
+    detailed = outliers is not None and outliers.count
+    for i, note in enumerate(noise_notes(noise)):
+        if detailed and note.startswith("outliers:"):
+            continue
+        say(f"  {label}: {note}", style="bold" if i == 0 else ("yellow" if note.startswith("fit poor") else "dim"))
+    if detailed:
+        say(f"  {label}: outliers: {outliers.summary(dt_s)}", style="yellow")
+    say(f"  {label}: slope read-outs (IEEE-952 cross-check, not the result): {readout_text(noise)}", style="dim")

@@ -1,15 +1,15 @@
-"""``fogdrift allan``: Allan variance and IEEE-952 noise coefficients of every axis."""
+"""``fogdrift allan``: Allan-family variance and IEEE-952 noise identification of every axis."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
 
-import typer
-
-from ._app import (EstOpt, FitTausOpt, OutOpt, TausOpt, app, console, csv_list, errors, parse_fit_taus,
-                   parse_taus, progress, with_load_options)
+from ._app import (EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, StatisticOpt, TausOpt, TermsOpt, app,
+                   check_plausible, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck,
+                   progress, run, with_load_options)
 from ._tables import noise_table, print_noise_notes
+
+DEFAULT_OUT = Path("out/allan")
 
 
 @app.command()
@@ -18,30 +18,40 @@ def allan(
     load,
     estimator: EstOpt = "overlapping",
     taus: TausOpt = "octave",
-    terms: Annotated[str, typer.Option("--terms", help="Noise terms to fit, e.g. Q,N,B,K,R.")] = "Q,N,B,K,R",
+    terms: TermsOpt = "",
+    statistic: StatisticOpt = "adev",
+    outliers: OutliersOpt = "warn",
     fit_taus: FitTausOpt = ":",
-    out: OutOpt = Path("out/allan"),
+    out: OutOpt = DEFAULT_OUT,
+    json_out: JsonOpt = False,
 ):
-    """Allan variance and IEEE-952 noise coefficients Q, N, B, K, R of every axis."""
+    """Allan variance and IEEE-952 noise coefficients Q, N, B, K, R of every axis: the terms are selected from
+    the data, with 95 % intervals, the fit's chi-squared and p-value, and what was left out and why."""
     from ..pipeline import AnalysisConfig, run_allan
     from ..report import noise_row, write_allan_outputs
 
-    with errors():
-        record = load.load()
+    with run("allan", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
+             expect=("allan.json", "allan.csv", "allan.png")) as r:
+        term_list = parse_terms(terms)
+        precheck(estimator=estimator, terms=term_list)
         cfg = AnalysisConfig(taus=parse_taus(taus), estimator=estimator, fit_tau_s=parse_fit_taus(fit_taus),
-                             terms=tuple(t.upper() for t in csv_list(terms)))
-        with progress("allan") as (allan_cb, _):
+                             terms=term_list, statistic=statistic, outliers=outliers).validate()
+        record = load.load()
+        echo_record(load, record)
+        check_plausible(record)
+        with progress("allan", record.axis_names) as (allan_cb, _):
             results = run_allan(record, cfg, progress=allan_cb)
-        console.print(noise_table(
-            f"{load.file.name}: {record.n_samples} samples at {record.fs_hz:g} Hz ({record.duration_s:.1f} s), "
-            f"{estimator} ADEV, 95 % intervals in brackets",
-            [[a.name] + noise_row(a.noise) for a in results]))
+        name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}[statistic]
+        console.print(noise_table(f"{load.file.name}: {estimator} {name}, 95 % intervals in brackets "
+                                  "(– (< x): not in the selected model, x its upper bound)",
+                                  [[a.name] + noise_row(a.noise) for a in results]))
         for a in results:
-            print_noise_notes(a.name, a.noise)
+            print_noise_notes(a.name, a.noise, a.outliers, record.dt_s)
         temp = record.metadata()["temperature"]
         if temp is not None:
             from ..temperature import summary_line
 
             console.print("  " + summary_line(temp), highlight=False)
-        files = write_allan_outputs(results, record, out)
-        console.print(f"wrote {files['json']}, {files['csv']}, {files['png']}")
+        files = write_allan_outputs(results, record, r.out.path)
+        r.wrote()
+        r.print_json(files["json"])

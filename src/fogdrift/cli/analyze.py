@@ -8,10 +8,14 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import ConfigError
-from ._app import (EstOpt, FitTausOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, console,
-                   csv_list, errors, parse_fit_taus, parse_level, parse_taus, progress, with_load_options)
+from ._app import (EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutliersOpt, OutOpt,
+                   StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_model_rate, check_plausible, console,
+                   csv_list, echo_record, parse_fit_taus, parse_level, parse_taus, parse_terms, precheck, progress,
+                   run, say, with_load_options)
 from ._tables import metrics_table, noise_table
-from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt
+from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt, model_axes_text
+
+DEFAULT_OUT = Path("out/analyze")
 
 
 @app.command()
@@ -36,7 +40,9 @@ def analyze(
     model_rate: ModelRateOpt = 1.0,
     taus: TausOpt = "octave",
     estimator: EstOpt = "overlapping",
-    terms: Annotated[str, typer.Option("--terms", help="Noise terms to fit, e.g. Q,N,B,K,R.")] = "Q,N,B,K,R",
+    terms: TermsOpt = "",
+    statistic: StatisticOpt = "adev",
+    outliers: OutliersOpt = "warn",
     fit_taus: FitTausOpt = ":",
     train_fraction: Annotated[float, typer.Option("--train-fraction", help="Chronological training share.")] = 0.6,
     val_fraction: Annotated[float, typer.Option("--val-fraction", help="Validation share (early stopping).")] = 0.2,
@@ -44,29 +50,48 @@ def analyze(
         "--causal-window", help="Window [s] of the causal (real-time) drift of the practical compensation.")] = 128.0,
     gm_window: Annotated[int, typer.Option("--gm-window", help="Rolling window [samples] of the one-step GM(1,1).")]
     = 8,
-    out: OutOpt = Path("out/analyze"),
+    heading: Annotated[bool, typer.Option(
+        "--heading/--no-heading", help="Also print the heading-error table (rolling 300-s calibrations, free-run "
+                                       "forecasts) and the filtering-artefact check of every model on the test "
+                                       "block, with the verdicts headline first.")] = False,
+    out: OutOpt = DEFAULT_OUT,
+    json_out: JsonOpt = False,
 ):
     """The whole method: Allan analysis, separation, drift models, compensation, Table 2 and an HTML report."""
     from ..pipeline import AnalysisConfig, run_analysis
     from ..report import metrics_rows, noise_row, verdict, write_report
 
-    with errors():
-        record = load.load()
-        other = load.load(apply_to) if apply_to else None
+    with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to], json_out=json_out,
+             expect=("analysis.json", "report.html")) as r:
         earth = {}
         for item in earth_axis or []:
             name, sep, orient = item.partition("=")
             if not sep:
                 raise ConfigError(f"--earth-axis must look like AXIS=ORIENTATION (e.g. gz=up), got {item!r}")
             earth[name.strip()] = orient.strip()
+        term_list = parse_terms(terms)
+        precheck(wavelet=wavelet, mode=mode, training=training, estimator=estimator, terms=term_list)
         cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
                              training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
                              model_rate_hz=model_rate or None, taus=parse_taus(taus), estimator=estimator,
-                             terms=tuple(t.upper() for t in csv_list(terms)), latitude_deg=latitude,
+                             terms=term_list, statistic=statistic, outliers=outliers, latitude_deg=latitude,
                              earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), train_fraction=train_fraction,
-                             val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window)
-        with progress("analyze") as (_, epoch_cb):
+                             val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window).validate()
+        if apply_to is not None and not apply_to.is_file():
+            raise ConfigError(f"--apply-to {apply_to}: no such file")
+        record = load.load()
+        check_model_rate(record, cfg.model_rate_hz)
+        echo_record(load, record)
+        check_plausible(record)
+        other = None
+        if apply_to:
+            other = load.load(apply_to)
+            check_model_rate(other, cfg.model_rate_hz)
+            echo_record(load, other, apply_to)
+            check_plausible(other)
+        with progress("analyze", record.axis_names) as (_, epoch_cb):
             result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb)
+        say(model_axes_text([ax.models for ax in result.axes], record))
         for res, title in ((result, load.file.name), (result.apply_to, apply_to.name if apply_to else "")):
             if res is None:
                 continue
@@ -74,10 +99,27 @@ def analyze(
                 console.print(noise_table(f"{title} axis {ax.name}: Table 2 (test block, {ax.models.dt_s:g} s "
                                           "samples; 95 % intervals)",
                                           [["original (whole record, native rate)"] + noise_row(ax.original.noise)]
-                                          + [[r.label] + noise_row(r.analysis.noise) for r in ax.table2]))
+                                          + [[row.label] + noise_row(row.analysis.noise) for row in ax.table2]))
                 console.print(metrics_table(f"{title} axis {ax.name}: one-step metrics on the test block",
                                             metrics_rows(ax.models)))
                 for line in verdict(ax.models):
-                    console.print("  " + line, highlight=False)
-        path = write_report(result, record, out)
-        console.print(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
+                    say("  " + line)
+        if heading:  # compensation evidence on the test block (fogdrift.evaluation)
+            from ..evaluation import evaluate_axis
+            from .compensate import print_evaluation
+
+            for ax in result.axes:
+                ev = evaluate_axis(ax.models, cfg)
+                for note in ev["notes"]:
+                    say("  " + note)
+                print_evaluation([ev["heading"]] if ev["heading"] else [],
+                                 [ev["artefacts"]] if ev["artefacts"] else [], ev["verdicts"])
+        path = write_report(result, record, r.out.path)
+        # the self-describing bundle 'fogdrift compensate' applies to other logs
+        from ..bundle import write_bundle
+
+        bundle = write_bundle(r.out.path / "bundle", [ax.models for ax in result.axes], cfg, record)
+        r.wrote()
+        say(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
+        say(f"bundle: {bundle.path}")
+        r.print_json(r.out.path / "analysis.json")

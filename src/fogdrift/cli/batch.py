@@ -1,4 +1,8 @@
-"""``fogdrift batch``: one command over many logs on Dask, with a Parquet summary and a fleet page."""
+"""``fogdrift batch``: one command over many logs on Dask, with a Parquet summary and a fleet page.
+
+The library side is :mod:`fogdrift.fleet`; ``--command`` takes a name of its command table
+(:data:`fogdrift.fleet.COMMANDS`), so a new batch command is one row there and needs nothing here.
+"""
 
 from __future__ import annotations
 
@@ -10,11 +14,10 @@ from typing import Annotated, Optional
 
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-from rich.text import Text
 
 from ..errors import ConfigError
-from ._app import (FLAGS, LOAD_PARAMS, EstOpt, FitTausOpt, LoadOptions, TausOpt, app, console, csv_list, err_console,
-                   errors, parse_fit_taus, parse_taus)
+from ._app import (FLAGS, LOAD_PARAMS, EstOpt, FitTausOpt, LoadOptions, OutliersOpt, StatisticOpt, TausOpt, TermsOpt,
+                   app, csv_list, err_console, parse_fit_taus, parse_taus, parse_terms, precheck, run, say)
 
 FLAGS.update({"glob": "--glob", "command": "--command", "scheduler": "--scheduler", "workers": "--workers"})
 
@@ -55,6 +58,15 @@ def _set_items(items) -> dict:
     return out
 
 
+DEFAULT_OUT = Path("out/batch")
+
+
+def _command_help() -> str:
+    from ..fleet.commands import COMMANDS  # light: the table, not the commands' libraries
+
+    return "Command per file: " + "; ".join(f"{c.name} ({c.description})" for c in COMMANDS.values()) + "."
+
+
 @app.command()
 @_with_reader_options
 def batch(
@@ -62,7 +74,7 @@ def batch(
     load,
     glob: Annotated[Optional[str], typer.Option("--glob", help="Files to take inside folders, e.g. '*.csv.gz'.")]
     = None,
-    command: Annotated[str, typer.Option("--command", help="Command per file: allan or analyze.")] = "allan",
+    command: Annotated[str, typer.Option("--command", help=_command_help())] = "allan",
     scheduler: Annotated[Optional[str], typer.Option(
         "--scheduler", help="Dask scheduler address (tcp://host:8786) of an existing cluster; 'serial' for no Dask. "
                             "Default: a local cluster of worker processes.")] = None,
@@ -70,7 +82,9 @@ def batch(
                                                                      "(default: the machine's cores).")] = None,
     estimator: EstOpt = "overlapping",
     taus: TausOpt = "octave",
-    terms: Annotated[str, typer.Option("--terms", help="Noise terms to fit, e.g. Q,N,B,K,R.")] = "Q,N,B,K,R",
+    terms: TermsOpt = "",
+    statistic: StatisticOpt = "adev",
+    outliers: OutliersOpt = "warn",
     fit_taus: FitTausOpt = ":",
     models: Annotated[Optional[str], typer.Option("--models", help="analyze: drift models (default: all).")] = None,
     model_rate: Annotated[Optional[float], typer.Option("--model-rate", help="analyze: modelling rate [Hz].")] = None,
@@ -80,16 +94,21 @@ def batch(
         "--set", help="Any other analysis setting NAME=VALUE (fogdrift.pipeline.AnalysisConfig), repeatable.")] = None,
     fail_on_error: Annotated[bool, typer.Option("--fail-on-error", help="Exit 1 if any file failed.")] = False,
     out: Annotated[Path, typer.Option("--out", help="Batch folder: one folder per file, summary.parquet, "
-                                                    "fleet.html.")] = Path("out/batch"),
+                                                    "fleet.html.")] = DEFAULT_OUT,
 ):
     """Run allan or analyze over many logs x axes on Dask; write summary.parquet and a fleet page."""
-    from ..fleet import run_batch
+    from ..fleet import BatchOutputDir, command_spec, run_batch
 
-    with errors():
+    with run("batch", out, default_out=DEFAULT_OUT, inputs=list(inputs), expect=("summary.parquet", "fleet.html"),
+             out_class=BatchOutputDir):
+        command_spec(command)
         if load.gaps not in ("error", "longest"):
-            raise ConfigError(f"--gaps must be 'error' or 'longest', got {load.gaps!r}")
+            raise ConfigError(f"{{opt:gaps}} must be 'error' or 'longest' in a batch, got {load.gaps!r}")
+        term_list = parse_terms(terms)
+        precheck(estimator=estimator, terms=term_list)
         analysis = {"taus": parse_taus(taus), "estimator": estimator, "fit_tau_s": list(parse_fit_taus(fit_taus)),
-                    "terms": [t.upper() for t in csv_list(terms)]}
+                    "terms": None if term_list is None else list(term_list), "statistic": statistic,
+                    "outliers": outliers}
         if command == "analyze":
             extra = {"models": csv_list(models), "model_rate_hz": model_rate, "epochs": epochs, "seed": seed}
             analysis.update({k: v for k, v in extra.items() if v is not None})
@@ -104,15 +123,14 @@ def batch(
                 bar.update(task, completed=done, total=total, description=f"batch {command}: {name}")
 
             result = run_batch(inputs, out, command=command, settings=settings, pattern=glob, scheduler=scheduler,
-                               workers=workers, progress=progress)
-        console.print(f"{result.n_files} files on {result.scheduler} in {result.wall_s:.1f} s: {result.n_ok} done, "
-                      f"{result.n_cached} unchanged (skipped), {result.n_error} failed", highlight=False)
+                               workers=workers, progress=progress, flags=FLAGS)
+        say(f"{result.n_files} files on {result.scheduler} in {result.wall_s:.1f} s: {result.n_ok} done, "
+            f"{result.n_cached} unchanged (skipped), {result.n_error} failed")
         for row in result.rows:
             if row.get("status") == "error":
-                err_console.print(Text(f"  {row['file']}: {row.get('error')}", style="red"), highlight=False,
-                                  soft_wrap=True)
-        console.print(f"summary: {result.summary_path}", highlight=False)
+                say(f"  {row['file']}: {row.get('error')}", style="red")
+        say(f"summary: {result.summary_path}")
         if result.page_path is not None:
-            console.print(f"fleet page: {result.page_path}", highlight=False)
+            say(f"fleet page: {result.page_path}")
         if fail_on_error and result.n_error:
             raise typer.Exit(code=1)

@@ -7,14 +7,16 @@ from typing import Annotated
 
 import typer
 
-from ._app import (LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app, console, csv_list, errors,
-                   parse_level, progress, with_load_options)
+from ._app import (JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app, check_model_rate,
+                   check_plausible, console, csv_list, echo_record, parse_level, precheck, progress, run, say,
+                   with_load_options)
 from ._tables import metrics_table
 
 from ..models import MODEL_NAMES, describe_models
 
 #: Default of --models: every registered model, in report order.
 ALL_MODELS = ",".join(MODEL_NAMES)
+DEFAULT_OUT = Path("out/model")
 ModelsOpt = Annotated[str, typer.Option(
     "--models", help="Comma-separated drift models (any case): " + "; ".join(describe_models()) + ".")]
 HiddenOpt = Annotated[int, typer.Option("--hidden", help="Elman hidden units.")]
@@ -22,6 +24,20 @@ LagsOpt = Annotated[int, typer.Option("--lags", help="Input lags p of Elman/grey
 EpochsOpt = Annotated[int, typer.Option("--epochs", help="Maximum training epochs (early stopping on validation).")]
 SeedOpt = Annotated[int, typer.Option("--seed", help="Random seed.")]
 TrainingOpt = Annotated[str, typer.Option("--training", help="bptt (Adam) or bp (classic traingdx).")]
+
+
+def model_axes_text(model_axes, record) -> str:
+    """One line: the modelling rate and the bias (and Earth rate) removed from each axis before modelling."""
+    from .separate import modelling_rate_text
+
+    parts = []
+    for ma in model_axes:
+        text = f"{ma.name} {ma.bias_dph:.6g} deg/h"
+        if ma.earth_rate_dph:
+            text += f" + Earth rate {ma.earth_rate_dph:.6g} deg/h"
+        parts.append(text)
+    return (f"modelling rate {modelling_rate_text(record, model_axes[0].dt_s)}; removed before modelling, the "
+            f"training-block mean of each axis: {', '.join(parts)}")
 
 
 @app.command()
@@ -38,24 +54,36 @@ def model(
     level: LevelOpt = "4",
     mode: ModeOpt = "symmetric",
     model_rate: ModelRateOpt = 1.0,
-    out: OutOpt = Path("out/model"),
+    out: OutOpt = DEFAULT_OUT,
+    json_out: JsonOpt = False,
 ):
     """Fit drift models on the training block and compare them on the test block."""
     from ..pipeline import AnalysisConfig, run_models
     from ..report import causal_metrics_rows, metrics_rows, verdict, write_model_outputs
 
-    with errors():
-        record = load.load()
+    with run("model", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
+             expect=("metrics.json",)) as r:
+        precheck(wavelet=wavelet, mode=mode, training=training)
         cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
                              training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
-                             model_rate_hz=model_rate or None)
-        with progress("model") as (_, epoch_cb):
+                             model_rate_hz=model_rate or None).validate()
+        record = load.load()
+        check_model_rate(record, cfg.model_rate_hz)
+        echo_record(load, record)
+        check_plausible(record)
+        with progress("model", record.axis_names) as (_, epoch_cb):
             results = run_models(record, cfg, progress=epoch_cb)
+        say(model_axes_text(results, record))
         for ma in results:
             console.print(metrics_table(f"axis {ma.name}: one-step metrics on the test block "
                                         f"(target: wavelet drift), dt {ma.dt_s:g} s", metrics_rows(ma)))
             console.print(metrics_table(f"axis {ma.name}: target = causal drift", causal_metrics_rows(ma)))
             for line in verdict(ma):
-                console.print("  " + line, highlight=False)
-        write_model_outputs(results, out)
-        console.print(f"wrote models, metrics.json and figures to {out}")
+                say("  " + line)
+        write_model_outputs(results, r.out.path)
+        # the self-describing bundle 'fogdrift compensate' applies to other logs
+        from ..bundle import write_bundle
+
+        say(f"bundle: {write_bundle(r.out.path / 'bundle', results, cfg, record).path}")
+        r.wrote()
+        r.print_json(r.out.path / "metrics.json")

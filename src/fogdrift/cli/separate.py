@@ -4,9 +4,21 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._app import (LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, console, errors,
-                   parse_level, parse_taus, with_load_options)
+from ._app import (JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, check_model_rate,
+                   check_plausible, console, echo_record, parse_level, parse_taus, precheck, progress, run, say,
+                   with_load_options)
 from ._tables import noise_table
+
+DEFAULT_OUT = Path("out/separate")
+
+
+def modelling_rate_text(record, dt_s: float) -> str:
+    """'1 Hz (100 Hz block-averaged in blocks of 100)' or '100 Hz (the native rate)'."""
+    fs = 1.0 / dt_s
+    k = int(round(record.fs_hz * dt_s))
+    if k <= 1:
+        return f"{fs:.6g} Hz (the native rate)"
+    return f"{fs:.6g} Hz ({record.fs_hz:.6g} Hz block-averaged in blocks of {k})"
 
 
 @app.command()
@@ -18,24 +30,35 @@ def separate(
     mode: ModeOpt = "symmetric",
     model_rate: ModelRateOpt = 1.0,
     taus: TausOpt = "octave",
-    out: OutOpt = Path("out/separate"),
+    out: OutOpt = DEFAULT_OUT,
+    json_out: JsonOpt = False,
 ):
     """Lifting-wavelet separation into drift (approximation) and white noise (details)."""
     from ..pipeline import AnalysisConfig, run_separation
     from ..report import noise_row, write_separation_outputs
 
-    with errors():
-        record = load.load()
+    with run("separate", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
+             expect=("separation.npz", "separation.csv", "separation_table.csv", "separation.json")) as r:
+        precheck(wavelet=wavelet, mode=mode)
         cfg = AnalysisConfig(wavelet=wavelet, level=parse_level(level), mode=mode,
-                             model_rate_hz=model_rate or None, taus=parse_taus(taus))
-        seps = run_separation(record, cfg)
+                             model_rate_hz=model_rate or None, taus=parse_taus(taus)).validate()
+        record = load.load()
+        check_model_rate(record, cfg.model_rate_hz)
+        echo_record(load, record)
+        check_plausible(record)
+        with progress("separate", record.axis_names):
+            seps = run_separation(record, cfg)
+        removed = ", ".join(f"{s.name} {s.mean_removed_dph:.6g} deg/h" for s in seps)
+        say(f"modelling rate {modelling_rate_text(record, seps[0].dt_s)}; the mean of each axis was removed before "
+            f"separating (a constant would go wholly into the drift): {removed}")
         for s in seps:
             console.print(noise_table(
                 f"axis {s.name}: {wavelet} level {s.level}, {mode}, dt {s.dt_s:g} s "
                 f"(max |drift + noise - input| = {abs(s.drift_dph + s.noise_dph - s.rate_dph).max():.2e} deg/h)",
                 [[label] + noise_row(aa.noise) for label, aa in s.rows]))
             if s.level_scan:
-                console.print("  level scan: " + "; ".join(
+                say("  level scan: " + "; ".join(
                     f"L{d.level}: noise slope {d.noise_adev_slope:+.2f}" for d in s.level_scan))
-        write_separation_outputs(seps, out)
-        console.print(f"wrote drift/noise series, figures and tables to {out}")
+        write_separation_outputs(seps, r.out.path)
+        r.wrote()
+        r.print_json(r.out.path / "separation.json")

@@ -17,8 +17,8 @@ The out-of-core Allan variance for single logs larger than memory is :mod:`fogdr
 """
 
 from .commands import COMMANDS, CommandSpec, command_spec
-from .runner import BatchResult, find_inputs, run_batch, settings_sha256
+from .runner import BatchOutputDir, BatchResult, find_inputs, run_batch, settings_sha256
 from .summary import COLUMNS, read_summary, write_summary
 
-__all__ = ["run_batch", "BatchResult", "find_inputs", "settings_sha256", "COMMANDS", "CommandSpec",
+__all__ = ["run_batch", "BatchResult", "BatchOutputDir", "find_inputs", "settings_sha256", "COMMANDS", "CommandSpec",
            "command_spec", "COLUMNS", "read_summary", "write_summary"]

@@ -2,16 +2,23 @@
 
 A command is a function ``run(record, settings, out_dir) -> list[dict]`` that calls the same library and
 report functions as the single command (so each file's folder holds what ``fogdrift allan`` or ``fogdrift
-analyze`` would write there) and returns one summary row per axis (:mod:`.summary` names the columns).
-Adding a command (the GMWM ``noise`` command, when it lands) is one function and one :class:`CommandSpec`
-row::
+analyze`` would write there) and returns one summary row per axis (:mod:`.summary` names the columns; a
+noise fit fills them with :func:`noise_columns`).  It runs inside the file's own
+:class:`~fogdrift.output.OutputDir`, so every file it writes through :func:`~fogdrift.output.atomic_path`
+(as the report functions do) is complete or absent.  Adding a command (the GMWM ``noise`` command, when it
+lands) is one function and one row of :data:`COMMANDS`::
 
-    COMMANDS["noise"] = CommandSpec("noise", run_noise, "GMWM noise model", settings=("gmwm",))
+    def run_noise_command(record, settings, out_dir):
+        results = ...                       # the calls `fogdrift noise` makes, writing into out_dir
+        return [{"axis": a.name, **record_columns(record), **noise_columns(a.noise)} for a in results]
+
+    COMMANDS["noise"] = CommandSpec("noise", run_noise_command, "GMWM noise model of every axis")
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 from ..errors import ConfigError
@@ -62,25 +69,28 @@ def record_columns(record) -> dict:
 
 
 def noise_columns(noise) -> dict:
-    """Summary columns of one noise fit: each coefficient with its 95 % interval and estimability, fit quality.
+    """Summary columns of one noise fit (:class:`fogdrift.noise.NoiseFit`).
 
-    ``noise_model`` is the set of terms whose 95 % interval excludes zero (``"N+B+K"``): the noise
-    model the data resolve.
+    Each coefficient with its 95 % interval and status (``resolved``, ``unresolved``, ``absent`` with
+    ``hi95`` its upper bound, ``not_estimable``); the selected model (``noise_model``, e.g. ``"N+B+K"``)
+    and the plausible ones; the fit's quality, chi-squared, dof, p-value and tau range; the IEEE reading of
+    the bias instability at the curve's minimum.
     """
     row = {}
-    resolved = []
     for name, unit in TERMS:
         term = noise.terms[name]
         row[f"{name}_{unit}"] = _f(term.value)
         row[f"{name}_lo95_{unit}"] = _f(term.lo95)
         row[f"{name}_hi95_{unit}"] = _f(term.hi95)
-        row[f"{name}_estimable"] = bool(term.estimable)
-        if term.estimable and term.lo95 is not None and term.lo95 > 0:
-            resolved.append(name)
-    row.update(noise_model="+".join(resolved) or "none", fit_method=str(noise.method),
-               fit_chi2_red=_f(noise.chi2_red), fit_n_points=int(noise.n_points),
-               fit_tau_min_s=_f(noise.tau_min_s), fit_tau_max_s=_f(noise.tau_max_s),
-               fitted_terms="+".join(noise.fitted_terms))
+        row[f"{name}_status"] = str(term.status)
+    b = noise.b_min or {}
+    row.update(statistic=str(noise.statistic), noise_model="+".join(noise.selected) or "none",
+               plausible_models="; ".join(noise.plausible) or None, fit_quality=str(noise.quality),
+               fit_chi2_red=_f(noise.chi2_red), fit_dof=int(noise.dof), fit_p_value=_f(noise.p_value),
+               fit_n_points=int(len(noise.fit_tau_s)), fit_tau_min_s=_f(noise.tau_min_s),
+               fit_tau_max_s=_f(noise.tau_max_s), b_min_dph=_f(b.get("value")), b_min_tau_s=_f(b.get("tau_s")),
+               b_min_bound_only=None if b.get("value") is None else bool(b.get("bound_only")),
+               outliers=None if not noise.outliers else int(noise.outliers.get("count") or 0))
     return row
 
 
@@ -91,7 +101,11 @@ def _config(settings: dict):
 
 
 def run_allan_command(record, settings: dict, out_dir) -> list[dict]:
-    """``fogdrift allan`` on one record: ``allan.json``, ``allan.csv``, ``allan.png`` and one row per axis."""
+    """``fogdrift allan`` on one record: ``allan.json``, ``allan.csv``, ``allan.png`` and one row per axis.
+
+    The same calls as the ``allan`` command (:func:`fogdrift.pipeline.run_allan`,
+    :func:`fogdrift.report.write_allan_outputs`), so the files are the ones it writes.
+    """
     from ..pipeline import run_allan
     from ..report import write_allan_outputs
 
@@ -101,12 +115,16 @@ def run_allan_command(record, settings: dict, out_dir) -> list[dict]:
 
 
 def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
-    """``fogdrift analyze`` on one record: ``report.html``, ``analysis.json`` and one row per axis with the verdict."""
+    """``fogdrift analyze`` on one record: ``report.html``, ``analysis.json``, the model ``bundle/`` and one row
+    per axis with the verdict."""
+    from ..bundle import write_bundle
     from ..pipeline import run_analysis
     from ..report import verdict, write_report
 
-    result = run_analysis(record, _config(settings))
+    cfg = _config(settings)
+    result = run_analysis(record, cfg)
     write_report(result, record, out_dir)
+    write_bundle(Path(out_dir) / "bundle", [ax.models for ax in result.axes], cfg, record)
     return [{"axis": ax.name, **record_columns(record), **noise_columns(ax.original.noise),
              "verdict": " ".join(verdict(ax.models))} for ax in result.axes]
 

@@ -1,14 +1,14 @@
 """The fleet page: one self-contained HTML file with a control chart per coefficient across the files.
 
-For every IEEE-952 coefficient that any file resolves, one figure with a panel per axis name: each file's
+For every IEEE-952 coefficient that any file's selected noise model contains, one figure with a panel per axis name: each file's
 estimate with its 95 % interval, the fleet mean and the mean +- 3 sigma lines (sigma: the sample standard
 deviation across the files of that axis).  A file is named an outlier when its estimate lies more than
 3 sigma from the mean of the *other* files (leave-one-out): with the point itself in the mean and sigma, no
 point of a fleet of n <= 10 can ever lie beyond 3 sigma (the largest possible |z| is (n - 1)/sqrt(n)), so
 the plain rule would never fire on a small fleet.  A file whose own 95 % interval contains the mean of the
 others is not named, however tight the fleet: its difference is within its measurement uncertainty.
-Not-estimable coefficients are drawn as open triangles
-at their 95 % upper bound and take no part in the statistics.  Figures are embedded as base64 PNG: the page
+A coefficient that is not in a file's selected model (or not estimable from it) is drawn as an open
+triangle at its 95 % upper bound and takes no part in the statistics.  Figures are embedded as base64 PNG: the page
 fetches nothing.
 """
 
@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..output import atomic_path
 from .commands import TERMS
 from .summary import UNITS
 
@@ -179,7 +180,8 @@ def write_fleet_page(rows: list[dict], path, *, command: str = "", settings: dic
              f"Control limits: fleet mean ± {SIGMA:g}σ per axis (σ = sample s.d. across files); a file is named an "
              f"outlier when it lies more than {SIGMA:g}σ from the mean of the other files (leave-one-out) and its own "
              "95 % interval excludes that mean. "
-             "Open triangles: not estimable, drawn at the 95 % upper bound.</p>"]
+             "Open triangles: not in that file's selected noise model (or not estimable), drawn at the 95 % upper "
+             "bound.</p>"]
     flagged_all = []
     for name, unit in TERMS:
         chart = _chart(good, name, unit, axes_names) if axes_names else None
@@ -194,7 +196,7 @@ def write_fleet_page(rows: list[dict], path, *, command: str = "", settings: dic
                  else '<p class="note">None.</p>')
     parts.append("<h2>Summary</h2>")
     cols = ["file", "axis", "status", "duration_s", "rate_hz"] + [f"{n}_{u}" for n, u in TERMS] + \
-           ["noise_model", "fit_chi2_red"]
+           ["noise_model", "fit_quality", "fit_chi2_red"]
     if any(r.get("verdict") for r in good):
         cols.append("verdict")
     if any(r.get("temperature_range_c") is not None for r in good):
@@ -208,6 +210,6 @@ def write_fleet_page(rows: list[dict], path, *, command: str = "", settings: dic
     doc = (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>fogdrift fleet</title>"
            f"<style>{_CSS}</style></head><body>{''.join(parts)}</body></html>")
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(doc, encoding="utf-8")
+    with atomic_path(path) as tmp:
+        tmp.write_text(doc, encoding="utf-8")
     return path

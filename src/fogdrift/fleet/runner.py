@@ -11,10 +11,19 @@ Scheduling (``scheduler``):
 
 Each file is one task (:func:`fogdrift.fleet.tasks.run_file`); a task that fails, or a worker that dies,
 becomes an error row, never a crashed batch.  Results are collected as they finish (``progress``).
+
+Outputs: the batch folder is a :class:`BatchOutputDir` (a :class:`fogdrift.output.OutputDir` that also
+counts the files whose folders are finished); each file's folder is its own ``OutputDir`` (written by the
+worker, ``batch.json`` last); ``summary.parquet`` and ``fleet.html`` are written through
+:func:`~fogdrift.output.atomic_path` after every file has finished.  An interruption (Ctrl-C,
+:mod:`fogdrift.interrupt`) stops the batch: finished folders stay complete (a re-run skips them), unfinished
+ones have no ``batch.json``, and no summary or page is written.  Local workers ignore SIGINT (a Ctrl-C in
+the terminal reaches the whole process group): the batch process alone decides, and its workers end with it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import glob as _glob
 import hashlib
 import json
@@ -26,13 +35,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
+from .. import interrupt
 from ..errors import ConfigError
 from ..io.readers.base import require
+from ..output import OutputDir, active
 from .commands import command_spec
 from .summary import COLUMNS, write_summary
-from .tasks import FileTask, run_file
+from .tasks import MANIFEST, FileTask, run_file
 
-__all__ = ["BatchResult", "run_batch", "find_inputs", "settings_sha256", "SUMMARY", "PAGE"]
+__all__ = ["BatchResult", "BatchOutputDir", "run_batch", "find_inputs", "settings_sha256", "SUMMARY", "PAGE"]
+
+#: Seconds to wait for an existing cluster's scheduler (``scheduler="tcp://..."``) before giving up.
+CONNECT_TIMEOUT_S = 20.0
 
 #: File names written into the batch folder.
 SUMMARY = "summary.parquet"
@@ -53,6 +67,64 @@ class BatchResult:
     wall_s: float
     scheduler: str
     notes: list = field(default_factory=list)
+
+
+class BatchOutputDir(OutputDir):
+    """The batch folder: an :class:`~fogdrift.output.OutputDir` whose :meth:`summary` also says which files'
+    folders are finished (the workers write those, each as its own ``OutputDir``).
+
+    :func:`run_batch` calls :meth:`start` with the number of files and :meth:`finished_file` as each
+    file's folder is complete; the CLI's Ctrl-C line is :meth:`summary`.
+    """
+
+    def __init__(self, path, **kwargs):
+        super().__init__(path, **kwargs)
+        self.tasks: list = []
+        self.finished: list[str] = []
+        self._t0 = 0.0
+
+    def start(self, tasks) -> None:
+        """The batch's :class:`~fogdrift.fleet.tasks.FileTask` list (before any is run)."""
+        self.tasks = list(tasks)
+        self.finished = []
+        self._t0 = time.time()
+
+    def finished_file(self, rel_out: str) -> None:
+        """A task's result arrived (its folder holds ``batch.json``, or it was unchanged)."""
+        if rel_out not in self.finished:
+            self.finished.append(rel_out)
+
+    def finished_files(self) -> list[str]:
+        """Folders finished in this run: reported, or holding a ``batch.json`` of these settings written since
+        the batch started (a worker may have finished a file its result has not yet reached us for)."""
+        done = list(self.finished)
+        for t in self.tasks:
+            if t.rel_out in done:
+                continue
+            man = Path(t.out_dir) / MANIFEST
+            try:
+                fresh = man.stat().st_mtime >= self._t0 - 1.0
+                same = fresh and json.loads(man.read_text()).get("settings_sha256") == t.settings_sha256
+            except (OSError, ValueError, AttributeError):
+                same = False
+            if same:
+                done.append(t.rel_out)
+        return done
+
+    def summary(self) -> str:
+        if not self.tasks:
+            return super().summary()
+        finished = self.finished_files()
+        k, n = len(finished), len(self.tasks)
+        shown = ", ".join(finished[:4]) + (f" and {k - 4} more" if k > 4 else "")
+        text = (f"{k} of {n} files finished" + (f" ({shown}: their folders in {self.path} are complete and a "
+                                                   "re-run skips them)" if k else "")
+                + (f"; {n - k} not finished (no batch.json: a re-run computes them)" if k < n else ""))
+        top = [name for name in (SUMMARY, PAGE) if name not in self.written]
+        if top:
+            earlier = " (the earlier run's are unchanged)" if any((self.path / t).exists() for t in top) else ""
+            text += f"; {' and '.join(top)} not written{earlier}"
+        return text + "; no partial file left"
 
 
 def settings_sha256(command: str, settings: dict) -> str:
@@ -131,7 +203,7 @@ def _error_rows(task: FileTask, exc: BaseException) -> list[dict]:
 
 def run_batch(inputs, out_dir, *, command: str = "allan", settings: dict | None = None, pattern: str | None = None,
               scheduler: str | None = None, workers: int | None = None, page: bool = True,
-              progress: Callable | None = None) -> BatchResult:
+              progress: Callable | None = None, flags: dict | None = None) -> BatchResult:
     """Run ``command`` over every input; write per-file folders, ``summary.parquet`` and ``fleet.html``.
 
     Parameters
@@ -140,7 +212,8 @@ def run_batch(inputs, out_dir, *, command: str = "allan", settings: dict | None 
         Files, folders (with ``pattern``), ROS 2 bag directories or wildcards.
     out_dir : str or Path
         Batch folder: ``<out_dir>/<file>/`` per input (as the single command writes it, plus
-        ``batch.json``), ``summary.parquet`` and ``fleet.html``.
+        ``batch.json``), ``summary.parquet`` and ``fleet.html``.  Checked before any work; its parent
+        must exist.
     command : str
         A name of :data:`fogdrift.fleet.commands.COMMANDS` (``"allan"``, ``"analyze"``).
     settings : dict, optional
@@ -156,6 +229,8 @@ def run_batch(inputs, out_dir, *, command: str = "allan", settings: dict | None 
         Write ``fleet.html``.
     progress : callable, optional
         ``progress(done, total, file)`` after each file.
+    flags : dict, optional
+        How error messages spell a setting (``{"unit": "--unit"}``; default ``unit=``).
 
     Returns
     -------
@@ -164,26 +239,45 @@ def run_batch(inputs, out_dir, *, command: str = "allan", settings: dict | None 
     Raises
     ------
     ConfigError
-        Unknown command, invalid settings, no inputs, or a scheduler that cannot be reached.
+        Unknown command, invalid settings, no inputs, a bad output folder, or a scheduler that cannot
+        be reached.
+    fogdrift.interrupt.Interrupted
+        An interruption was requested (see the module docstring for what is left on disk).
     """
     t0 = time.perf_counter()
     spec = command_spec(command)
     settings = json.loads(json.dumps(settings or {}, default=str))     # plain, picklable, hashable
     _validate(settings)
     paths = find_inputs(inputs, pattern)
-    out = Path(out_dir).resolve()
-    out.mkdir(parents=True, exist_ok=True)
+    own = active(out_dir)
+    if own is not None and own.path == Path(out_dir).expanduser().absolute():
+        frame = contextlib.nullcontext(own)      # the caller's frame (the CLI) already holds the folder
+    else:
+        frame = BatchOutputDir(out_dir, command=f"batch {spec.name}", create_parents=False, protect=paths)
+    with frame as od:
+        return _run(od, paths, spec, settings, scheduler, workers, page, progress, flags, t0)
+
+
+def _run(od, paths, spec, settings, scheduler, workers, page, progress, flags, t0) -> BatchResult:
+    out = od.path
     digest = settings_sha256(spec.name, settings)
     names = _names(paths)
     tasks = [FileTask(path=str(p), file=n, out_dir=str(out / _folder(n)), rel_out=_folder(n), command=spec.name,
-                      settings=settings, settings_sha256=digest) for p, n in zip(paths, names)]
+                      settings=settings, settings_sha256=digest, flags=flags) for p, n in zip(paths, names)]
     results: dict[int, list] = {}
+    if isinstance(od, BatchOutputDir):
+        od.start(tasks)
+    od.expect(SUMMARY, *((PAGE,) if page else ()))
 
     def done(i, rows):
         results[i] = rows
+        if isinstance(od, BatchOutputDir) and (Path(tasks[i].out_dir) / MANIFEST).exists():
+            od.finished_file(tasks[i].rel_out)
         if progress is not None:
             progress(len(results), len(tasks), tasks[i].file)
+        interrupt.check()
 
+    interrupt.check()
     if scheduler == "serial":
         used = "serial (in-process loop)"
         for i, task in enumerate(tasks):
@@ -232,25 +326,63 @@ def _validate(settings: dict) -> None:
         raise ConfigError(f"unknown analysis setting: {exc}") from None
 
 
+def _quiet_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker (if this process has none yet) with its leak warning off.
+
+    The local cluster's process handles hold semaphores; when a Ctrl-C ends this process before the cluster
+    has closed, the tracker removes them, as it should, and would print a ``UserWarning`` about "leaked
+    semaphore objects" to the terminal after the one ``interrupted:`` line.  The tracker takes its warning
+    filters from this process's ``sys.warnoptions`` when it starts.
+    """
+    import sys
+    from multiprocessing import resource_tracker
+
+    if getattr(resource_tracker._resource_tracker, "_fd", None) is not None:  # already running: leave it
+        return
+    saved = list(sys.warnoptions)
+    sys.warnoptions.append("ignore:resource_tracker:UserWarning")
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        sys.warnoptions[:] = saved
+
+
+def _ignore_sigint() -> bool:
+    """In a local worker process: ignore SIGINT (the batch process alone handles Ctrl-C; see the module docstring)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        return True
+    return False
+
+
 def _run_dask(tasks, scheduler, workers, done) -> str:
     distributed = require("distributed", "fleet", "running a batch on Dask")
-    cluster = None
-    if scheduler:
-        try:
-            client = distributed.Client(scheduler, timeout="20s")
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ConfigError(f"cannot reach the Dask scheduler {scheduler!r}: {exc}; check {{opt:scheduler}}") \
-                from None
-        used = f"Dask cluster at {scheduler}"
-    else:
-        n = int(workers or os.cpu_count() or 1)
-        if n < 1:
-            raise ConfigError(f"workers must be >= 1; got {workers!r} in {{opt:workers}}")
-        cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                           dashboard_address=None, silence_logs=logging.ERROR, env=_worker_env(n))
-        client = distributed.Client(cluster)
-        used = f"local Dask cluster, {n} worker processes"
+    cluster = client = None
+    interrupted = False
     try:
+        if scheduler:
+            try:
+                client = distributed.Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S:g}s")
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise ConfigError(f"cannot reach the Dask scheduler {scheduler!r}: {exc}; check {{opt:scheduler}}") \
+                    from None
+            used = f"Dask cluster at {scheduler}"
+        else:
+            n = int(workers or os.cpu_count() or 1)
+            if n < 1:
+                raise ConfigError(f"workers must be >= 1; got {workers!r} in {{opt:workers}}")
+            with _sigint_blocked_for_children():
+                _quiet_resource_tracker()
+                cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                                   host="127.0.0.1", dashboard_address=None,
+                                                   silence_logs=logging.ERROR, env=_worker_env(n))
+                client = distributed.Client(cluster)
+                client.run(_ignore_sigint)               # each worker process's main thread
+            used = f"local Dask cluster, {n} worker processes"
+        interrupt.check()                                # a Ctrl-C while the cluster started
         futures = {client.submit(run_file, t, pure=False, key=f"fogdrift-{i}-{t.settings_sha256[:8]}"): i
                    for i, t in enumerate(tasks)}
         for fut in distributed.as_completed(futures):
@@ -260,8 +392,69 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
             except Exception as exc:  # noqa: BLE001 -- a killed worker, a lost task: an error row
                 rows = _error_rows(tasks[i], exc)
             done(i, rows)
+    except KeyboardInterrupt:
+        interrupted = True
+        if cluster is not None:                      # our own workers: stop them now, then tidy their folders
+            _kill_workers(cluster)
+            _remove_temporaries(tasks)
+        raise
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        _close(client, cluster, quick=interrupted)
     return used
+
+
+@contextlib.contextmanager
+def _sigint_blocked_for_children():
+    """Block SIGINT in this thread while the local cluster starts, so that the threads it creates, and the
+    processes they spawn, start with SIGINT blocked: a Ctrl-C in the terminal (sent to the whole process
+    group) then never reaches a worker that is still importing (it would print a traceback).  This process
+    still gets the signal (another thread takes it; the interruption flag is checked right after)."""
+    import signal
+    import threading
+
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _kill_workers(cluster) -> None:
+    """SIGKILL the worker processes of a local cluster (their tasks cannot be stopped any other way)."""
+    import signal
+
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        with contextlib.suppress(Exception):
+            os.kill(nanny.process.process.pid, signal.SIGKILL)
+
+
+def _remove_temporaries(tasks) -> None:
+    """Remove the temporary files killed workers left in the files' folders (never a complete file)."""
+    from ..output import TMP_PREFIX
+
+    for task in tasks:
+        folder = Path(task.out_dir)
+        for tmp in (folder.rglob(TMP_PREFIX + "*") if folder.is_dir() else ()):
+            if tmp.is_file() and not tmp.name.startswith(f"{TMP_PREFIX}{os.getpid()}-"):
+                with contextlib.suppress(OSError):
+                    tmp.unlink()
+
+
+def _close(client, cluster, *, quick: bool) -> None:
+    """Close the client and the local cluster; after an interruption, without waiting for running tasks.
+
+    The local workers are child processes that end when this process does (distributed's parent-alive
+    pipe), so a quick close never leaves a worker behind.
+    """
+    kwargs = {"timeout": 2} if quick else {}
+    if client is not None:
+        with contextlib.suppress(Exception):
+            if quick and client.futures:
+                client.cancel(list(client.futures.values()), force=True)
+            client.close(**kwargs)
+    if cluster is not None:
+        with contextlib.suppress(Exception):
+            cluster.close(**kwargs)

@@ -5,6 +5,8 @@ schema is fixed (every column present, nullable) so that DuckDB and pandas see t
 batch succeeded, partly failed or was cached::
 
     duckdb -c "SELECT file, axis, N_dprh, N_lo95_dprh, N_hi95_dprh FROM 'out/summary.parquet' WHERE status <> 'error'"
+
+The file is written through :func:`fogdrift.output.atomic_path`: complete or absent.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..io.readers.base import require
+from ..output import atomic_path
 from .commands import TERMS
 
 __all__ = ["COLUMNS", "UNITS", "write_summary", "read_summary", "schema"]
@@ -37,19 +40,26 @@ COLUMNS: tuple = (
     ("temperature_range_c", "float", "deg C"),
     ("temperature_change_c", "float", "deg C, end minus start of the log"),
     ("temperature_slope_c_per_h", "float", "deg C/h, least-squares slope"),
+    ("statistic", "str", "Allan-family statistic of the noise fit: adev, hdev or mdev"),
     *[c for name, unit in TERMS for c in (
-        (f"{name}_{unit}", "float", f"{name} estimate"),
+        (f"{name}_{unit}", "float", f"{name} estimate (null when not in the selected model)"),
         (f"{name}_lo95_{unit}", "float", f"{name} 95 % lower bound"),
-        (f"{name}_hi95_{unit}", "float", f"{name} 95 % upper bound"),
-        (f"{name}_estimable", "bool", f"{name} estimable from this record"),
+        (f"{name}_hi95_{unit}", "float", f"{name} 95 % upper bound (for an absent term: its upper bound)"),
+        (f"{name}_status", "str", f"{name}: resolved, unresolved, absent or not_estimable"),
     )],
-    ("noise_model", "str", "terms whose 95 % interval excludes zero, e.g. N+B+K"),
-    ("fitted_terms", "str", "terms fitted"),
-    ("fit_method", "str", "noise-fit method"),
+    ("noise_model", "str", "selected noise model, e.g. N+B+K"),
+    ("plausible_models", "str", "models within the selection window of the best, '; '-separated"),
+    ("fit_quality", "str", "good, acceptable or poor"),
     ("fit_chi2_red", "float", "reduced chi-squared of the noise fit"),
+    ("fit_dof", "int", "degrees of freedom of the noise fit"),
+    ("fit_p_value", "float", "p-value of the noise fit's chi-squared"),
     ("fit_n_points", "int", "taus in the noise fit"),
     ("fit_tau_min_s", "float", "s"),
     ("fit_tau_max_s", "float", "s"),
+    ("b_min_dph", "float", "deg/h, bias instability read at the minimum of the fitted ADEV (IEEE-952 practice)"),
+    ("b_min_tau_s", "float", "s, tau of that minimum"),
+    ("b_min_bound_only", "bool", "true when the fitted ADEV still falls at the longest tau (b_min is a bound)"),
+    ("outliers", "int", "samples beyond the outlier threshold"),
     ("verdict", "str", "analyze: which drift model beat persistence on the test block"),
     ("wall_s", "float", "s, processing time of the file (0 when cached)"),
     ("settings_sha256", "str", "SHA-256 of the command and its settings (re-runs skip unchanged files)"),
@@ -85,8 +95,8 @@ def write_summary(rows: list[dict], path) -> Path:
             raise KeyError(f"summary row has unknown columns {sorted(extra)}")
     table = pa.Table.from_pylist([{n: row.get(n) for n in sch.names} for row in rows], schema=sch)
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    pq.write_table(table, path)
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp)
     return path
 
 

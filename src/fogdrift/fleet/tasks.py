@@ -2,9 +2,13 @@
 
 :func:`run_file` is what each Dask task (or the serial loop) calls; it never raises for a bad file: a
 :class:`~fogdrift.errors.FogdriftError` or any other exception becomes one row with ``status = "error"``.
-Each file's folder holds the command's outputs and ``batch.json`` (SHA-256 of the file, SHA-256 of the
-settings, the rows), which lets a re-run skip the file when both are unchanged.  Unexpected exceptions
-(a bug, memory) are not cached and write ``error.txt`` with the traceback.
+
+Each file's folder is its own :class:`fogdrift.output.OutputDir`: every file in it is written under a
+temporary name and renamed when complete, the previous run's files there are replaced at the first write,
+and ``batch.json`` (SHA-256 of the input, SHA-256 of the settings, the rows) is written **last**.  So a
+folder with ``batch.json`` is complete; a file interrupted or killed half-way has none, and the next run
+recomputes it.  A re-run skips a file when ``batch.json`` names the same SHA-256 and settings.  Unexpected
+exceptions (a bug, memory) are not cached and write ``error.txt`` with the traceback.
 """
 
 from __future__ import annotations
@@ -20,7 +24,7 @@ from ..errors import FogdriftError
 
 __all__ = ["FileTask", "run_file", "load_record", "MANIFEST"]
 
-#: Name of the per-file manifest.
+#: Name of the per-file manifest, written last.
 MANIFEST = "batch.json"
 
 
@@ -35,6 +39,7 @@ class FileTask:
     command: str
     settings: dict       # {"load": {...}, "gaps": "error"|"longest", "analysis": {...}}
     settings_sha256: str
+    flags: dict | None = None   # {opt:NAME} -> how messages spell a setting (the CLI's flags), else NAME=
 
 
 def load_record(path, settings: dict):
@@ -53,13 +58,14 @@ def _base(task: FileTask, sha256) -> dict:
             "out_dir": task.rel_out, "settings_sha256": task.settings_sha256}
 
 
-def _cached(task: FileTask, sha256: str):
+def cached_rows(task: FileTask, sha256: str):
+    """The rows of the file's ``batch.json`` when it names ``sha256`` and the task's settings, else None."""
     man = Path(task.out_dir) / MANIFEST
     try:
         doc = json.loads(man.read_text())
     except (OSError, ValueError):
         return None
-    if doc.get("sha256") != sha256 or doc.get("settings_sha256") != task.settings_sha256:
+    if not isinstance(doc, dict) or doc.get("sha256") != sha256 or doc.get("settings_sha256") != task.settings_sha256:
         return None
     rows = doc.get("rows") or []
     for row in rows:
@@ -70,46 +76,64 @@ def _cached(task: FileTask, sha256: str):
     return rows
 
 
+def _plausibility(record, flags) -> list[str]:
+    """The plausibility findings the single commands print as warnings (a likely wrong unit or time unit)."""
+    from ..plausibility import check_record
+
+    return [f"implausible: {f.render(flags)}" for f in check_record(record)]
+
+
+def _warning_text(w, flags) -> str:
+    from ..errors import render_options
+
+    return f"{w.category.__name__}: {render_options(str(w.message), flags)}"
+
+
 def run_file(task: FileTask) -> list[dict]:
-    """Process one input; returns its summary rows (one per axis, or one error row). Never raises."""
+    """Process one input; returns its summary rows (one per axis, or one error row).
+
+    Never raises for a bad file or a failing command; only an interruption (:mod:`fogdrift.interrupt`,
+    a ``KeyboardInterrupt``) passes through, leaving the file's folder without ``batch.json``.
+    """
     from ..io.hashing import path_sha256
+    from ..output import OutputDir, atomic_path
     from .commands import command_spec
 
     t0 = time.perf_counter()
     out = Path(task.out_dir)
     sha256 = None
-    caught = []
     try:
         sha256 = path_sha256(task.path)
-        cached = _cached(task, sha256)
-        if cached is not None:
-            return cached
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "error.txt").unlink(missing_ok=True)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            record = load_record(task.path, task.settings)
-            rows = command_spec(task.command).run(record, task.settings, out)
-        status, error, cache = "ok", None, True
-    except FogdriftError as exc:             # bad input or settings: deterministic, cached like a result
-        rows, status, error, cache = [{}], "error", f"{type(exc).__name__}: {exc}", True
-    except Exception as exc:  # noqa: BLE001 -- one file must never crash the batch
-        rows, status, error, cache = [{}], "error", f"{type(exc).__name__}: {exc}", False
+    except Exception as exc:  # noqa: BLE001 -- an unreadable input is a row
+        rows = [{**_base(task, None), "status": "error", "error": f"{type(exc).__name__}: {exc}",
+                 "wall_s": time.perf_counter() - t0}]
+        return rows
+    cached = cached_rows(task, sha256)
+    if cached is not None:
+        return cached
+    caught = []
+    notes = []
+    with OutputDir(out, command=f"batch {task.command}", create_parents=True, protect=[task.path]) as od:
         try:
-            out.mkdir(parents=True, exist_ok=True)
-            (out / "error.txt").write_text(traceback.format_exc())
-        except OSError:
-            pass
-    seen = list(dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught))
-    wall = time.perf_counter() - t0
-    rows = [{**_base(task, sha256), **row, "status": status, "error": error,
-             "warnings": "; ".join(seen) or None, "wall_s": wall} for row in rows]
-    if cache and sha256 is not None:
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-            (out / MANIFEST).write_text(json.dumps({"sha256": sha256, "settings_sha256": task.settings_sha256,
-                                                    "command": task.command, "settings": task.settings,
-                                                    "rows": rows}, indent=1, default=str))
-        except OSError:
-            pass
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                record = load_record(task.path, task.settings)
+                notes = _plausibility(record, task.flags)
+                rows = command_spec(task.command).run(record, task.settings, od.path)
+            status, error, cache = "ok", None, True
+        except FogdriftError as exc:         # bad input or settings: deterministic, cached like a result
+            rows, status, error, cache = [{}], "error", f"{type(exc).__name__}: {exc.render(task.flags)}", True
+        except Exception as exc:  # noqa: BLE001 -- one file must never crash the batch
+            rows, status, error, cache = [{}], "error", f"{type(exc).__name__}: {exc}", False
+            with atomic_path(od.path / "error.txt") as tmp:
+                tmp.write_text(traceback.format_exc())
+        seen = list(dict.fromkeys(notes + [_warning_text(w, task.flags) for w in caught]))
+        wall = time.perf_counter() - t0
+        rows = [{**_base(task, sha256), **row, "status": status, "error": error,
+                 "warnings": "; ".join(seen) or None, "wall_s": wall} for row in rows]
+        if cache:
+            doc = {"sha256": sha256, "settings_sha256": task.settings_sha256, "command": task.command,
+                   "settings": task.settings, "rows": rows}
+            with atomic_path(od.path / MANIFEST) as tmp:
+                tmp.write_text(json.dumps(doc, indent=1, default=str))
     return rows

@@ -35,12 +35,15 @@ writes it ``{opt:NAME}`` (see :mod:`fogdrift.errors`).
 Each record carries the SHA-256 of the file's bytes (``GyroRecord.sha256``), computed from
 the bytes the reader streamed, not by a second read.
 
-Units declared in the file.  A text header cell ``name[unit]`` names the column ``name`` and
+Units are never guessed.  A text header cell ``name[unit]`` names the column ``name`` and
 declares its unit: ``gz[deg/s]``, ``gyro x [inc:arcsec]`` (rate units of
 :data:`fogdrift.units.RATE_UNITS` or ``inc:<angle>``), ``t[ms]`` (time units of
-:data:`fogdrift.units.TIME_UNITS`: s, ms, us, ns).  A declared unit is used only when the
-caller gives none (``unit=None``, ``time_unit=None``); the rate columns used must then
-declare one unit between them.  The record keeps each axis's declared unit
+:data:`fogdrift.units.TIME_UNITS`: s, ms, us, ns); a time column may also declare its unit by
+a name suffix (``t_s``, ``time_ms``, :func:`time_unit_of_name`).  A declared unit is used
+when the caller gives none (``unit=None``, ``time_unit=None``); the rate columns used must
+then declare one unit between them.  A rate (or time) unit that is neither given nor
+declared is a :class:`~fogdrift.errors.ConfigError` naming ``{opt:unit}``
+(``{opt:time_unit}``), never a default.  The record keeps each axis's declared unit
 (``GyroRecord.declared_units``).
 
 Conventions: sample ``k`` of a record covers ``[t0_s + k dt_s, t0_s + (k+1) dt_s)``, so
@@ -75,13 +78,14 @@ Everything else (column choice, time checks, gaps, unit conversion, the record) 
 """
 
 from .hashing import file_sha256
-from .load import DT_TOLERANCE, GAP_FACTOR, TIME_COLUMN_NAMES, load, load_segments
+from .load import DT_TOLERANCE, GAP_FACTOR, TIME_COLUMN_NAMES, load, load_segments, time_unit_of_name
 from .record import GyroRecord, block_average, decimation_factor, from_array
 
 __all__ = [
     "GyroRecord",
     "load",
     "load_segments",
+    "time_unit_of_name",
     "from_array",
     "block_average",
     "decimation_factor",

@@ -19,8 +19,10 @@ from typing import Callable
 import numpy as np
 
 from ..errors import ConfigError, DataFormatError
-from ._checks import check_path, parse_unit, unit_scale
+from ._checks import check_path, parse_unit, unit_scale, valid_units
+from .readers._columns import unit_list
 from .readers.base import require
+from .readers.hdf5 import UNIT_ATTRS
 
 __all__ = ["ChunkSource", "open_source"]
 
@@ -99,7 +101,7 @@ def _npy(p: Path, column):
             rows = np.fromfile(fh, dtype=dtype, count=(b - a) * ncol, offset=offset + a * ncol * isz)
             return rows.reshape(b - a, ncol)[:, j]
 
-    return n, f"col{j}", read, f"npy {dtype} {shape}", None
+    return n, f"col{j}", read, f"npy {dtype} {shape}", None, None
 
 
 def _binary(p: Path, column, layout, scale, header_bytes, sequence):
@@ -145,7 +147,7 @@ def _binary(p: Path, column, layout, scale, header_bytes, sequence):
                 )
             state["last"] = int(s[-1])
 
-    return n, name, read, f"raw binary {dtype.itemsize}-byte records, field {name!r} x {factor:g}", check
+    return n, name, read, f"raw binary {dtype.itemsize}-byte records, field {name!r} x {factor:g}", check, None
 
 
 def _hdf5(p: Path, column, dataset):
@@ -163,12 +165,17 @@ def _hdf5(p: Path, column, dataset):
                                   column=dataset)
         ds = fh[dataset]
         n = ds.shape[0]
+        attr = next((ds.attrs[k] for k in UNIT_ATTRS if k in ds.attrs), None)
         if ds.dtype.names:
             names = [f for f in ds.dtype.names if ds.dtype.fields[f][0].kind in "biuf"]
             key = _column_name(column, names, p)
+            declared = unit_list(attr, len(ds.dtype.names), dataset, p)
+            declared = None if declared is None else declared[ds.dtype.names.index(key)]
         else:
             ncol = 1 if ds.ndim == 1 else ds.shape[1]
             key = _column_index(column, [f"col{k}" for k in range(ncol)], p)
+            declared = unit_list(attr, ncol, dataset, p)
+            declared = None if declared is None else declared[key]
         compound, ndim = bool(ds.dtype.names), ds.ndim
 
     def read(a, b):
@@ -178,7 +185,7 @@ def _hdf5(p: Path, column, dataset):
                 return ds.fields(key)[a:b]
             return ds[a:b] if ndim == 1 else ds[a:b, key]
 
-    return n, (key if compound else f"col{key}"), read, f"HDF5 dataset {dataset}", None
+    return n, (key if compound else f"col{key}"), read, f"HDF5 dataset {dataset}", None, declared
 
 
 def _column_index(column, names, p) -> int:
@@ -207,7 +214,7 @@ def _column_name(column, names, p) -> str:
     return names[_column_index(column, names, p)]
 
 
-def open_source(path, *, column=None, unit="deg/h", rate_hz=None, dt_s=None, layout=None, scale=None,
+def open_source(path, *, column=None, unit=None, rate_hz=None, dt_s=None, layout=None, scale=None,
                 header_bytes=0, sequence=None, dataset=None) -> ChunkSource:
     """Open one column of a ``.npy``, raw binary (``layout`` given) or HDF5 file for windowed reads.
 
@@ -216,8 +223,10 @@ def open_source(path, *, column=None, unit="deg/h", rate_hz=None, dt_s=None, lay
     path : str or Path
     column : int or str, optional
         Column (name or 0-based index); required when there are several.
-    unit : str
-        Unit of the stored numbers after ``scale`` (a rate unit or ``inc:<angle>``), default deg/h.
+    unit : str, optional
+        Unit of the stored numbers after ``scale`` (a rate unit or ``inc:<angle>``).  Required
+        unless an HDF5 dataset declares it in a ``units``/``unit`` attribute: units are never
+        guessed.
     rate_hz, dt_s : float
         Sample rate or interval (one of them is required).
     layout, scale, header_bytes, sequence
@@ -232,7 +241,7 @@ def open_source(path, *, column=None, unit="deg/h", rate_hz=None, dt_s=None, lay
     Raises
     ------
     ConfigError
-        Missing rate, bad unit, ambiguous column, a format other than npy/binary/HDF5.
+        Missing rate or unit, bad unit, ambiguous column, a format other than npy/binary/HDF5.
     DataFormatError
         Unreadable header, truncated file, unknown column or dataset.
     """
@@ -242,20 +251,32 @@ def open_source(path, *, column=None, unit="deg/h", rate_hz=None, dt_s=None, lay
     dt = _interval_option(dt_s, rate_hz)
     if dt is None:
         raise ConfigError(f"{p}: the out-of-core path needs the sample rate; pass {{opt:rate_hz}} (or dt_s)")
-    kind, base = parse_unit(unit)
-    factor = unit_scale(kind, base, dt)
+    if unit is not None:
+        parse_unit(unit)
     if layout is not None:
-        n, name, read, what, check = _binary(p, column, layout, scale, header_bytes, sequence)
+        n, name, read, what, check, declared = _binary(p, column, layout, scale, header_bytes, sequence)
     else:
         from .registry import select_reader
 
         fmt = select_reader(p).name
         if fmt == "npy":
-            n, name, read, what, check = _npy(p, column)
+            n, name, read, what, check, declared = _npy(p, column)
         elif fmt == "hdf5":
-            n, name, read, what, check = _hdf5(p, column, dataset)
+            n, name, read, what, check, declared = _hdf5(p, column, dataset)
         else:
             raise ConfigError(f"{p}: out-of-core reading supports .npy, raw binary (pass {{opt:layout}}) and HDF5; "
                               f"got a {fmt} file (load it with fogdrift.io.load)")
+    if unit is None:
+        if declared is None:
+            raise ConfigError(f"{p}: no rate unit: {what} declares none; pass {{opt:unit}} ({', '.join(valid_units())}; "
+                              "units are never guessed)")
+        try:
+            parse_unit(declared)
+        except ConfigError:
+            raise DataFormatError(f"unknown unit {declared!r} declared in the file; expected one of {valid_units()} "
+                                  "(or pass {opt:unit})", path=p, column=str(name)) from None
+        unit = declared
+    kind, base = parse_unit(unit)
+    factor = unit_scale(kind, base, dt)
     return ChunkSource(path=p, n_samples=int(n), dt_s=dt, name=str(name), scale_to_dph=factor,
                        describe=f"{what}, unit {unit}", _read=read, check=check)

@@ -32,9 +32,10 @@ from .readers.base import Table, split_unit_label
 from .record import GyroRecord
 from .registry import reader_by_name, select_reader
 
-__all__ = ["load", "load_segments", "TIME_COLUMN_NAMES", "GAP_FACTOR", "DT_TOLERANCE"]
+__all__ = ["load", "load_segments", "time_unit_of_name", "TIME_COLUMN_NAMES", "GAP_FACTOR", "DT_TOLERANCE"]
 
-#: Column names (compared case-insensitively) that ``time_column="auto"`` takes as time.
+#: Column names (compared case-insensitively) that ``time_column="auto"`` takes as time; so does one of the
+#: first, third or last with a time-unit suffix (``t_ms``, ``time_us``, ``timestamp_ns``).
 TIME_COLUMN_NAMES = ("t", "t_s", "time", "time_s", "timestamp")
 #: A time step larger than ``GAP_FACTOR`` sample intervals is a gap.
 GAP_FACTOR = 1.5
@@ -83,11 +84,14 @@ def load(
         Unit of the numbers: a rate unit from :data:`fogdrift.units.RATE_UNITS`
         (``"deg/h"``, ``"deg/s"``, ``"rad/s"``, ``"rad/h"``, ``"arcsec/s"``) or an angle increment
         per sample ``"inc:deg"``, ``"inc:rad"``, ``"inc:arcsec"``.  Default: the unit the
-        file declares for the rate columns (``gz[deg/s]``), else deg/h.  A given unit takes
+        file declares for the rate columns (``gz[deg/s]``); a file that declares none needs
+        ``unit`` (ConfigError otherwise: a unit is never guessed).  A given unit takes
         precedence over a declared one (a note records the difference).
     time_unit : {"s", "ms", "us", "ns"}, optional
         Unit of the time column (:data:`fogdrift.units.TIME_UNITS`).  Default: the unit the
-        header declares for it (``t[ms]``), else s.
+        header declares for it, in brackets (``t[ms]``) or by a name suffix (``t_s``,
+        ``time_ms``); a time column that declares none needs ``time_unit``.  Not needed
+        without a time column or for a format's own time stamps (always in s).
     delimiter : None or str
         Text only.  ``None`` detects it from the first non-comment lines (tab, comma,
         semicolon, else whitespace); or one of ``","``, ``";"``, ``"\\t"``, ``" "``
@@ -123,8 +127,8 @@ def load(
     ------
     ConfigError
         Invalid option (unit, time_unit, dt_s/rate_hz, delimiter, gaps, min_samples,
-        format, reader_options), a column selected twice, or no way to know the sample
-        interval.
+        format, reader_options), a column selected twice, no way to know the sample
+        interval, or a rate unit / time unit neither given nor declared by the file.
     DataFormatError
         Missing/empty/unknown-format file, header only, non-numeric cell, NaN/inf (also
         after conversion to deg/h), ragged row, unsorted or duplicate time, gap, unknown
@@ -145,7 +149,7 @@ def load(
     >>> d = tempfile.mkdtemp(); p = os.path.join(d, "g.csv")
     >>> with open(p, "w") as fh:
     ...     _ = fh.write("t_s,gx,gy\\n0.00,1,2\\n0.01,3,4\\n0.02,5,6\\n")
-    >>> rec = load(p, columns="gy")
+    >>> rec = load(p, columns="gy", unit="deg/h")
     >>> rec.dt_s, rec.axis_names, rec.rate_dph[:, 0].tolist()
     (0.01, ('gy',), [2.0, 4.0, 6.0])
 
@@ -156,6 +160,15 @@ def load(
     >>> rec = load(p)
     >>> rec.dt_s, rec.input_unit, rec.rate_dph[:, 0].round(9).tolist()
     (0.01, 'deg/s', [3.6, 7.2, 10.8])
+
+    A unit is never guessed: without ``unit`` a file that declares none is refused.
+
+    >>> with open(p, "w") as fh:
+    ...     _ = fh.write("t_s,gz\\n0,1\\n0.01,2\\n")
+    >>> load(p)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.ConfigError: ...g.csv: no rate unit: the file declares none for gz; pass unit= (deg/h, ...
     """
     if gaps not in ("error", "split"):
         raise ConfigError(f"gaps must be 'error' or 'split'; got {gaps!r}")
@@ -473,7 +486,7 @@ def _resolve_columns(table: Table, columns, time_column, temperature=None):
         if table.time_s is not None:
             table_time = True
         elif table.named:
-            t_idx = next((j for j, a in enumerate(names) if a.lower() in TIME_COLUMN_NAMES), None)
+            t_idx = next((j for j, a in enumerate(names) if _is_time_name(a)), None)
     else:
         t_idx = resolve(time_column, "time_column")
 
@@ -509,10 +522,10 @@ def _header_error(table: Table, message: str, col: int) -> DataFormatError:
 
 
 def _rate_unit(table: Table, r_idx, unit, notes: list):
-    """(kind, base, unit string) for the rate columns: the given unit, else the declared one, else deg/h."""
+    """(kind, base, unit string) for the rate columns: the given unit, else the declared one; never a guess."""
     declared = {j: table.units[j] for j in r_idx}
     if unit is None and table.unit_hint and set(declared.values()) == {None}:
-        raise ConfigError(f"{table.path}: {table.unit_hint}")
+        raise ConfigError(f"{table.path}: {table.unit_hint} ({', '.join(valid_units())}; units are never guessed)")
     if unit is not None:
         kind, base = parse_unit(unit)
         other = {table.names[j]: u for j, u in declared.items() if u is not None and u.strip() != unit.strip()}
@@ -521,7 +534,11 @@ def _rate_unit(table: Table, r_idx, unit, notes: list):
         return kind, base, unit
     kinds = set(declared.values())
     if kinds == {None}:
-        return "rate", "deg/h", "deg/h"
+        cols = [table.names[j] for j in r_idx]
+        raise ConfigError(
+            f"{table.path}: no rate unit: the file declares none for {', '.join(cols)}; pass {{opt:unit}} "
+            f"({', '.join(valid_units())}), or declare it in the header as {cols[0]}[deg/s] (units are never guessed)"
+        )
     first = declared[r_idx[0]]
     odd = next(j for j in r_idx if declared[j] != first) if len(kinds) > 1 else None
     if odd is not None:
@@ -561,11 +578,34 @@ def _temperature_offset(table: Table, tm_idx, notes: list) -> float:
     return offset
 
 
+def _is_time_name(name: str) -> bool:
+    low = name.strip().lower()
+    return low in TIME_COLUMN_NAMES or (time_unit_of_name(low) is not None
+                                        and low.rpartition("_")[0] in ("t", "time", "timestamp"))
+
+
+def time_unit_of_name(name: str) -> str | None:
+    """The time unit a column name declares by its suffix (``t_s``, ``time_ms``, ``stamp_us``), else None.
+
+    Examples
+    --------
+    >>> time_unit_of_name("t_s"), time_unit_of_name("Time_MS"), time_unit_of_name("time"), time_unit_of_name("gz_s2")
+    ('s', 'ms', None, None)
+    """
+    stem, sep, suffix = name.strip().rpartition("_")
+    suffix = suffix.lower()
+    return suffix if sep and stem and suffix in units.TIME_UNITS else None
+
+
 def _time_scale(table: Table, t_idx, time_unit, notes: list) -> float:
-    """Factor from the time column's unit to s: the given time_unit, else the declared one, else s."""
+    """Factor from the time column's unit to s: the given time_unit, else the declared one; never a guess.
+
+    A column declares its unit in brackets (``t[ms]``) or by a suffix of its name (``t_s``, ``time_ms``).
+    """
     if t_idx is None:
         return 1.0
     declared = table.units[t_idx]
+    name = table.names[t_idx]
     if time_unit is not None:
         if declared is not None and declared.strip() != time_unit:
             notes.append(f"the file declares time unit {declared!r}; time_unit {time_unit!r} given takes precedence")
@@ -577,10 +617,15 @@ def _time_scale(table: Table, t_idx, time_unit, notes: list) -> float:
                 table, f"unknown time unit {unit!r} declared in the header; expected one of "
                        f"{list(units.TIME_UNITS)} (or pass {{opt:time_unit}}), got {unit!r}", t_idx,
             )
+    elif time_unit_of_name(name) is not None:
+        unit = time_unit_of_name(name)
     else:
-        return 1.0
-    if unit != "s":
-        notes.append(f"time column in {unit}")
+        raise ConfigError(
+            f"{table.path}: time column {name!r} declares no unit; pass {{opt:time_unit}} "
+            f"({', '.join(units.TIME_UNITS)}), or name it {name}[s] or {name}_s in the header, or leave it out "
+            "with {opt:time_column} none and give the sample rate as {opt:rate_hz} (units are never guessed)"
+        )
+    notes.append(f"time column {name!r} in {unit}")
     return units.time_scale_to_s(unit)
 
 

@@ -31,6 +31,7 @@ import numpy as np
 
 from .._util import check_series, json_default
 from ..errors import ConfigError, ModelFileError, NotFittedError
+from ..output import atomic_path
 from .registry import class_for_file, file_class_names
 
 __all__ = ["DriftModel", "load_model", "check_series", "FORMAT_VERSION"]
@@ -51,6 +52,10 @@ class DriftModel:
     label = "model"
     #: True when ``fit`` uses ``y_val`` (early stopping); False: ``y_val`` is accepted and ignored.
     uses_validation = False
+    #: What the model is fed when it compensates a gyro: ``"drift"`` (a separated drift series, the
+    #: paper's framing; the causal drift in real time) or ``"rate"`` (the bias-removed rate itself, e.g.
+    #: a Kalman filter whose noise model includes the white noise).
+    input_kind = "drift"
 
     @classmethod
     def _param_names(cls) -> list[str]:
@@ -98,7 +103,6 @@ class DriftModel:
         base = Path(path)
         if base.suffix in (".json", ".npz"):
             base = base.with_suffix("")
-        base.parent.mkdir(parents=True, exist_ok=True)
         meta, arrays = self._get_state()
         doc = {
             "format": "fogdrift-model",
@@ -109,8 +113,11 @@ class DriftModel:
         }
         json_path = base.with_suffix(".json")
         npz_path = base.with_suffix(".npz")
-        json_path.write_text(json.dumps(doc, indent=2, default=json_default))
-        np.savez(npz_path, **{k: np.asarray(v) for k, v in arrays.items()})
+        # each file complete or absent (temporary name, renamed when written): fogdrift.output.atomic_path
+        with atomic_path(json_path) as tmp:
+            tmp.write_text(json.dumps(doc, indent=2, default=json_default))
+        with atomic_path(npz_path) as tmp:
+            np.savez(tmp, **{k: np.asarray(v) for k, v in arrays.items()})
         return json_path, npz_path
 
     @classmethod

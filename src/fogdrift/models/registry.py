@@ -84,6 +84,8 @@ MODELS: tuple[ModelSpec, ...] = (
               (("mode", "rolling"),)),
     ModelSpec("ar", "fogdrift.models.ar", "AR", "AR(p)",
               "least-squares AR(p) with intercept, p = `lags`", (("order", "lags"),)),
+    ModelSpec("kalman", "fogdrift.models.kalman", "Kalman", "Kalman",
+              "Kalman filter on the rate from the training block's noise model (bias, random walk, Gauss-Markov)"),
     ModelSpec("persistence", "fogdrift.models.persistence", "Persistence", "persistence",
               "repeat the last value (the baseline every table shows)"),
 )

@@ -153,8 +153,9 @@ class Table:
     ``non_rate`` : set of str
         Columns never taken as rate data by default (a sequence counter).
     ``unit_hint`` : str or None
-        The file carries no physical unit: :func:`fogdrift.io.load` refuses to assume deg/h and
-        raises a ConfigError with this text unless a unit is given or declared.
+        How to supply the rate unit in this format when neither the caller nor the file gives
+        one: :func:`fogdrift.io.load` never guesses it and raises a ConfigError with this text
+        (instead of the text reader's "declare it in the header" advice).
     ``extra_notes`` : list of str
         Provenance for the record's notes (absolute start time, gain used, ...).
     """

@@ -194,6 +194,8 @@ def _open(h5py, p: Path, fh, dataset) -> Table:
         named, mm = True, None
     layout = layout_columns(items, p, what)
     table = HDF5Table(p, layout=layout, named=named, sha256=sha256, what=what)
+    table.unit_hint = (f"{what} has no {UNIT_ATTRS[0]!r} attribute for its rate columns; pass {{opt:unit}}, or "
+                       f"set the attribute on the dataset, e.g. {UNIT_ATTRS[0]}='deg/s'")
     if mm is not None and not layout.left_out:
         table.data = mm.reshape(mm.shape[0], -1)
     return table

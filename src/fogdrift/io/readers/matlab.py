@@ -55,6 +55,7 @@ class MatTable(Table):
         self.layout = layout
         self.what = what
         self.extra_notes = list(notes)
+        self.unit_hint = "MATLAB files carry no units; pass {opt:unit}"
 
     def read(self, used) -> np.ndarray:
         if self.data is None:

@@ -1,0 +1,176 @@
+"""The result of an Allan-family computation (:class:`AllanResult`)."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+
+import numpy as np
+
+from .statistics import get_statistic
+
+__all__ = ["AllanResult"]
+
+#: Array fields, in serialisation order; ``var``/``dev`` stems are replaced by the statistic's.
+_ARRAYS = ("tau_s", "m", "var_dph2", "dev_dph", "dev_lo68_dph", "dev_hi68_dph", "dev_lo95_dph",
+           "dev_hi95_dph", "n_terms", "edf", "noise_alpha")
+
+
+@dataclass(frozen=True)
+class AllanResult:
+    """An Allan-family statistic of a rate series at a grid of cluster times.
+
+    All arrays have shape ``(n_tau,)``.  The fields are generic (``var_dph2``, ``dev_dph``,
+    ...) and ``statistic`` says which member of the family they hold.  For the Allan deviation
+    the historical names ``avar_dph2``, ``adev_dph``, ``adev_lo68_dph``, ``adev_hi68_dph``,
+    ``adev_lo95_dph`` and ``adev_hi95_dph`` read the same arrays; for another statistic they
+    raise AttributeError (a Hadamard deviation is not an Allan deviation).  Serialised results
+    name the columns after the statistic: ``avar_dph2``/``adev_dph``, ``hvar_dph2``/``hdev_dph``
+    or ``mvar_dph2``/``mdev_dph`` (and ``<dev>_lo68_dph`` etc.).
+
+    Attributes
+    ----------
+    tau_s : ndarray
+        Cluster times ``m * dt_s`` in s.
+    m : ndarray of int
+        Cluster sizes (averaging factors).
+    var_dph2 : ndarray
+        The statistic's variance in (deg/h)^2.
+    dev_dph : ndarray
+        Its deviation (square root) in deg/h.
+    n_terms : ndarray of int
+        Number of squared differences averaged at each tau.
+    edf : ndarray
+        Equivalent degrees of freedom, clipped to ``[1, n_terms]`` (rule in ``edf_rule``).
+    dev_lo68_dph, dev_hi68_dph, dev_lo95_dph, dev_hi95_dph : ndarray
+        Chi-squared confidence bounds of the deviation in deg/h (68.27 % and 95 %).
+    noise_alpha : ndarray of int
+        Power-law alpha assumed for each tau's EDF.
+    estimator : str
+        Sampling: ``"overlapping"``, ``"non-overlapping"`` or ``"fast"``.
+    edf_rule : str
+        How alpha and the EDF were chosen, in words.
+    dt_s : float
+        Sample interval in s.
+    n_samples : int
+        Number of rate samples N.
+    statistic : str
+        ``"adev"`` (Allan), ``"hdev"`` (Hadamard) or ``"mdev"`` (modified Allan); see
+        :data:`fogdrift.allan.STATISTICS`.
+    """
+
+    tau_s: np.ndarray
+    m: np.ndarray
+    var_dph2: np.ndarray
+    dev_dph: np.ndarray
+    n_terms: np.ndarray
+    edf: np.ndarray
+    dev_lo68_dph: np.ndarray
+    dev_hi68_dph: np.ndarray
+    dev_lo95_dph: np.ndarray
+    dev_hi95_dph: np.ndarray
+    noise_alpha: np.ndarray
+    estimator: str
+    edf_rule: str
+    dt_s: float
+    n_samples: int
+    statistic: str = "adev"
+
+    def __len__(self) -> int:
+        return int(self.tau_s.size)
+
+    # --- historical Allan names ---------------------------------------------------------
+    def _allan(self, field_name: str) -> np.ndarray:
+        if self.statistic != "adev":
+            stat = get_statistic(self.statistic)
+            raise AttributeError(
+                f"this result holds the {stat.long_name} ({self.statistic!r}), not the Allan deviation; "
+                f"read {field_name!r} (columns {stat.var_name}_dph2 / {stat.dev_name}_dph when serialised)"
+            )
+        return getattr(self, field_name)
+
+    @property
+    def avar_dph2(self) -> np.ndarray:
+        """Allan variance in (deg/h)^2 (``var_dph2`` of an ``"adev"`` result)."""
+        return self._allan("var_dph2")
+
+    @property
+    def adev_dph(self) -> np.ndarray:
+        """Allan deviation in deg/h (``dev_dph`` of an ``"adev"`` result)."""
+        return self._allan("dev_dph")
+
+    @property
+    def adev_lo68_dph(self) -> np.ndarray:
+        """Lower 68 % bound of the Allan deviation (``dev_lo68_dph``)."""
+        return self._allan("dev_lo68_dph")
+
+    @property
+    def adev_hi68_dph(self) -> np.ndarray:
+        """Upper 68 % bound of the Allan deviation (``dev_hi68_dph``)."""
+        return self._allan("dev_hi68_dph")
+
+    @property
+    def adev_lo95_dph(self) -> np.ndarray:
+        """Lower 95 % bound of the Allan deviation (``dev_lo95_dph``)."""
+        return self._allan("dev_lo95_dph")
+
+    @property
+    def adev_hi95_dph(self) -> np.ndarray:
+        """Upper 95 % bound of the Allan deviation (``dev_hi95_dph``)."""
+        return self._allan("dev_hi95_dph")
+
+    # --- serialisation ------------------------------------------------------------------
+    def column_names(self) -> tuple:
+        """Serialised column names: ``tau_s, m, <var>_dph2, <dev>_dph, <dev>_lo68_dph, ...``.
+
+        Examples
+        --------
+        >>> from fogdrift.allan import allan_variance
+        >>> allan_variance([1, 3, 2, 5, 4, 4, 6, 3], 1.0, statistic="mdev").column_names()[:4]
+        ('tau_s', 'm', 'mvar_dph2', 'mdev_dph')
+        """
+        stat = get_statistic(self.statistic)
+        return tuple(c.replace("var_", f"{stat.var_name}_", 1) if c.startswith("var_")
+                     else c.replace("dev_", f"{stat.dev_name}_", 1) if c.startswith("dev_") else c
+                     for c in _ARRAYS)
+
+    def to_dict(self) -> dict:
+        """JSON-serialisable dict: arrays become lists of float/int, units are in the keys."""
+        out: dict = {"statistic": self.statistic}
+        for name, key in zip(_ARRAYS, self.column_names()):
+            arr = np.asarray(getattr(self, name))
+            if arr.dtype.kind in "iu":
+                out[key] = [int(v) for v in arr]
+            else:
+                out[key] = [float(v) for v in arr]
+        out.update(
+            estimator=self.estimator,
+            edf_rule=self.edf_rule,
+            dt_s=float(self.dt_s),
+            n_samples=int(self.n_samples),
+        )
+        return out
+
+    def to_csv(self, path) -> None:
+        """Write one row per tau; two ``#`` comment lines, then a header whose names carry units.
+
+        Columns: ``tau_s, m, <var>_dph2 [(deg/h)^2], <dev>_dph [deg/h]``, the four deviation
+        bounds in deg/h, ``n_terms, edf, noise_alpha`` (``<var>``/``<dev>``: avar/adev,
+        hvar/hdev or mvar/mdev).
+        """
+        stat = get_statistic(self.statistic)
+        names = self.column_names()
+        with open(path, "w", newline="") as fh:
+            fh.write(
+                f"# fogdrift {stat.long_name}; statistic={self.statistic}; estimator={self.estimator}; "
+                f"dt_s={self.dt_s!r}; n_samples={self.n_samples}\n"
+            )
+            fh.write(
+                f"# units: tau_s [s]; {stat.var_name}_dph2 [(deg/h)^2]; {stat.dev_name}_* [deg/h]; "
+                f"edf rule: {self.edf_rule}\n"
+            )
+            writer = csv.writer(fh)
+            writer.writerow(names)
+            cols = [np.asarray(getattr(self, c)) for c in _ARRAYS]
+            for i in range(self.tau_s.size):
+                writer.writerow([repr(c[i].item()) if c.dtype.kind == "f" else int(c[i]) for c in cols])

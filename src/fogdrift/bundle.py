@@ -1,0 +1,487 @@
+"""The model bundle: everything needed to re-apply fitted drift models to a new log, in one directory.
+
+``analyze`` and ``model`` write one bundle per run at ``OUT/bundle/``; ``fogdrift compensate`` reads it.
+Layout (no pickle; every file is JSON or NPZ)::
+
+    bundle/
+      manifest.json          format, format_version, fogdrift version, the training input (source,
+                             SHA-256, time range, split), input unit, native and modelling sample
+                             intervals, wavelet / mode, the analysis settings, and per axis: bias and
+                             how it was estimated, Earth-rate setting, level, causal-drift window,
+                             noise model, and the model files with their SHA-256
+      <axis>/<model>.json    one fitted drift model (:meth:`fogdrift.models.DriftModel.save`)
+      <axis>/<model>.npz
+
+Model keys are registry names (:data:`fogdrift.models.MODEL_NAMES`: ``"ar"``, ``"kalman"``, ...).
+The noise model of an axis is the Allan fit of its training block at the modelling rate (coefficients
+A_-2..A_2 in (deg/h)^2 with tau in s, their covariance and the IEEE-952 terms), the Kalman model's
+state-space components if one was fitted, and a ``"gmwm"`` slot (None until a GMWM fit exists).
+
+:func:`load_bundle` validates everything (keys, types, units, intervals, wavelet and level, the models'
+classes and the files' SHA-256) and refuses a bundle of a newer format version with one clear line.
+
+Examples
+--------
+>>> import tempfile
+>>> from fogdrift.io import from_array
+>>> from fogdrift.pipeline import AnalysisConfig, run_models
+>>> from fogdrift.simulate import simulate
+>>> rec = from_array(simulate(6000, 1.0, arw_dprh=0.05, rrw_dphrh=0.5, bias_dph=3.0, seed=1), dt_s=1.0,
+...                  axis_names=["gz"])
+>>> cfg = AnalysisConfig(models=("ar", "persistence"), model_rate_hz=None)
+>>> out = tempfile.mkdtemp()
+>>> b = write_bundle(out, run_models(rec, cfg), cfg, rec)
+>>> back = load_bundle(out)
+>>> back.axis_names, sorted(back.axis("gz").models), back.axis("gz").causal_window
+(('gz',), ['ar', 'persistence'], 128)
+"""
+
+from __future__ import annotations
+
+import datetime
+import hashlib
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from ._util import json_default
+from .errors import ConfigError, FogdriftError, ModelFileError
+from .output import atomic_path
+
+__all__ = [
+    "BUNDLE_FORMAT",
+    "BUNDLE_FORMAT_VERSION",
+    "BundleAxis",
+    "Bundle",
+    "bundle_from_model_axes",
+    "save_bundle",
+    "write_bundle",
+    "load_bundle",
+]
+
+BUNDLE_FORMAT = "fogdrift-bundle"
+#: Version of the bundle layout (manifest keys, file names). Readers refuse a newer one.
+BUNDLE_FORMAT_VERSION = 1
+MANIFEST = "manifest.json"
+
+
+@dataclass(frozen=True)
+class BundleAxis:
+    """One axis of a bundle.
+
+    Attributes
+    ----------
+    name : str
+        Axis name as in the training log (``gx``); logs are matched to it by name.
+    bias_dph : float
+        Constant bias removed before modelling [deg/h] (Earth rate not included).
+    bias_method : str
+        How ``bias_dph`` was estimated, in words (samples and times of the training block).
+    earth_rate_dph : float
+        Earth-rate projection removed with the bias [deg/h] (0 without a latitude).
+    earth_orientation : str, list or None
+        Axis orientation used for the projection (``"up"``, an east-north-up vector), or None.
+    level : int
+        Wavelet decomposition level of the drift separation.
+    causal_window : int
+        Window [samples at the modelling rate] of the causal (real-time) drift fed to the drift models.
+    noise_model : dict
+        ``{"allan": {...} or None, "kalman_components": [...] or None, "gmwm": None}``.
+    models : dict
+        Registry name -> fitted :class:`~fogdrift.models.DriftModel`.
+    """
+
+    name: str
+    bias_dph: float
+    bias_method: str
+    earth_rate_dph: float
+    earth_orientation: object
+    level: int
+    causal_window: int
+    noise_model: dict
+    models: dict
+
+
+@dataclass(frozen=True)
+class Bundle:
+    """A loaded (or freshly built) bundle; see the module docstring.
+
+    Attributes
+    ----------
+    axes : tuple of BundleAxis
+    input_unit : str
+        Unit of the training log's numbers (``"deg/s"``); a log to compensate must match it or be
+        mapped explicitly (``apply_unit``).
+    native_dt_s, model_dt_s : float
+        Sample interval of the training log and of the modelling series [s];
+        ``model_dt_s = block_average_factor * native_dt_s``.
+    block_average_factor : int
+    wavelet, mode : str
+        Lifting wavelet and boundary mode of the drift separation.
+    latitude_deg : float or None
+    training : dict
+        ``source, sha256, t0_s, t_end_s, duration_s, n_samples, split`` (modelling-rate sample ranges
+        ``[start, stop)`` of train / val / test and their times in s).
+    settings : dict
+        The analysis settings (:meth:`fogdrift.pipeline.AnalysisConfig.to_dict`).
+    fogdrift_version : str
+    format_version : int
+    created_utc : str
+    path : Path or None
+        Directory it was loaded from or saved to.
+    """
+
+    axes: tuple
+    input_unit: str
+    native_dt_s: float
+    model_dt_s: float
+    block_average_factor: int
+    wavelet: str
+    mode: str
+    latitude_deg: float | None
+    training: dict
+    settings: dict
+    fogdrift_version: str = __version__
+    format_version: int = BUNDLE_FORMAT_VERSION
+    created_utc: str = ""
+    path: Path | None = field(default=None, compare=False)
+
+    @property
+    def axis_names(self) -> tuple:
+        return tuple(a.name for a in self.axes)
+
+    def axis(self, name: str) -> BundleAxis:
+        """The axis called ``name`` (exact match)."""
+        for a in self.axes:
+            if a.name == name:
+                return a
+        raise ConfigError(f"the bundle has no axis {name!r}; its axes are {list(self.axis_names)}")
+
+    @property
+    def model_names(self) -> tuple:
+        """Registry names of the models every axis has, in registry order."""
+        from .models import MODEL_NAMES
+
+        common = set.intersection(*(set(a.models) for a in self.axes)) if self.axes else set()
+        return tuple(n for n in MODEL_NAMES if n in common)
+
+
+# ------------------------------------------------------------------------------------------------------
+# building
+# ------------------------------------------------------------------------------------------------------
+def _registry_name(label: str) -> str:
+    from .models import MODELS
+
+    for spec in MODELS:
+        if spec.label == label:
+            return spec.name
+    raise ConfigError(f"fitted model {label!r} is not in the model registry")
+
+
+def _level_of(ma, cfg) -> int:
+    """The level the pipeline used for this axis (resolved again, on the same series, if it was "auto")."""
+    if cfg.level != "auto":
+        return int(cfg.level)
+    from .lifting import choose_level, level_scan
+
+    return int(choose_level(level_scan(ma.rate_dph, ma.dt_s, wavelet=cfg.wavelet, mode=cfg.mode)))
+
+
+def _causal_window(ma, cfg, level: int) -> int:
+    """The causal-drift window of ``pipeline._fit_axis_models`` (warm-up inside the training block)."""
+    from .lifting import get_wavelet
+
+    reach = (get_wavelet(cfg.wavelet).filter_length - 1) * 2**level
+    b = ma.split["train"][1]
+    return int(min(max(int(round(cfg.causal_window_s / ma.dt_s)), reach), b))
+
+
+def _allan_noise_model(x, dt_s) -> dict:
+    from .allan import allan_variance
+    from .noise import fit_noise
+
+    try:
+        fit = fit_noise(allan_variance(x, dt_s, taus="octave"))
+    except FogdriftError as exc:
+        return {"source": "training block at the modelling rate", "A": None, "reason": str(exc)}
+    return {
+        "source": "training block at the modelling rate",
+        "A": [float(a) for a in fit.A],
+        "selected": list(fit.selected),
+        "fit_quality": {"chi2_red": float(fit.chi2_red), "p_value": float(fit.p_value), "quality": fit.quality},
+        "A_unit": "(deg/h)^2 with tau in s: sigma^2(tau) = sum_n A_n tau^n, n = -2..2",
+        "tau_range_s": [float(fit.tau_min_s), float(fit.tau_max_s)],
+        "terms": {k: t.to_dict() for k, t in fit.terms.items()},
+    }
+
+
+def bundle_from_model_axes(model_axes, cfg, record) -> Bundle:
+    """A :class:`Bundle` (not yet saved) from the pipeline's fitted axes.
+
+    Parameters
+    ----------
+    model_axes : list of fogdrift.pipeline.ModelAxis
+        From :func:`~fogdrift.pipeline.run_models` or ``[ax.models for ax in run_analysis(...).axes]``.
+    cfg : fogdrift.pipeline.AnalysisConfig
+        The settings of that run.
+    record : fogdrift.io.GyroRecord
+        The training log as loaded (native rate): unit, interval, SHA-256 and time range.
+    """
+    if not model_axes:
+        raise ConfigError("no fitted axes to bundle")
+    dt_m = float(model_axes[0].dt_s)
+    factor = int(round(dt_m / record.dt_s))
+    axes = []
+    for ma in model_axes:
+        level = _level_of(ma, cfg)
+        a, b = ma.split["train"]
+        orient = cfg.earth_axes.get(ma.name) if cfg.latitude_deg is not None else None
+        t0 = record.t0_s
+        method = (f"mean of the training block at the modelling rate (samples {a}..{b - 1} of {dt_m:g} s, "
+                  f"t = {t0 + a * dt_m:.6g}..{t0 + b * dt_m:.6g} s)"
+                  + (f" minus the Earth-rate projection {ma.earth_rate_dph:.6g} deg/h" if ma.earth_rate_dph else ""))
+        kalman = next((m for m in ma.fitted.values() if type(m).__name__ == "Kalman"), None)
+        noise = {"allan": _allan_noise_model(ma.rate_dph[a:b], dt_m),
+                 "kalman_components": None if kalman is None else kalman.components_,
+                 "gmwm": None}
+        axes.append(BundleAxis(
+            name=ma.name, bias_dph=float(ma.bias_dph), bias_method=method, earth_rate_dph=float(ma.earth_rate_dph),
+            earth_orientation=orient, level=level, causal_window=_causal_window(ma, cfg, level), noise_model=noise,
+            models={_registry_name(label): model for label, model in ma.fitted.items()},
+        ))
+    split = {k: {"samples": list(v), "t_s": [record.t0_s + v[0] * dt_m, record.t0_s + v[1] * dt_m]}
+             for k, v in model_axes[0].split.items()}
+    training = {
+        "source": record.source, "sha256": record.sha256, "t0_s": record.t0_s,
+        "t_end_s": record.t0_s + record.duration_s, "duration_s": record.duration_s,
+        "n_samples": record.n_samples, "axis_names": list(record.axis_names), "split": split,
+    }
+    return Bundle(
+        axes=tuple(axes), input_unit=record.input_unit, native_dt_s=float(record.dt_s), model_dt_s=dt_m,
+        block_average_factor=factor, wavelet=cfg.wavelet, mode=cfg.mode,
+        latitude_deg=None if cfg.latitude_deg is None else float(cfg.latitude_deg), training=training,
+        settings=cfg.to_dict(), created_utc=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+    )
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _safe(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "_"
+
+
+def save_bundle(bundle: Bundle, out_dir) -> Path:
+    """Write ``bundle`` to the directory ``out_dir`` (created; an existing manifest is replaced); returns it."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    axes_doc = []
+    for ax in bundle.axes:
+        files = {}
+        for name, model in ax.models.items():
+            rel = f"{_safe(ax.name)}/{_safe(name)}"
+            json_path, npz_path = model.save(out / rel)
+            files[name] = {"file": rel, "class": type(model).__name__, "label": model.label,
+                           "input": model.input_kind,
+                           "sha256": {"json": _sha256(json_path), "npz": _sha256(npz_path)}}
+        axes_doc.append({
+            "name": ax.name, "bias_dph": ax.bias_dph, "bias_method": ax.bias_method,
+            "earth_rate_dph": ax.earth_rate_dph, "earth_orientation": ax.earth_orientation, "level": ax.level,
+            "causal_window": ax.causal_window, "causal_window_s": ax.causal_window * bundle.model_dt_s,
+            "noise_model": ax.noise_model, "models": files,
+        })
+    doc = {
+        "format": BUNDLE_FORMAT, "format_version": BUNDLE_FORMAT_VERSION, "fogdrift_version": bundle.fogdrift_version,
+        "created_utc": bundle.created_utc, "input_unit": bundle.input_unit, "rate_unit_internal": "deg/h",
+        "native_dt_s": bundle.native_dt_s, "native_rate_hz": 1.0 / bundle.native_dt_s,
+        "model_dt_s": bundle.model_dt_s, "model_rate_hz": 1.0 / bundle.model_dt_s,
+        "block_average_factor": bundle.block_average_factor, "wavelet": bundle.wavelet, "mode": bundle.mode,
+        "latitude_deg": bundle.latitude_deg, "training": bundle.training, "settings": bundle.settings,
+        "axes": axes_doc,
+    }
+    text = json.dumps(_finite(json.loads(json.dumps(doc, default=json_default))), indent=2, allow_nan=False)
+    # the manifest last and whole (temporary name, renamed): a bundle without one is incomplete, never half-read
+    with atomic_path(out / MANIFEST) as tmp:
+        tmp.write_text(text)
+    return out
+
+
+def _finite(obj):
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_finite(v) for v in obj]
+    return obj
+
+
+def write_bundle(out_dir, model_axes, cfg, record) -> Bundle:
+    """Build (:func:`bundle_from_model_axes`) and save (:func:`save_bundle`) a bundle; returns it with ``path`` set.
+
+    This is the one call ``analyze`` / ``model`` make: ``write_bundle(out / "bundle", model_axes, cfg, record)``.
+    """
+    bundle = bundle_from_model_axes(model_axes, cfg, record)
+    path = save_bundle(bundle, out_dir)
+    return _with_path(bundle, path)
+
+
+def _with_path(bundle: Bundle, path: Path) -> Bundle:
+    import dataclasses
+
+    return dataclasses.replace(bundle, path=Path(path))
+
+
+# ------------------------------------------------------------------------------------------------------
+# loading
+# ------------------------------------------------------------------------------------------------------
+class _Doc:
+    """Typed access to the manifest with located errors (``manifest.json: axes[1].level: ...``)."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def fail(self, where: str, what: str):
+        raise ModelFileError(f"{self.path}: {where}: {what}")
+
+    def get(self, obj, key, kind, where, *, optional=False):
+        if not isinstance(obj, dict) or key not in obj:
+            if optional:
+                return None
+            self.fail(f"{where}{key}", "missing")
+        value = obj[key]
+        if value is None and optional:
+            return None
+        if kind == "number":
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                self.fail(f"{where}{key}", f"expected a finite number, got {value!r}")
+            return float(value)
+        if kind == "positive":
+            v = self.get(obj, key, "number", where)
+            if not v > 0:
+                self.fail(f"{where}{key}", f"expected a number > 0, got {value!r}")
+            return v
+        if kind == "int":
+            if isinstance(value, bool) or not isinstance(value, int):
+                self.fail(f"{where}{key}", f"expected an integer, got {value!r}")
+            return value
+        if not isinstance(value, kind):
+            self.fail(f"{where}{key}", f"expected {kind.__name__}, got {type(value).__name__}")
+        return value
+
+
+def load_bundle(path) -> Bundle:
+    """Load and validate a bundle directory (or its ``manifest.json``).
+
+    Raises
+    ------
+    ModelFileError
+        Missing or corrupt manifest, a newer format version, a missing or wrong key, an invalid unit,
+        interval, wavelet, mode, level or window, a model file that is missing, modified (SHA-256) or of
+        another class.  The message names the file and the key.
+    """
+    from .lifting import MODES, max_level, wavelist
+    from .models import load_model, model_spec
+    from .units import INCREMENT_UNITS, RATE_UNITS
+
+    p = Path(path)
+    root = p.parent if p.name == MANIFEST else p
+    mpath = root / MANIFEST
+    try:
+        raw = json.loads(mpath.read_text())
+    except FileNotFoundError:
+        raise ModelFileError(f"{mpath}: bundle manifest not found; expected the directory written by "
+                             "'fogdrift analyze' or 'fogdrift model' (OUT/bundle)") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ModelFileError(f"{mpath}: not valid JSON ({exc})") from None
+    d = _Doc(mpath)
+    if not isinstance(raw, dict) or raw.get("format") != BUNDLE_FORMAT:
+        raise ModelFileError(f"{mpath}: not a fogdrift bundle (format {raw.get('format') if isinstance(raw, dict) else None!r})")
+    version = d.get(raw, "format_version", "int", "")
+    if version > BUNDLE_FORMAT_VERSION:
+        raise ModelFileError(
+            f"{mpath}: bundle format version {version} was written by fogdrift {raw.get('fogdrift_version')}; "
+            f"this fogdrift {__version__} reads format version {BUNDLE_FORMAT_VERSION} and older: upgrade fogdrift")
+    if version < 1:
+        d.fail("format_version", f"expected an integer >= 1, got {version}")
+    unit = d.get(raw, "input_unit", str, "")
+    if unit not in RATE_UNITS and not (unit.startswith("inc:") and unit[4:] in INCREMENT_UNITS):
+        d.fail("input_unit", f"unknown unit {unit!r}")
+    native = d.get(raw, "native_dt_s", "positive", "")
+    model_dt = d.get(raw, "model_dt_s", "positive", "")
+    factor = d.get(raw, "block_average_factor", "int", "")
+    if factor < 1 or abs(factor * native - model_dt) > 1e-9 * model_dt:
+        d.fail("block_average_factor", f"model_dt_s {model_dt!r} is not {factor} x native_dt_s {native!r}")
+    wavelet = d.get(raw, "wavelet", str, "")
+    if wavelet not in wavelist():
+        d.fail("wavelet", f"unknown wavelet {wavelet!r}; expected one of {wavelist()}")
+    mode = d.get(raw, "mode", str, "")
+    if mode not in MODES:
+        d.fail("mode", f"unknown mode {mode!r}; expected one of {list(MODES)}")
+    latitude = d.get(raw, "latitude_deg", "number", "", optional=True)
+    training = d.get(raw, "training", dict, "")
+    settings = d.get(raw, "settings", dict, "")
+    axes_raw = d.get(raw, "axes", list, "")
+    if not axes_raw:
+        d.fail("axes", "no axis")
+    axes, seen = [], set()
+    for i, ax in enumerate(axes_raw):
+        w = f"axes[{i}]."
+        name = d.get(ax, "name", str, w)
+        if name in seen:
+            d.fail(f"{w}name", f"axis {name!r} appears twice")
+        seen.add(name)
+        window = d.get(ax, "causal_window", "int", w)
+        level = d.get(ax, "level", "int", w)
+        if window < 2:
+            d.fail(f"{w}causal_window", f"expected an integer >= 2, got {window}")
+        if not 1 <= level <= max_level(window, wavelet, mode):
+            d.fail(f"{w}level", f"level {level} is not valid for a {window}-sample window with {wavelet}")
+        models_raw = d.get(ax, "models", dict, w)
+        if not models_raw:
+            d.fail(f"{w}models", "no model")
+        models = {}
+        for key, entry in models_raw.items():
+            wm = f"{w}models.{key}."
+            try:
+                spec = model_spec(key)
+            except ConfigError:
+                d.fail(f"{w}models", f"unknown model {key!r}")
+            rel = d.get(entry, "file", str, wm)
+            cls = d.get(entry, "class", str, wm)
+            if cls != spec.cls:
+                d.fail(f"{wm}class", f"{key!r} is a {spec.cls}, got {cls!r}")
+            sums = d.get(entry, "sha256", dict, wm)
+            base = root / rel
+            for ext in ("json", "npz"):
+                f = base.with_suffix("." + ext)
+                if not f.is_file():
+                    raise ModelFileError(f"{f}: model file of {name}/{key} is missing")
+                if sums.get(ext) != _sha256(f):
+                    raise ModelFileError(f"{f}: SHA-256 differs from the manifest; the model file was modified "
+                                         "after the bundle was written")
+            model = load_model(base)
+            if type(model).__name__ != spec.cls:
+                raise ModelFileError(f"{base}.json: holds a {type(model).__name__}, the manifest says {spec.cls}")
+            models[spec.name] = model
+        axes.append(BundleAxis(
+            name=name, bias_dph=d.get(ax, "bias_dph", "number", w), bias_method=d.get(ax, "bias_method", str, w),
+            earth_rate_dph=d.get(ax, "earth_rate_dph", "number", w),
+            earth_orientation=ax.get("earth_orientation"), level=level, causal_window=window,
+            noise_model=d.get(ax, "noise_model", dict, w), models=models,
+        ))
+    return Bundle(
+        axes=tuple(axes), input_unit=unit, native_dt_s=native, model_dt_s=model_dt, block_average_factor=factor,
+        wavelet=wavelet, mode=mode, latitude_deg=latitude, training=training, settings=settings,
+        fogdrift_version=str(raw.get("fogdrift_version", "")), format_version=version,
+        created_utc=str(raw.get("created_utc", "")), path=root,
+    )

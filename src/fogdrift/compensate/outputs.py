@@ -1,0 +1,151 @@
+"""Files ``fogdrift compensate`` writes, streamed: the compensated log (CSV and NPZ), the Allan accumulators
+behind the before/after figure, and the figure itself.
+
+Output unit: the log's own unit (so the files are drop-in replacements of the input), declared in the CSV
+header (``gz[deg/s]``, readable by :func:`fogdrift.io.load`) and in the NPZ (``unit``).  Columns / arrays:
+time ``t_s``, the compensated rate per axis, the subtracted drift estimate per axis (``<axis>_drift``), and for
+a Kalman model its 1-sigma (``<axis>_drift_sigma``).  The NPZ is written without holding the arrays: each array
+goes to a temporary ``.npy`` (header first, rows appended) and the archive is assembled at the end.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["CsvWriter", "NpzWriter", "AllanAccumulator", "plot_before_after"]
+
+
+class CsvWriter:
+    """Append rows to ``path``: header ``t_s,<axes>[unit],<axes>_drift[unit](,<axes>_drift_sigma[unit])``."""
+
+    def __init__(self, path, axis_names, unit, with_sigma):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._fh = open(self.path, "w")
+        cols = ["t_s"] + [f"{a}[{unit}]" for a in axis_names] + [f"{a}_drift[{unit}]" for a in axis_names]
+        if with_sigma:
+            cols += [f"{a}_drift_sigma[{unit}]" for a in axis_names]
+        self._fh.write(",".join(cols) + "\n")
+
+    def write(self, t, comp, drift, sigma):
+        parts = [t[:, None], comp, drift] + ([sigma] if sigma is not None else [])
+        np.savetxt(self._fh, np.hstack(parts), delimiter=",", fmt="%.12g")
+
+    def close(self):
+        self._fh.close()
+
+    abort = close
+
+
+class NpzWriter:
+    """An ``.npz`` of known shapes written row block by row block (see the module docstring)."""
+
+    def __init__(self, path, n_samples, axis_names, unit, scale_to_dph, with_sigma):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._dir = tempfile.mkdtemp(prefix="fogdrift-npz-", dir=self.path.parent)
+        k = len(axis_names)
+        shapes = {"t_s": (n_samples,), "compensated": (n_samples, k), "drift_estimate": (n_samples, k)}
+        if with_sigma:
+            shapes["drift_sigma"] = (n_samples, k)
+        self._files = {}
+        for name, shape in shapes.items():
+            fh = open(os.path.join(self._dir, name + ".npy"), "wb")
+            np.lib.format.write_array_header_2_0(fh, {"descr": "<f8", "fortran_order": False, "shape": shape})
+            self._files[name] = fh
+        self._small = {"axis_names": np.array(list(axis_names)), "unit": np.array(unit),
+                       "scale_to_dph": np.array(float(scale_to_dph))}
+        self.n = 0
+        self.n_samples = n_samples
+
+    def write(self, t, comp, drift, sigma):
+        arrays = {"t_s": t, "compensated": comp, "drift_estimate": drift}
+        if sigma is not None:
+            arrays["drift_sigma"] = sigma
+        for name, a in arrays.items():
+            self._files[name].write(np.ascontiguousarray(a, dtype="<f8").tobytes())
+        self.n += t.shape[0]
+
+    def abort(self):
+        """Close and remove the temporary files (after an error)."""
+        for name, fh in self._files.items():
+            fh.close()
+            os.remove(os.path.join(self._dir, name + ".npy"))
+        os.rmdir(self._dir)
+
+    def close(self):
+        for fh in self._files.values():
+            fh.close()
+        if self.n != self.n_samples:  # pragma: no cover - the engine emits every sample once
+            raise RuntimeError(f"NPZ writer got {self.n} rows, expected {self.n_samples}")
+        with zipfile.ZipFile(self.path, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
+            for name in self._files:
+                zf.write(os.path.join(self._dir, name + ".npy"), arcname=name + ".npy")
+            for name, a in self._small.items():
+                with zf.open(name + ".npy", "w") as fh:
+                    np.lib.format.write_array(fh, a, allow_pickle=False)
+        for name in self._files:
+            os.remove(os.path.join(self._dir, name + ".npy"))
+        os.rmdir(self._dir)
+
+
+class AllanAccumulator:
+    """Block sums of the raw and compensated rate for the before/after Allan analysis, in bounded memory.
+
+    Records of up to ``max_points`` samples are kept at the native rate; longer ones are block-averaged by
+    ``f = ceil(n / max_points)`` (the Allan variance at tau >= f dt is then computed from these averages,
+    exactly for the non-overlapping part of the estimator).
+    """
+
+    def __init__(self, n_samples, n_axes, max_points=1 << 22):
+        self.f = max(1, math.ceil(n_samples / max_points))
+        self._carry = [np.empty((0, n_axes)), np.empty((0, n_axes))]
+        self._out = [[], []]
+
+    def add(self, before, after):
+        for i, x in enumerate((before, after)):
+            x = np.concatenate([self._carry[i], x])
+            nb = x.shape[0] // self.f
+            self._out[i].append(x[: nb * self.f].reshape(nb, self.f, -1).mean(axis=1))
+            self._carry[i] = x[nb * self.f:]
+
+    def series(self, start: int = 0):
+        """(before, after) block series from native sample ``start`` on (rounded up to a whole block)."""
+        k0 = -(-int(start) // self.f)
+        return tuple(np.concatenate(o)[k0:] for o in self._out)
+
+
+def plot_before_after(curves, path, title) -> Path:
+    """ADEV of the log before and after compensation, one panel per axis.
+
+    ``curves``: list of ``(axis, AllanResult before, AllanResult after, label)``.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    n = len(curves)
+    fig, axs = plt.subplots(1, n, figsize=(5.2 * n, 4.2), squeeze=False)
+    for ax, (name, before, after, label) in zip(axs[0], curves):
+        for r, color, text in ((before, "k", "log (bias removed)"), (after, "C3", f"compensated: {label}")):
+            yerr = np.vstack([r.adev_dph - r.adev_lo68_dph, r.adev_hi68_dph - r.adev_dph])
+            ax.errorbar(r.tau_s, r.adev_dph, yerr=yerr, fmt="o-", ms=3, lw=0.8, color=color, label=text)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("τ [s]")
+        ax.set_ylabel("σ(τ) [deg/h]")
+        ax.set_title(f"{title}: {name}")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return path

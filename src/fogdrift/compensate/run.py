@@ -1,0 +1,290 @@
+"""``compensate_file``: a bundle applied to a new log, end to end (read, match, stream, write, evaluate)."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import ConfigError
+from .engine import BIAS_ONLY, AxisPlan, StreamCompensator
+from .outputs import AllanAccumulator, CsvWriter, NpzWriter, plot_before_after
+from .sources import DEFAULT_CHUNK, match_log, open_log
+
+__all__ = ["CompensationResult", "compensate_file", "parse_bias", "default_model"]
+
+FORMATS = ("csv", "npz")
+
+
+def parse_bias(value):
+    """``"keep"`` -> ``"keep"``; ``"re-estimate:300"`` (or a number) -> 300.0 seconds.
+
+    Examples
+    --------
+    >>> parse_bias("keep"), parse_bias("re-estimate:120"), parse_bias(60)
+    ('keep', 120.0, 60.0)
+    """
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        seconds = float(value)
+    elif isinstance(value, str) and value.strip().lower() == "keep":
+        return "keep"
+    elif isinstance(value, str) and value.strip().lower().startswith("re-estimate:"):
+        try:
+            seconds = float(value.split(":", 1)[1])
+        except ValueError:
+            seconds = math.nan
+    else:
+        seconds = math.nan
+    if not (math.isfinite(seconds) and seconds > 0):
+        raise ConfigError(f"bias must be 'keep' or 're-estimate:SECONDS' with SECONDS > 0; got {value!r}; "
+                          "pass {opt:bias}")
+    return seconds
+
+
+def default_model(bundle) -> str:
+    """The model used when none is named: the Kalman filter if the bundle has one, else constant bias only."""
+    return "kalman" if "kalman" in bundle.model_names else BIAS_ONLY
+
+
+def _model_name(bundle, model) -> str:
+    from ..models import model_spec
+
+    if model is None:
+        return default_model(bundle)
+    key = str(model).strip().lower()
+    if key in (BIAS_ONLY, "constant-bias", "none"):
+        return BIAS_ONLY
+    try:
+        name = model_spec(key).name
+    except ConfigError:
+        name = None
+    if name not in bundle.model_names:
+        raise ConfigError(f"model {model!r} is not in the bundle; pass {{opt:model}} as one of "
+                          f"{', '.join(bundle.model_names + (BIAS_ONLY,))}")
+    return name
+
+
+@dataclass
+class CompensationResult:
+    """What :func:`compensate_file` did: ``summary`` (the JSON), the files, messages and evaluations."""
+
+    summary: dict
+    files: dict
+    messages: list
+    heading: list = field(default_factory=list)  # HeadingResult per axis
+    artefacts: list = field(default_factory=list)  # ArtefactResult per axis
+    verdicts: list = field(default_factory=list)  # Verdict objects, reading order
+
+
+def _allan_rows(before, after, dt):
+    from ..allan import allan_variance
+
+    a = allan_variance(before, dt, taus="octave")
+    b = allan_variance(after, dt, taus="octave")
+    return a, b, [{"tau_s": float(t), "adev_before_dph": float(x), "adev_after_dph": float(y),
+                   "ratio": float(y / x) if x > 0 else None}
+                  for t, x, y in zip(a.tau_s, a.adev_dph, b.adev_dph)]
+
+
+def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_unit=None, axis_map=None,
+                    accept_rate=False, columns=None, time_column="auto", rate_hz=None, time_unit=None,
+                    chunk_samples=DEFAULT_CHUNK, formats=FORMATS, figures=True, heading=True, artefacts=False,
+                    calib_s=300.0, step_s=300.0, horizons_s=(60.0, 600.0, 3600.0), max_model_rate_samples=1 << 23,
+                    segment=None, progress=None) -> CompensationResult:
+    """Compensate the log ``path`` with ``bundle`` and write the results to ``out_dir``.
+
+    Parameters
+    ----------
+    bundle : Bundle or path
+        A bundle or its directory (:func:`fogdrift.bundle.load_bundle`).
+    path : str or Path
+        The log to compensate (any format :func:`fogdrift.io.load` reads; ``.npy`` is streamed).
+    out_dir : str or Path
+        Output directory: ``compensated.csv``, ``compensated.npz``, ``compensation.json``,
+        ``compensation_allan.png``.
+    model : str, optional
+        Registry name of a model of the bundle, or ``"bias"`` (constant bias only); default
+        :func:`default_model`.
+    bias : "keep" or "re-estimate:SECONDS" or float
+        Keep the bundle's bias, or re-estimate it on the first SECONDS of the log (see
+        :mod:`fogdrift.compensate.engine`).
+    apply_unit, axis_map, accept_rate
+        How to map a log that does not match the bundle (:func:`~fogdrift.compensate.sources.match_log`).
+    columns, time_column, rate_hz, time_unit
+        How to read the log (as :func:`fogdrift.io.load`).
+    chunk_samples : int
+        Rows read at a time; the outputs do not depend on it.
+    formats : sequence of {"csv", "npz"}
+    figures : bool
+        Write the before/after Allan figure.
+    heading, artefacts : bool
+        Run the heading-error evaluation (every model of the bundle plus constant bias, on the whole log) /
+        the filtering-artefact check; skipped with a note when the log has more than
+        ``max_model_rate_samples`` samples at the modelling rate.
+    calib_s, step_s, horizons_s
+        Heading-error protocol (:func:`fogdrift.evaluation.heading.heading_errors`).
+    segment : int, optional
+        Processing segment in modelling intervals (default fixed by the block-average factor; see
+        :class:`~fogdrift.compensate.engine.StreamCompensator`).  Tests use short segments.
+    progress : callable, optional
+        ``progress(done_samples, total_samples)``.
+
+    Returns
+    -------
+    CompensationResult
+    """
+    from ..bundle import Bundle, load_bundle
+
+    t_start = time.perf_counter()
+    b = bundle if isinstance(bundle, Bundle) else load_bundle(bundle)
+    bad = [f for f in formats if f not in FORMATS]
+    if bad or not formats:
+        raise ConfigError(f"formats must be a non-empty subset of {list(FORMATS)}; got {list(formats)!r}")
+    bias_mode = parse_bias(bias)
+    name = _model_name(b, model)
+    source = open_log(path, columns=columns, time_column=time_column, rate_hz=rate_hz, time_unit=time_unit)
+    match = match_log(source, b, apply_unit=apply_unit, axis_map=axis_map, accept_rate=accept_rate)
+    plans = [AxisPlan(log_ax, b.axis(b_ax), name) for log_ax, b_ax in match.axes]
+    engine = StreamCompensator(plans, factor=match.factor, model_dt_s=b.model_dt_s, wavelet=b.wavelet, mode=b.mode,
+                               bias=bias_mode, segment=segment,
+                               keep_model_rate=(heading or artefacts)
+                               and source.n_samples // match.factor <= max_model_rate_samples)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    names = [a for a, _ in match.axes]
+    scale = match.scale_to_dph
+    writers, files = [], {}
+    if "csv" in formats:
+        writers.append(CsvWriter(out / "compensated.csv", names, match.unit, engine.has_sigma))
+        files["csv"] = out / "compensated.csv"
+    if "npz" in formats:
+        writers.append(NpzWriter(out / "compensated.npz", source.n_samples, names, match.unit, scale,
+                                 engine.has_sigma))
+        files["npz"] = out / "compensated.npz"
+    acc = AllanAccumulator(source.n_samples, len(names))
+
+    def emit(blocks):
+        for blk in blocks:
+            for w in writers:
+                w.write(blk.t_s, blk.compensated_dph / scale, blk.drift_dph / scale,
+                        None if blk.sigma_dph is None else blk.sigma_dph / scale)
+            acc.add(blk.rate_dph, blk.compensated_dph)
+
+    try:
+        for t, x in source.chunks(scale, chunk_samples):
+            emit(engine.push(t, x))
+            if progress is not None:
+                progress(engine.n_in, source.n_samples)
+        emit(engine.finish())
+    except BaseException:
+        for w in writers:
+            w.abort()
+        raise
+    for w in writers:
+        w.close()
+
+    messages = list(match.notes)
+    biases = engine.biases()
+    if bias_mode == "keep":
+        messages.append("bias: kept from the bundle (" + ", ".join(
+            f"{p.log_name} {p.bundle_axis.bias_dph:.6g} deg/h" for p in plans) + ")")
+    else:
+        messages.append(f"bias: RE-ESTIMATED on the first {engine.n_cal * b.model_dt_s:g} s of the log "
+                        f"({engine.n_cal} samples at {1 / b.model_dt_s:g} Hz), minus the Earth rate: " + ", ".join(
+                            f"{p.log_name} {bo:.6g} deg/h (bundle {p.bundle_axis.bias_dph:.6g})"
+                            for p, (bo, _) in zip(plans, biases))
+                        + "; before that the bundle's bias and no drift model were used")
+    first = engine.first_active()
+    axes_doc = []
+    curves = []
+    for k, (p, (bias_out, bias_total)) in enumerate(zip(plans, biases)):
+        start = first[k] if first[k] is not None else source.n_samples
+        before, after = acc.series(start)
+        doc = {"axis": p.log_name, "bundle_axis": p.bundle_axis.name, "bias_dph": bias_out,
+               "bias_plus_earth_dph": bias_total, "bundle_bias_dph": p.bundle_axis.bias_dph,
+               "earth_rate_dph": p.bundle_axis.earth_rate_dph,
+               "model_active_from_s": None if first[k] is None else first[k] * source.dt_s,
+               "causal_window_s": p.bundle_axis.causal_window * b.model_dt_s}
+        if before.shape[0] >= 8:
+            a_res, b_res, rows = _allan_rows(before[:, k], after[:, k], source.dt_s * acc.f)
+            doc["allan_before_after"] = rows
+            curves.append((p.log_name, a_res, b_res, name))
+        axes_doc.append(doc)
+    if figures and curves:
+        files["figure"] = plot_before_after(curves, out / "compensation_allan.png", "ADEV before / after")
+
+    result = CompensationResult(summary={}, files=files, messages=messages)
+    z_all = engine.model_rate_series() if engine.keep_model_rate else None
+    if (heading or artefacts) and z_all is None:
+        messages.append(f"evaluation skipped: more than {max_model_rate_samples} samples at the modelling rate")
+    if z_all is not None and z_all.shape[0]:
+        _evaluate(result, b, plans, biases, z_all, heading=heading, artefacts=artefacts, calib_s=calib_s,
+                  step_s=step_s, horizons_s=horizons_s)
+    result.summary = {
+        "fogdrift_result": "compensation",
+        "bundle": str(b.path) if b.path else None, "bundle_training_sha256": b.training.get("sha256"),
+        "log": str(source.path), "log_sha256": source.sha256, "model": name,
+        "model_label": "constant bias" if name == BIAS_ONLY else plans[0].model.label,
+        "bias_mode": "keep" if bias_mode == "keep" else {"re_estimate_s": bias_mode},
+        "unit": match.unit, "scale_to_dph": scale, "native_dt_s": source.dt_s, "model_dt_s": b.model_dt_s,
+        "block_average_factor": match.factor, "n_samples": source.n_samples, "chunk_samples": int(chunk_samples),
+        "design": "drift estimate of modelling interval j = the model's one-step prediction from modelling samples "
+                  "< j, held over the interval's native samples (zero-order hold); compensated = rate - bias - "
+                  "drift estimate (the Earth-rate projection stays in the output)",
+        "messages": messages, "axes": axes_doc, "files": {k: str(v) for k, v in files.items()},
+        "heading": [h.to_dict() for h in result.heading], "artefacts": [a.to_dict() for a in result.artefacts],
+        "verdicts": [v.to_dict() for v in result.verdicts], "wall_s": time.perf_counter() - t_start,
+    }
+    files["json"] = _write_json(result.summary, out / "compensation.json")
+    result.summary["files"]["json"] = str(files["json"])
+    return result
+
+
+def _write_json(obj, path) -> Path:
+    import json
+
+    from .._util import json_default
+
+    def clean(o):
+        if isinstance(o, float):
+            return o if math.isfinite(o) else None
+        if isinstance(o, dict):
+            return {str(k): clean(v) for k, v in o.items()}
+        if isinstance(o, (list, tuple)):
+            return [clean(v) for v in o]
+        return o
+
+    data = clean(json.loads(json.dumps(obj, default=json_default)))
+    Path(path).write_text(json.dumps(data, indent=2, allow_nan=False))
+    return Path(path)
+
+
+def _evaluate(result, b, plans, biases, z_all, *, heading, artefacts, calib_s, step_s, horizons_s):
+    from ..evaluation.artefacts import artefact_check
+    from ..evaluation.heading import heading_errors
+    from ..evaluation.verdicts import artefact_verdict, heading_verdict
+    from ..errors import FogdriftError
+
+    for k, (p, (_, bias_total)) in enumerate(zip(plans, biases)):
+        ax = p.bundle_axis
+        z = z_all[:, k] - bias_total
+        models = {m.label: m for m in ax.models.values()}
+        opts = dict(causal_window=ax.causal_window, wavelet=b.wavelet, level=ax.level, mode=b.mode, axis=p.log_name)
+        if heading:
+            try:
+                h = heading_errors(z, b.model_dt_s, models, calib_s=calib_s, step_s=step_s, horizons_s=horizons_s,
+                                   **opts)
+            except FogdriftError as exc:
+                result.messages.append(f"{p.log_name}: heading evaluation skipped ({exc})")
+            else:
+                result.heading.append(h)
+                result.verdicts.append(heading_verdict(h))
+        if artefacts:
+            try:
+                a = artefact_check(z, b.model_dt_s, models, **opts)
+            except FogdriftError as exc:
+                result.messages.append(f"{p.log_name}: artefact check skipped ({exc})")
+            else:
+                result.artefacts.append(a)
+                result.verdicts.append(artefact_verdict(a))

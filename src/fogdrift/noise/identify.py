@@ -1,0 +1,581 @@
+"""IEEE-952 noise identification on an Allan-family curve: model selection, honest intervals, visible fit quality.
+
+Procedure (method notes §2.5 and §9; each step is a function below):
+
+1. **Working points.**  The measured taus nearest the lattice ``tau_0 2^(k / max_per_octave)`` are fitted (points
+   closer than that are almost perfectly correlated and only make the covariance ill-conditioned), so the result
+   does not depend on whether the curve was computed on an octave, a 100-point or a 1,000-point grid.
+2. **Covariance.**  The estimates' correlation and EDF come from the model itself
+   (:func:`.covariance.estimator_covariance` with the spectrum of the current coefficients), so neighbouring taus
+   are not counted as independent evidence.
+3. **Objective.**  Whitened Wilson-Hilferty scores (:mod:`.engine`), no term above the data's ~4-sigma bound.
+4. **Model selection.**  Every subset of the allowed terms is fitted with one common covariance (that of the
+   full model) and scored by ``IC = Q + 2 k`` (an AIC/WIC analogue: ``Q`` is a chi-squared when the covariance
+   is right).  All candidates and scores are kept.
+5. **Fit range.**  Short taus that no candidate describes (an output low-pass filter, an anti-alias roll-off, a
+   vibration bump) are left out automatically: the fit range grows from the long-tau half towards short taus one
+   point at a time and stops at a point that costs more than a 4-sigma chi-squared increase, or that lies 2.5
+   sigma below the white-noise line of the current model (no IEEE term can lower the curve: only a filter can).
+   Never more than half of the octaves.  What was excluded, and why, is recorded.
+6. **Intervals.**  Profile intervals (Brent) at the t-quantile of the residual degrees of freedom, widened by the
+   reduced chi-squared when it exceeds 1, and taken as the union over every *plausible* model (IC within
+   ``plausible_delta`` of the best): a term is "resolved" only if every plausible model needs it.  A term not in
+   the best model gets a one-sided 95 % upper bound from the model plus that term.
+7. **Checks and words.**  A flat bias-instability floor above the measured curve's minimum is refused (the
+   classical bound min ADEV / 0.664 is reported instead); the fit quality (chi-squared, p-value, worst tau
+   range with the sign and size of the misfit) is always returned, with the reason for every term that is not
+   resolved.
+
+Simulation checks (tests): over 50 seeds each of white + random walk, white + flicker + random walk and
+quantization + white + random walk + ramp, the 95 % intervals cover the true coefficient of every present term in
+>= 90 % of seeds and claim an absent term (lower bound > 0) in <= 5 %.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.stats import chi2, t as student_t
+
+from ..errors import ConfigError, InsufficientDataError
+from ..units import B_FACTOR
+from .covariance import estimator_covariance, expected_variance, ieee_spectrum, ramp_cross_variance
+from .engine import ScoreProblem, all_subsets, fit_subsets, profile_interval
+from .result import NoiseFit, NoiseTerm
+from .terms import TERM_TABLE, TERMS, UNESTIMABLE, laws_of
+
+__all__ = ["identify", "thin_taus", "POOR_CHI2_RED"]
+
+_NAMES = TERMS
+#: A fit whose reduced chi-squared exceeds this is "poor" (the misfit is several times the statistical error).
+POOR_CHI2_RED = 4.0
+
+
+# ---------------------------------------------------------------------------------------------------------
+def thin_taus(tau_s, per_octave: int) -> np.ndarray:
+    """Indices of the points of increasing ``tau_s`` nearest to the lattice ``tau_0 2^(k/per_octave)``.
+
+    Each lattice node takes the measured tau closest to it (within half a lattice step), so an octave grid, a
+    decade grid and dense log grids all give (nearly) the same working points: the fit does not depend on the
+    display grid.
+
+    Examples
+    --------
+    >>> thin_taus(np.array([1.0, 2, 3, 4, 5, 8, 9, 16]), 1).tolist()
+    [0, 1, 3, 5, 7]
+    """
+    lt = np.log2(np.asarray(tau_s, dtype=np.float64))
+    if lt.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    nodes = lt[0] + np.arange(0.0, lt[-1] - lt[0] + 1e-9 + 1.0 / per_octave, 1.0 / per_octave)
+    keep = []
+    for v in nodes:
+        k = int(np.argmin(np.abs(lt - v)))
+        if abs(lt[k] - v) <= 0.5 / per_octave + 1e-9 and (not keep or k > keep[-1]):
+            keep.append(k)
+    return np.asarray(keep, dtype=np.int64)
+
+
+class _Context:
+    """Data of one fit: working points, the statistic's laws, sample interval, record length."""
+
+    def __init__(self, tau, m, y, y_hi, n, dt, statistic, names, inflation=None, strides=None):
+        self.tau, self.m, self.y, self.y_hi = tau, m, y, y_hi
+        self.inflation = np.ones(tau.size) if inflation is None else inflation
+        self.strides = np.ones(tau.size) if strides is None else strides
+        self.n, self.dt, self.statistic = n, dt, statistic
+        self.laws = laws_of(statistic)
+        self.names = names  # allowed terms, in TERMS order
+        self.cols = tuple(_NAMES.index(t) for t in names)
+        # design column of each term (the law's tau shape; its constant is part of the fitted A)
+        self.X = np.stack([self.laws[t].shape(tau, dt) if t in self.laws else np.zeros_like(tau) for t in _NAMES],
+                          axis=1)
+        if "B" in self.laws:  # flicker: the sampled process is not flat at small m (+19 % at m = 1 for ADEV)
+            self.X[:, _NAMES.index("B")] *= flicker_shape(m, statistic)
+        self.upper = self._upper()
+
+    def _upper(self, C=None):
+        """Largest coefficient of each term that keeps it, alone, below every point's ~4-sigma upper bound.
+
+        With the model's relative covariance ``C`` the bound of a point is ``y nu / chi2_nu(3.2e-5)`` (the
+        4-sigma lower quantile of chi2_nu / nu); before a model exists, the measured 95 % interval stretched to
+        ~4 sigma.  A curve's EDF from its local slope can be badly off at a sharp turn, so the model's is used
+        as soon as there is one.
+        """
+        if C is None:
+            ub_pt = self.y * (self.y_hi / self.y) ** (4.0 / 1.96)
+        else:
+            nu = 2.0 / np.diag(C)
+            with np.errstate(divide="ignore"):  # nu << 1: the quantile is 0 and the point bounds nothing
+                ub_pt = self.y * nu / chi2.ppf(3.17e-5, nu)
+        return np.array([np.min(ub_pt / self.X[:, i]) if np.all(self.X[:, i] > 0) else 0.0 for i in range(5)])
+
+    def sub(self, start):
+        c = _Context.__new__(_Context)
+        c.__dict__.update(self.__dict__)
+        for k in ("tau", "m", "y", "y_hi", "X", "inflation", "strides"):
+            setattr(c, k, getattr(self, k)[start:])
+        c.upper = c._upper()
+        return c
+
+    def x2(self, A):
+        """Squared coefficient of each term in its Allan-law unit, from the law coefficients ``A``."""
+        return {t: max(A[_NAMES.index(t)], 0.0) / self.laws[t].scale(self.dt) for t in self.laws}
+
+    def relcov(self, A, exact_ramp=False):
+        """Relative covariance of the working points under the model ``A`` (its spectrum, this statistic).
+
+        A deterministic rate ramp has no spectrum.  For model *selection* (``exact_ramp=False``) it is given the
+        variance of a rate random walk with the same Allan variance at the longest tau -- conservative, so that a
+        spurious ramp in the full model cannot make the long-tau scatter look significant; for the final fit of a
+        model that holds a ramp (``exact_ramp=True``) its real, much smaller effect is used
+        (:func:`~fogdrift.noise.covariance.ramp_cross_variance`), which keeps the ramp estimate unbiased.
+        """
+        x2 = self.x2(A)
+        a_allan = [TERM_TABLE[t].avar_coefficient * x2.get(t, 0.0) for t in _NAMES]
+        if not exact_ramp and a_allan[4] > 0:
+            a_allan[3] += 1.5 * a_allan[4] * float(self.tau[-1])
+        spec = ieee_spectrum(a_allan, self.dt)
+        V = estimator_covariance(self.m, self.n, spec, statistic=self.statistic)
+        if exact_ramp and a_allan[4] > 0 and self.statistic != "hdev":  # per-sample units: A_R dt^2
+            # a strided sum (fast / non-overlapping sampling) no longer telescopes: about `stride` boundary blocks
+            V = V + np.diag(self.strides * ramp_cross_variance(self.m, self.n, spec, a_allan[4] * self.dt**2))
+        s = np.sqrt(self.inflation)
+        mu = self.X @ A
+        C = V * np.outer(s, s) / np.outer(mu, mu)
+        # floor: relative s.d. 1e-6 (a noise-free curve, or a term with no spectrum, still has rounding)
+        return C + np.diag(np.full(mu.size, 1e-12))
+
+
+def flicker_shape(m, statistic="adev") -> np.ndarray:
+    """Variance of sampled flicker rate noise (two-sided spectrum ``1/|f|`` up to the Nyquist frequency) at
+    averaging factors ``m``, relative to its large-``m`` plateau, which the IEEE-952 law uses at every tau.
+
+    Examples
+    --------
+    >>> np.round(flicker_shape([1, 2, 4, 64]), 3).tolist()
+    [1.189, 1.089, 1.029, 1.0]
+    """
+    m = np.asarray(m, dtype=np.float64)
+    key = (statistic, tuple(m.tolist()))
+    if key not in _FLICKER:
+        spec = lambda f: 1.0 / np.abs(f)  # noqa: E731
+        var = expected_variance(m, spec, statistic=statistic, per_octave=64)
+        plateau = expected_variance([2.0**22], spec, statistic=statistic, per_octave=64)[0]
+        _FLICKER[key] = var / plateau
+    return _FLICKER[key]
+
+
+_FLICKER: dict = {}
+
+
+def _select(ctx: _Context, penalty: float, iters: int = 2, C=None):
+    """Common-covariance model selection on the points of ``ctx`` (``C``: a fixed relative covariance)."""
+    from scipy.optimize import nnls
+
+    cols = ctx.cols
+    if C is not None:
+        prob = ScoreProblem(ctx.X, ctx.y, C, ctx._upper(C))
+        res = fit_subsets(prob, all_subsets(cols), penalty)
+        best = min(res, key=lambda s: res[s]["ic"])
+        return {"best": best, "res": res, "prob": prob, "C": C, "A_full": res[tuple(cols)]["a"]}
+    # pilot: relative-error NNLS on scaled columns (the powers of tau span many decades)
+    w = 1.0 / ctx.y
+    Xw = ctx.X[:, cols] * w[:, None]
+    sc = np.linalg.norm(Xw, axis=0)
+    sc[sc == 0] = 1.0
+    try:
+        a, _ = nnls(Xw / sc, ctx.y * w, maxiter=100 * len(cols))
+    except RuntimeError:
+        from scipy.optimize import lsq_linear
+
+        a = lsq_linear(Xw / sc, ctx.y * w, bounds=(0.0, np.inf)).x
+    A = np.zeros(5)
+    A[list(cols)] = np.minimum(a / sc, ctx.upper[list(cols)])
+    if not np.any(A > 0):
+        A[list(cols)] = ctx.upper[list(cols)] * 1e-3
+    for _ in range(iters):
+        C = ctx.relcov(A)
+        prob = ScoreProblem(ctx.X, ctx.y, C, ctx._upper(C))
+        a, _q = prob.fit(cols)
+        newA = np.zeros(5)
+        newA[list(cols)] = a
+        done = np.allclose(newA, A, rtol=2e-2, atol=0.0)
+        A = newA
+        if done:
+            break
+    res = fit_subsets(prob, all_subsets(cols), penalty)
+    best = min(res, key=lambda s: res[s]["ic"])
+    return {"best": best, "res": res, "prob": prob, "C": C, "A_full": A}
+
+
+def _reduced(sel, n_points):
+    r = sel["res"][sel["best"]]
+    return r["q"] / max(1, n_points - len(sel["best"]))
+
+
+def _choose_start(ctx: _Context, penalty: float, max_fraction: float = 0.5, thresh: float = 16.0,
+                  thresh_below: float = 6.25):
+    """First fitted point: grow the fit range from where the curve is visibly white noise (else from the long-tau
+    half) toward short taus, one point at a time, while
+    adding the point raises the best model's chi-squared by at most ``thresh`` (a 4-sigma effect) times
+    ``max(1, chi2_red)`` of the current range.  The model of the current range is re-selected at each step, so a
+    term that only shows at short taus (quantization) can enter; a filter roll-off or a bump that no term
+    explains stops the growth.  At most ``max_fraction`` of the octaves are left out.
+    """
+    tau = ctx.tau
+    span = math.log2(tau[-1] / tau[0])
+    cap = 0
+    while cap + 1 < tau.size - 3 and math.log2(tau[-1] / tau[cap + 1]) >= (1 - max_fraction) * span:
+        cap += 1
+    # start where the curve is visibly white noise (the earliest run of >= 3 points with local ADEV slope within
+    # 0.1 of -1/2): the model of a range that holds white noise knows N, so its white-noise line is a reliable
+    # reference for the points below it.  Without such a run, start from the long-tau half.
+    start0, from_white = cap, False
+    ld, lt = 0.5 * np.log(ctx.y), np.log(tau)
+    sd = np.log(ctx.y_hi / ctx.y) / (2.0 * 1.96)  # ~ s.d. of log ADEV of each point
+    white = np.zeros(tau.size, dtype=bool)
+    for k in range(1, tau.size - 1):  # central slope and its s.d. (neighbours treated as independent: generous)
+        slope = (ld[k + 1] - ld[k - 1]) / (lt[k + 1] - lt[k - 1])
+        sd_slope = math.hypot(sd[k + 1], sd[k - 1]) / (lt[k + 1] - lt[k - 1])
+        white[k] = abs(slope + 0.5) <= max(0.02, 2.5 * sd_slope)
+    for k in range(0, cap + 1):
+        if white[k:k + 3].all() and k + 3 <= tau.size:
+            start0, from_white = k, True
+            break
+    # one covariance for the whole scan: that of the full model fitted to every point
+    C_all = _select(ctx, penalty)["C"]
+    cache = {}
+
+    def get(k):
+        if k not in cache:
+            cache[k] = _select(ctx.sub(k), penalty, C=C_all[k:, k:])
+        return cache[k]
+
+    s = start0
+    while s > 0:
+        here = get(s)
+        q_here = here["res"][here["best"]]["q"]
+        q_more = get(s - 1)["res"][get(s - 1)["best"]]["q"]
+        red = max(1.0, _reduced(here, tau.size - s))
+        # IEEE-952 terms are additive and non-negative, so no term can put a point BELOW the white-noise line
+        # N^2/tau of the current model: only noise or an output filter can, and refitting would let the terms
+        # rebalance around it (N down, B up).  Such a point is judged by its score against that line, no refit.
+        # (Only when the current fit is not poor: a poor fit's N is no reliable anchor.)
+        a_here = here["res"][here["best"]]["a"]
+        i_n = _NAMES.index("N")
+        if from_white and a_here[i_n] > 0 and _reduced(here, tau.size - s) <= POOR_CHI2_RED:
+            white = np.zeros(5)
+            white[i_n] = a_here[i_n]
+            line = float(ctx.X[s - 1] @ white)
+            if ctx.y[s - 1] < line:
+                rel_var = float(C_all[s - 1, s - 1])
+                nu = 2.0 / rel_var
+                u = (math.cbrt(ctx.y[s - 1] / line) - 1.0 + 2.0 / (9.0 * nu)) / math.sqrt(2.0 / (9.0 * nu))
+                if u < -math.sqrt(thresh_below * red):
+                    break
+        if q_more - q_here > thresh * red:
+            break
+        s -= 1
+    return s, _select(ctx.sub(s), penalty), "grown"
+
+
+def _slope(tau, var):
+    lt, ls = np.log(tau), 0.5 * np.log(var)
+    if tau.size < 2:
+        return math.nan
+    return float(np.polyfit(lt, ls, 1)[0])
+
+
+def _describe_excluded(ctx: _Context, start: int, sel) -> str:
+    """Why the short taus [0, start) were left out, in words."""
+    tau, y = ctx.tau[: start + 1], ctx.y[: start + 1]
+    model = (ctx.X[: start + 1] @ sel["res"][sel["best"]]["a"])
+    ratio = np.sqrt(y / model)  # ADEV data / model
+    slope = _slope(tau[:-1], y[:-1]) if start >= 2 else _slope(tau, y)
+    g = np.sqrt(y * tau)  # ADEV * sqrt(tau): flat for white noise
+    sd = np.log(ctx.y_hi[: start + 1] / y) / (2 * 1.96)  # ~ relative sd of the ADEV
+    # a bump: an interior maximum of ADEV*sqrt(tau) clearly (2 sd) above where the fit starts
+    interior = [k for k in range(1, start) if g[k] > g[k - 1] and g[k] >= g[k + 1]
+                and g[k] > g[start] * (1 + 2 * max(sd[k], 0.01))]
+    i_max = max(interior, key=lambda k: g[k]) if interior else -1
+    if i_max > 0:
+        f_hz = 1.0 / (2.0 * tau[i_max])
+        return (f"a bump in the curve near tau = {tau[i_max]:.3g} s (an oscillation or vibration near {f_hz:.3g} Hz), "
+                "not a noise term")
+    if np.all(ratio[:-1] < 1.0) and slope > -0.5:
+        kind = (f"ADEV below the model with a slope of {slope:+.2f} (flatter than white noise's -0.5): an output "
+                "low-pass / anti-alias filter or correlated samples, not a noise term")
+    elif slope < -1.0:
+        kind = f"a slope of {slope:+.2f}, steeper than quantization's -1: not an IEEE-952 term"
+    else:
+        kind = f"a shape no IEEE-952 term describes (ADEV up to {100 * (ratio.max() - 1):+.0f} % off the model)"
+    return kind
+
+
+def _worst_region(tau, z):
+    """Contiguous run of |z| > 2 with the largest sum of z^2: (i0, i1) inclusive, or None."""
+    best, cur = None, None
+    for i, v in enumerate(z):
+        if abs(v) > 2.0:
+            if cur is None:
+                cur = [i, i, 0.0]
+            cur[1] = i
+            cur[2] += v * v
+        else:
+            if cur is not None and (best is None or cur[2] > best[2]):
+                best = cur
+            cur = None
+    if cur is not None and (best is None or cur[2] > best[2]):
+        best = cur
+    if best is None and z.size:
+        i = int(np.argmax(np.abs(z)))
+        best = [i, i, float(z[i] ** 2)]
+    return None if best is None else (best[0], best[1])
+
+
+def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev", terms=None, tau_range_s=None,
+             max_per_octave=1, ic_penalty=2.0, plausible_delta=6.0, var_inflation=None, strides=None) -> NoiseFit:
+    """Identify the IEEE-952 noise terms of one Allan-family curve (see the module docstring).
+
+    Parameters
+    ----------
+    tau_s, var : array_like, shape (n_tau,)
+        Averaging times [s] (increasing) and the statistic's variance [(deg/h)^2].
+    n_samples : int
+        Number of rate samples the curve was computed from.
+    dt_s : float
+        Sample interval [s].
+    var_hi95 : array_like, shape (n_tau,)
+        Upper 95 % bound of each variance (bounds the terms; from the EDF or a published CI).
+    m : array_like of int, optional
+        Averaging factors (default ``round(tau_s / dt_s)``).
+    statistic : str
+        Key of :data:`fogdrift.noise.VARIANCE_LAWS` (``adev``, ``hdev``, ``mdev``).
+    terms : sequence of str, optional
+        Fixed model (no selection), e.g. ``("N", "K")``.
+    tau_range_s : (float or None, float or None), optional
+        Fit range; without it, short taus no model describes are excluded automatically.
+    max_per_octave : int
+        Working points per octave.
+    ic_penalty, plausible_delta : float
+        Information-criterion penalty per term and the IC window of plausible models.
+    var_inflation : array_like, shape (n_tau,), optional
+        Factor by which each estimate's variance exceeds the overlapping estimator's (non-overlapping or strided
+        sampling); the model covariance is scaled by ``sqrt(f_i f_j)``.
+    strides : array_like, shape (n_tau,), optional
+        Start-index stride of each estimate (1 overlapping, ``m`` non-overlapping, ``b`` fast).
+
+    Returns
+    -------
+    NoiseFit
+        Without read-outs (:func:`fogdrift.noise.fit_noise` adds them from the whole curve).
+    """
+    laws = laws_of(statistic)
+    tau = np.asarray(tau_s, dtype=np.float64)
+    y = np.asarray(var, dtype=np.float64)
+    y_hi = np.asarray(var_hi95, dtype=np.float64)
+    mm = np.rint(tau / dt_s) if m is None else np.asarray(m, dtype=np.float64)
+    # a degenerate interval (exact, noise-free curves) bounds nothing
+    y_hi = np.where(np.isfinite(y_hi) & (y_hi > y * (1 + 1e-6)), y_hi, 1e6 * np.abs(y))
+    ok = (y > 0) & np.isfinite(y)
+    if tau_range_s is not None:
+        lo, hi = tau_range_s
+        ok &= (tau >= (lo if lo is not None else 0.0)) & (tau <= (hi if hi is not None else math.inf))
+    infl_pt = np.ones(tau.size) if var_inflation is None else np.asarray(var_inflation, dtype=np.float64)
+    strd = np.ones(tau.size) if strides is None else np.asarray(strides, dtype=np.float64)
+    tau, y, y_hi, mm, infl_pt, strd = tau[ok], y[ok], y_hi[ok], mm[ok], infl_pt[ok], strd[ok]
+    idx = thin_taus(tau, max_per_octave)
+    tau, y, y_hi, mm, infl_pt, strd = tau[idx], y[idx], y_hi[idx], mm[idx], infl_pt[idx], strd[idx]
+    allowed = tuple(t for t in _NAMES if t in laws) if terms is None else tuple(terms)
+    bad = [t for t in allowed if t not in laws]
+    if bad:
+        why = "; ".join(UNESTIMABLE.get((statistic, t), f"{statistic} has no law for {t}") for t in bad)
+        raise ConfigError(f"{statistic} cannot estimate term(s) {bad}: {why}; drop them from {{opt:terms}} "
+                          f"or use another {{opt:statistic}}")
+    if tau.size < len(allowed) + 2 if terms is not None else tau.size < 4:
+        need = len(allowed) + 2 if terms is not None else 4
+        raise InsufficientDataError(
+            f"the noise fit needs at least {need} taus at least 1/{max_per_octave} octave apart in the fit range; "
+            f"got {tau.size} (widen {{opt:fit_taus}} or fit fewer {{opt:terms}})", needed=need, got=int(tau.size))
+    ctx = _Context(tau, mm, y, y_hi, int(n_samples), float(dt_s), statistic, allowed, infl_pt, strd)
+
+    excluded, notes = [], []
+    if tau_range_s is None and terms is None:
+        start, sel, how = _choose_start(ctx, ic_penalty)
+    else:
+        start, how = 0, "fixed"
+        sel = _select(ctx, ic_penalty)
+    if start > 0:
+        excluded.append({"tau_min_s": float(tau[0]), "tau_max_s": float(tau[start - 1]),
+                         "reason": _describe_excluded(ctx, start, sel)})
+    c = ctx.sub(start)
+    if terms is not None:
+        sel["best"] = tuple(_NAMES.index(t) for t in allowed)
+    prob, res = sel["prob"], sel["res"]
+    sel_res = res  # the selection stage's fits (one common covariance): what the candidate table reports
+    best = sel["best"]
+    if terms is None:  # a term at exactly zero is not in the model: use the subset without it
+        nz = tuple(i for i in best if res[best]["a"][i] > 0)
+        if nz and nz != best and nz in res:
+            best = nz
+    ic_best = res[best]["ic"]
+    plaus = [best] if terms is not None else [k for k, v in res.items() if v["ic"] <= ic_best + plausible_delta]
+    # (problem, fits) pairs whose intervals are united: the selection's conservative covariance, and -- when the
+    # selected model holds a ramp -- the ramp's real (much smaller) covariance, which gives the estimate.  A ramp
+    # that really is a random walk in disguise keeps the wide interval; a real ramp gets an unbiased value.
+    views = [(prob, res)]
+    if res[best]["a"][_NAMES.index("R")] > 0:
+        C_exact = c.relcov(res[best]["a"], exact_ramp=True)
+        prob = ScoreProblem(c.X, c.y, C_exact, c._upper(C_exact))
+        res = {**res, **fit_subsets(prob, plaus, ic_penalty)}
+        views.append((prob, res))
+    A = res[best]["a"]
+    q = res[best]["q"]
+    dof = max(1, c.tau.size - len(best))
+    chi2_red = q / dof
+    p = float(chi2.sf(q, dof))
+    quality = "good" if p >= 0.01 else "acceptable" if chi2_red <= POOR_CHI2_RED else "poor"
+    infl = max(1.0, chi2_red)
+    d2 = float(student_t.ppf(0.975, dof) ** 2) * infl
+    d1 = float(student_t.ppf(0.95, dof) ** 2) * infl
+    mu = c.X @ A
+    z = prob.scores(mu)
+
+    candidates = [{"terms": [_NAMES[i] for i in k], "chi2": float(v["q"]), "ic": float(v["ic"]),
+                   "delta_ic": float(v["ic"] - sel_res[best]["ic"]), "plausible": k in plaus}
+                  for k, v in sorted(sel_res.items(), key=lambda kv: kv[1]["ic"])]
+
+    out_terms = {}
+    for i, name in enumerate(_NAMES):
+        spec = TERM_TABLE[name]
+        if name not in laws:
+            out_terms[name] = NoiseTerm(name, None, spec.unit, None, None, "not_estimable",
+                                        UNESTIMABLE.get((statistic, name), f"{statistic} has no law for {name}"))
+            continue
+        conv = spec.to_unit / math.sqrt(laws[name].scale(dt_s))
+        if name not in allowed:
+            out_terms[name] = NoiseTerm(name, None, spec.unit, None, None, "absent",
+                                        f"not fitted (terms={'+'.join(allowed)})")
+            continue
+        los, his, lacking = [], [], []
+        for mod in plaus:
+            if i not in mod:
+                lacking.append(mod)
+            for v_prob, v_res in views:
+                r = v_res[mod]
+                if i in mod:
+                    lo, hi = profile_interval(v_prob, mod, r["a"], i, r["q"], d2)
+                else:
+                    big = tuple(sorted(mod + (i,)))
+                    rb = v_res.get(big) or fit_subsets(v_prob, [big], ic_penalty)[big]
+                    lo, (_, hi) = 0.0, profile_interval(v_prob, big, rb["a"], i, rb["q"], d1, lower=False)
+                los.append(lo)
+                his.append(hi)
+        lo_v, hi_v = conv * math.sqrt(min(los)), conv * math.sqrt(max(his))
+        if i in best:
+            val = conv * math.sqrt(A[i])
+            if min(los) > 0:
+                status, reason = "resolved", ""
+            else:
+                status = "unresolved"
+                reason = _unresolved_reason(name, lacking, plaus, res, ic_best)
+            out_terms[name] = NoiseTerm(name, val, spec.unit, lo_v, hi_v, status, reason)
+        else:
+            out_terms[name] = NoiseTerm(name, None, spec.unit, 0.0, hi_v, "absent",
+                                        _absent_reason(c, name, A, max(his)))
+    # a flat floor must not sit above the measured curve
+    if "B" in laws and out_terms["B"].value is not None:
+        _check_floor(out_terms, c, A)
+    if quality != "good":
+        i01 = _worst_region(c.tau, z)
+        if i01 is not None:
+            i0, i1 = i01
+            dev = np.sqrt(c.y[i0:i1 + 1] / mu[i0:i1 + 1]) - 1.0
+            k = int(np.argmax(np.abs(dev)))
+            side = "above" if dev[k] > 0 else "below"
+            notes.append(
+                f"fit {quality}: chi2_red = {chi2_red:.3g} (p = {p:.2g}); the model misses the curve most at "
+                f"tau = {c.tau[i0]:.3g}-{c.tau[i1]:.3g} s, where the measured deviation is {side} the model by up to "
+                f"{100 * abs(dev[k]):.0f} %" + _shape_hint(c.tau[i0:i1 + 1], c.y[i0:i1 + 1], dev))
+        if infl > 1:
+            notes.append(f"intervals widened by sqrt(chi2_red) = {math.sqrt(infl):.3g} for the misfit")
+    b_min = _classical_b(c, A) if statistic == "adev" else {}
+    return NoiseFit(
+        statistic=statistic, dt_s=float(dt_s), terms=out_terms, selected=tuple(_NAMES[i] for i in best), A=A,
+        candidates=candidates, plausible=["+".join(_NAMES[i] for i in k) for k in plaus], fit_tau_s=c.tau,
+        fit_var=c.y, model_var=mu, z=z, chi2=float(q), dof=int(dof), chi2_red=float(chi2_red), p_value=p,
+        quality=quality, inflation=float(infl), excluded=excluded, notes=notes, b_min=b_min,
+        n_samples=int(n_samples),
+    )
+
+
+def _shape_hint(tau, y, dev) -> str:
+    if tau.size >= 2 and np.any(dev < 0) and np.all(dev <= 0.05):
+        return ("; the curve falls faster than the fitted terms allow (a correlated/Gauss-Markov component or "
+                "bounded platform motion; `fogdrift noise` models Gauss-Markov terms)")
+    if tau.size >= 2:
+        return f"; local ADEV slope there {_slope(tau, y):+.2f}"
+    return ""
+
+
+def _unresolved_reason(name, lacking, plaus, res, ic_best) -> str:
+    if lacking:
+        alt = "+".join(_NAMES[i] for i in lacking[0])
+        return (f"not resolved from zero: the model {alt} without {name} describes the curve about as well "
+                f"(IC {res[lacking[0]]['ic'] - ic_best:+.1f})")
+    return "not resolved from zero: its 95 % interval reaches 0"
+
+
+def _absent_reason(c: _Context, name, A, hi_a) -> str:
+    """Why a term is not in the model: where would it show at its upper bound?"""
+    law = c.laws[name]
+    i = _NAMES.index(name)
+    grid = np.logspace(math.log10(c.tau[0]) - 4, math.log10(c.tau[-1]) + 4, 801)
+    rest = sum(A[j] * c.laws[n].shape(grid, c.dt) for j, n in enumerate(_NAMES) if n in c.laws and j != i)
+    dom = grid[hi_a * law.shape(grid, c.dt) >= rest]
+    if law.power >= 0 and (dom.size == 0 or dom.min() > c.tau[-1]):
+        where = "beyond the record" if dom.size == 0 else f"only beyond tau = {dom.min():.3g} s"
+        return f"not in the model: at its upper bound it would dominate {where} (longest fitted tau {c.tau[-1]:.3g} s); a longer record can resolve it"
+    if law.power < 0 and (dom.size == 0 or dom.max() < c.tau[0]):
+        return f"not in the model: at its upper bound it would dominate only below the fitted range (tau < {c.tau[0]:.3g} s)"
+    return "not in the model: the curve shows no sign of it in the fitted range"
+
+
+def _check_floor(terms, c: _Context, A) -> None:
+    """Refuse a flat B floor above the measured curve's minimum (its 95 % upper bound): the data fall below it."""
+    i = _NAMES.index("B")
+    floor_var = A[i]
+    k = int(np.argmin(c.y))
+    if floor_var > c.y_hi[k]:
+        scale = c.laws["B"].scale(c.dt)
+        bound = math.sqrt(c.y[k] / scale) * TERM_TABLE["B"].to_unit
+        name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}.get(c.statistic, c.statistic)
+        terms["B"] = NoiseTerm(
+            "B", None, TERM_TABLE["B"].unit, None, bound, "not_estimable",
+            f"a flat floor of {math.sqrt(floor_var / scale):.3g} deg/h is contradicted by the measured curve, which "
+            f"falls to {math.sqrt(c.y[k]):.3g} deg/h at tau = {c.tau[k]:.3g} s: no bias-instability floor within the "
+            f"record; classical bound B <= min {name} / {math.sqrt(scale):.4g} = {bound:.3g} deg/h")
+
+
+def _classical_b(c: _Context, A) -> dict:
+    """IEEE-952 practice: bias instability read at the minimum of the (fitted) Allan deviation, B = min ADEV / 0.664.
+
+    The minimum is searched on the fitted curve inside the fitted tau range.  When it sits at the longest tau the
+    curve is still falling there and the value is only an upper bound.  The interval is the measured point's 95 %
+    interval at the tau nearest the minimum.
+    """
+    grid = np.logspace(math.log10(c.tau[0]), math.log10(c.tau[-1]), 400)
+    var = sum(A[i] * c.laws[n].shape(grid, c.dt) for i, n in enumerate(_NAMES) if n in c.laws)
+    k = int(np.argmin(var))
+    j = int(np.argmin(np.abs(np.log(c.tau / grid[k]))))
+    value = math.sqrt(var[k]) / B_FACTOR
+    at_edge = k >= grid.size - 2
+    lo = math.sqrt(c.y[j] * (c.y[j] / c.y_hi[j])) / B_FACTOR  # symmetric-in-log guess of the lower bound
+    return {
+        "value": value, "unit": "deg/h", "tau_s": float(grid[k]), "bound_only": bool(at_edge),
+        "lo95": None if at_edge else lo, "hi95": math.sqrt(c.y_hi[j]) / B_FACTOR,
+        "rule": "min of the fitted ADEV / 0.664 (IEEE Std 952-1997 C.2); an upper bound when the curve still "
+                "falls at the longest fitted tau",
+    }

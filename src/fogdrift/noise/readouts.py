@@ -1,0 +1,109 @@
+"""The classic IEEE-952 slope read-outs, as a labelled cross-check of the fit.
+
+IEEE Std 952-1997 Annex C reads each coefficient off a straight line of its slope on the log-log ADEV plot:
+Q = sigma(sqrt 3 s) on the -1 line, N = sigma(1 h) on the -1/2 line, K = sigma(3 h) on the +1/2 line,
+R = sigma(sqrt 2 h) on the +1 line, and B = min sigma / 0.664.  Each read-out here takes the measured point whose
+local slope is nearest the term's slope (within 0.2, on the side of the ADEV minimum where the term can live) and
+says whether the fitted model has that term dominating there.  A read-out taken where another term dominates is a
+transition, not a measurement of its term, and is labelled so; a read-out that disagrees with the fit beyond the
+fit's interval says why.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Readout", "slope_readouts"]
+
+_B = math.sqrt(2.0 * math.log(2.0) / math.pi)
+_URAD_PER_ARCSEC = math.pi / 0.648
+#: term -> (slope of sigma, tau [s] at which the line is read, factor to the reported unit, unit)
+_READ = {
+    "Q": (-1.0, math.sqrt(3.0), _URAD_PER_ARCSEC, "urad"),
+    "N": (-0.5, 3600.0, 1.0, "deg/sqrt(h)"),
+    "K": (0.5, 3.0 * 3600.0, 1.0, "deg/h^1.5"),
+    "R": (1.0, math.sqrt(2.0) * 3600.0, 1.0, "deg/h^2"),
+}
+
+
+@dataclass(frozen=True)
+class Readout:
+    """One slope read-out: ``value`` [``unit``] read at the measured ``tau_s`` (None when the curve shows no such
+    slope); ``dominated`` is True when the fitted model's own term makes up at least half of the variance there;
+    ``note`` explains a disagreement with the fit."""
+
+    term: str
+    value: float | None
+    unit: str
+    tau_s: float | None
+    slope: float | None
+    dominated: bool | None
+    note: str
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+    def text(self) -> str:
+        if self.value is None:
+            return f"{self.term}: no {self.term}-slope in the curve"
+        where = "its term dominates" if self.dominated else "another term dominates"
+        out = f"{self.term} {self.value:.3g} {self.unit} (read at tau = {self.tau_s:.3g} s, {where})"
+        return out + (f"; {self.note}" if self.note else "")
+
+
+def slope_readouts(tau_s, adev_dph, fit=None) -> dict:
+    """Read-outs of Q, N, B, K, R from a measured ADEV curve, checked against ``fit`` (a CurveFit) when given.
+
+    Returns
+    -------
+    dict
+        Term -> :class:`Readout`.
+    """
+    tau = np.asarray(tau_s, dtype=np.float64)
+    s = np.asarray(adev_dph, dtype=np.float64)
+    ok = s > 0
+    tau, s = tau[ok], s[ok]
+    out = {}
+    if tau.size < 3:
+        return {t: Readout(t, None, u, None, None, None, "too few taus") for t, (_, _, _, u) in _READ.items()}
+    slope = np.gradient(np.log(s), np.log(tau))
+    i_min = int(np.argmin(s))
+    for term, (mu, tau_read, fac, unit) in _READ.items():
+        side = np.arange(tau.size) <= i_min if mu < 0 else np.arange(tau.size) >= i_min
+        dist = np.where(side, np.abs(slope - mu), np.inf)
+        i = int(np.argmin(dist))
+        if dist[i] > 0.2:
+            out[term] = Readout(term, None, unit, None, None, None, "the curve shows no such slope")
+            continue
+        value = float(s[i] * (tau_read / tau[i]) ** mu * fac)
+        out[term] = _judge(term, value, unit, float(tau[i]), float(slope[i]), fit)
+    if 0 < i_min < s.size - 1:
+        out["B"] = _judge("B", float(s[i_min] / _B), "deg/h", float(tau[i_min]), float(slope[i_min]), fit)
+    else:
+        out["B"] = Readout("B", None, "deg/h", None, None, None,
+                           "the ADEV has no interior minimum (still falling or rising at the record's end)")
+    return {t: out[t] for t in ("Q", "N", "B", "K", "R")}
+
+
+def _judge(term, value, unit, tau, slope, fit) -> Readout:
+    if fit is None or fit.statistic != "adev":
+        return Readout(term, value, unit, tau, slope, None, "")
+    parts = {n: float(fit.term_dev_dph(n, [tau])[0]) ** 2 for n in ("Q", "N", "B", "K", "R")}
+    total = sum(parts.values())
+    share = parts[term] / total if total > 0 else 0.0
+    dominated = share >= 0.5
+    t = fit.terms[term]
+    note = ""
+    lo, hi = (t.lo95 or 0.0), t.hi95
+    if hi is not None and not (lo <= value <= hi):
+        if not dominated:
+            top = max(parts, key=parts.get)
+            note = f"differs from the fit: {top} makes up {100 * parts[top] / total:.0f} % of the model there"
+        elif fit.fit_tau_s[0] > tau or tau > fit.fit_tau_s[-1]:
+            note = "differs from the fit: read outside the fitted tau range"
+        else:
+            note = "differs from the fit: one point of a curve that is not a single straight line there"
+    return Readout(term, value, unit, tau, slope, dominated, note)

@@ -1,0 +1,205 @@
+"""Result types of the noise identification: one coefficient (:class:`NoiseTerm`) and the whole fit
+(:class:`NoiseFit`), JSON-serialisable, with the fitted curve available at any tau."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .terms import TERM_TABLE, TERMS, laws_of
+
+__all__ = ["NoiseTerm", "NoiseFit", "TERM_STATUSES"]
+
+#: What a coefficient's ``status`` can be (see :class:`NoiseTerm`).
+TERM_STATUSES = ("resolved", "unresolved", "absent", "not_estimable")
+
+
+def _f(x):
+    return None if x is None else float(x)
+
+
+@dataclass(frozen=True)
+class NoiseTerm:
+    """One IEEE-952 coefficient.
+
+    Attributes
+    ----------
+    name : str
+        ``"Q"``, ``"N"``, ``"B"``, ``"K"`` or ``"R"``.
+    value : float or None
+        Estimate in ``unit`` from the selected model; None when the term is not in it.
+    unit : str
+    lo95, hi95 : float or None
+        95 % interval over every plausible model (``lo95 = 0``: the data allow the term to vanish).  For an
+        absent term ``hi95`` is a one-sided 95 % upper bound.
+    status : str
+        ``"resolved"`` (in the selected model, every plausible model needs it, lower bound > 0);
+        ``"unresolved"`` (in the selected model, but its interval reaches 0); ``"absent"`` (not in the selected
+        model); ``"not_estimable"`` (the data or the statistic cannot support a number; ``hi95`` may bound it).
+    reason : str
+        Empty for a resolved term; otherwise the real cause, in words.
+    """
+
+    name: str
+    value: float | None
+    unit: str
+    lo95: float | None
+    hi95: float | None
+    status: str
+    reason: str
+
+    @property
+    def estimable(self) -> bool:
+        """True when a value is reported (resolved or unresolved)."""
+        return self.status in ("resolved", "unresolved")
+
+    @property
+    def resolved(self) -> bool:
+        return self.status == "resolved"
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "value": _f(self.value), "unit": self.unit, "lo95": _f(self.lo95),
+                "hi95": _f(self.hi95), "status": self.status, "estimable": self.estimable, "reason": self.reason}
+
+
+@dataclass
+class NoiseFit:
+    """Result of :func:`fogdrift.noise.fit_noise`.
+
+    Attributes
+    ----------
+    statistic : str
+        ``"adev"``, ``"hdev"`` or ``"mdev"``: whose laws were fitted.
+    dt_s : float
+        Sample interval [s].
+    terms : dict[str, NoiseTerm]
+        Q [urad], N [deg/sqrt(h)], B [deg/h], K [deg/h^1.5], R [deg/h^2].
+    selected : tuple of str
+        Terms of the selected model.
+    A : ndarray, shape (5,)
+        Fitted law coefficients of Q, N, B, K, R (0 for terms not in the model), variance in (deg/h)^2.
+    candidates : list of dict
+        Every candidate model: terms, chi2, IC, delta IC, plausible.
+    plausible : list of str
+        Models within the IC window of the best ("N+K", ...).
+    fit_tau_s, fit_var, model_var, z : ndarray
+        The fitted working points, their measured and fitted variance and standardized (normal-score) residuals.
+    chi2, dof, chi2_red, p_value : float
+        Goodness of fit (the whitened score objective is chi-squared with ``dof`` degrees of freedom when the
+        model holds).
+    quality : str
+        ``"good"`` (p >= 0.01), ``"acceptable"`` (chi2_red <= 4) or ``"poor"``.
+    inflation : float
+        Factor ``max(1, chi2_red)`` applied to the profile thresholds (intervals widened by its square root).
+    excluded : list of dict
+        Tau ranges left out of the fit and why.
+    notes : list of str
+        Fit-quality and other statements, in words.
+    b_min : dict
+        Bias instability read at the minimum of the fitted ADEV (IEEE-952 practice), with its tau.
+    readouts : dict
+        Term -> :class:`fogdrift.noise.readouts.Readout`: slope read-outs, a labelled cross-check.
+    n_samples : int
+        Record length the curve came from.
+    outliers : dict or None
+        The outlier report of the rate that was analysed, when the caller attached it.
+    """
+
+    statistic: str
+    dt_s: float
+    terms: dict
+    selected: tuple
+    A: np.ndarray
+    candidates: list
+    plausible: list
+    fit_tau_s: np.ndarray
+    fit_var: np.ndarray
+    model_var: np.ndarray
+    z: np.ndarray
+    chi2: float
+    dof: int
+    chi2_red: float
+    p_value: float
+    quality: str
+    inflation: float
+    excluded: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+    b_min: dict = field(default_factory=dict)
+    readouts: dict = field(default_factory=dict)
+    n_samples: int = 0
+    outliers: dict | None = None
+
+    # -- the fitted curve ------------------------------------------------------------------------------------
+    @property
+    def fitted_terms(self) -> tuple:
+        return tuple(self.selected)
+
+    @property
+    def tau_min_s(self) -> float:
+        return float(self.fit_tau_s[0]) if len(self.fit_tau_s) else math.nan
+
+    @property
+    def tau_max_s(self) -> float:
+        return float(self.fit_tau_s[-1]) if len(self.fit_tau_s) else math.nan
+
+    def _x2(self, name) -> float:
+        """Squared coefficient of a term in its Allan-law unit."""
+        law = laws_of(self.statistic).get(name)
+        if law is None:
+            return 0.0
+        return float(self.A[TERMS.index(name)]) / law.scale(self.dt_s)
+
+    def _term_var(self, name, tau_s, statistic) -> np.ndarray:
+        law = laws_of(statistic).get(name)
+        t = np.asarray(tau_s, dtype=np.float64)
+        if law is None:
+            return np.zeros_like(t)
+        return self._x2(name) * law.scale(self.dt_s) * law.shape(t, self.dt_s)
+
+    def model_dev_dph(self, tau_s, statistic=None) -> np.ndarray:
+        """Fitted deviation [deg/h] of ``statistic`` (default: the fitted one) at ``tau_s`` [s]."""
+        st = statistic or self.statistic
+        return np.sqrt(sum(self._term_var(n, tau_s, st) for n in TERMS))
+
+    def term_dev_dph(self, name, tau_s, statistic=None) -> np.ndarray:
+        """Deviation [deg/h] of one term alone (its asymptote on the log-log plot)."""
+        return np.sqrt(self._term_var(name, tau_s, statistic or self.statistic))
+
+    def model_adev_dph(self, tau_s) -> np.ndarray:
+        return self.model_dev_dph(tau_s, "adev")
+
+    def term_adev_dph(self, name, tau_s) -> np.ndarray:
+        return self.term_dev_dph(name, tau_s, "adev")
+
+    def coefficient(self, name) -> float:
+        """The term's coefficient in its reported unit from ``A`` (0 when absent)."""
+        return TERM_TABLE[name].to_unit * math.sqrt(self._x2(name))
+
+    # -- serialisation ------------------------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        return {
+            "statistic": self.statistic,
+            "dt_s": float(self.dt_s),
+            "n_samples": int(self.n_samples),
+            "selected": list(self.selected),
+            "terms": {k: v.to_dict() for k, v in self.terms.items()},
+            "A": [float(a) for a in self.A],
+            "candidates": self.candidates,
+            "plausible": list(self.plausible),
+            "fit": {
+                "tau_min_s": self.tau_min_s,
+                "tau_max_s": self.tau_max_s,
+                "points": [{"tau_s": float(t), "var_dph2": float(v), "model_var_dph2": float(m), "z": float(z)}
+                           for t, v, m, z in zip(self.fit_tau_s, self.fit_var, self.model_var, self.z)],
+                "chi2": float(self.chi2), "dof": int(self.dof), "chi2_red": float(self.chi2_red),
+                "p_value": float(self.p_value), "quality": self.quality,
+                "interval_inflation": float(self.inflation),
+            },
+            "excluded": self.excluded,
+            "notes": list(self.notes),
+            "b_min": self.b_min,
+            "readouts": {k: v.to_dict() for k, v in self.readouts.items()},
+            "outliers": self.outliers,
+        }

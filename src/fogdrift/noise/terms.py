@@ -1,0 +1,261 @@
+"""The IEEE-952 noise terms as data: one table of facts, and each Allan-family statistic's laws.
+
+:data:`TERM_TABLE` is the one home of the statistic-independent facts of the five terms Q, N,
+B, K, R (long name, power-law alpha, Allan law, units, header label, conversion to the reported
+unit, source).  :data:`VARIANCE_LAWS` gives, for each statistic of :data:`fogdrift.allan.STATISTICS`,
+how each term enters its variance; :data:`UNESTIMABLE` says why a statistic cannot see a term.
+:mod:`fogdrift.noise` (the fit) re-exports all of it; report, pipeline and CLI should read
+units, headers and long names from here.
+
+Units: rate deg/h, tau and dt in s; a term's coefficient X in these "Allan-law units"
+(``law_unit``) is converted to the reported unit by ``to_unit``.
+
+The laws marked "derived" were derived for this module from the noise PSD and the statistic's
+transfer function (or directly from the difference operator) and are checked in
+``tests/test_noise.py``: by quadrature (flicker constants), against exact discrete sums, and on
+simulated signals at a tolerance set by the EDF.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from types import MappingProxyType
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..units import B_FACTOR, URAD_PER_ARCSEC
+
+__all__ = [
+    "TermSpec",
+    "TERM_TABLE",
+    "TERMS",
+    "TERM_UNITS",
+    "TERM_HEADERS",
+    "term_spec",
+    "TermLaw",
+    "VARIANCE_LAWS",
+    "UNESTIMABLE",
+    "laws_of",
+    "default_terms",
+]
+
+
+# ----------------------------------------------------------------------------------------
+# The IEEE-952 terms: one table
+# ----------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TermSpec:
+    """Facts of one IEEE-952 noise term (statistic-independent).
+
+    Attributes
+    ----------
+    name : str
+        ``"Q"``, ``"N"``, ``"B"``, ``"K"`` or ``"R"``.
+    long_name : str
+        ``"quantization"``, ``"angle random walk"``, ...
+    avar_power : int
+        Power of tau of the term in the Allan variance (-2 .. 2).
+    avar_coefficient : float
+        ``c`` in the Allan law ``sigma^2 = c X^2 tau^avar_power`` (X in ``law_unit``).
+    law_unit : str
+        Unit of the coefficient X when the rate is in deg/h and tau in s.
+    unit : str
+        Unit in which fogdrift reports the term.
+    suffix : str
+        Name suffix of that unit in column and key names (``"_urad"``, ``"_dprh"``, ...).
+    header : str
+        Table header label, e.g. ``"N [deg/√h]"``.
+    to_unit : float
+        X[unit] = ``to_unit`` * X[law_unit].
+    alpha : int or None
+        Power-law exponent of the rate PSD (the EDF noise type); None for the deterministic ramp.
+    source : str
+        Where the law and conversion come from.
+    """
+
+    name: str
+    long_name: str
+    avar_power: int
+    avar_coefficient: float
+    law_unit: str
+    unit: str
+    suffix: str
+    header: str
+    to_unit: float
+    alpha: int | None
+    source: str
+
+    def from_A(self, A, coefficient=None) -> float:
+        """The term in ``unit`` from its fitted coefficient ``A = c X^2`` (``c`` default: Allan).
+
+        Examples
+        --------
+        >>> round(term_spec("K").from_A(3.7037037e-8), 6)      # K^2/3 with K = 0.02 deg/h^1.5
+        0.02
+        """
+        c = self.avar_coefficient if coefficient is None else float(coefficient)
+        return self.to_unit * math.sqrt(float(A) / c)
+
+    def to_A(self, value, coefficient=None) -> float:
+        """Inverse of :meth:`from_A`: ``c (value / to_unit)^2``."""
+        c = self.avar_coefficient if coefficient is None else float(coefficient)
+        return c * (float(value) / self.to_unit) ** 2
+
+
+_IEEE = "IEEE Std 952-1997 Annex C; method notes 2.2-2.3"
+
+#: The five IEEE-952 terms, in order of the power of tau in the Allan variance.
+TERM_TABLE = MappingProxyType({
+    "Q": TermSpec("Q", "quantization", -2, 3.0, "(deg/h) s = arcsec", "urad", "_urad", "Q [µrad]",
+                  URAD_PER_ARCSEC, 2, _IEEE + "; 1 (deg/h) s = 1 arcsec = 4.848137 urad"),
+    "N": TermSpec("N", "angle random walk", -1, 1.0, "(deg/h) sqrt(s)", "deg/sqrt(h)", "_dprh",
+                  "N [deg/√h]", 1.0 / 60.0, 0, _IEEE + "; sqrt(s) = sqrt(h)/60"),
+    "B": TermSpec("B", "bias instability", 0, B_FACTOR**2, "deg/h", "deg/h", "_dph", "B [deg/h]",
+                  1.0, -1, _IEEE + "; flat level (2 ln2/pi) B^2 for tau >> 1/f0, sigma_min = 0.6643 B"),
+    "K": TermSpec("K", "rate random walk", 1, 1.0 / 3.0, "(deg/h)/sqrt(s)", "deg/h^1.5", "_dphrh",
+                  "K [deg/h^1.5]", 60.0, -2, _IEEE + "; 1/sqrt(s) = 60/sqrt(h)"),
+    "R": TermSpec("R", "rate ramp", 2, 0.5, "(deg/h)/s", "deg/h^2", "_dph2", "R [deg/h²]",
+                  3600.0, None, _IEEE + "; 1/s = 3600/h"),
+})
+
+#: Noise terms in order of the power of tau in the Allan variance: Q, N, B, K, R.
+TERMS = tuple(TERM_TABLE)
+#: Units in which :class:`NoiseFit` reports each term.
+TERM_UNITS = {k: v.unit for k, v in TERM_TABLE.items()}
+#: Table header labels ("Q [µrad]", ...).
+TERM_HEADERS = {k: v.header for k, v in TERM_TABLE.items()}
+
+
+def term_spec(name) -> TermSpec:
+    """The :class:`TermSpec` of ``name`` (``"Q"``, ``"N"``, ``"B"``, ``"K"``, ``"R"``).
+
+    Examples
+    --------
+    >>> s = term_spec("N")
+    >>> s.long_name, s.unit, s.header, s.avar_power
+    ('angle random walk', 'deg/sqrt(h)', 'N [deg/√h]', -1)
+    """
+    try:
+        return TERM_TABLE[name]
+    except (KeyError, TypeError):
+        raise ConfigError(f"term must be one of {TERMS}, got {name!r}") from None
+
+
+# ----------------------------------------------------------------------------------------
+# Each statistic's law for each term
+# ----------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TermLaw:
+    """How one term enters one statistic's variance.
+
+    ``sigma^2(tau) = X^2 dt^dt_power tau^power sum_k series[k] (dt/tau)^(2k)``, X in the
+    term's ``law_unit``.  The fit estimates ``A = series[0] dt^dt_power X^2``, the coefficient
+    of the leading power, with the design column :meth:`shape`.
+
+    Attributes
+    ----------
+    power : int
+        Leading power of tau.
+    series : tuple of float
+        ``series[0]`` is the constant of the leading power, the rest the small-m corrections.
+    dt_power : int
+        Power of the sample interval in the constant (1 for white PM under MVAR).
+    exact : bool
+        True if exact at every m for the signals of :func:`fogdrift.simulate.simulate`;
+        False for the asymptotic flicker plateau.
+    source : str
+    """
+
+    power: int
+    series: tuple
+    dt_power: int = 0
+    exact: bool = True
+    source: str = ""
+
+    def scale(self, dt_s) -> float:
+        """``A / X^2 = series[0] dt^dt_power``."""
+        if self.dt_power and dt_s is None:
+            raise ConfigError("this law needs the sample interval dt_s")
+        return self.series[0] * (float(dt_s) ** self.dt_power if self.dt_power else 1.0)
+
+    def shape(self, tau_s, dt_s=None, *, leading_only=False) -> np.ndarray:
+        """Design column ``tau^power (1 + sum_{k>=1} series[k]/series[0] (dt/tau)^(2k))``."""
+        t = np.asarray(tau_s, dtype=np.float64)
+        # float ** int64-array (the 'dd->d' pow loop), bit-identical to the earlier tau[:, None] ** powers
+        out = np.power(t, np.full(t.shape, self.power, dtype=np.int64))
+        if len(self.series) > 1 and not leading_only:
+            if dt_s is None:
+                raise ConfigError("this law needs the sample interval dt_s")
+            r2 = (float(dt_s) / t) ** 2
+            out = out * (1.0 + sum(c / self.series[0] * r2**k for k, c in enumerate(self.series[1:], 1)))
+        return out
+
+
+_LN2, _LN3 = math.log(2.0), math.log(3.0)
+_SIM = "exact for fogdrift.simulate signals"
+
+#: The law of each term under each statistic (keys: ``AllanResult.statistic``, then term).
+#: A term missing from a statistic's table contributes nothing to it (see :data:`UNESTIMABLE`).
+VARIANCE_LAWS = MappingProxyType({
+    "adev": MappingProxyType({  # the Allan laws of TERM_TABLE
+        k: TermLaw(v.avar_power, (v.avar_coefficient,), exact=(k != "B"),
+                   source=v.source + ("; asymptotic plateau of flicker rate noise" if k == "B" else "; " + _SIM))
+        for k, v in TERM_TABLE.items()
+    }),
+    "hdev": MappingProxyType({
+        "Q": TermLaw(-2, (10.0 / 3.0,), source="derived: the third difference of white angle noise has "
+                     "variance (1+9+9+1) Q^2, divided by 6 tau^2; " + _SIM),
+        "N": TermLaw(-1, (1.0,), source="derived: the second difference of white-rate cluster means has "
+                     "variance 6 N^2/tau, divided by 6 (the normalisation of SP 1065 eq. 17); " + _SIM),
+        "B": TermLaw(0, ((4.0 * _LN2 - 1.5 * _LN3) / math.pi,), exact=False,
+                     source="derived: (8/3) h_-1 int sin^6 x / x^3 dx = (4 ln2 - 1.5 ln3) h_-1 with "
+                     "h_-1 = B^2/pi (0.3580 B^2, 0.811 of AVAR); asymptotic plateau, checked by quadrature"),
+        "K": TermLaw(1, (1.0 / 6.0,), source="derived: cluster means of Brownian rate, "
+                     "E(ybar3 - 2 ybar2 + ybar1)^2 = K^2 tau, divided by 6 (half the AVAR law); " + _SIM),
+    }),
+    "mdev": MappingProxyType({
+        "Q": TermLaw(-3, (3.0,), dt_power=1, source="derived: the three m-point window sums of white "
+                     "angle noise are disjoint, variance 6 m Q^2, so 3 Q^2 dt/tau^3; " + _SIM),
+        "N": TermLaw(-1, (0.5, 0.5), source="derived: triangular weights with sum of squares m^3 + m give "
+                     "N^2/(2 tau) (1 + dt^2/tau^2); " + _SIM),
+        "B": TermLaw(0, ((27.0 / 8.0 * _LN3 - 4.0 * _LN2) / math.pi,), exact=False,
+                     source="derived: 2 h_-1 int sin^6 x / x^5 dx = (27/8 ln3 - 4 ln2) h_-1 with "
+                     "h_-1 = B^2/pi (0.2977 B^2, 0.675 of AVAR); asymptotic plateau (m -> inf), checked "
+                     "by quadrature"),
+        "K": TermLaw(1, (11.0 / 40.0, 1.0 / 24.0, 1.0 / 60.0), source="derived: Brownian rate, "
+                     "K^2 tau (11/40 + (dt/tau)^2/24 + (dt/tau)^4/60) (1/3 at m = 1, 33/40 of AVAR as "
+                     "m -> inf); " + _SIM),
+        "R": TermLaw(2, (0.5,), source="derived: the second difference of a quadratic angle is constant, "
+                     "so R^2 tau^2/2 as for AVAR; exact"),
+    }),
+})
+
+#: Why a statistic cannot estimate a term: (statistic, term) -> reason.
+UNESTIMABLE = MappingProxyType({
+    ("hdev", "R"): "the Hadamard variance cancels a linear rate drift exactly (the third difference of a "
+                   "quadratic angle is zero), so it carries no information on the rate ramp R",
+})
+
+
+def laws_of(statistic):
+    """The law table of a statistic (ConfigError for an unknown one)."""
+    try:
+        return VARIANCE_LAWS[statistic]
+    except (KeyError, TypeError):
+        raise ConfigError(
+            f"no IEEE-952 variance laws for statistic {statistic!r}; expected one of {tuple(VARIANCE_LAWS)}"
+        ) from None
+
+
+def default_terms(statistic="adev") -> tuple:
+    """The terms a statistic can estimate, in :data:`TERMS` order (all five except R for hdev).
+
+    Examples
+    --------
+    >>> default_terms("hdev")
+    ('Q', 'N', 'B', 'K')
+    """
+    laws = laws_of(statistic)
+    return tuple(t for t in TERMS if t in laws)

@@ -1,0 +1,371 @@
+"""Output folders that never hold a half-written file, nor a stale one from an earlier run.
+
+* :func:`check_out_dir` validates a folder **before any work**: it must be a writable folder, or not exist yet
+  with a writable parent folder (a missing parent is an error unless ``create_parents``; it is usually a typo).
+* :func:`atomic_path` writes a file through a temporary name in the same folder (``.fogdrift-tmp-<pid>-<name>``,
+  same suffix, so ``np.savez`` and ``savefig`` see the real extension) and renames it when complete: the final
+  name holds a complete file or nothing.
+* :class:`OutputDir` is one run's output folder.  Inside ``with OutputDir(...)``, every :func:`atomic_path`
+  under it is recorded in a manifest (:data:`MANIFEST`, JSON, rewritten after each file).  At the run's first
+  write, the files the previous run's manifest lists are removed (and the folders it created, when empty):
+  the folder then holds the files of one run only, listed in its manifest with ``"complete": true`` once the
+  run finished.  Files fogdrift did not write (not in a manifest) are never touched; nor are the run's inputs.
+  Leftover temporary files of a process that no longer runs (in the folder and the subfolders the previous run
+  created) are removed at the first write too.
+
+An interrupted run (see :mod:`fogdrift.interrupt`) leaves only complete files; :meth:`OutputDir.summary` says
+which were written and which were not.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import re
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from .errors import ConfigError
+from .interrupt import check, critical
+
+__all__ = ["MANIFEST", "TMP_PREFIX", "OutputDir", "atomic_path", "check_out_dir", "active"]
+
+#: Name of the manifest a run keeps in its output folder.
+MANIFEST = ".fogdrift-manifest.json"
+#: Prefix of the temporary files (followed by the process id, a dash and the final name).
+TMP_PREFIX = ".fogdrift-tmp-"
+_TMP = re.compile(re.escape(TMP_PREFIX) + r"(\d+)-")
+
+_active: list["OutputDir"] = []
+
+
+def check_out_dir(path, *, create_parents: bool = False) -> Path:
+    """Validate an output folder before any work; return it as an absolute Path (nothing is created).
+
+    Raises
+    ------
+    ConfigError
+        ``path`` exists and is not a folder; a parent is a file; the parent folder does not exist (unless
+        ``create_parents``); the folder (or the one it would be created in) is not writable.  The message
+        names the setting ``{opt:out}``.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp()
+    >>> check_out_dir(os.path.join(d, "run1")).name
+    'run1'
+    >>> check_out_dir(os.path.join(d, "missing", "run1"))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.ConfigError: out= .../missing/run1: its parent folder .../missing does not exist; ...
+    """
+    p = Path(path).expanduser().absolute()
+    if p.exists() and not p.is_dir():
+        raise ConfigError(f"{{opt:out}} {p} exists and is not a folder; choose a folder (new or one fogdrift wrote "
+                          "before)")
+    if p.is_dir():
+        _probe(p, p)
+        return p
+    parent = p.parent
+    existing = parent
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise ConfigError(f"{{opt:out}} {p}: {existing} is a file, not a folder")
+    if existing != parent and not create_parents:
+        raise ConfigError(f"{{opt:out}} {p}: its parent folder {parent} does not exist; create it first or choose "
+                          "another folder")
+    _probe(existing, p)
+    return p
+
+
+def _probe(folder: Path, target: Path) -> None:
+    """Create and remove a temporary file in ``folder``: the real test of writability (ACLs, read-only mounts)."""
+    try:
+        fd, name = tempfile.mkstemp(prefix=f"{TMP_PREFIX}{os.getpid()}-probe", dir=folder)
+    except OSError as exc:
+        raise ConfigError(f"{{opt:out}} {target}: cannot write in {folder} ({exc.strerror or exc})") from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(name)
+
+
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True
+
+
+def active(path=None) -> "OutputDir | None":
+    """The innermost active :class:`OutputDir` (that contains ``path``, if given), else None."""
+    for out in reversed(_active):
+        if path is None:
+            return out
+        try:
+            Path(path).absolute().relative_to(out.path)
+            return out
+        except ValueError:
+            continue
+    return None
+
+
+@contextlib.contextmanager
+def atomic_path(path):
+    """Yield a temporary path next to ``path``; rename it to ``path`` when the block ends without error.
+
+    Parent folders are created.  Inside an active :class:`OutputDir` that contains ``path``, the file is
+    recorded in its manifest (and an interruption requested before the write raises first).  On an error
+    the temporary file is removed and ``path`` is left as it was.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> target = Path(tempfile.mkdtemp()) / "table.csv"
+    >>> with atomic_path(target) as tmp:
+    ...     _ = tmp.write_text("tau_s,adev_dph\\n")
+    ...     print(tmp.name.startswith(".fogdrift-tmp-"), tmp.suffix, target.exists())
+    True .csv False
+    >>> target.read_text()
+    'tau_s,adev_dph\\n'
+    """
+    out = active(path)
+    if out is not None:
+        with out.file(path) as tmp:
+            yield tmp
+        return
+    final = Path(path)
+    final.parent.mkdir(parents=True, exist_ok=True)
+    tmp = final.with_name(f"{TMP_PREFIX}{os.getpid()}-{final.name}")
+    try:
+        yield tmp
+        os.replace(tmp, final)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+class OutputDir:
+    """One run's output folder (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The folder; validated at once by :func:`check_out_dir`, created at the first write.
+    command : str
+        What wrote it (stored in the manifest).
+    create_parents : bool
+        Create missing parent folders (the CLI allows it only for its default ``out/<command>``).
+    protect : sequence of paths
+        Files never removed as stale (the run's inputs).
+
+    Attributes
+    ----------
+    written : list of str
+        Files written so far by this run, relative to the folder, in order.
+    removed : list of str
+        Files of the previous run removed at this run's first write.
+    """
+
+    def __init__(self, path, *, command: str, create_parents: bool = False, protect=()):
+        self.path = check_out_dir(path, create_parents=create_parents)
+        self.command = command
+        self.create_parents = create_parents
+        self.protect = {Path(p).absolute() for p in protect}
+        self.written: list[str] = []
+        self.removed: list[str] = []
+        self.expected: list[str] = []
+        self.complete = False
+        self._created_dirs: list[str] = []
+        self._pending: set[Path] = set()
+        self._opened = False
+        self._lock = threading.RLock()
+        self._aborted = False
+        self._started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+
+    # -- context ------------------------------------------------------------------------------------
+    def __enter__(self):
+        _active.append(self)
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        try:
+            if exc_type is None and self._opened:
+                with self._lock:
+                    self.complete = True
+                    self._write_manifest()
+        finally:
+            self._discard_pending()
+            _active.remove(self)
+        return False
+
+    def expect(self, *names) -> None:
+        """Declare files the run means to write (relative names), for :meth:`summary`."""
+        self.expected.extend(str(n) for n in names)
+
+    # -- writing ------------------------------------------------------------------------------------
+    def _rel(self, path) -> str:
+        return Path(path).absolute().relative_to(self.path).as_posix()
+
+    @contextlib.contextmanager
+    def file(self, path):
+        """Like :func:`atomic_path`, for a path inside this folder (relative paths are taken inside it)."""
+        check()
+        final = Path(path) if Path(path).is_absolute() else self.path / path
+        rel = self._rel(final)
+        with self._lock:
+            if self._aborted:
+                raise RuntimeError("output folder closed after an interruption")
+            self._open()
+            self._make_dirs(final.parent)
+            tmp = final.with_name(f"{TMP_PREFIX}{os.getpid()}-{final.name}")
+            self._pending.add(tmp)
+        try:
+            yield tmp
+            with critical(), self._lock:
+                if self._aborted:
+                    raise RuntimeError("output folder closed after an interruption")
+                os.replace(tmp, final)
+                self._pending.discard(tmp)
+                if rel not in self.written:
+                    self.written.append(rel)
+                self._write_manifest()
+        except BaseException:
+            with self._lock:
+                self._pending.discard(tmp)
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+            raise
+
+    def _make_dirs(self, folder: Path) -> None:
+        missing = []
+        f = folder
+        while not f.exists():
+            missing.append(f)
+            f = f.parent
+        for d in reversed(missing):
+            d.mkdir(exist_ok=True)
+            try:
+                rel = self._rel(d)
+            except ValueError:  # a parent of the output folder itself (create_parents)
+                continue
+            if rel != "." and rel not in self._created_dirs:
+                self._created_dirs.append(rel)
+
+    def _open(self) -> None:
+        """First write: create the folder, remove the previous run's files and dead temporaries."""
+        if self._opened:
+            return
+        if self.path.exists() and not self.path.is_dir():
+            raise ConfigError(f"{{opt:out}} {self.path} exists and is not a folder")
+        if not self.path.exists():
+            if self.create_parents:
+                self.path.mkdir(parents=True, exist_ok=True)
+            else:
+                self.path.mkdir()
+        previous = self._read_manifest()
+        for rel in previous.get("files", []):
+            target = self._inside(rel)
+            if target is None or target in self.protect or not target.is_file() or target.is_symlink():
+                continue
+            with contextlib.suppress(OSError):
+                target.unlink()
+                self.removed.append(rel)
+        for rel in sorted(previous.get("dirs", []), key=lambda r: r.count("/"), reverse=True):
+            target = self._inside(rel)
+            if target is not None and target.is_dir() and not any(target.iterdir()):
+                with contextlib.suppress(OSError):
+                    target.rmdir()
+        folders = [self.path] + [d for d in (self._inside(r) for r in previous.get("dirs", [])) if d is not None]
+        for folder in folders:  # not recursive: --out may be a big folder of other things
+            for stale in (folder.glob(TMP_PREFIX + "*") if folder.is_dir() else ()):
+                m = _TMP.match(stale.name)
+                if m and stale.is_file() and not _pid_alive(int(m.group(1))):
+                    with contextlib.suppress(OSError):
+                        stale.unlink()
+        self._opened = True
+        self._write_manifest()
+
+    def _inside(self, rel) -> Path | None:
+        """``rel`` as a path inside the folder, or None if it is absolute or leaves it."""
+        if not isinstance(rel, str) or not rel or Path(rel).is_absolute():
+            return None
+        target = (self.path / rel).absolute()
+        try:
+            target.resolve().relative_to(self.path.resolve())
+        except (ValueError, OSError):
+            return None
+        return target
+
+    def _read_manifest(self) -> dict:
+        try:
+            doc = json.loads((self.path / MANIFEST).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return {}
+        return doc if isinstance(doc, dict) and doc.get("fogdrift_manifest") == 1 else {}
+
+    def _write_manifest(self) -> None:
+        from . import __version__
+
+        doc = {"fogdrift_manifest": 1, "command": self.command, "fogdrift_version": __version__,
+               "started": self._started, "complete": self.complete, "files": self.written,
+               "dirs": self._created_dirs}
+        target = self.path / MANIFEST
+        tmp = target.with_name(f"{TMP_PREFIX}{os.getpid()}-{MANIFEST}")
+        tmp.write_text(json.dumps(doc, indent=1), encoding="utf-8")
+        os.replace(tmp, target)
+
+    def _discard_pending(self) -> None:
+        with self._lock:
+            for tmp in list(self._pending):
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+            self._pending.clear()
+
+    # -- interruption -------------------------------------------------------------------------------
+    def abort(self, timeout: float = 0.3) -> None:
+        """From another thread: stop further renames and remove unfinished temporary files."""
+        got = self._lock.acquire(timeout=timeout)
+        try:
+            self._aborted = True
+            for tmp in list(self._pending):
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+            self._pending.clear()
+        finally:
+            if got:
+                self._lock.release()
+
+    def summary(self) -> str:
+        """One line: what this run wrote and what it did not (complete files only; no partial file left)."""
+        where = str(self.path)
+        if not self.written:
+            kept = " (the earlier run's files there are unchanged)" if not self._opened and \
+                (self.path / MANIFEST).exists() else ""
+            return f"nothing was written to {where}{kept}"
+        missing = [n for n in self.expected if n not in self.written]
+        text = f"wrote {len(self.written)} complete file(s) to {where}: {_listing(self.written)}"
+        if missing:
+            text += f"; not written: {_listing(missing)}"
+        elif not self.complete:
+            text += "; the rest of the run's files were not written"
+        if self.removed:
+            text += f"; the earlier run's {len(self.removed)} file(s) there were removed"
+        return text + "; no partial file left"
+
+
+def _listing(names, limit: int = 6) -> str:
+    names = list(names)
+    if len(names) <= limit:
+        return ", ".join(names)
+    return ", ".join(names[:limit]) + f" and {len(names) - limit} more"

@@ -1,0 +1,264 @@
+"""Is a record plausible for any gyro?  Checks that catch a wrong rate unit or time unit.
+
+Multiplying every sample by a constant changes no ratio (slopes, B/N, signal-to-noise), so a wrong unit
+shows only in absolute levels.  :func:`check_record` applies four rules to a record in deg/h and names
+the units under which the numbers would be plausible:
+
+``white-noise``
+    The white-noise floor ``N_floor = min over tau of sigma(tau) sqrt(tau) / 60`` [deg/sqrt(h)] (sigma the
+    overlapping Allan deviation in deg/h, tau in s) is an upper bound of the angle random walk N: every
+    IEEE-952 term adds to sigma^2(tau), and the N term alone is N^2 3600 / tau (method notes §2.2, §2.3).
+    A floor whose 68 % upper bound is below :data:`ARW_MIN_DPRH` (1e-4 deg/sqrt(h), quieter than the best
+    strategic-grade gyro) or whose 68 % lower bound is above :data:`ARW_MAX_DPRH` (100 deg/sqrt(h), noisier
+    than any gyro at every tau) is implausible.
+``range``
+    ``max |rate|`` above :data:`RANGE_MAX_DPH` (1e4 deg/s) is beyond the range of any gyro.
+``earth-rate``
+    A 3-axis record whose white-noise floor is navigation grade (below :data:`NAV_GRADE_DPRH` on every axis)
+    resolves the Earth rate, 15.04 deg/h (method notes §6), in its mean vector; a mean vector shorter than
+    :data:`EARTH_FRACTION` of it says the numbers are smaller than their unit claims (e.g. a deg/s log read
+    as deg/h), unless the Earth rate and bias were removed beforehand or the base was not static.
+``sample-rate``
+    A sample rate at or below :data:`RATE_MIN_HZ` (0.1 Hz) or above :data:`RATE_MAX_HZ` suggests a time
+    column read in the wrong unit (a 100 Hz log with its time in ms read as s comes out at 0.1 Hz).
+
+A unit is "likely" when the record rescaled to it passes the first three rules; candidates are tried in
+:data:`CANDIDATE_UNITS` order (the common gyro output units first) and at most two are named.
+
+The checks warn; they never change the data.  Messages name settings as ``{opt:unit}`` (see
+:mod:`fogdrift.errors`).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import FogdriftWarning, render_options
+from .units import EARTH_RATE_DPH, INCREMENT_UNITS, RATE_UNITS
+
+__all__ = [
+    "Finding",
+    "NoiseFloor",
+    "check_record",
+    "noise_floor",
+    "warn_implausible",
+    "ARW_MIN_DPRH",
+    "ARW_MAX_DPRH",
+    "RANGE_MAX_DPH",
+    "NAV_GRADE_DPRH",
+    "EARTH_FRACTION",
+    "RATE_MIN_HZ",
+    "RATE_MAX_HZ",
+    "CANDIDATE_UNITS",
+    "MAX_CHECK_SAMPLES",
+    "MIN_CLUSTERS",
+]
+
+#: Quieter than the best strategic-grade gyro [deg/sqrt(h)].
+ARW_MIN_DPRH = 1e-4
+#: Noisier than any gyro [deg/sqrt(h)].
+ARW_MAX_DPRH = 100.0
+#: Beyond the measurement range of any gyro: 1e4 deg/s [deg/h].
+RANGE_MAX_DPH = 1e4 * 3600.0
+#: A white-noise floor below this [deg/sqrt(h)] is navigation grade: such a gyro resolves the Earth rate.
+NAV_GRADE_DPRH = 0.01
+#: A static navigation-grade triad's mean vector is at least this fraction of the Earth rate.
+EARTH_FRACTION = 0.2
+#: Sample rates at or below / above these [Hz] suggest a time column read in the wrong unit.
+RATE_MIN_HZ = 0.1
+RATE_MAX_HZ = 2e5
+#: Units tried when naming the likely unit: the common gyro output units, most common first (increments only
+#: when the data were read as increments; rad/h and arcsec/s are rare enough not to be suggested).
+CANDIDATE_UNITS = ("deg/s", "rad/s", "deg/h", "inc:arcsec", "inc:rad", "inc:deg")
+#: The noise floor uses at most this many samples per axis (the first ones), so the check stays cheap.
+MAX_CHECK_SAMPLES = 1 << 22
+#: Taus longer than 1/MIN_CLUSTERS of the record are left out of the noise floor: a minimum over noisy
+#: estimates is biased low (with 40 clusters one white-noise ADEV estimate is within about +-11 % at 68 %).
+MIN_CLUSTERS = 40
+
+
+@dataclass(frozen=True)
+class NoiseFloor:
+    """White-noise floor of one axis [deg/sqrt(h)]: the estimate and its 68 % bounds (see the module docstring)."""
+
+    estimate: float
+    lo68: float
+    hi68: float
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One implausibility.
+
+    Attributes
+    ----------
+    rule : str
+        ``"white-noise"``, ``"range"``, ``"earth-rate"`` or ``"sample-rate"``.
+    axes : tuple of str
+        Axes concerned (empty for the sample rate).
+    message : str
+        One line; settings are written ``{opt:NAME}`` (render with :func:`fogdrift.errors.render_options`).
+    likely_units : tuple of str
+        Units under which the numbers would be plausible, most likely first (may be empty).
+    """
+
+    rule: str
+    axes: tuple
+    message: str
+    likely_units: tuple = ()
+
+    def render(self, flags: dict | None = None) -> str:
+        """The message with ``{opt:NAME}`` rendered through ``flags`` (library spelling ``NAME=`` by default)."""
+        return render_options(self.message, flags)
+
+
+def noise_floor(rate_dph, dt_s) -> NoiseFloor:
+    """White-noise floor ``min over tau of sigma(tau) sqrt(tau_s) / 60`` [deg/sqrt(h)] of one rate series.
+
+    Uses the overlapping Allan deviation on the octave grid of :func:`fogdrift.allan.allan_variance`, the taus
+    up to 1/:data:`MIN_CLUSTERS` of the record, and at most :data:`MAX_CHECK_SAMPLES` samples.
+    ``lo68``/``hi68`` take the same minimum over the 68 % bounds.
+
+    Examples
+    --------
+    White rate noise of 0.5 deg/sqrt(h) sampled at 100 Hz has sigma = 60 N / sqrt(tau) = 300 deg/h at tau = 0.01 s:
+
+    >>> import numpy as np
+    >>> x = np.random.default_rng(1).normal(0.0, 300.0, 200_000)
+    >>> round(noise_floor(x, 0.01).estimate, 1)
+    0.5
+    """
+    from .allan import allan_variance
+
+    x = np.asarray(rate_dph, dtype=np.float64)[:MAX_CHECK_SAMPLES]
+    if x.size < 8:
+        return NoiseFloor(math.nan, math.nan, math.nan)
+    res = allan_variance(x, dt_s, taus="octave", estimator="overlapping")
+    keep = x.size / np.asarray(res.m, dtype=np.float64) >= MIN_CLUSTERS
+    if not keep.any():
+        keep = np.ones(np.asarray(res.m).shape, dtype=bool)
+    root = np.sqrt(np.asarray(res.tau_s, dtype=np.float64)[keep]) / 60.0
+    return NoiseFloor(float(np.min(res.adev_dph[keep] * root)), float(np.min(res.adev_lo68_dph[keep] * root)),
+                      float(np.min(res.adev_hi68_dph[keep] * root)))
+
+
+def _factor(unit: str, record) -> float:
+    """Multiply the record's deg/h values by this to get what they would be were the file in ``unit``."""
+    if unit.startswith("inc:"):
+        scale = INCREMENT_UNITS[unit[4:]] / record.dt_s
+    else:
+        scale = RATE_UNITS[unit]
+    return scale / float(record.scale_to_dph)
+
+
+def _fmt(x: float) -> str:
+    """Three significant digits, plain notation from 1e-3 to 1e4."""
+    if not math.isfinite(x):
+        return "n/a"
+    return f"{x:.3g}" if x == 0 or 1e-3 <= abs(x) < 1e4 else f"{x:.2e}"
+
+
+def _violations(floors, peaks, means, factor: float = 1.0) -> set:
+    """Rules broken by the record rescaled by ``factor`` (floors, peaks, means per axis)."""
+    broken = set()
+    if any(f.hi68 * factor < ARW_MIN_DPRH or f.lo68 * factor > ARW_MAX_DPRH for f in floors if math.isfinite(f.hi68)):
+        broken.add("white-noise")
+    if any(p * factor > RANGE_MAX_DPH for p in peaks):
+        broken.add("range")
+    if len(means) == 3 and all(math.isfinite(f.hi68) and f.hi68 * factor < NAV_GRADE_DPRH for f in floors) \
+            and float(np.linalg.norm(means)) * factor < EARTH_FRACTION * EARTH_RATE_DPH:
+        broken.add("earth-rate")
+    return broken
+
+
+def check_record(record) -> list[Finding]:
+    """Findings for a :class:`~fogdrift.io.GyroRecord` that no gyro would produce (see the module docstring).
+
+    Returns
+    -------
+    list of Finding
+        Empty when the record is plausible.  Each finding's ``likely_units`` lists the units under which the
+        numbers pass the white-noise, range and Earth-rate rules.
+
+    Examples
+    --------
+    A 0.5 deg/sqrt(h) gyro whose deg/h log was read as deg/s looks 3600 times noisier than any gyro:
+
+    >>> import numpy as np
+    >>> from fogdrift.io import from_array
+    >>> numbers = np.random.default_rng(1).normal(0.0, 300.0, 20_000)  # deg/h in the file
+    >>> [(f.rule, f.likely_units) for f in check_record(from_array(numbers, dt_s=0.01, unit="deg/s"))]
+    [('white-noise', ('deg/h',))]
+    """
+    names = tuple(record.axis_names)
+    floors = [noise_floor(record.axis(n), record.dt_s) for n in names]
+    rates = [np.asarray(record.axis(n), dtype=np.float64) for n in names]
+    peaks = [float(np.max(np.abs(r))) if r.size else 0.0 for r in rates]
+    means = [float(np.mean(r)) if r.size else 0.0 for r in rates]
+    unit = record.input_unit
+    broken = _violations(floors, peaks, means)
+    findings = []
+    if broken:
+        likely = []
+        for cand in CANDIDATE_UNITS:
+            if cand == unit or (cand.startswith("inc:") and not str(unit).startswith("inc:")):
+                continue  # increments are named only when the data were read as increments
+            f = _factor(cand, record)
+            if not _violations(floors, peaks, means, f) and not any(math.isclose(f, _factor(u, record))
+                                                                    for u in likely):
+                likely.append(cand)
+        likely = tuple(likely[:2])
+        hint = _hint(likely, floors, record)
+        if "white-noise" in broken:
+            low = [n for n, f in zip(names, floors) if f.hi68 < ARW_MIN_DPRH]
+            high = [n for n, f in zip(names, floors) if f.lo68 > ARW_MAX_DPRH]
+            axes = tuple(low or high)
+            levels = ", ".join(f"{n} {_fmt(f.estimate)}" for n, f in zip(names, floors) if n in axes)
+            what = (f"implausibly quiet for any gyro: white-noise floor N <= {levels} deg/√h with the rate read as "
+                    f"{unit}, below the {ARW_MIN_DPRH:g} deg/√h of the best gyros") if low else \
+                   (f"implausibly noisy for any gyro: white-noise floor N = {levels} deg/√h at every τ with the rate "
+                    f"read as {unit}, above {ARW_MAX_DPRH:g} deg/√h")
+            findings.append(Finding("white-noise", axes, f"{what}; {hint}", likely))
+        if "range" in broken:
+            axes = tuple(n for n, p in zip(names, peaks) if p > RANGE_MAX_DPH)
+            levels = ", ".join(f"{n} {p / 3600.0:.3g} deg/s" for n, p in zip(names, peaks) if n in axes)
+            findings.append(Finding("range", axes, f"max |rate| {levels} with the rate read as {unit} is beyond the "
+                                                   f"range of any gyro ({RANGE_MAX_DPH / 3600:g} deg/s); {hint}",
+                                    likely))
+        if "earth-rate" in broken:
+            norm = float(np.linalg.norm(means))
+            findings.append(Finding(
+                "earth-rate", names,
+                f"with the rate read as {unit} these 3 axes are navigation grade (white-noise floor N <= "
+                f"{_fmt(max(f.estimate for f in floors))} deg/√h) yet their mean vector is {norm:.3g} deg/h; a static "
+                f"gyro of that grade shows the Earth rate, {EARTH_RATE_DPH:.2f} deg/h (unless bias and Earth rate were "
+                f"removed before, or the base moved); {hint}", likely))
+    fs = record.fs_hz
+    if fs <= RATE_MIN_HZ or fs > RATE_MAX_HZ:
+        slow = fs <= RATE_MIN_HZ
+        findings.append(Finding(
+            "sample-rate", (),
+            f"sample rate {fs:.4g} Hz (interval {record.dt_s:.4g} s) is unusually {'low' if slow else 'high'} for a "
+            f"gyro log; check {{opt:time_unit}} ({'a time column in ms read as s gives a 1000 times longer step' if slow else 'a time column in s read as ms gives a 1000 times shorter step'}) "
+            "and {opt:rate_hz}"))
+    return findings
+
+
+def _hint(likely, floors, record) -> str:
+    if not likely:
+        return "check {opt:unit}"
+    worst = max((f.estimate for f in floors if math.isfinite(f.estimate)), default=math.nan)
+    named = " or ".join(f"{u} (N <= {_fmt(worst * _factor(u, record))} deg/√h)" for u in likely)
+    return f"the numbers fit {named}: check {{opt:unit}}"
+
+
+def warn_implausible(record) -> list[Finding]:
+    """:func:`check_record`, issuing one :class:`~fogdrift.errors.FogdriftWarning` per finding; returns them."""
+    findings = check_record(record)
+    for f in findings:
+        warnings.warn(f"{record.source}: {f.render()}", FogdriftWarning, stacklevel=2)
+    return findings

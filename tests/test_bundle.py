@@ -1,0 +1,150 @@
+"""Model bundle: a round trip gives identical predictions and settings; every refusal is one clear error.
+
+Independent checks: the causal window and level recomputed from the pipeline's documented rule, the SHA-256 of
+the training file from :mod:`hashlib`, the split times from the record's t0 and interval.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+
+import numpy as np
+import pytest
+from numpy.testing import assert_array_equal
+from typer.testing import CliRunner
+
+from fogdrift.bundle import BUNDLE_FORMAT_VERSION, load_bundle, write_bundle
+from fogdrift.errors import ModelFileError
+from fogdrift.io import from_array
+from fogdrift.pipeline import AnalysisConfig, run_models
+from fogdrift.simulate import simulate
+
+
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory):
+    """A 2-axis record at 10 Hz, models at 1 Hz: AR, GM(1,1), Kalman, persistence."""
+    rate = np.column_stack([
+        simulate(60000, 0.1, arw_dprh=0.05, rrw_dphrh=1.0, bias_dph=3.0, seed=s) for s in (1, 2)])
+    rec = from_array(rate / 3600.0, dt_s=0.1, unit="deg/s", axis_names=["gx", "gz"])
+    cfg = AnalysisConfig(models=("ar", "gm11", "kalman", "persistence"), latitude_deg=45.0, earth_axes={"gz": "up"})
+    axes = run_models(rec, cfg)
+    out = tmp_path_factory.mktemp("b") / "bundle"
+    bundle = write_bundle(out, axes, cfg, rec)
+    return rec, cfg, axes, bundle, out
+
+
+def test_round_trip_same_settings_and_predictions(fitted):
+    rec, cfg, axes, bundle, out = fitted
+    back = load_bundle(out)
+    assert back.axis_names == ("gx", "gz")
+    assert back.input_unit == "deg/s" and back.native_dt_s == 0.1 and back.model_dt_s == 1.0
+    assert back.block_average_factor == 10 and back.wavelet == "db2" and back.mode == "symmetric"
+    assert back.latitude_deg == 45.0 and back.format_version == BUNDLE_FORMAT_VERSION
+    assert back.model_names == ("gm11", "ar", "kalman", "persistence")
+    split = back.training["split"]
+    assert split["test"]["t_s"] == [4800.0, 6000.0] and split["test"]["samples"] == [4800, 6000]
+    for ma in axes:
+        ax = back.axis(ma.name)
+        assert ax.bias_dph == ma.bias_dph and ax.earth_rate_dph == ma.earth_rate_dph
+        assert ax.level == 4
+        assert ax.causal_window == 128  # max(round(128 s / 1 s), (4 - 1) * 2**4) with 3600 training samples
+        assert "training block" in ax.bias_method
+        A = ax.noise_model["allan"]["A"]
+        assert len(A) == 5 and A[1] > 0  # white noise identified
+        assert ax.noise_model["gmwm"] is None
+        assert ax.noise_model["kalman_components"] == ma.fitted["Kalman"].components_
+        e, f = ma.split["test"]
+        z = ma.rate_dph[e:f]
+        for name, model in ax.models.items():
+            orig = next(m for m in ma.fitted.values() if type(m) is type(model))
+            assert_array_equal(model.predict(z, history=ma.rate_dph[:e]), orig.predict(z, history=ma.rate_dph[:e]))
+    assert back.axis("gz").earth_orientation == "up" and back.axis("gx").earth_orientation is None
+    assert back.axis("gz").earth_rate_dph == pytest.approx(10.635640, abs=1e-5)  # method notes §6 table
+
+
+def test_training_input_is_described(fitted, tmp_path):
+    rec, cfg, axes, _, _ = fitted
+    path = tmp_path / "rec.npy"
+    np.save(path, np.asarray(rec.rate_dph))
+    from fogdrift.io import load
+
+    loaded = load(path, rate_hz=10.0, unit="deg/h")
+    axes2 = run_models(loaded, AnalysisConfig(models=("persistence",)))
+    b = write_bundle(tmp_path / "bundle", axes2, AnalysisConfig(models=("persistence",)), loaded)
+    doc = json.loads((tmp_path / "bundle" / "manifest.json").read_text())
+    assert doc["training"]["sha256"] == hashlib.sha256(path.read_bytes()).hexdigest()
+    assert doc["training"]["t_end_s"] == pytest.approx(6000.0) and doc["training"]["t0_s"] == 0.0
+    assert doc["fogdrift_version"] and doc["settings"]["models"] == ["persistence"]
+    assert b.path == tmp_path / "bundle"
+
+
+def _copy(out, tmp_path):
+    dst = tmp_path / "copy"
+    shutil.copytree(out, dst)
+    return dst, json.loads((dst / "manifest.json").read_text())
+
+
+def _write(dst, doc):
+    (dst / "manifest.json").write_text(json.dumps(doc))
+
+
+def test_newer_format_is_refused_with_a_clear_message(fitted, tmp_path):
+    dst, doc = _copy(fitted[4], tmp_path)
+    doc["format_version"] = BUNDLE_FORMAT_VERSION + 1
+    doc["fogdrift_version"] = "9.9"
+    _write(dst, doc)
+    with pytest.raises(ModelFileError, match=r"format version 2 was written by fogdrift 9.9.*upgrade fogdrift"):
+        load_bundle(dst)
+
+
+@pytest.mark.parametrize("edit, fragment", [
+    (lambda d: d.pop("native_dt_s"), "native_dt_s: missing"),
+    (lambda d: d.update(input_unit="furlong/s"), "input_unit: unknown unit"),
+    (lambda d: d.update(block_average_factor=7), "block_average_factor"),
+    (lambda d: d.update(wavelet="db9"), "wavelet"),
+    (lambda d: d["axes"][0].update(level=9), "axes[0].level"),
+    (lambda d: d["axes"][0].update(causal_window=1), "axes[0].causal_window"),
+    (lambda d: d["axes"][1].update(name="gx"), "appears twice"),
+    (lambda d: d["axes"][0]["models"]["ar"].update({"class": "GM11"}), "models.ar.class"),
+    (lambda d: d["axes"][0]["models"].update(lstm=d["axes"][0]["models"]["ar"]), "unknown model 'lstm'"),
+    (lambda d: d.update(format="something-else"), "not a fogdrift bundle"),
+    (lambda d: d["axes"][0].update(bias_dph="3"), "axes[0].bias_dph: expected a finite number"),
+])
+def test_invalid_manifests_name_the_key(fitted, tmp_path, edit, fragment):
+    dst, doc = _copy(fitted[4], tmp_path)
+    edit(doc)
+    _write(dst, doc)
+    with pytest.raises(ModelFileError) as info:
+        load_bundle(dst)
+    assert fragment in str(info.value) and "manifest.json" in str(info.value)
+
+
+def test_modified_or_missing_model_files_are_refused(fitted, tmp_path):
+    dst, _ = _copy(fitted[4], tmp_path)
+    path = dst / "gx" / "ar.json"
+    doc = json.loads(path.read_text())
+    doc["state"]["intercept_"] += 1.0
+    path.write_text(json.dumps(doc))
+    with pytest.raises(ModelFileError, match="SHA-256 differs"):
+        load_bundle(dst)
+    (dst / "gx" / "ar.npz").unlink()
+    with pytest.raises(ModelFileError, match="missing"):
+        load_bundle(dst)
+    with pytest.raises(ModelFileError, match="manifest not found"):
+        load_bundle(tmp_path / "nowhere")
+    (dst / "manifest.json").write_text("{not json")
+    with pytest.raises(ModelFileError, match="not valid JSON"):
+        load_bundle(dst / "manifest.json")
+
+
+def test_model_command_writes_a_loadable_bundle(bundled_path, tmp_path):
+    from fogdrift.cli import app
+
+    result = CliRunner().invoke(app, ["model", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models", "ar,persistence",
+                                      "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    b = load_bundle(tmp_path / "bundle")
+    assert b.axis_names == ("gz",) and b.model_names == ("ar", "persistence")
+    assert b.training["sha256"] == hashlib.sha256(bundled_path.read_bytes()).hexdigest()
