@@ -29,6 +29,7 @@ def main() -> int:
         ["bench_lifting.py", "--sizes", sizes, "--json", str(out / "lifting.json")],
         ["bench_elman.py", "--json", str(out / "elman.json")],
         ["bench_compensate.py", "--sizes", sizes, "--json", str(out / "compensate.json")],
+        ["bench_noise.py", "--json", str(out / "noise.json")],
     ]
     status = 0
     for job in jobs:

@@ -104,10 +104,13 @@ def noise_notes(noise) -> list[str]:
     b = noise.b_min or {}
     if b.get("value") is not None:
         if b.get("bound_only"):
-            out.append(f"bias instability (IEEE reading at the ADEV minimum): the fitted curve still falls at the "
-                       f"longest tau, so B_min < {_fmt(b['value'], 3)} deg/h")
+            why = ("the fitted flat floor lies above the measured curve, so the measured minimum bounds it"
+                   if "measured curve" in b.get("rule", "") else "the curve still falls at the longest tau")
+            out.append(f"bias instability (IEEE reading at the ADEV minimum): B_min < {_fmt(b['value'], 3)} deg/h "
+                       f"(min at tau = {_fmt(b['tau_s'], 3)} s; {why})")
         else:
-            out.append(f"bias instability (IEEE reading, min of the fitted ADEV / 0.664): B_min = {_fmt(b['value'], 3)} "
+            which = "measured" if "measured ADEV" in b.get("rule", "") else "fitted"
+            out.append(f"bias instability (IEEE reading, min of the {which} ADEV / 0.664): B_min = {_fmt(b['value'], 3)} "
                        f"deg/h at tau = {_fmt(b['tau_s'], 3)} s")
     for t in noise.terms.values():
         if t.reason and t.status != "resolved":

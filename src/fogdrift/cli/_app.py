@@ -152,12 +152,15 @@ class LoadOptions:
                     time_column=None if self.time_column.lower() == "none" else self.time_column,
                     temperature=self.temperature, format=self.format, reader_options=self.reader_options())
 
-    def load(self, path=None):
-        """Load ``path`` (default: ``file``) with these options; ``--gaps longest`` keeps the longest segment."""
+    def load(self, path=None, *, unit=None, time_unit=None):
+        """Load ``path`` (default: ``file``) with these options; ``--gaps longest`` keeps the longest segment.
+
+        ``unit`` / ``time_unit`` override ``--unit`` / ``--time-unit`` (a second recording's own units)."""
         from ..io import load, load_segments
 
         path = self.file if path is None else path
         kwargs = self.load_kwargs()
+        kwargs.update(unit=unit or self.unit, time_unit=time_unit or self.time_unit)
         if self.gaps == "error":
             return load(path, **kwargs)
         if self.gaps == "longest":

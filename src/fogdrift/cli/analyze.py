@@ -27,7 +27,13 @@ def analyze(
     earth_axis: Annotated[Optional[list[str]], typer.Option(
         "--earth-axis", help="AXIS=ORIENTATION (up, down, north, south, east, west), repeatable.")] = None,
     apply_to: Annotated[Optional[Path], typer.Option("--apply-to", help="Second recording: apply the fitted "
-                                                     "models unchanged to it.")] = None,
+                                                     "models unchanged to it (axes matched by name; its bias is "
+                                                     "re-estimated on its own training share, and said so).")] = None,
+    apply_unit: Annotated[Optional[str], typer.Option(
+        "--apply-unit", help="Rate unit of the --apply-to recording (default: --unit, or its header's).")] = None,
+    apply_time_unit: Annotated[Optional[str], typer.Option(
+        "--apply-time-unit", help="Time unit of the --apply-to recording (default: --time-unit, or its header's).")]
+    = None,
     models: ModelsOpt = ALL_MODELS,
     hidden: HiddenOpt = 16,
     lags: LagsOpt = 4,
@@ -85,13 +91,18 @@ def analyze(
         check_plausible(record)
         other = None
         if apply_to:
-            other = load.load(apply_to)
+            other = load.load(apply_to, unit=apply_unit, time_unit=apply_time_unit)
+            other = _match_axes(record, other, apply_to)
             check_model_rate(other, cfg.model_rate_hz)
             echo_record(load, other, apply_to)
             check_plausible(other)
+        elif apply_unit or apply_time_unit:
+            raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
         with progress("analyze", record.axis_names) as (_, epoch_cb):
             result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb)
         say(model_axes_text([ax.models for ax in result.axes], record))
+        if result.apply_to is not None:
+            say(apply_note(result, apply_to))
         for res, title in ((result, load.file.name), (result.apply_to, apply_to.name if apply_to else "")):
             if res is None:
                 continue
@@ -119,7 +130,40 @@ def analyze(
         from ..bundle import write_bundle
 
         bundle = write_bundle(r.out.path / "bundle", [ax.models for ax in result.axes], cfg, record)
+        # the compensated test block (what each model's causal compensation gives; loadable by fogdrift.io.load)
+        from ..compensate.test_block import write_compensated_test_block
+
+        comp = write_compensated_test_block([ax.models for ax in result.axes], r.out.path, t0_s=record.t0_s)
         r.wrote()
         say(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
         say(f"bundle: {bundle.path}")
+        say(f"compensated test block: {', '.join(p.name for p in comp)} (modelling rate, deg/h)")
         r.print_json(r.out.path / "analysis.json")
+
+
+def _match_axes(record, other, path):
+    """The --apply-to recording's axes matched to the fitted ones BY NAME; refuses axes without a model."""
+    fitted = list(record.axis_names)
+    extra = [a for a in other.axis_names if a not in fitted]
+    if extra:
+        raise ConfigError(f"--apply-to {path}: axes {extra} have no fitted model (the fitted recording has "
+                          f"{fitted}); axes are matched by name: select matching ones with --columns")
+    missing = [a for a in fitted if a not in other.axis_names]
+    if missing:
+        say(f"--apply-to {path.name}: axes {missing} are not in this recording: not applied there", style="yellow")
+    return other
+
+
+def apply_note(result, path) -> str:
+    """One line saying what --apply-to re-estimated and what it kept."""
+    cfg = result.config
+    parts = []
+    fitted = {a.name: a.models for a in result.axes}
+    for ax in result.apply_to.axes:
+        ma, src = ax.models, fitted.get(ax.name)
+        e, f = ma.split["train"]
+        parts.append(f"{ax.name} {ma.bias_dph:+.4g} deg/h on its first {(f - e) * ma.dt_s:g} s "
+                     f"(fitted recording: {src.bias_dph:+.4g} deg/h)" if src is not None else ax.name)
+    return (f"--apply-to {path.name}: models applied unchanged (axes by name); bias re-estimated on its own "
+            f"training share ({cfg.train_fraction:g}): " + "; ".join(parts)
+            + "; Earth rate, wavelet, level and modelling rate as for the fitted recording")

@@ -27,6 +27,7 @@ from .identify import POOR_CHI2_RED, identify, thin_taus
 from .readouts import Readout, slope_readouts
 from .result import TERM_STATUSES, NoiseFit, NoiseTerm
 from .terms import (
+    DISPLAY_UNITS,
     TERM_HEADERS,
     TERM_TABLE,
     TERM_UNITS,
@@ -54,6 +55,7 @@ __all__ = [
     "TERMS",
     "TERM_UNITS",
     "TERM_HEADERS",
+    "DISPLAY_UNITS",
     "TERM_TABLE",
     "TermSpec",
     "term_spec",
@@ -116,8 +118,8 @@ def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penal
     ----------
     allan : AllanResult or a curve object
         Needs ``statistic``, ``tau_s`` [s], ``var_dph2`` [(deg/h)^2], ``dev_hi95_dph`` [deg/h], ``n_samples`` and
-        ``dt_s`` [s]; ``m`` (averaging factors) if present.  A published curve can be given the same way
-        (:func:`fogdrift.curves.load_curves`).
+        ``dt_s`` [s]; ``m`` (averaging factors) if present.  A published curve (taus, variances, upper 95 %
+        bounds, record length) can be given the same way, or its arrays passed to :func:`identify`.
     terms : sequence of str or None, keyword-only
         ``None`` (default): the model is selected from the data among every subset of the terms the statistic can
         estimate.  A sequence fixes the model (no selection), e.g. ``("N", "K")``.

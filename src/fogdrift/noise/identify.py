@@ -215,6 +215,12 @@ def _reduced(sel, n_points):
     return r["q"] / max(1, n_points - len(sel["best"]))
 
 
+def _tau_span(lo: float, hi: float) -> str:
+    """``"0.64"`` for one point, ``"0.64-5.12"`` for a range (3 significant digits)."""
+    a, b = f"{lo:.3g}", f"{hi:.3g}"
+    return a if a == b else f"{a}-{b}"
+
+
 def _choose_start(ctx: _Context, penalty: float, max_fraction: float = 0.5, thresh: float = 16.0,
                   thresh_below: float = 6.25):
     """First fitted point: grow the fit range from where the curve is visibly white noise (else from the long-tau
@@ -310,7 +316,10 @@ def _describe_excluded(ctx: _Context, start: int, sel) -> str:
     elif slope < -1.0:
         kind = f"a slope of {slope:+.2f}, steeper than quantization's -1: not an IEEE-952 term"
     else:
-        kind = f"a shape no IEEE-952 term describes (ADEV up to {100 * (ratio.max() - 1):+.0f} % off the model)"
+        dev = ratio[:-1] - 1.0 if start >= 1 else ratio - 1.0
+        k = int(np.argmax(np.abs(dev)))
+        kind = (f"a shape no IEEE-952 term describes: the ADEV is {'above' if dev[k] > 0 else 'below'} the model by up "
+                f"to {100 * abs(dev[k]):.2g} %, many times its statistical error there")
     return kind
 
 
@@ -497,11 +506,13 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             side = "above" if dev[k] > 0 else "below"
             notes.append(
                 f"fit {quality}: chi2_red = {chi2_red:.3g} (p = {p:.2g}); the model misses the curve most at "
-                f"tau = {c.tau[i0]:.3g}-{c.tau[i1]:.3g} s, where the measured deviation is {side} the model by up to "
+                f"tau = {_tau_span(c.tau[i0], c.tau[i1])} s, where the measured deviation is {side} the model by up to "
                 f"{100 * abs(dev[k]):.0f} %" + _shape_hint(c.tau[i0:i1 + 1], c.y[i0:i1 + 1], dev))
         if infl > 1:
             notes.append(f"intervals widened by sqrt(chi2_red) = {math.sqrt(infl):.3g} for the misfit")
-    b_min = _classical_b(c, A) if statistic == "adev" else {}
+    b_min = _classical_b(c, A, floor_refused=out_terms.get("B") is not None and out_terms["B"].status ==
+                         "not_estimable" and "contradicted" in (out_terms["B"].reason or "")) \
+        if statistic == "adev" else {}
     return NoiseFit(
         statistic=statistic, dt_s=float(dt_s), terms=out_terms, selected=tuple(_NAMES[i] for i in best), A=A,
         candidates=candidates, plausible=["+".join(_NAMES[i] for i in k) for k in plaus], fit_tau_s=c.tau,
@@ -559,13 +570,21 @@ def _check_floor(terms, c: _Context, A) -> None:
             f"record; classical bound B <= min {name} / {math.sqrt(scale):.4g} = {bound:.3g} deg/h")
 
 
-def _classical_b(c: _Context, A) -> dict:
+def _classical_b(c: _Context, A, floor_refused: bool = False) -> dict:
     """IEEE-952 practice: bias instability read at the minimum of the (fitted) Allan deviation, B = min ADEV / 0.664.
 
     The minimum is searched on the fitted curve inside the fitted tau range.  When it sits at the longest tau the
-    curve is still falling there and the value is only an upper bound.  The interval is the measured point's 95 %
-    interval at the tau nearest the minimum.
+    curve is still falling there and the value is only an upper bound, never above the one the measured curve
+    gives (min measured ADEV / 0.664).  When the fitted flat floor was refused (it lies above the measured curve)
+    the measured minimum is the only reading.  The interval is the measured point's 95 % interval at the tau
+    nearest the minimum.
     """
+    if floor_refused:
+        j = int(np.argmin(c.y))
+        return {"value": math.sqrt(c.y[j]) / B_FACTOR, "unit": "deg/h", "tau_s": float(c.tau[j]), "bound_only": True,
+                "lo95": None, "hi95": math.sqrt(c.y_hi[j]) / B_FACTOR,
+                "rule": "min of the measured ADEV / 0.664 (IEEE Std 952-1997 C.2), an upper bound: the fitted flat "
+                        "floor lies above the measured curve"}
     grid = np.logspace(math.log10(c.tau[0]), math.log10(c.tau[-1]), 400)
     var = sum(A[i] * c.laws[n].shape(grid, c.dt) for i, n in enumerate(_NAMES) if n in c.laws)
     k = int(np.argmin(var))
@@ -573,9 +592,20 @@ def _classical_b(c: _Context, A) -> dict:
     value = math.sqrt(var[k]) / B_FACTOR
     at_edge = k >= grid.size - 2
     lo = math.sqrt(c.y[j] * (c.y[j] / c.y_hi[j])) / B_FACTOR  # symmetric-in-log guess of the lower bound
+    rule = ("min of the fitted ADEV / 0.664 (IEEE Std 952-1997 C.2); an upper bound when the curve still falls at "
+            "the longest fitted tau")
+    jm = int(np.argmin(c.y))
+    if at_edge:  # two valid upper bounds: the fitted curve's end and the measured minimum; keep the tighter
+        if math.sqrt(c.y[jm]) / B_FACTOR < value:
+            value, j, k = math.sqrt(c.y[jm]) / B_FACTOR, jm, None
+    elif not lo <= value <= math.sqrt(c.y_hi[j]) / B_FACTOR:
+        # the fitted curve misses the measured points at its minimum (a poor fit): read the measured curve
+        value, j, k = math.sqrt(c.y[jm]) / B_FACTOR, jm, None
+        lo = math.sqrt(c.y[j] * (c.y[j] / c.y_hi[j])) / B_FACTOR
+        rule = ("min of the measured ADEV / 0.664 (IEEE Std 952-1997 C.2): the fitted curve misses the measured "
+                "points at its minimum")
     return {
-        "value": value, "unit": "deg/h", "tau_s": float(grid[k]), "bound_only": bool(at_edge),
-        "lo95": None if at_edge else lo, "hi95": math.sqrt(c.y_hi[j]) / B_FACTOR,
-        "rule": "min of the fitted ADEV / 0.664 (IEEE Std 952-1997 C.2); an upper bound when the curve still "
-                "falls at the longest fitted tau",
+        "value": value, "unit": "deg/h", "tau_s": float(grid[k] if k is not None else c.tau[j]),
+        "bound_only": bool(at_edge),
+        "lo95": None if at_edge else lo, "hi95": math.sqrt(c.y_hi[j]) / B_FACTOR, "rule": rule,
     }

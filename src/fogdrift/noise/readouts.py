@@ -16,16 +16,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..units import B_FACTOR, URAD_PER_ARCSEC
+from .terms import DISPLAY_UNITS, TERM_UNITS
+
 __all__ = ["Readout", "slope_readouts"]
 
-_B = math.sqrt(2.0 * math.log(2.0) / math.pi)
-_URAD_PER_ARCSEC = math.pi / 0.648
 #: term -> (slope of sigma, tau [s] at which the line is read, factor to the reported unit, unit)
 _READ = {
-    "Q": (-1.0, math.sqrt(3.0), _URAD_PER_ARCSEC, "urad"),
-    "N": (-0.5, 3600.0, 1.0, "deg/sqrt(h)"),
-    "K": (0.5, 3.0 * 3600.0, 1.0, "deg/h^1.5"),
-    "R": (1.0, math.sqrt(2.0) * 3600.0, 1.0, "deg/h^2"),
+    "Q": (-1.0, math.sqrt(3.0), URAD_PER_ARCSEC, TERM_UNITS["Q"]),
+    "N": (-0.5, 3600.0, 1.0, TERM_UNITS["N"]),
+    "K": (0.5, 3.0 * 3600.0, 1.0, TERM_UNITS["K"]),
+    "R": (1.0, math.sqrt(2.0) * 3600.0, 1.0, TERM_UNITS["R"]),
 }
 
 
@@ -50,7 +51,7 @@ class Readout:
         if self.value is None:
             return f"{self.term}: no {self.term}-slope in the curve"
         where = "its term dominates" if self.dominated else "another term dominates"
-        out = f"{self.term} {self.value:.3g} {self.unit} (read at tau = {self.tau_s:.3g} s, {where})"
+        out = f"{self.term} {self.value:.3g} {DISPLAY_UNITS.get(self.term, self.unit)} (read at tau = {self.tau_s:.3g} s, {where})"
         return out + (f"; {self.note}" if self.note else "")
 
 
@@ -81,7 +82,7 @@ def slope_readouts(tau_s, adev_dph, fit=None) -> dict:
         value = float(s[i] * (tau_read / tau[i]) ** mu * fac)
         out[term] = _judge(term, value, unit, float(tau[i]), float(slope[i]), fit)
     if 0 < i_min < s.size - 1:
-        out["B"] = _judge("B", float(s[i_min] / _B), "deg/h", float(tau[i_min]), float(slope[i_min]), fit)
+        out["B"] = _judge("B", float(s[i_min] / B_FACTOR), TERM_UNITS["B"], float(tau[i_min]), float(slope[i_min]), fit)
     else:
         out["B"] = Readout("B", None, "deg/h", None, None, None,
                            "the ADEV has no interior minimum (still falling or rising at the record's end)")

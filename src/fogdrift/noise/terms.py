@@ -126,6 +126,9 @@ TERMS = tuple(TERM_TABLE)
 TERM_UNITS = {k: v.unit for k, v in TERM_TABLE.items()}
 #: Table header labels ("Q [µrad]", ...).
 TERM_HEADERS = {k: v.header for k, v in TERM_TABLE.items()}
+#: The units as printed for people (tables, notes, read-outs): "µrad", "deg/√h", "deg/h", "deg/h^1.5", "deg/h²".
+#: ``TERM_UNITS`` (ASCII) stays the unit string of JSON and CSV fields.
+DISPLAY_UNITS = {k: v.header.split("[", 1)[1].rstrip("]") for k, v in TERM_TABLE.items()}
 
 
 def term_spec(name) -> TermSpec:
