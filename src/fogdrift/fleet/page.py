@@ -123,7 +123,9 @@ def _chart(rows, name, unit, axes_names):
             ax.axhline(b, color="C3", lw=0.8, ls="--")
         for k in outliers(vals, [r.get(lo) for r in sel], [r.get(hi) for r in sel]):
             ax.plot([k], [vals[k]], "o", ms=9, mfc="none", color="C3", mew=1.5)
-            ax.annotate(files[k], (k, vals[k]), textcoords="offset points", xytext=(5, 5), fontsize=7, color="C3")
+            right = k >= len(sel) / 2          # label towards the middle, inside the panel
+            ax.annotate(files[k], (k, vals[k]), textcoords="offset points", xytext=(-7 if right else 7, 5),
+                        ha="right" if right else "left", fontsize=7, color="C3")
             flagged.append((axis, files[k], vals[k]))
         ax.set_xticks(x)
         ax.set_xticklabels([f if len(f) <= 18 else "…" + f[-17:] for f in files], rotation=60, ha="right",
@@ -131,6 +133,7 @@ def _chart(rows, name, unit, axes_names):
         ax.set_title(f"{name}, axis {axis}", fontsize=9)
         ax.set_ylabel(f"{name} [{_UNIT_TEXT[unit]}]")
         ax.grid(alpha=0.3)
+    fig.tight_layout()
     return _png(fig), flagged
 
 
@@ -138,7 +141,7 @@ def _fmt(x) -> str:
     if x is None:
         return "–"
     if isinstance(x, float):
-        return f"{x:.4g}"
+        return f"{x:.0f}" if 1e4 <= abs(x) < 1e9 and x == round(x) else f"{x:.4g}"
     return str(x)
 
 
