@@ -362,6 +362,7 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
     distributed = require("distributed", "fleet", "running a batch on Dask")
     cluster = client = None
     interrupted = False
+    muted = {}
     try:
         if scheduler:
             try:
@@ -394,12 +395,19 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
             done(i, rows)
     except KeyboardInterrupt:
         interrupted = True
+        # the in-process scheduler would log the gather the interruption cut short ("Couldn't gather keys")
+        # as an ERROR after the one interrupted: line; the batch is over, say nothing more
+        muted = {name: logging.getLogger(name).level for name in ("distributed", "tornado")}
+        for name in muted:
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
         if cluster is not None:                      # our own workers: stop them now, then tidy their folders
             _kill_workers(cluster)
             _remove_temporaries(tasks)
         raise
     finally:
         _close(client, cluster, quick=interrupted)
+        for name, level in muted.items():          # closed: a library caller's logging as it was
+            logging.getLogger(name).setLevel(level)
     return used
 
 
