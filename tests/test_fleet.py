@@ -113,6 +113,7 @@ def test_unexpected_exception_is_a_row_not_cached(tmp_path, monkeypatch):
     assert not (tmp_path / "o" / "a.csv" / "batch.json").exists()
 
 
+@pytest.mark.slow
 def test_existing_cluster_by_address(tmp_path, monkeypatch):
     from distributed import LocalCluster
 
