@@ -51,7 +51,8 @@ def _generate(folder: Path, files: int, samples: int) -> list[Path]:
         rate = rng.normal(scale=5.0, size=(samples, 3)) + np.cumsum(rng.normal(scale=0.01, size=(samples, 3)), axis=0)
         t = np.arange(samples) / 100.0
         p = folder / f"unit{k:02d}.csv"
-        np.savetxt(p, np.column_stack([t, rate]), delimiter=",", header="t_s,gx,gy,gz", comments="", fmt="%.9g")
+        np.savetxt(p, np.column_stack([t, rate]), delimiter=",", header="t_s,gx[deg/h],gy[deg/h],gz[deg/h]", comments="",
+                   fmt="%.9g")
         out.append(p)
     return out
 

@@ -62,22 +62,22 @@ def _cases(d: Path, n: int, n_bag: int):
     cases = []
 
     np.save(d / "a.npy", np.column_stack([t, g]))
-    cases.append(("npy", d / "a.npy", {"time_column": 0}, lambda p: np.array(np.load(p))))
+    cases.append(("npy", d / "a.npy", {"time_column": 0, "unit": "deg/h", "time_unit": "s"}, lambda p: np.array(np.load(p))))
     np.savez(d / "a.npz", t=t, gx=g[:, 0], gy=g[:, 1], gz=g[:, 2])
-    cases.append(("npz", d / "a.npz", {}, lambda p: {k: v for k, v in np.load(p).items()}))
+    cases.append(("npz", d / "a.npz", {"unit": "deg/h", "time_unit": "s"}, lambda p: {k: v for k, v in np.load(p).items()}))
     np.savetxt(d / "a.csv", np.column_stack([t, g]), delimiter=",", header="t_s,gx,gy,gz", comments="", fmt="%.9g")
-    cases.append(("text (CSV)", d / "a.csv", {}, lambda p: np.loadtxt(p, delimiter=",", skiprows=1)))
+    cases.append(("text (CSV)", d / "a.csv", {"unit": "deg/h"}, lambda p: np.loadtxt(p, delimiter=",", skiprows=1)))
     with h5py.File(d / "a.h5", "w") as f:
         f.create_dataset("imu/t", data=t)
         f.create_dataset("imu/gyro", data=g, chunks=(65536, 3))
-    cases.append(("hdf5 (chunked group)", d / "a.h5", {},
+    cases.append(("hdf5 (chunked group)", d / "a.h5", {"unit": "deg/h", "time_unit": "s"},
                   lambda p: [h5py.File(p, "r")["imu/gyro"][:], h5py.File(p, "r")["imu/t"][:]]))
     with h5py.File(d / "c.h5", "w") as f:
         f.create_dataset("rate", data=g)
-    cases.append(("hdf5 (contiguous, memory-mapped)", d / "c.h5", {"rate_hz": 100.0},
+    cases.append(("hdf5 (contiguous, memory-mapped)", d / "c.h5", {"rate_hz": 100.0, "unit": "deg/h"},
                   lambda p: h5py.File(p, "r")["rate"][:]))
     sio.savemat(d / "a.mat", {"imu": {"t": t, "gx": g[:, 0], "gy": g[:, 1], "gz": g[:, 2]}})
-    cases.append(("mat v5", d / "a.mat", {}, lambda p: sio.loadmat(p)))
+    cases.append(("mat v5", d / "a.mat", {"unit": "deg/h", "time_unit": "s"}, lambda p: sio.loadmat(p)))
     rec = np.zeros(n, dtype=[("seq", "<u4"), ("gx", "<i4"), ("gy", "<i4"), ("gz", "<i4")])
     rec["seq"] = np.arange(n)
     for k, c in enumerate(("gx", "gy", "gz")):
