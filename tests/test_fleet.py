@@ -19,6 +19,7 @@ from typer.testing import CliRunner
 from fogdrift.cli import app
 from fogdrift.errors import ConfigError
 from fogdrift.fleet import COLUMNS, read_summary, run_batch
+from fogdrift.io import load
 from fogdrift.fleet import commands as fleet_commands
 
 duckdb = pytest.importorskip("duckdb")
@@ -167,4 +168,7 @@ def test_analyze_batch_rows_carry_the_verdict(tmp_path):
     assert row["status"] == "ok", row["error"]
     assert row["verdict"].startswith("AR(p) ") and "persistence one step ahead" in row["verdict"]
     assert (tmp_path / "o" / "a.csv" / "report.html").is_file()
+    assert (tmp_path / "o" / "a.csv" / "bundle").is_dir()
+    block = load(tmp_path / "o" / "a.csv" / "compensated_test_gz.csv")      # as `fogdrift analyze` writes it
+    assert block.n_samples > 100
     assert json.loads((tmp_path / "o" / "a.csv" / "analysis.json").read_text())["sha256"] == row["sha256"]

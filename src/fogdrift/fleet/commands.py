@@ -115,8 +115,8 @@ def run_allan_command(record, settings: dict, out_dir) -> list[dict]:
 
 
 def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
-    """``fogdrift analyze`` on one record: ``report.html``, ``analysis.json``, the model ``bundle/`` and one row
-    per axis with the verdict."""
+    """``fogdrift analyze`` on one record: ``report.html``, ``analysis.json``, the model ``bundle/``, the
+    compensated test block per axis (``compensated_test_<axis>.csv``) and one row per axis with the verdict."""
     from ..bundle import write_bundle
     from ..pipeline import run_analysis
     from ..report import verdict, write_report
@@ -125,6 +125,9 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     result = run_analysis(record, cfg)
     write_report(result, record, out_dir)
     write_bundle(Path(out_dir) / "bundle", [ax.models for ax in result.axes], cfg, record)
+    from ..compensate.test_block import write_compensated_test_block
+
+    write_compensated_test_block([ax.models for ax in result.axes], out_dir, t0_s=record.t0_s)
     return [{"axis": ax.name, **record_columns(record), **noise_columns(ax.original.noise),
              "verdict": " ".join(verdict(ax.models))} for ax in result.axes]
 
