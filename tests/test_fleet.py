@@ -167,6 +167,10 @@ def test_analyze_batch_rows_carry_the_verdict(tmp_path):
     row = res.rows[0]
     assert row["status"] == "ok", row["error"]
     assert row["verdict"].startswith("AR(p) ") and "persistence one step ahead" in row["verdict"]
+    doc = json.loads((tmp_path / "o" / "a.csv" / "analysis.json").read_text())
+    ev = doc["axes"][0]["evaluation"]                                # as `fogdrift analyze` stores it
+    assert row["compensation_outcome"] == ev["headline"]["data"]["outcome"]
+    assert row["compensation_outcome"] in ("reduces", "mixed", "none", "undetermined")
     assert (tmp_path / "o" / "a.csv" / "report.html").is_file()
     assert (tmp_path / "o" / "a.csv" / "bundle").is_dir()
     block = load(tmp_path / "o" / "a.csv" / "compensated_test_gz.csv")      # as `fogdrift analyze` writes it

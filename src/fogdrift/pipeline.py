@@ -283,6 +283,7 @@ class AnalysisAxis:
     separation: SeparationAxis  # whole record at the modelling rate (figures 5, 6)
     models: ModelAxis
     table2: list  # CompensatedSignal rows, test block at the modelling rate
+    evaluation: object = None  # fogdrift.evaluation.AxisEvaluation, set by evaluation.evaluate_analysis
 
     def to_dict(self) -> dict:
         return {
@@ -291,6 +292,7 @@ class AnalysisAxis:
             "separation": self.separation.to_dict(),
             "models": self.models.to_dict(),
             "table2": [row.to_dict() for row in self.table2],
+            "evaluation": None if self.evaluation is None else self.evaluation.to_dict(),
         }
 
 

@@ -67,7 +67,7 @@ FLAGS = {
     "models": "--models", "latitude_deg": "--latitude", "earth_axes": "--earth-axis", "outliers": "--outliers",
     "lags": "--lags", "hidden": "--hidden", "epochs": "--epochs", "training": "--training", "seed": "--seed",
     "apply_unit": "--apply-unit", "axis_map": "--axis-map", "accept_rate": "--accept-rate", "bias": "--bias",
-    "model": "--model", "chunk_samples": "--chunk", "out": "--out",
+    "model": "--model", "chunk_samples": "--chunk", "out": "--out", "pdf": "--pdf",
     # reader options (fogdrift.io.registry.READERS) and the temperature column
     "temperature": "--temperature", "topic": "--topic", "stamp": "--stamp", "dataset": "--dataset",
     "variable": "--variable", "gain": "--gain", "layout": "--layout", "scale": "--scale",

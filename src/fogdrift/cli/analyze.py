@@ -57,9 +57,12 @@ def analyze(
     gm_window: Annotated[int, typer.Option("--gm-window", help="Rolling window [samples] of the one-step GM(1,1).")]
     = 8,
     heading: Annotated[bool, typer.Option(
-        "--heading/--no-heading", help="Also print the heading-error table (rolling 300-s calibrations, free-run "
-                                       "forecasts) and the filtering-artefact check of every model on the test "
-                                       "block, with the verdicts headline first.")] = False,
+        "--heading/--no-heading", help="Heading-error evaluation (rolling 300-s calibrations every 60 s, free-run "
+                                       "forecasts) and filtering-artefact check of every model on the test block: "
+                                       "printed, stored in analysis.json and leading the report's compensation "
+                                       "verdicts (--no-heading skips it).")] = True,
+    pdf: Annotated[bool, typer.Option("--pdf", help="Also write report.pdf (the same HTML printed by headless "
+                                                    "Chromium).")] = False,
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
 ):
@@ -68,7 +71,11 @@ def analyze(
     from ..report import metrics_rows, noise_row, verdict, write_report
 
     with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to], json_out=json_out,
-             expect=("analysis.json", "report.html")) as r:
+             expect=("analysis.json", "report.html") + (("report.pdf",) if pdf else ())) as r:
+        if pdf:  # no Chromium: refused before any work
+            from ..report.pdf import find_chromium
+
+            find_chromium()
         earth = {}
         for item in earth_axis or []:
             name, sep, orient = item.partition("=")
@@ -115,17 +122,17 @@ def analyze(
                                             metrics_rows(ax.models)))
                 for line in verdict(ax.models):
                     say("  " + line)
-        if heading:  # compensation evidence on the test block (fogdrift.evaluation)
-            from ..evaluation import evaluate_axis
+        if heading:  # compensation evidence on the test block, stored in the result (fogdrift.evaluation)
+            from ..evaluation import evaluate_analysis
             from .compensate import print_evaluation
 
-            for ax in result.axes:
-                ev = evaluate_axis(ax.models, cfg)
-                for note in ev["notes"]:
+            for ev in evaluate_analysis(result):
+                for note in ev.notes:
                     say("  " + note)
-                print_evaluation([ev["heading"]] if ev["heading"] else [],
-                                 [ev["artefacts"]] if ev["artefacts"] else [], ev["verdicts"])
-        path = write_report(result, record, r.out.path)
+                print_evaluation([ev.heading] if ev.heading else [], [ev.artefacts] if ev.artefacts else [],
+                                 ev.verdicts)
+                say(ev.headline.lines[0])
+        path = write_report(result, record, r.out.path, evaluated=heading, pdf=pdf)
         # the self-describing bundle 'fogdrift compensate' applies to other logs
         from ..bundle import write_bundle
 
@@ -135,7 +142,7 @@ def analyze(
 
         comp = write_compensated_test_block([ax.models for ax in result.axes], r.out.path, t0_s=record.t0_s)
         r.wrote()
-        say(f"report: {path.resolve()}  ({result.wall_s:.1f} s)")
+        say(f"report: {path.resolve()}{'  (+ report.pdf)' if pdf else ''}  ({result.wall_s:.1f} s)")
         say(f"bundle: {bundle.path}")
         say(f"compensated test block: {', '.join(p.name for p in comp)} (modelling rate, deg/h)")
         r.print_json(r.out.path / "analysis.json")

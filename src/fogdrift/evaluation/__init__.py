@@ -4,13 +4,16 @@
 * :mod:`.artefacts` -- injected step, ramp and sinusoids: how much real rate each compensator removes;
 * :mod:`.verdicts` -- the verdict sentences and tables, headline first (heading error), the paper's one-step
   figures last and labelled;
-* :func:`evaluate_axis` -- both evaluations on the test block of one axis of a pipeline run.
+* :func:`evaluate_axis` -- both evaluations on the test block of one axis of a pipeline run;
+* :mod:`.analysis` -- :func:`evaluate_analysis` stores them (:class:`AxisEvaluation`) in every axis of an
+  analysis result, so ``analysis.json`` and the report carry them.
 """
 
+from .analysis import AxisEvaluation, evaluate_analysis
 from .artefacts import ArtefactResult, ArtefactRow, artefact_check, default_frequencies
 from .heading import CONSTANT_BIAS, HORIZONS_S, HeadingResult, HeadingRow, angle_error_deg, heading_errors
-from .verdicts import (Verdict, artefact_table, artefact_verdict, causal_verdict, compensation_verdicts, heading_table,
-                       heading_verdict, paper_measure_verdict, table2_marks)
+from .verdicts import (OUTCOMES, Verdict, artefact_table, artefact_verdict, causal_verdict, compensation_verdicts,
+                       heading_table, heading_verdict, headline_verdict, paper_measure_verdict, table2_marks)
 
 __all__ = [
     "heading_errors",
@@ -32,7 +35,11 @@ __all__ = [
     "heading_table",
     "artefact_table",
     "table2_marks",
+    "headline_verdict",
+    "OUTCOMES",
     "evaluate_axis",
+    "evaluate_analysis",
+    "AxisEvaluation",
 ]
 
 

@@ -25,6 +25,9 @@ __all__ = [
     "heading_table",
     "artefact_table",
     "table2_marks",
+    "headline_verdict",
+    "independent_origins",
+    "OUTCOMES",
 ]
 
 #: Relative change of the RMS heading error that counts as a real difference (5 %).
@@ -63,8 +66,28 @@ def _pct(ratio) -> str:
     return "±0 %" if pct == 0 else f"{pct:+d} %"
 
 
+#: Label of the reference compensator (as in :mod:`.heading`).
+CONSTANT_BIAS_LABEL = "constant bias"
+
 #: Fewest origins on which a horizon's verdict says which model reduces the heading error.
 MIN_ORIGINS = 10
+
+
+def independent_origins(n_origins: int, step_s, horizon_s: float) -> int:
+    """Origins whose horizon windows do not overlap: ``1 + floor((n - 1) step / max(step, H))``.
+
+    Errors of origins closer than the horizon share most of their integration window, so they are not
+    independent evidence; a verdict counts only these.  ``step_s`` None: all origins count.
+
+    Examples
+    --------
+    >>> independent_origins(31, 300.0, 60.0), independent_origins(31, 300.0, 600.0), independent_origins(21, 300.0, 3600.0)
+    (31, 16, 2)
+    """
+    n = int(n_origins)
+    if n <= 1 or step_s is None or step_s >= horizon_s:
+        return max(n, 0)
+    return 1 + int((n - 1) * float(step_s) / float(horizon_s) + 1e-9)
 
 
 def heading_verdict(result, *, material: float = MATERIAL, min_origins: int = MIN_ORIGINS) -> Verdict:
@@ -72,7 +95,8 @@ def heading_verdict(result, *, material: float = MATERIAL, min_origins: int = MI
 
     A model *reduces* the heading error when its RMS is at least ``material`` (5 %) below constant bias's,
     *worsens* it when at least 5 % above; in between the difference is not material.  With fewer than
-    ``min_origins`` origins the numbers are shown but no model is said to reduce or worsen anything.
+    ``min_origins`` independent origins (:func:`independent_origins`: horizon windows that do not overlap) the
+    numbers are shown but no model is said to reduce or worsen anything.
 
     Examples
     --------
@@ -107,9 +131,12 @@ def heading_verdict(result, *, material: float = MATERIAL, min_origins: int = MI
                 worse.append(label)
         lines.append(f"{result.axis}, {h:g} s after a {result.calib_s:g}-s calibration ({base.n_origins} origins): "
                      f"constant bias leaves {_f(base.rms_deg)} deg RMS; " + "; ".join(parts) + ".")
-        if base.n_origins < min_origins:
-            lines.append(f"{result.axis}, {h:g} s: {base.n_origins} origin(s) are too few to judge (need "
-                         f"{min_origins}; use a longer held-out record or a smaller origin step).")
+        n_ind = independent_origins(base.n_origins, getattr(result, "step_s", None), h)
+        if n_ind < min_origins:
+            count = (f"{base.n_origins} origin(s)" if n_ind == base.n_origins else
+                     f"{base.n_origins} origin(s), {n_ind} of them with non-overlapping horizons,")
+            lines.append(f"{result.axis}, {h:g} s: {count} are too few to judge (need {min_origins}; use a longer "
+                         "held-out record" + (" or a smaller origin step" if n_ind == base.n_origins else "") + ").")
             data[str(h)] = {"reduces": [], "worsens": [], "constant_bias_rms_deg": base.rms_deg,
                             "too_few_origins": True}
             continue
@@ -228,3 +255,116 @@ def table2_marks(table2_rows, artefacts) -> dict:
         if model in flagged and getattr(row, "kind", "") == "practical":
             out[row.label] = f"improvement partly removes real rate (artefact check: {', '.join(f'{f:g}' for f in flagged[model])} Hz)"
     return out
+
+
+#: Outcome of :func:`headline_verdict` -> what it means (the report colours it: green, amber, red, grey).
+OUTCOMES = {
+    "reduces": "a model reduces the heading error at a judged horizon, worsens it at none and passes the artefact "
+               "check",
+    "mixed": "a model reduces the heading error at a judged horizon but worsens it at another, or removes real "
+             "rate (artefact check)",
+    "none": "no model reduces the heading error by 5 % or more at any judged horizon",
+    "undetermined": "too few calibration origins (or no heading evaluation): nothing can be judged",
+}
+
+
+def _horizon_list(hs) -> str:
+    hs = [f"{h:g}" for h in hs]
+    return hs[0] if len(hs) == 1 else ", ".join(hs[:-1]) + " or " + hs[-1]
+
+
+def headline_verdict(heading=None, artefacts=None, *, axis: str = "", reason: str = "", material: float = MATERIAL,
+                     min_origins: int = MIN_ORIGINS) -> Verdict:
+    """ONE sentence per axis: did any compensator reduce the heading error, judged against constant bias.
+
+    Only horizons with at least ``min_origins`` independent calibration origins (:func:`independent_origins`)
+    are judged.  The best model is the one
+    that reduces the error (by ``material`` or more) at the most judged horizons, then by the largest factor.
+    ``data["outcome"]`` is one of :data:`OUTCOMES`: *reduces* only when that model worsens the error at no
+    judged horizon and the artefact check (when it ran) flags nothing for it; *mixed* when it does either;
+    *none* when no model reduces it; *undetermined* when no horizon can be judged.
+
+    Parameters
+    ----------
+    heading : HeadingResult or None
+        None: the heading evaluation did not run (``reason`` says why).
+    artefacts : ArtefactResult or None
+    axis : str
+        Axis name (default: the heading result's).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> def row(m, h, rms, ratio):
+    ...     return NS(model=m, horizon_s=h, n_origins=30, rms_deg=rms, ratio_to_bias=ratio)
+    >>> h = NS(axis="gx", calib_s=300.0, horizons_s=(60.0, 600.0),
+    ...        rows=[row("constant bias", 60.0, 1.0, 1.0), row("Kalman", 60.0, 0.8, 0.8),
+    ...              row("constant bias", 600.0, 8.0, 1.0), row("Kalman", 600.0, 8.1, 1.0125)])
+    >>> v = headline_verdict(h)
+    >>> v.data["outcome"], v.data["model"]
+    ('reduces', 'Kalman')
+    >>> print(v.lines[0])
+    gx: Kalman reduces the heading error by 20 % at 60 s after a 300-s calibration (0.8 vs 1 deg RMS, 30 origins) and worsens it at no judged horizon (60, 600 s); artefact check not run.
+    """
+    axis = axis or getattr(heading, "axis", "")
+    if heading is None:
+        why = reason or "not run"
+        return Verdict("headline", [f"{axis}: heading error not evaluated ({why}); no compensation verdict."],
+                       {"outcome": "undetermined", "model": None, "reason": why})
+    by_h = {h: {r.model: r for r in heading.rows if r.horizon_s == h} for h in heading.horizons_s}
+    step = getattr(heading, "step_s", None)
+    judged = [h for h, rows in by_h.items() if CONSTANT_BIAS_LABEL in rows
+              and independent_origins(rows[CONSTANT_BIAS_LABEL].n_origins, step, h) >= min_origins]
+    if not judged:
+        h0 = heading.horizons_s[0]
+        n0 = by_h[h0][CONSTANT_BIAS_LABEL].n_origins if CONSTANT_BIAS_LABEL in by_h[h0] else 0
+        line = (f"{axis}: cannot judge whether any model reduces the heading error: the held-out block gives "
+                f"{n0} calibration origin(s) at {h0:g} s ({heading.calib_s:g}-s calibrations every "
+                f"{heading.step_s:g} s; need {min_origins}).")
+        return Verdict("headline", [line], {"outcome": "undetermined", "model": None, "judged_horizons_s": []})
+    better, worse = {}, {}
+    for h in judged:
+        for label, r in by_h[h].items():
+            if label == CONSTANT_BIAS_LABEL:
+                continue
+            if math.isfinite(r.ratio_to_bias) and r.ratio_to_bias <= 1.0 - material:
+                better.setdefault(label, []).append(h)
+            elif not math.isfinite(r.ratio_to_bias) or r.ratio_to_bias >= 1.0 + material:
+                worse.setdefault(label, []).append(h)
+    flagged = {}
+    if artefacts is not None:
+        flagged = {r.model: list(r.flagged_hz) for r in artefacts.rows if r.flagged_hz}
+    base = {h: by_h[h][CONSTANT_BIAS_LABEL] for h in judged}
+    data = {"judged_horizons_s": judged, "reduces": {k: v for k, v in better.items()},
+            "worsens": {k: v for k, v in worse.items()}, "flagged_hz": flagged}
+    if not better:
+        rms = " / ".join(_f(base[h].rms_deg) for h in judged)
+        line = (f"{axis}: no model reduces the heading error by {100 * material:.0f} % or more at "
+                f"{_horizon_list(judged)} s after a {heading.calib_s:g}-s calibration (constant bias leaves {rms} deg "
+                f"RMS" + (f"; worse: {', '.join(sorted(worse))}" if worse else "") + ").")
+        return Verdict("headline", [line], {"outcome": "none", "model": None, **data})
+
+    def gain(label):
+        return min(by_h[h][label].ratio_to_bias for h in better[label])
+
+    best = sorted(better, key=lambda k: (-len(better[k]), gain(k)))[0]
+    h = min(better[best], key=lambda x: by_h[x][best].ratio_to_bias)
+    r = by_h[h][best]
+    what = (f"{axis}: {best} reduces the heading error by {100 * (1 - r.ratio_to_bias):.0f} % at {h:g} s after a "
+            f"{heading.calib_s:g}-s calibration ({_f(r.rms_deg)} vs {_f(base[h].rms_deg)} deg RMS, {r.n_origins} "
+            "origins)")
+    buts = []
+    if best in worse:
+        buts.append("worsens it by " + ", ".join(f"{_pct(by_h[x][best].ratio_to_bias)} at {x:g} s"
+                                                 for x in worse[best]))
+    if best in flagged:
+        buts.append(f"removes real rate near {', '.join(f'{f:g}' for f in flagged[best])} Hz (artefact check)")
+    if buts:
+        line = what + " but " + " and ".join(buts) + "."
+        outcome = "mixed"
+    else:
+        check = "artefact check not run" if artefacts is None else "artefact check clean"
+        line = what + f" and worsens it at no judged horizon ({', '.join(f'{x:g}' for x in judged)} s); {check}."
+        outcome = "reduces"
+    return Verdict("headline", [line], {"outcome": outcome, "model": best, "horizon_s": h,
+                                        "ratio_to_bias": r.ratio_to_bias, **data})

@@ -115,21 +115,29 @@ def run_allan_command(record, settings: dict, out_dir) -> list[dict]:
 
 
 def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
-    """``fogdrift analyze`` on one record: ``report.html``, ``analysis.json``, the model ``bundle/``, the
-    compensated test block per axis (``compensated_test_<axis>.csv``) and one row per axis with the verdict."""
+    """``fogdrift analyze`` on one record: the heading-error and artefact evaluation (on by default, as in the
+    single command), ``report.html``, ``analysis.json``, the model ``bundle/``, the compensated test block per
+    axis (``compensated_test_<axis>.csv``) and one row per axis with the verdicts."""
     from ..bundle import write_bundle
+    from ..compensate.test_block import write_compensated_test_block
+    from ..evaluation import evaluate_analysis
     from ..pipeline import run_analysis
     from ..report import verdict, write_report
 
     cfg = _config(settings)
     result = run_analysis(record, cfg)
-    write_report(result, record, out_dir)
+    evaluations = {ev.axis: ev for ev in evaluate_analysis(result)}
+    write_report(result, record, out_dir, evaluated=True)
     write_bundle(Path(out_dir) / "bundle", [ax.models for ax in result.axes], cfg, record)
-    from ..compensate.test_block import write_compensated_test_block
-
     write_compensated_test_block([ax.models for ax in result.axes], out_dir, t0_s=record.t0_s)
-    return [{"axis": ax.name, **record_columns(record), **noise_columns(ax.original.noise),
-             "verdict": " ".join(verdict(ax.models))} for ax in result.axes]
+    rows = []
+    for ax in result.axes:
+        ev = evaluations.get(ax.name)
+        rows.append({"axis": ax.name, **record_columns(record), **noise_columns(ax.original.noise),
+                     "verdict": " ".join(verdict(ax.models)),
+                     "compensation_outcome": None if ev is None else str(ev.outcome),
+                     "compensation_headline": None if ev is None else " ".join(ev.headline.lines)})
+    return rows
 
 
 #: The batch commands (``--command``); the GMWM ``noise`` command will be one more row.

@@ -1,0 +1,112 @@
+"""The evaluation as part of an analysis result: heading error, artefact check and verdicts of every axis.
+
+:func:`evaluate_analysis` runs :func:`fogdrift.evaluation.evaluate_axis` on the test block of every axis of a
+:class:`fogdrift.pipeline.AnalysisResult` (and of its ``apply_to`` result: the models applied unchanged to a
+second recording) and stores an :class:`AxisEvaluation` in ``axis.evaluation``, so that
+``AnalysisResult.to_dict()`` (``analysis.json``) and the report carry it.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from .heading import HORIZONS_S
+
+__all__ = ["AxisEvaluation", "evaluate_analysis"]
+
+
+@dataclass
+class AxisEvaluation:
+    """Heading-error and artefact evaluation of one axis's test block, with the verdicts.
+
+    Attributes
+    ----------
+    axis : str
+    heading : fogdrift.evaluation.HeadingResult or None
+        None when not run or when the test block is too short (``notes`` says which).
+    artefacts : fogdrift.evaluation.ArtefactResult or None
+    verdicts : list of Verdict
+        In reading order: heading, artefacts, causal target, paper's measure.
+    headline : Verdict
+        One sentence (:func:`~fogdrift.evaluation.headline_verdict`); ``headline.data["outcome"]`` is
+        ``reduces``, ``mixed``, ``none`` or ``undetermined``.
+    notes : list of str
+    settings : dict
+        ``calibration_window_s``, ``origin_step_s``, ``horizons_s`` requested, ``artefacts`` (bool).
+    wall_s : float
+        Seconds the evaluation of this axis took.
+    """
+
+    axis: str
+    heading: object
+    artefacts: object
+    verdicts: list
+    headline: object
+    notes: list = field(default_factory=list)
+    settings: dict = field(default_factory=dict)
+    wall_s: float = 0.0
+
+    @property
+    def outcome(self) -> str:
+        return self.headline.data.get("outcome", "undetermined")
+
+    def to_dict(self) -> dict:
+        return {
+            "axis": self.axis,
+            "headline": self.headline.to_dict(),
+            "heading": None if self.heading is None else self.heading.to_dict(),
+            "artefacts": None if self.artefacts is None else self.artefacts.to_dict(),
+            "verdicts": [v.to_dict() for v in self.verdicts],
+            "notes": list(self.notes),
+            "settings": dict(self.settings),
+            "wall_s": self.wall_s,
+        }
+
+
+def evaluate_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, horizons_s=HORIZONS_S,
+                      artefacts: bool = True) -> list:
+    """Evaluate every axis of ``result`` (and of ``result.apply_to``) in place; return the evaluations.
+
+    Parameters
+    ----------
+    result : fogdrift.pipeline.AnalysisResult
+    calib_s, step_s : float
+        Calibration window before each rolling origin and the origins' spacing [s].  The default spacing, 60 s,
+        is the shortest horizon: the 60-s error windows do not overlap (the 300-s calibration windows do), so a
+        held-out block of 30 min gives about 25 independent 60-s origins; the verdicts count only origins with
+        non-overlapping horizons (:func:`~fogdrift.evaluation.verdicts.independent_origins`).
+    horizons_s : sequence of float
+        Free-run forecast horizons [s] (those the test block cannot hold are dropped, with a note).
+    artefacts : bool
+        Also run the filtering-artefact check (injected step, ramp, sinusoids).
+
+    Returns
+    -------
+    list of AxisEvaluation
+        The fitted recording's axes first, then the ``apply_to`` recording's; each is also stored as
+        ``axis.evaluation``.
+    """
+    from ..interrupt import checkpoint
+    from . import evaluate_axis
+    from .verdicts import headline_verdict
+
+    out = []
+    for res in (result, getattr(result, "apply_to", None)):
+        if res is None:
+            continue
+        for ax in res.axes:
+            checkpoint("heading-error and artefact evaluation", axis=ax.name)
+            t0 = time.perf_counter()
+            ev = evaluate_axis(ax.models, res.config, artefacts=artefacts, calib_s=calib_s, step_s=step_s,
+                               horizons_s=tuple(horizons_s))
+            reason = "; ".join(n for n in ev["notes"] if "heading" in n) or ""
+            headline = headline_verdict(ev["heading"], ev["artefacts"], axis=ax.name, reason=reason)
+            ax.evaluation = AxisEvaluation(
+                axis=ax.name, heading=ev["heading"], artefacts=ev["artefacts"], verdicts=ev["verdicts"],
+                headline=headline, notes=list(ev["notes"]),
+                settings={"calibration_window_s": float(calib_s), "origin_step_s": float(step_s),
+                          "horizons_s": [float(h) for h in horizons_s], "artefacts": bool(artefacts)},
+                wall_s=time.perf_counter() - t0)
+            out.append(ax.evaluation)
+    return out

@@ -1,0 +1,45 @@
+"""Render fogdrift results: tables (rows of strings with units), figures (matplotlib PNG), JSON/CSV files and
+one self-contained HTML report (and its PDF).
+
+This package only reads results produced by the library (:mod:`fogdrift.pipeline`); the library never imports
+it.  Figures follow the reference paper's numbering (Tang et al. 2012): 1 signal, 2 spectrum, 3 Allan, 5 drift
+and white noise, 6 Allan of the drift, 8 model against drift, 9 residual, 10–11 the same on a second recording.
+
+* :mod:`.tables` -- rows of strings with units (noise coefficients, one-step metrics), shared with the console;
+* :mod:`.figures` -- the PNG figures;
+* :mod:`.files` -- the per-command output files (JSON, CSV, NPZ);
+* :mod:`.html` -- ``report.html``.
+"""
+
+from .figures import (_plt, _safe, _save, plot_allan, plot_models, plot_residuals, plot_separation,
+                      plot_separation_allan, plot_signal, plot_spectrum)
+from .files import write_allan_outputs, write_json, write_model_outputs, write_separation_outputs
+from .html import write_report
+from .tables import (METRICS_HEADERS, NOISE_HEADERS, causal_metrics_rows, fit_summary, metrics_rows, noise_notes,
+                     noise_row, not_estimable_notes, readout_text, term_text, verdict)
+
+__all__ = [
+    "NOISE_HEADERS",
+    "METRICS_HEADERS",
+    "noise_row",
+    "term_text",
+    "fit_summary",
+    "readout_text",
+    "noise_notes",
+    "not_estimable_notes",
+    "metrics_rows",
+    "causal_metrics_rows",
+    "verdict",
+    "write_json",
+    "write_allan_outputs",
+    "write_separation_outputs",
+    "write_model_outputs",
+    "write_report",
+    "plot_allan",
+    "plot_signal",
+    "plot_spectrum",
+    "plot_separation",
+    "plot_separation_allan",
+    "plot_models",
+    "plot_residuals",
+]

@@ -1,0 +1,312 @@
+"""Figures (matplotlib PNG), numbered as in the reference paper (Tang et al. 2012).
+
+Every figure is drawn :data:`FIG_WIDTH_IN` wide at :data:`DPI` (about 1200 px: the report's column width, so a
+figure is shown at its own size, full width) with the fonts of :data:`STYLE`.  Time series mark what the
+numbers do not use: Fig. 1 and Fig. 5 draw the train / validation / test split; Figs. 8 and 9 shade the first
+``score_from`` (= ``lags``) samples of the test block, whose inputs reach into the validation block and which no
+metric scores, and scale their y axis on the scored part only.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..output import atomic_path
+
+#: Width [in] of every report figure; with :data:`DPI` about 1200 px.
+FIG_WIDTH_IN = 12.0
+#: Resolution of the PNG files [dots per inch].
+DPI = 100
+#: Font sizes and line widths of every figure (legible at the report's column width).
+STYLE = {"font.size": 12, "axes.titlesize": 13, "axes.labelsize": 12, "xtick.labelsize": 11, "ytick.labelsize": 11,
+         "legend.fontsize": 10, "figure.titlesize": 14, "axes.grid": True, "grid.alpha": 0.3}
+#: Colours of the chronological blocks (Fig. 1, Fig. 5).
+BLOCK_COLOURS = {"train": "#4c72b0", "val": "#dd8452", "test": "#55a868"}
+BLOCK_LABELS = {"train": "training", "val": "validation", "test": "test (held out)"}
+#: Colour of the samples no metric scores (start of the test block).
+UNSCORED = "0.8"
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _styled(fn):
+    """Draw inside ``matplotlib.rc_context(STYLE)`` (global rcParams stay untouched)."""
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        import matplotlib
+
+        _plt()
+        with matplotlib.rc_context(STYLE):
+            return fn(*args, **kwargs)
+
+    return wrapper
+
+
+def _save(fig, path) -> Path:
+    path = Path(path)
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=DPI)
+    finally:
+        _plt().close(fig)
+    return path
+
+
+def _safe(name) -> str:
+    """An axis or model name as a file-name part (deterministic; no path separators)."""
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._") or "axis"
+
+
+def _envelope(t, y, max_points=4000):
+    """Bin a long series: (t of each bin, min, max, mean); short series come back unbinned."""
+    y = np.asarray(y, dtype=float)
+    if y.size <= 2 * max_points:
+        return t, y, y, y
+    k = int(np.ceil(y.size / max_points))
+    n = (y.size // k) * k
+    yy = y[:n].reshape(-1, k)
+    return t[:n].reshape(-1, k).mean(axis=1), yy.min(axis=1), yy.max(axis=1), yy.mean(axis=1)
+
+
+def _draw_split(ax, split_s, *, label=True):
+    """Shade the blocks ``{"train": (t0, t1), ...}`` [s] and name them above the plot."""
+    for name, (a, b) in split_s.items():
+        ax.axvspan(a, b, color=BLOCK_COLOURS.get(name, "0.9"), alpha=0.10, lw=0, zorder=0)
+        ax.axvline(a, color=BLOCK_COLOURS.get(name, "0.5"), lw=1.0, ls="--", zorder=1)
+        if label:
+            ax.text((a + b) / 2, 1.02, BLOCK_LABELS.get(name, name), transform=ax.get_xaxis_transform(),
+                    ha="center", va="bottom", fontsize=11, color=BLOCK_COLOURS.get(name, "k"))
+
+
+def _limits(*arrays, pad=0.08):
+    """y limits covering the finite values of ``arrays`` (the scored part), padded."""
+    vals = np.concatenate([np.asarray(a, dtype=float).ravel() for a in arrays])
+    vals = vals[np.isfinite(vals)]
+    if vals.size == 0:
+        return None
+    lo, hi = float(vals.min()), float(vals.max())
+    span = hi - lo or abs(hi) or 1.0
+    return lo - pad * span, hi + pad * span
+
+
+# -------------------------------------------------------------------------------------------------------------
+# figures
+
+
+@_styled
+def plot_allan(axes_list, path, title=None) -> Path:
+    """Fig. 3: log-log deviation with 68 % error bars, the fitted curve over the fitted range (points used marked,
+    left-out taus shaded), each selected term's asymptote, and the fit statistic."""
+    plt = _plt()
+    n = len(axes_list)
+    size = (FIG_WIDTH_IN, 5.6) if n == 1 else (5.6 * n, 4.8)
+    fig, axs = plt.subplots(1, n, figsize=size, squeeze=False, layout="constrained")
+    for ax, aa in zip(axs[0], axes_list):
+        r, fit = aa.allan, aa.noise
+        label = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}.get(getattr(r, "statistic", "adev"), "deviation")
+        yerr = np.vstack([r.dev_dph - r.dev_lo68_dph, r.dev_hi68_dph - r.dev_dph])
+        ax.errorbar(r.tau_s, r.dev_dph, yerr=yerr, fmt="o", ms=4, color="k", lw=0.8, mfc="white",
+                    label=f"{label} (68 % CI)")
+        used = np.isin(np.round(r.tau_s, 12), np.round(fit.fit_tau_s, 12))
+        ax.plot(r.tau_s[used], r.dev_dph[used], "o", ms=5, color="k", zorder=4, label="fitted points")
+        for i, e in enumerate(fit.excluded):
+            ax.axvspan(e["tau_min_s"] / 1.2, e["tau_max_s"] * 1.2, color="0.85", zorder=0,
+                       label="left out" if i == 0 else None)
+        tau = np.logspace(np.log10(fit.tau_min_s), np.log10(fit.tau_max_s), 200)
+        ax.loglog(tau, fit.model_dev_dph(tau), "r-", lw=2.0, label=f"fit {'+'.join(fit.selected)}")
+        for name, style in zip(("Q", "N", "B", "K", "R"), ("--", "-.", ":", "--", "-.")):
+            if name in fit.selected and fit.terms[name].value:
+                ax.loglog(tau, fit.term_dev_dph(name, tau), style, lw=1.2, label=name)
+        pos = r.dev_lo68_dph > 0
+        lo = np.nanmin(r.dev_lo68_dph[pos]) if np.any(pos) else np.nanmin(r.dev_dph)
+        ax.set_ylim(lo / 3, np.nanmax(r.dev_hi68_dph) * 3)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("τ [s]")
+        ax.set_ylabel(f"{label} σ(τ) [deg/h]")
+        ax.set_title(f"{title or label}: {aa.name}   χ²_red {fit.chi2_red:.3g}, p = {fit.p_value:.2g} "
+                     f"({fit.quality})")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(ncols=2 if n == 1 else 1)
+    return _save(fig, path)
+
+
+@_styled
+def plot_signal(record, path, split_s=None) -> Path:
+    """Fig. 1: the rate of every axis over time (min/max envelope of long records and the mean), with the
+    train / validation / test blocks shaded when ``split_s`` ``{"train": (t0, t1), ...}`` [s] is given."""
+    plt = _plt()
+    fig, axs = plt.subplots(record.n_axes, 1, figsize=(FIG_WIDTH_IN, 1.0 + 2.3 * record.n_axes), squeeze=False,
+                            sharex=True, layout="constrained")
+    t = record.t0_s + np.arange(record.n_samples) * record.dt_s
+    for i, (ax, name) in enumerate(zip(axs[:, 0], record.axis_names)):
+        tb, lo, hi, mean = _envelope(t, record.axis(name))
+        if tb is not t:
+            ax.fill_between(tb, lo, hi, color="C0", alpha=0.35, lw=0, label="min–max per bin")
+        ax.plot(tb, mean, lw=0.6, color="C0", label="mean per bin" if tb is not t else None)
+        if split_s:
+            _draw_split(ax, split_s, label=i == 0)
+        ax.set_ylabel(f"{name} [deg/h]")
+    axs[-1, 0].set_xlabel("t [s]")
+    fig.suptitle("Gyro output (Fig. 1)" + ("; dashed: train / validation / test split" if split_s else ""))
+    return _save(fig, path)
+
+
+@_styled
+def plot_spectrum(record, path) -> Path:
+    """Fig. 2: Welch power spectral density of every axis."""
+    from scipy.signal import welch
+
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(FIG_WIDTH_IN, 4.8), layout="constrained")
+    for name in record.axis_names:
+        x = np.asarray(record.axis(name), dtype=float)
+        f, p = welch(x - x.mean(), fs=record.fs_hz, nperseg=min(len(x), 4096))
+        ax.loglog(f[1:], p[1:], lw=1.0, label=name)
+    ax.set_xlabel("f [Hz]")
+    ax.set_ylabel("PSD [(deg/h)²/Hz]")
+    ax.set_title("Spectrum of the output (Fig. 2)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    return _save(fig, path)
+
+
+@_styled
+def plot_separation(sep, path, split=None) -> Path:
+    """Fig. 5: drift and white noise over time; ``split`` ``{"train": [i0, i1), ...}`` (sample indices at the
+    separation's rate) draws the blocks the models use (they separate inside each block)."""
+    plt = _plt()
+    t = np.arange(sep.rate_dph.size) * sep.dt_s
+    fig, axs = plt.subplots(2, 1, figsize=(FIG_WIDTH_IN, 6.0), sharex=True, layout="constrained")
+    tb, lo, hi, mean = _envelope(t, sep.rate_dph)
+    if tb is not t:
+        axs[0].fill_between(tb, lo, hi, color="0.75", lw=0, label="input (min–max per bin)")
+    else:
+        axs[0].plot(t, sep.rate_dph, lw=0.5, color="0.65", label="input")
+    axs[0].plot(t, sep.drift_dph, lw=1.4, color="C3", label=f"drift (approximation, level {sep.level})")
+    axs[0].set_ylabel("[deg/h]")
+    axs[0].legend(loc="upper right")
+    tb, lo, hi, mean = _envelope(t, sep.noise_dph)
+    if tb is not t:
+        axs[1].fill_between(tb, lo, hi, color="C0", alpha=0.6, lw=0, label="white noise (details, min–max per bin)")
+    else:
+        axs[1].plot(t, sep.noise_dph, lw=0.5, color="C0", label="white noise (details)")
+    axs[1].set_ylabel("[deg/h]")
+    axs[1].set_xlabel("t [s]")
+    axs[1].legend(loc="upper right")
+    if split:
+        for i, ax in enumerate(axs):
+            _draw_split(ax, {k: (a * sep.dt_s, b * sep.dt_s) for k, (a, b) in split.items()}, label=i == 0)
+    fig.suptitle(f"Drift and white noise of the whole record, axis {sep.name}, dt = {sep.dt_s:g} s (Fig. 5)")
+    return _save(fig, path)
+
+
+@_styled
+def plot_separation_allan(sep, path) -> Path:
+    """Fig. 6: ADEV of original, drift and noise."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(FIG_WIDTH_IN, 5.2), layout="constrained")
+    for (label, aa), color in zip(sep.rows, ("k", "C3", "C0")):
+        r = aa.allan
+        yerr = np.vstack([r.dev_dph - r.dev_lo68_dph, r.dev_hi68_dph - r.dev_dph])
+        ax.errorbar(r.tau_s, r.dev_dph, yerr=yerr, fmt="o-", ms=4, lw=1.0, color=color, label=label)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("τ [s]")
+    ax.set_ylabel("σ(τ) [deg/h]")
+    ax.set_title(f"Allan deviation of drift and noise, axis {sep.name} (Fig. 6)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    return _save(fig, path)
+
+
+def _test_axis(model_axis):
+    e, _ = model_axis.split["test"]
+    y = model_axis.drift_blocks["test"]
+    return (e + np.arange(y.size)) * model_axis.dt_s, y, int(getattr(model_axis, "score_from", 0) or 0)
+
+
+def _label(model_axis, label):
+    model = model_axis.fitted.get(label)
+    if getattr(model, "input_kind", "drift") == "rate":
+        return f"{label} (estimates the rate's drift, not the wavelet drift)"
+    return label
+
+
+def _shade_unscored(ax, t, k, dt):
+    if k > 0:
+        ax.axvspan(t[0] - dt / 2, t[min(k, t.size) - 1] + dt / 2, color=UNSCORED, alpha=0.6, lw=0, zorder=0,
+                   label=f"first {k} samples: not scored")
+
+
+@_styled
+def plot_models(model_axis, path, fig_no=8, *, residual=False) -> Path:
+    """Fig. 8: one-step predictions against the test-block drift, over the whole test block and zoomed on its
+    largest excursion; with ``residual``, Fig. 9 (:func:`plot_residuals`)."""
+    if residual:
+        return plot_residuals(model_axis, path, fig_no)
+    plt = _plt()
+    t, y, k = _test_axis(model_axis)
+    dt = model_axis.dt_s
+    fig, axs = plt.subplots(2, 1, figsize=(FIG_WIDTH_IN, 8.0), layout="constrained")
+    scored = slice(k, None)
+    centre = k + int(np.nanargmax(np.abs(y[scored]))) if y.size > k else 0
+    half = max(30, y.size // 20)
+    lo, hi = max(k, centre - half), min(y.size, centre + half)
+    for ax, part in zip(axs, (slice(0, y.size), slice(lo, hi))):
+        _shade_unscored(ax, t, k if part.start == 0 else 0, dt)
+        ax.plot(t[part], y[part], "k-", lw=2.2, label="wavelet drift (test block)")
+        for label, yhat in model_axis.predictions.items():
+            ax.plot(t[part], yhat[part], lw=1.0, label=_label(model_axis, label))
+        lim = _limits(y[max(part.start, k):part.stop],
+                      *[p[max(part.start, k):part.stop] for p in model_axis.predictions.values()])
+        if lim:
+            ax.set_ylim(*lim)
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel("drift [deg/h]")
+    axs[0].set_title(f"One-step drift models, axis {model_axis.name} (Fig. {fig_no}): test block")
+    axs[1].set_title(f"zoom on the largest drift excursion, t = {t[lo]:g} – {t[hi - 1]:g} s")
+    axs[0].legend(ncols=2, loc="best")
+    return _save(fig, path)
+
+
+@_styled
+def plot_residuals(model_axis, path, fig_no=9) -> Path:
+    """Fig. 9: residual drift after compensation (wavelet drift minus each model's one-step prediction) on the
+    test block, one panel per model, each scaled on its scored part and labelled with its RMS."""
+    plt = _plt()
+    t, y, k = _test_axis(model_axis)
+    preds = list(model_axis.predictions.items())
+    n = max(1, len(preds))
+    fig, axs = plt.subplots(n, 1, figsize=(FIG_WIDTH_IN, 1.2 + 1.55 * n), sharex=True, squeeze=False,
+                            layout="constrained")
+    for ax, (label, yhat) in zip(axs[:, 0], preds):
+        r = y - yhat
+        _shade_unscored(ax, t, k, model_axis.dt_s)
+        ax.plot(t, r, lw=0.8, color="C3")
+        ax.axhline(0.0, color="k", lw=0.6)
+        rs = r[k:][np.isfinite(r[k:])]
+        rms = float(np.sqrt(np.mean(rs**2))) if rs.size else float("nan")
+        lim = _limits(rs, pad=0.1)
+        if lim:
+            ax.set_ylim(*lim)
+        ax.text(0.005, 0.95, f"{_label(model_axis, label)}: RMS {rms:.3g} deg/h (scored part)",
+                transform=ax.transAxes, va="top", fontsize=11,
+                bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "none"})
+        ax.set_ylabel("[deg/h]")
+    axs[-1, 0].set_xlabel("t [s]")
+    fig.suptitle(f"Residual drift after one-step compensation, axis {model_axis.name} (Fig. {fig_no}); "
+                 f"y scales differ between panels; grey: not scored")
+    return _save(fig, path)

@@ -1,0 +1,120 @@
+"""Files of the per-command outputs: strict JSON, CSV tables and curves, NPZ series, each written atomically."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .._util import json_default
+from ..output import atomic_path
+from .figures import _safe, plot_allan, plot_models, plot_residuals, plot_separation, plot_separation_allan
+
+def _clean(obj):
+    """Replace NaN/inf by None so the JSON is strict."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    return obj
+
+
+def write_json(obj, path) -> Path:
+    path = Path(path)
+    data = json.loads(json.dumps(obj, default=json_default))
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(_clean(data), indent=2, allow_nan=False))
+    return path
+
+
+
+def _noise_csv_rows(label, aa):
+    cells = []
+    for name in ("Q", "N", "B", "K", "R"):
+        t = aa.noise.terms[name]
+        cells += [t.value, t.lo95, t.hi95]
+    return [label] + ["" if c is None else repr(float(c)) for c in cells]
+
+
+def _noise_csv_header():
+    from ..noise import TERM_TABLE
+
+    head = ["signal"]
+    for name, spec in TERM_TABLE.items():
+        head += [f"{name}{spec.suffix}", f"{name}_lo95{spec.suffix}", f"{name}_hi95{spec.suffix}"]
+    return head
+
+
+def _write_rows_csv(path, header, rows) -> Path:
+    path = Path(path)
+    with atomic_path(path) as tmp, open(tmp, "w") as fh:
+        fh.write(",".join(header) + "\n")
+        for row in rows:
+            fh.write(",".join(str(c) for c in row) + "\n")
+    return path
+
+
+def write_allan_outputs(allan_axes, record, out_dir) -> dict:
+    """``allan.json``, ``allan.csv`` (curve of every axis, with units) and ``allan.png``."""
+    out = Path(out_dir)
+    write_json({"source": record.source, "record": record.metadata(),
+                "axes": [a.to_dict() for a in allan_axes]}, out / "allan.json")
+    rows = []
+    for a in allan_axes:
+        r = a.allan
+        for i in range(r.tau_s.size):
+            rows.append([a.name, repr(float(r.tau_s[i])), int(r.m[i]), repr(float(r.dev_dph[i])),
+                         repr(float(r.var_dph2[i])), int(r.n_terms[i]), repr(float(r.edf[i])),
+                         repr(float(r.dev_lo68_dph[i])), repr(float(r.dev_hi68_dph[i])),
+                         repr(float(r.dev_lo95_dph[i])), repr(float(r.dev_hi95_dph[i]))])
+    dev = {"adev": "adev", "hdev": "hdev", "mdev": "mdev"}.get(getattr(allan_axes[0].allan, "statistic", "adev"), "dev")
+    var = {"adev": "avar", "hdev": "hvar", "mdev": "mvar"}.get(dev, "var")
+    _write_rows_csv(out / "allan.csv",
+                    ["axis", "tau_s", "m", f"{dev}_dph", f"{var}_dph2", "n_terms", "edf", f"{dev}_lo68_dph",
+                     f"{dev}_hi68_dph", f"{dev}_lo95_dph", f"{dev}_hi95_dph"], rows)
+    plot_allan(allan_axes, out / "allan.png")
+    return {"json": out / "allan.json", "csv": out / "allan.csv", "png": out / "allan.png"}
+
+
+def write_separation_outputs(seps, out_dir) -> dict:
+    """Drift and noise series (CSV and NPZ), Fig. 5 and 6 per axis, the Q..R table (JSON and CSV)."""
+    out = Path(out_dir)
+    arrays = {}
+    for s in seps:
+        arrays[f"{s.name}_input_dph"] = s.rate_dph
+        arrays[f"{s.name}_drift_dph"] = s.drift_dph
+        arrays[f"{s.name}_noise_dph"] = s.noise_dph
+    with atomic_path(out / "separation.npz") as tmp:
+        np.savez(tmp, dt_s=np.array(seps[0].dt_s), **arrays)
+    n = seps[0].rate_dph.size
+    cols = ["t_s"] + list(arrays)
+    data = np.column_stack([np.arange(n) * seps[0].dt_s] + [arrays[c] for c in cols[1:]])
+    with atomic_path(out / "separation.csv") as tmp:
+        np.savetxt(tmp, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+    rows = [_noise_csv_rows(f"{s.name}:{label}", aa) for s in seps for label, aa in s.rows]
+    _write_rows_csv(out / "separation_table.csv", _noise_csv_header(), rows)
+    write_json({"axes": [s.to_dict() for s in seps]}, out / "separation.json")
+    files = {}
+    for s in seps:
+        files[f"fig5_{s.name}"] = plot_separation(s, out / f"fig5_drift_noise_{_safe(s.name)}.png")
+        files[f"fig6_{s.name}"] = plot_separation_allan(s, out / f"fig6_allan_{_safe(s.name)}.png")
+    return files
+
+
+def write_model_outputs(model_axes, out_dir) -> dict:
+    """Saved models (JSON + NPZ), metrics JSON, Fig. 8 and 9 per axis."""
+    out = Path(out_dir)
+    for ma in model_axes:
+        for label, model in ma.fitted.items():
+            safe = label.replace("(", "").replace(")", "").replace(",", "").replace(" ", "_").lower()
+            model.save(out / "models" / f"{_safe(ma.name)}_{_safe(safe)}")
+        plot_models(ma, out / f"fig8_models_{_safe(ma.name)}.png")
+        plot_residuals(ma, out / f"fig9_residual_{_safe(ma.name)}.png")
+    write_json({"axes": [ma.to_dict() for ma in model_axes]}, out / "metrics.json")
+    return {"dir": out}
+
+

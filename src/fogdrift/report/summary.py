@@ -1,0 +1,204 @@
+"""The report's first screen, as data: the recording, the headline noise coefficients, one compensation verdict
+per axis, and what the record cannot support.
+
+Every function returns plain rows of strings (units in the labels) or dicts, so the same content goes into
+``report.html`` and into ``analysis.json`` (key ``report_summary``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .tables import _fmt, term_text
+
+__all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "recording_rows", "noise_headline", "verdict_items",
+           "cannot_support", "summary_dict"]
+
+#: Terms of the headline table, in the order an engineer reads them (white noise first, quantization last).
+HEADLINE_TERMS = ("N", "B", "K", "R", "Q")
+
+#: Outcome of a headline verdict -> badge text (the colour is never the only signal).
+OUTCOME_LABELS = {"reduces": "REDUCES", "mixed": "MIXED", "none": "NO GAIN", "undetermined": "CANNOT JUDGE"}
+
+
+def _duration(seconds) -> str:
+    """``1847 s (30.8 min)``, ``10000 s (2.78 h)``."""
+    if seconds is None:
+        return "–"
+    s = float(seconds)
+    if s >= 7200:
+        return f"{s:.6g} s ({s / 3600:.3g} h)"
+    if s >= 120:
+        return f"{s:.6g} s ({s / 60:.3g} min)"
+    return f"{s:.6g} s"
+
+
+def _effective_rate(result) -> str:
+    """The modelling rate actually used: the averaged record's rate and its block-average factor."""
+    m = getattr(result, "model_record", None) or {}
+    fs, k = m.get("fs_hz"), m.get("block_average_factor") or 1
+    if fs is None:
+        return "native rate"
+    native = m.get("native_fs_hz") or fs
+    return f"{fs:.6g} Hz (native {native:.6g} Hz averaged in blocks of {k})" if k > 1 else f"{fs:.6g} Hz (native)"
+
+
+def _unit_text(rec: dict) -> str:
+    unit = rec.get("input_unit") or "?"
+    declared = [u for u in rec.get("declared_units") or [] if u]
+    how = "declared in the file's header" if declared else "given by the user (--unit)"
+    return f"{unit} ({how}); converted to deg/h" if unit != "deg/h" else f"deg/h ({how})"
+
+
+def recording_rows(result, sensor: str | None = None) -> list:
+    """``[label, value]`` rows describing the recording: file, sensor, duration, rate, axes, units."""
+    rec = result.record
+    fs = rec.get("native_fs_hz") or rec.get("fs_hz")
+    return [
+        ["file", Path(str(result.source)).name],
+        ["sensor", sensor or "not stated in the file"],
+        ["duration", f"{_duration(rec.get('duration_s'))}, {rec.get('n_samples')} samples"],
+        ["sample rate", f"{fs:.6g} Hz (dt {rec.get('dt_s'):.6g} s)" if fs else "–"],
+        ["axes", ", ".join(rec.get("axis_names", []))],
+        ["rate unit", _unit_text(rec)],
+        ["modelling rate", _effective_rate(result)],
+    ]
+
+
+def noise_headline(result) -> tuple:
+    """``(headers, rows)``: one column per axis; rows N, B, K, R, Q (value [95 % interval]), the IEEE B_min
+    reading, the selected model, chi2_red with the fit quality, and the fitted tau range."""
+    from ..noise import TERM_TABLE
+
+    axes = list(result.axes)
+    headers = ["whole record, native rate"] + [f"axis {ax.name}" for ax in axes]
+    fits = [ax.original.noise for ax in axes]
+    rows = []
+    for name in HEADLINE_TERMS:
+        spec = TERM_TABLE[name]
+        rows.append([f"{spec.header.split(' [')[0]} {spec.long_name} [{spec.header.split('[')[1]}"]
+                    + [term_text(f.terms[name]) for f in fits])
+    rows.append(["B_min, IEEE reading at the ADEV minimum [deg/h]"] + [_b_min(f) for f in fits])
+    rows.append(["selected noise model"] + ["+".join(f.selected) or "(none)" for f in fits])
+    rows.append(["χ²_red (fit quality, p)"] + [f"{_fmt(f.chi2_red, 3)} ({f.quality}, p = {f.p_value:.2g})"
+                                               for f in fits])
+    rows.append(["fitted τ range [s]"] + [f"{_fmt(f.tau_min_s, 3)} – {_fmt(f.tau_max_s, 3)}" for f in fits])
+    return headers, rows
+
+
+def _b_min(noise) -> str:
+    b = noise.b_min or {}
+    if b.get("value") is None:
+        return "–"
+    if b.get("bound_only"):
+        why = "fitted floor above the measured curve" if "measured curve" in b.get("rule", "") else \
+            "curve still falling"
+        return f"< {_fmt(b['value'], 3)} ({why})"
+    return f"{_fmt(b['value'], 3)} at τ = {_fmt(b.get('tau_s'), 3)} s"
+
+
+def verdict_items(result, *, evaluated: bool = True) -> list:
+    """One dict per axis: ``axis``, ``outcome`` (reduces|mixed|none|undetermined), ``sentence``.
+
+    Axes without an evaluation (``analyze --no-heading``) get the *undetermined* outcome with a sentence that
+    says so.
+    """
+    items = []
+    for ax in result.axes:
+        ev = getattr(ax, "evaluation", None)
+        if ev is None:
+            why = "--no-heading" if not evaluated else "not run"
+            items.append({"axis": ax.name, "outcome": "undetermined",
+                          "sentence": f"{ax.name}: heading error not evaluated ({why}); no compensation verdict."})
+        else:
+            items.append({"axis": ax.name, "outcome": ev.outcome, "sentence": ev.headline.lines[0]})
+    return items
+
+
+def _term_limits(result) -> list:
+    """Rows ``[axis, term, status, 95 % bound, reason]`` of every term that is not resolved."""
+    from ..noise import TERM_TABLE
+    from ..noise.terms import DISPLAY_UNITS
+
+    rows = []
+    for ax in result.axes:
+        for name in HEADLINE_TERMS:
+            t = ax.original.noise.terms[name]
+            if t.status == "resolved":
+                continue
+            status = {"not_estimable": "not estimable (n/e)", "absent": "not in the model",
+                      "unresolved": "in the model, interval reaches 0"}.get(t.status, t.status)
+            bound = "–" if t.hi95 is None else f"< {_fmt(t.hi95, 3)} {DISPLAY_UNITS.get(name, t.unit)}"
+            rows.append([ax.name, f"{name} ({TERM_TABLE[name].long_name})", status, bound, t.reason or "–"])
+    return rows
+
+
+def _grouped(items: list) -> list:
+    """Identical statements of several axes once, prefixed by the axes: ``gx, gy: ...``."""
+    order, axes_of = [], {}
+    for axis, text in items:
+        if text not in axes_of:
+            order.append(text)
+            axes_of[text] = []
+        if axis not in axes_of[text]:
+            axes_of[text].append(axis)
+    return [f"{', '.join(axes_of[t])}: {t}" if axes_of[t] else t for t in order]
+
+
+def _strip_axis(text: str, axis: str) -> str:
+    return text[len(axis) + 2:] if text.startswith(f"{axis}: ") else text
+
+
+def cannot_support(result) -> dict:
+    """What the record cannot support: ``terms`` (rows of :func:`_term_limits`, with their headers) and
+    ``items`` (sentences: horizons too long or with too few origins, evaluations skipped, the longest tau,
+    metrics that are NaN by design)."""
+    from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
+
+    items = []
+    for ax in result.axes:
+        r = ax.original.allan
+        items.append((ax.name, f"the Allan curve reaches τ = {_fmt(float(r.tau_s[-1]), 3)} s of a "
+                               f"{_fmt(result.record.get('duration_s'), 4)}-s record: noise that shows only at longer τ "
+                               "(slow rate random walk, ramp) is not observed"))
+        ev = getattr(ax, "evaluation", None)
+        ma = ax.models
+        e, f = ma.split["test"]
+        block = f"the held-out test block ({_fmt((f - e) * ma.dt_s, 4)} s)"
+        if ev is not None:
+            for note in ev.notes:
+                items.append((ax.name, _strip_axis(note, ax.name)))
+            h = ev.heading
+            if h is not None:
+                for note in h.notes:
+                    items.append((ax.name, f"heading error: {note}"))
+                base = {r.horizon_s: r for r in h.rows if r.model == "constant bias"}
+                for hz in h.horizons_s:
+                    n = base[hz].n_origins
+                    k = independent_origins(n, h.step_s, hz)
+                    if k < MIN_ORIGINS:
+                        items.append((ax.name, f"heading error at {hz:g} s: {block} gives {n} origin(s), {k} with "
+                                               f"non-overlapping horizons; a verdict needs {MIN_ORIGINS} (the numbers "
+                                               "are shown, not judged)"))
+            if ev.artefacts is not None:
+                for note in ev.artefacts.notes:
+                    if note.startswith("frequencies"):
+                        items.append((ax.name, f"artefact check: {note}"))
+        for note in ma.notes:
+            if note.startswith("p0 is unstable near zero"):
+                items.append((ax.name, "p0 [%] is NaN (the drift crosses zero in the test block; see the glossary: "
+                                       "read p0_w, RMSE and MASE instead)"))
+            else:
+                items.append((ax.name, f"one-step metrics: {note}"))
+    return {"term_headers": ["axis", "term", "status", "95 % bound", "why"], "terms": _term_limits(result),
+            "items": _grouped(items)}
+
+
+def summary_dict(result, sensor: str | None = None, *, evaluated: bool = True) -> dict:
+    """The first screen as JSON-able data (stored in ``analysis.json`` as ``report_summary``)."""
+    headers, rows = noise_headline(result)
+    out = {"recording": dict(recording_rows(result, sensor)), "noise": {"headers": headers, "rows": rows},
+           "verdicts": verdict_items(result, evaluated=evaluated), "cannot_support": cannot_support(result)}
+    if getattr(result, "apply_to", None) is not None:
+        out["apply_to_verdicts"] = verdict_items(result.apply_to, evaluated=evaluated)
+    return out

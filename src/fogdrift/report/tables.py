@@ -1,0 +1,156 @@
+"""Tables of strings with units: noise coefficients, one-step metrics and the paper-measure sentences.
+
+Nothing here prints or writes; the console (:mod:`fogdrift.cli`) and the HTML report use the same rows.
+"""
+
+from __future__ import annotations
+
+import math
+
+NOISE_HEADERS = ("Q [µrad]", "N [deg/√h]", "B [deg/h]", "K [deg/h^1.5]", "R [deg/h²]")
+
+METRICS_HEADERS = (
+    "model",
+    "RMSE [deg/h]",
+    "MAE [deg/h]",
+    "max|e| [deg/h]",
+    "MASE",
+    "skill vs persistence",
+    "p0 [%]",
+    "p0_w [%]",
+    "p0 as measured [%] (persistence)",
+)
+
+
+def _fmt(x, digits=4) -> str:
+    if x is None:
+        return "–"
+    x = float(x)
+    if not math.isfinite(x):
+        return "NaN"
+    if x == 0:
+        return "0"
+    if abs(x) >= 1e4 or abs(x) < 1e-3:
+        return f"{x:.{digits - 1}e}"
+    return f"{x:.{digits}g}"
+
+
+def term_text(term) -> str:
+    """``value [lo95, hi95]`` for a term in the model; ``- (< hi95)`` for one that is not; ``n/e`` when the data
+    cannot support a number (the reason is in the notes)."""
+    if term.value is None:
+        if term.status == "not_estimable":
+            return "n/e" if term.hi95 is None else f"n/e (< {_fmt(term.hi95, 3)})"
+        return "–" if term.hi95 is None else f"– (< {_fmt(term.hi95, 3)})"
+    text = _fmt(term.value)
+    if term.lo95 is not None and term.hi95 is not None:
+        text += f" [{_fmt(term.lo95, 3)}, {_fmt(term.hi95, 3)}]"
+    return text
+
+
+def noise_row(noise) -> list[str]:
+    """Five cells Q, N, B, K, R of a NoiseFit (95 % intervals in brackets; – = not in the model, with its upper
+    bound; n/e = not estimable)."""
+    return [term_text(noise.terms[name]) for name in ("Q", "N", "B", "K", "R")]
+
+
+def fit_summary(noise) -> str:
+    """One line: the selected model, the fit statistic and p-value, the fitted tau range."""
+    return (f"model {'+'.join(noise.selected) or '(none)'} selected from {len(noise.candidates)} candidates; "
+            f"chi2_red {_fmt(noise.chi2_red, 3)} on {noise.dof} dof (p = {noise.p_value:.2g}, fit {noise.quality}); "
+            f"fitted tau {_fmt(noise.tau_min_s, 3)} .. {_fmt(noise.tau_max_s, 3)} s")
+
+
+def readout_text(noise) -> str:
+    """The classic IEEE-952 slope read-outs, labelled as a cross-check (with where each was read)."""
+    parts = [ro.text() for ro in noise.readouts.values() if ro.value is not None]
+    return "; ".join(parts) if parts else "no term's slope is visible in the curve"
+
+
+def noise_notes(noise) -> list[str]:
+    """Everything a reader needs beside the table, in words: fit quality, what was left out and why, the
+    classical bias instability, each term that is not resolved and why, outliers."""
+    out = [fit_summary(noise)]
+    for e in noise.excluded:
+        out.append(f"left out tau {_fmt(e['tau_min_s'], 3)} .. {_fmt(e['tau_max_s'], 3)} s: {e['reason']}")
+    out += list(noise.notes)
+    b = noise.b_min or {}
+    if b.get("value") is not None:
+        if b.get("bound_only"):
+            why = ("the fitted flat floor lies above the measured curve, so the measured minimum bounds it"
+                   if "measured curve" in b.get("rule", "") else "the curve still falls at the longest tau")
+            out.append(f"bias instability (IEEE reading at the ADEV minimum): B_min < {_fmt(b['value'], 3)} deg/h "
+                       f"(min at tau = {_fmt(b['tau_s'], 3)} s; {why})")
+        else:
+            which = "measured" if "measured ADEV" in b.get("rule", "") else "fitted"
+            out.append(f"bias instability (IEEE reading, min of the {which} ADEV / 0.664): B_min = {_fmt(b['value'], 3)} "
+                       f"deg/h at tau = {_fmt(b['tau_s'], 3)} s")
+    for t in noise.terms.values():
+        if t.reason and t.status != "resolved":
+            out.append(f"{t.name}: {t.reason}")
+    if noise.outliers and noise.outliers.get("count"):
+        o = noise.outliers
+        out.append(f"outliers: {o['count']} samples ({100 * o['fraction']:.3g} %) beyond {o['threshold_sigma']:g} "
+                   f"robust sigma, action: {o['action']}")
+    return out
+
+
+def not_estimable_notes(noise) -> list[str]:
+    """Kept for callers of the earlier API: the notes of :func:`noise_notes`."""
+    return noise_notes(noise)
+
+
+def metrics_rows(model_axis) -> list[list[str]]:
+    """One row per model of the test-block metrics (paper target: the wavelet drift of the test block)."""
+    rows = []
+    for label, m in model_axis.metrics.items():
+        p0m, p0p = model_axis.p0_as_measured.get(label, (float("nan"), float("nan")))
+        rows.append([
+            label, _fmt(m.rmse_dph), _fmt(m.mae_dph), _fmt(m.max_abs_dph), _fmt(m.mase), _fmt(m.skill),
+            _fmt(m.p0_pct), _fmt(m.p0_weighted_pct), f"{_fmt(p0m, 5)} ({_fmt(p0p, 5)})",
+        ])
+    return rows
+
+
+def causal_metrics_rows(model_axis) -> list[list[str]]:
+    rows = []
+    for label, m in model_axis.causal_metrics.items():
+        rows.append([label, _fmt(m.rmse_dph), _fmt(m.mae_dph), _fmt(m.max_abs_dph), _fmt(m.mase), _fmt(m.skill),
+                     _fmt(m.p0_pct), _fmt(m.p0_weighted_pct), "–"])
+    return rows
+
+
+def verdict(model_axis) -> list[str]:
+    """Plain-language sentences: which model beat persistence on the test block, judged on RMSE and MAE.
+
+    A model "beat" persistence only if both its RMSE and its MAE are lower; if one is lower and the other
+    higher the verdict says "mixed" (RMSE is dominated by a few large errors, MAE by typical ones).
+    """
+    learned = {k: v for k, v in model_axis.metrics.items() if k != "persistence"}
+    if not learned:
+        return ["Only the persistence baseline was run."]
+    any_m = next(iter(model_axis.metrics.values()))
+    p_rmse = any_m.rmse_persistence_dph
+    p_mae = model_axis.metrics["persistence"].mae_dph if "persistence" in model_axis.metrics else None
+    lines = []
+    for label, m in learned.items():
+        d_rmse = 100.0 * (m.rmse_dph / p_rmse - 1.0)
+        text = f"RMSE {_fmt(m.rmse_dph)} vs {_fmt(p_rmse)} deg/h ({d_rmse:+.1f} %)"
+        if p_mae is None:
+            better = d_rmse < 0
+            word = "beat" if better else "did NOT beat"
+        else:
+            d_mae = 100.0 * (m.mae_dph / p_mae - 1.0)
+            text += f", MAE {_fmt(m.mae_dph)} vs {_fmt(p_mae)} deg/h ({d_mae:+.1f} %)"
+            if d_rmse < 0 and d_mae < 0:
+                word = "beat"
+            elif d_rmse >= 0 and d_mae >= 0:
+                word = "did NOT beat"
+            else:
+                word = "gave a MIXED result against"
+        lines.append(f"{label} {word} persistence one step ahead: {text}.")
+    best = min(learned, key=lambda k: learned[k].rmse_dph)
+    lines.append(f"Lowest RMSE among learned models on the test block: {best}.")
+    return lines
+
+

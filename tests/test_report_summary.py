@@ -1,0 +1,70 @@
+"""The report's one-sentence compensation verdict (outcome and colour) and its compensation tables, from
+hand-made heading-error and artefact results whose outcome is known by construction."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace as NS
+
+import pytest
+
+from fogdrift.evaluation import ArtefactResult, ArtefactRow, headline_verdict
+from fogdrift.evaluation.verdicts import independent_origins
+from fogdrift.report.html import _artefact_table, _heading_table, _verdict_li
+
+
+def _row(model, h, rms, ratio, n=30):
+    return NS(model=model, horizon_s=h, n_origins=n, rms_deg=rms, ratio_to_bias=ratio, median_abs_deg=rms,
+              p90_abs_deg=2 * rms, wins_vs_bias=0.5, predicted_sigma_deg=None, inside_sigma=None)
+
+
+def _heading(kalman_60, kalman_600, n=30, step_s=300.0):
+    """Constant bias and Kalman at 60 s and 600 s; 30 origins every 300 s: all independent at both horizons."""
+    rows = [_row("constant bias", 60.0, 1.0, 1.0, n), _row("Kalman", 60.0, kalman_60, kalman_60, n),
+            _row("constant bias", 600.0, 8.0, 1.0, n), _row("Kalman", 600.0, 8.0 * kalman_600, kalman_600, n)]
+    return NS(axis="gx", calib_s=300.0, step_s=step_s, horizons_s=(60.0, 600.0), rows=rows, notes=[])
+
+
+def _artefacts(flagged=()):
+    row = ArtefactRow(model="Kalman", gains={0.01: 0.5 if flagged else 1.0, 0.1: 1.0}, step_survival={10.0: 0.9},
+                      ramp_survival=0.8, adev_ratio={0.01: 0.7, 0.1: None}, flagged_hz=tuple(flagged))
+    base = ArtefactRow(model="constant bias", gains={0.01: 1.0, 0.1: 1.0}, step_survival={10.0: 1.0},
+                       ramp_survival=1.0, adev_ratio={0.01: 1.0, 0.1: None}, flagged_hz=())
+    return ArtefactResult(axis="gx", dt_s=1.0, amplitude_dph=3.0, frequencies_hz=[0.01, 0.1], step_delays_s=(10.0,),
+                          rows=[base, row])
+
+
+@pytest.mark.parametrize("k60, k600, flagged, outcome", [
+    (0.80, 1.00, (), "reduces"),      # -20 % at 60 s, no change at 600 s, artefact check clean
+    (0.80, 1.10, (), "mixed"),        # -20 % at 60 s but +10 % at 600 s
+    (0.80, 1.00, (0.01,), "mixed"),   # reduces, but removes real rate at 0.01 Hz
+    (0.97, 1.03, (), "none"),         # within +-5 % everywhere: not material
+    (1.20, 1.30, (), "none"),         # worse everywhere
+])
+def test_headline_outcome_by_construction(k60, k600, flagged, outcome):
+    v = headline_verdict(_heading(k60, k600), _artefacts(flagged))
+    assert v.data["outcome"] == outcome, v.lines
+    assert len(v.lines) == 1 and v.lines[0].startswith("gx: ")
+    if outcome != "none":
+        assert v.data["model"] == "Kalman" and "20 %" in v.lines[0]
+
+
+def test_overlapping_origins_are_not_judged():
+    """30 origins every 60 s: at 600 s only 1 + 29*60/600 = 3 have non-overlapping horizons, and at 60 s all 30
+    count; with 9 origins nothing can be judged at all."""
+    assert independent_origins(30, 60.0, 600.0) == 3 and independent_origins(30, 60.0, 60.0) == 30
+    v = headline_verdict(_heading(1.0, 0.5, step_s=60.0), None)  # halves the error, but only where not judged
+    assert v.data["outcome"] == "none" and v.data["judged_horizons_s"] == [60.0]
+    v = headline_verdict(_heading(0.5, 0.5, n=9), None)
+    assert v.data["outcome"] == "undetermined" and "cannot judge" in v.lines[0]
+    assert headline_verdict(None, None, axis="gz", reason="--no-heading").data["outcome"] == "undetermined"
+
+
+def test_verdict_badge_and_tables_render():
+    v = headline_verdict(_heading(0.8, 1.0), _artefacts((0.01,)))
+    li = _verdict_li({"outcome": v.data["outcome"], "sentence": v.lines[0]})
+    assert li.startswith('<li class="v-mixed"><span class="badge">MIXED</span>gx: Kalman')
+    h = _heading_table(_heading(0.8, 1.1))
+    assert h.index("constant bias") < h.index("Kalman")  # constant bias first at each horizon
+    assert '<td class="good">0.8</td>' in h and '<td class="bad">1.1</td>' in h
+    a = _artefact_table(_artefacts((0.01,)))
+    assert '<td class="flag">0.5 ⚑</td>' in a and "sinusoid 0.1 Hz: gain" in a and "ramp: surviving slope" in a
