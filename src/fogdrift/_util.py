@@ -32,6 +32,21 @@ def check_series(y, name: str = "y", *, min_length: int = 1) -> np.ndarray:
     return arr
 
 
+def check_count(value, name: str = "n_samples", minimum: int = 2) -> int:
+    """``value`` as an int ``>= minimum`` (an integral float is accepted), or a ConfigError naming ``name``.
+
+    >>> check_count(4.0), check_count(10, "levels", 1)
+    (4, 10)
+    """
+    try:
+        n = int(value)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be an integer >= {minimum}, got {value!r}") from None
+    if n != value or n < minimum:
+        raise ConfigError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return n
+
+
 def json_default(obj):
     """``json.dumps(default=...)`` hook: numpy scalars and arrays, objects with ``to_dict()``."""
     if isinstance(obj, np.generic):

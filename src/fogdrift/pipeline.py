@@ -96,6 +96,10 @@ class AnalysisConfig:
     fit_tau_s : tuple of (float or None, float or None)
         Tau range [s] of the noise fit (None = no limit), e.g. to leave out a vibration bump that the
         IEEE-952 model does not describe.
+    noise_method : str
+        ``"allan"`` (default): the noise table is the Allan fit (:mod:`fogdrift.noise`); ``"gmwm"``: also the GMWM
+        model selection on the Haar wavelet variance of the native-rate record (:mod:`fogdrift.gmwm.analysis`),
+        which the report shows as the noise table.
     """
 
     model_rate_hz: float | None = 1.0
@@ -121,6 +125,7 @@ class AnalysisConfig:
     terms: tuple | None = None
     fit_tau_s: tuple = (None, None)
     outliers: str = "warn"
+    noise_method: str = "allan"
 
     def validate(self) -> "AnalysisConfig":
         if not 0 < self.train_fraction < 1 or not 0 <= self.val_fraction < 1:
@@ -144,6 +149,8 @@ class AnalysisConfig:
             raise ConfigError(f"statistic must be one of {tuple(STATISTICS)}, got {self.statistic!r} ({{opt:statistic}})")
         if self.outliers not in OUTLIER_ACTIONS:
             raise ConfigError(f"outliers must be one of {OUTLIER_ACTIONS}, got {self.outliers!r} ({{opt:outliers}})")
+        if self.noise_method not in ("allan", "gmwm"):
+            raise ConfigError(f"noise_method must be 'allan' or 'gmwm', got {self.noise_method!r} ({{opt:noise_method}})")
         if self.model_rate_hz is not None and not self.model_rate_hz > 0:
             raise ConfigError(f"model_rate_hz must be > 0 Hz or None; got {self.model_rate_hz!r}")
         if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
@@ -284,11 +291,13 @@ class AnalysisAxis:
     models: ModelAxis
     table2: list  # CompensatedSignal rows, test block at the modelling rate
     evaluation: object = None  # fogdrift.evaluation.AxisEvaluation, set by evaluation.evaluate_analysis
+    gmwm: object = None  # fogdrift.gmwm.analysis.GmwmAxis of the native-rate record (noise_method "gmwm")
 
     def to_dict(self) -> dict:
         return {
             "name": self.name,
             "original": self.original.to_dict(),
+            "gmwm": None if self.gmwm is None else self.gmwm.to_dict(),
             "separation": self.separation.to_dict(),
             "models": self.models.to_dict(),
             "table2": [row.to_dict() for row in self.table2],
@@ -651,13 +660,19 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
         original = analyse_allan(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s, cfg)
         original.outliers = outlier_reports[name]
         original.noise.outliers = outlier_reports[name].to_dict()
+        gmwm = None
+        if cfg.noise_method == "gmwm":
+            from .gmwm.analysis import analyse_gmwm
+
+            checkpoint("GMWM noise model (native rate)", axis=name)
+            gmwm = analyse_gmwm(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s)
         checkpoint("separation", axis=name)
         rate, bias, earth = _prepared_axis(rec_m, name, cfg)
         sep = _separation_axis(name, rate, rec_m.dt_s, cfg)
         lvl_cfg = _with_level(cfg, sep.level)
         ma = _fit_axis_models(name, rate, rec_m.dt_s, lvl_cfg, bias, earth, progress,
                               fitted=None if fitted_from is None else _fitted_models_for(name, fitted_from))
-        axes.append(AnalysisAxis(name, original, sep, ma, _table2(ma, lvl_cfg)))
+        axes.append(AnalysisAxis(name, original, sep, ma, _table2(ma, lvl_cfg), gmwm=gmwm))
     result = AnalysisResult(
         config=cfg,
         source=source or record.source,

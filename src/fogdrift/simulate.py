@@ -31,6 +31,7 @@ import math
 
 import numpy as np
 
+from ._util import check_count
 from .errors import ConfigError
 from .units import B_FACTOR as B_FLAT_FACTOR  # the flat ADEV of flicker rate noise in units of B
 from .units import URAD_PER_ARCSEC, check_dt_s, earth_rate_projection_dph
@@ -132,12 +133,7 @@ def simulate(
     >>> y.shape, round(float(y.mean()), 1)
     ((1000,), 2.0)
     """
-    try:
-        n = int(n_samples)
-    except (TypeError, ValueError):
-        raise ConfigError(f"n_samples must be an integer >= 2, got {n_samples!r}") from None
-    if n != n_samples or n < 2:
-        raise ConfigError(f"n_samples must be an integer >= 2, got {n_samples!r}")
+    n = check_count(n_samples)
     dt = check_dt_s(dt_s)
     q = _nonneg("q_urad", q_urad) / URAD_PER_ARCSEC  # (deg/h) s
     arw = _nonneg("arw_dprh", arw_dprh) * 60.0  # (deg/h) sqrt(s)

@@ -1,4 +1,4 @@
-"""Command-line interface: ``fogdrift allan | separate | model | analyze | compensate | batch``.
+"""Command-line interface: ``fogdrift allan | noise | separate | model | analyze | compensate | batch``.
 
 One module per command; :mod:`fogdrift.cli._app` holds the typer application, the shared load options and the
 edge (:func:`~fogdrift.cli._app.run`).  Commands only declare options, call the library (:mod:`fogdrift.pipeline`)
@@ -19,7 +19,7 @@ __all__ = ["app", "main"]
 
 
 def _commands():
-    from . import allan, analyze, batch, compensate, model, separate  # noqa: F401  (register the commands)
+    from . import allan, analyze, batch, compensate, model, noise, separate  # noqa: F401  (register the commands)
     from ._app import app
 
     return app
@@ -45,14 +45,19 @@ def main():  # console-script entry point
     from .. import interrupt
 
     code = 0
-    with interrupt.SigintGuard(on_timeout=_on_timeout, grace_s=0.6):
-        try:
-            _commands()(prog_name="fogdrift")
-        except SystemExit as exc:
-            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
-        except KeyboardInterrupt:  # before a command's frame took over (imports, option parsing)
+    try:  # outside the guard too: a Ctrl-C while the guard itself starts (handler set, watchdog not yet running)
+        with interrupt.SigintGuard(on_timeout=_on_timeout, grace_s=0.6):
+            try:
+                _commands()(prog_name="fogdrift")
+            except SystemExit as exc:
+                code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+            except KeyboardInterrupt:  # before a command's frame took over (imports, option parsing)
+                os.write(2, b"interrupted: nothing was written\n")
+                code = 130
+    except KeyboardInterrupt:
+        if code != 130:
             os.write(2, b"interrupted: nothing was written\n")
-            code = 130
+        code = 130
     if interrupt.requested() and code != 130:  # Ctrl-C after the command's frame had finished
         os.write(2, b"interrupted: after the run had finished (its files were all written)\n")
         code = 130

@@ -63,6 +63,10 @@ def analyze(
                                        "verdicts (--no-heading skips it).")] = True,
     pdf: Annotated[bool, typer.Option("--pdf", help="Also write report.pdf (the same HTML printed by headless "
                                                     "Chromium).")] = False,
+    noise_method: Annotated[str, typer.Option(
+        "--noise-method", help="Noise model of the original output: allan (the Allan fit) or gmwm (also the GMWM "
+                               "model selection on the wavelet variance; the report shows its table first).")]
+    = "allan",
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
 ):
@@ -89,7 +93,8 @@ def analyze(
                              model_rate_hz=model_rate or None, taus=parse_taus(taus), estimator=estimator,
                              terms=term_list, statistic=statistic, outliers=outliers, latitude_deg=latitude,
                              earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), train_fraction=train_fraction,
-                             val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window).validate()
+                             val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window,
+                             noise_method=noise_method).validate()
         if apply_to is not None and not apply_to.is_file():
             raise ConfigError(f"--apply-to {apply_to}: no such file")
         record = load.load()
@@ -122,6 +127,10 @@ def analyze(
                                             metrics_rows(ax.models)))
                 for line in verdict(ax.models):
                     say("  " + line)
+                if ax.gmwm is not None:
+                    from .noise import print_gmwm
+
+                    print_gmwm(f"{title} (whole record, native rate)", [ax.gmwm])
         if heading:  # compensation evidence on the test block, stored in the result (fogdrift.evaluation)
             from ..evaluation import evaluate_analysis
             from .compensate import print_evaluation

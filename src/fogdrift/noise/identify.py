@@ -134,15 +134,22 @@ class _Context:
         """
         x2 = self.x2(A)
         a_allan = [TERM_TABLE[t].avar_coefficient * x2.get(t, 0.0) for t in _NAMES]
+        mu = self.X @ A
         if not exact_ramp and a_allan[4] > 0:
-            a_allan[3] += 1.5 * a_allan[4] * float(self.tau[-1])
+            extra = 1.5 * a_allan[4] * float(self.tau[-1])
+            a_allan[3] += extra
+            if "K" in self.laws:
+                # relative to the stand-in random walk's own mean: the stand-in lends the ramp its *relative*
+                # scatter; dividing its variance by the (much smaller, short-tau) ramp mean instead made every
+                # estimate look like ~0.1 EDF, so that any model -- even 10^5 x the data -- "fitted"
+                mu = mu + self.X[:, _NAMES.index("K")] * (extra / TERM_TABLE["K"].avar_coefficient
+                                                         * self.laws["K"].scale(self.dt))
         spec = ieee_spectrum(a_allan, self.dt)
         V = estimator_covariance(self.m, self.n, spec, statistic=self.statistic)
         if exact_ramp and a_allan[4] > 0 and self.statistic != "hdev":  # per-sample units: A_R dt^2
             # a strided sum (fast / non-overlapping sampling) no longer telescopes: about `stride` boundary blocks
             V = V + np.diag(self.strides * ramp_cross_variance(self.m, self.n, spec, a_allan[4] * self.dt**2))
         s = np.sqrt(self.inflation)
-        mu = self.X @ A
         C = V * np.outer(s, s) / np.outer(mu, mu)
         # floor: relative s.d. 1e-6 (a noise-free curve, or a term with no spectrum, still has rounding)
         return C + np.diag(np.full(mu.size, 1e-12))

@@ -321,6 +321,10 @@ def _axis_section(ax, result, fig_dir, pre, fig_offset, evaluated) -> str:
                   "separates the whole record for display."),
              _img(plot_separation_allan(ax.separation, fig_dir / f"{pre}fig6_allan_{name}.png")),
              _compensation_section(ax, fig_dir, pre, fig_offset, evaluated), "</section>"]
+    if getattr(ax, "gmwm", None) is not None:  # analyze --noise-method gmwm: the GMWM table first
+        from ..report_gmwm import gmwm_noise_html
+
+        parts.insert(2, gmwm_noise_html(ax.gmwm))
     return "\n".join(parts)
 
 

@@ -1,0 +1,157 @@
+"""``fogdrift noise``: noise model of every axis by GMWM (wavelet variance) or by the Allan fit.
+
+``--method gmwm`` (default): Haar wavelet variance, WIC model selection over candidate latent models (or one
+``--model``), short scales no candidate explains excluded with the reason, the IEEE-952 table (N, K, R, Q, B,
+GM T_c / sigma) with 95 % intervals, and the J statistic with its caveat.  ``--curve TABLE`` fits a published WV
+curve (the SMAC table format) instead of a log.  ``--method allan`` runs the Allan noise fit of ``fogdrift allan``.
+"""
+
+from __future__ import annotations
+
+import inspect
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ..errors import ConfigError
+from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run, say,
+                   with_load_options)
+
+DEFAULT_OUT = Path("out/noise")
+
+MethodOpt = Annotated[str, typer.Option("--method", help="gmwm (wavelet variance, model selection by WIC) or "
+                                                         "allan (the Allan-variance fit of 'fogdrift allan').")]
+ModelOpt = Annotated[str, typer.Option("--model", help="GMWM model: 'auto' (select by WIC among the default "
+                                                       "candidates) or terms such as 'WN+RW+GM', 'QN+WN+RW+2GM' "
+                                                       "(QN, WN, RW, DR, GM, FLICKER).")]
+ScalesOpt = Annotated[Optional[int], typer.Option("--scales", help="Number of wavelet scales J (2, 4, ..., 2^J "
+                                                                   "samples; default floor(log2 N) - 1).")]
+RobustOpt = Annotated[bool, typer.Option("--robust", help="Huber-robust wavelet variance (logs with outliers).")]
+CurveOpt = Annotated[Optional[Path], typer.Option("--curve", help="Fit a published Haar WV table (SMAC format: "
+                                                                  "scale_s, wvar, n_samples, sample_rate_hz, ...) "
+                                                                  "instead of a log; FILE is then not given.")]
+SensorOpt = Annotated[Optional[str], typer.Option("--sensor", help="With --curve: the table's sensor_key to fit.")]
+
+
+def _optional_file(func):
+    """Make the FILE argument optional (``--curve`` replaces it)."""
+    sig = inspect.signature(func)
+    params = [p.replace(default=None, annotation=Annotated[Optional[Path], typer.Argument(
+        help="Gyro log: CSV/TXT (optionally .gz), .npy or .npz (omit with --curve).")]) if p.name == "file" else p
+        for p in sig.parameters.values()]
+    func.__signature__ = sig.replace(parameters=params)
+    return func
+
+
+def _fmt(x, digits=4):
+    from ..report_gmwm import fmt
+
+    return fmt(x, digits)
+
+
+def print_gmwm(title, axes):
+    """Per axis: IEEE table, candidates (WIC, why rejected), excluded scales, J with its caveat."""
+    from ..gmwm.analysis import J_CAVEAT, ieee_rows
+
+    for a in axes:
+        sel = a.selection
+        console.print(fitted_table(f"{title} axis {a.name}: GMWM {sel.selected}"
+                                   f"{'' if sel.passed_checks else ' (no candidate passed every check)'}, "
+                                   "95 % intervals",
+                                   ["quantity", "value", "95 % interval", "unit", "from"],
+                                   [[r[0], _fmt(r[1]), f"[{_fmt(r[2])}, {_fmt(r[3])}]", r[4], r[5]]
+                                    for r in ieee_rows(a)]))
+        console.print(fitted_table(f"{title} axis {a.name}: candidates (smallest WIC among those passing wins)",
+                                   ["candidate", "WIC", "passed", "why rejected"],
+                                   [[c.model + (" *" if c.model == sel.selected else ""), _fmt(c.wic),
+                                     "yes" if c.passed else "no", "; ".join(c.reasons)] for c in sel.candidates]))
+        fit = sel.fit
+        say(f"  {a.name}: J = {_fmt(fit.q)}, df {fit.df}, p = {_fmt(fit.j_pvalue, 2)} ({J_CAVEAT})", style="dim")
+        for x in sel.excluded:
+            say(f"  {a.name}: scale {_fmt(x.scale_s)} s excluded: {x.reason}", style="yellow")
+        if sel.scan_note:
+            say(f"  {a.name}: {sel.scan_note}", style="yellow")
+
+
+@app.command()
+@_optional_file
+@with_load_options
+def noise(
+    load,
+    method: MethodOpt = "gmwm",
+    model: ModelOpt = "auto",
+    scales: ScalesOpt = None,
+    robust: RobustOpt = False,
+    curve: CurveOpt = None,
+    sensor: SensorOpt = None,
+    out: OutOpt = DEFAULT_OUT,
+    json_out: JsonOpt = False,
+):
+    """Noise model of every axis: GMWM model selection (wavelet variance) with the IEEE-952 table and 95 %
+    intervals, or the Allan fit; writes noise.json, wvar.csv (gmwm) and noise.png."""
+    method = method.lower()
+    expect = ("noise.json", "wvar.csv", "noise.png") if method == "gmwm" else ("noise.json", "noise.png")
+    with run("noise", out, default_out=DEFAULT_OUT, inputs=[load.file, curve], json_out=json_out,
+             expect=expect) as r:
+        from ..gmwm.analysis import analyse_gmwm, analyse_wvar, candidates_for, read_curve
+        from ..report_gmwm import write_gmwm_outputs
+
+        if method not in ("gmwm", "allan"):
+            raise ConfigError(f"{{opt:method}} must be 'gmwm' or 'allan'; got {method!r}")
+        if (curve is None) == (load.file is None):
+            raise ConfigError("give either a log FILE or {opt:curve} TABLE (one of them)")
+        if method == "allan":
+            if curve is not None or model.lower() != "auto" or scales is not None or robust:
+                raise ConfigError("--curve, --model, --scales and --robust belong to --method gmwm; the Allan "
+                                  "fit selects its terms itself (use 'fogdrift allan --terms' to fix them)")
+            return _allan(load, r)
+        candidates_for(model)  # refuse a bad --model before reading anything
+        if scales is not None and scales < 1:
+            raise ConfigError(f"{{opt:scales}} must be >= 1; got {scales}")
+        if curve is not None:
+            wvs = read_curve(curve, sensor=sensor, unit=load.unit,
+                             axes=None if load.columns is None else [c.strip() for c in load.columns.split(",")])
+            if scales is not None:
+                wvs = [wv.select(wv.level <= scales) for wv in wvs]
+            say(f"{curve.name}: published WV curve{'' if sensor is None else ' of ' + sensor}, axes "
+                f"{', '.join(w.axis_names[0] for w in wvs)}, {wvs[0].n_samples} samples at dt {wvs[0].dt_s:g} s")
+            with progress("noise"):
+                axes = [analyse_wvar(w.axis_names[0], w, model=model) for w in wvs]
+            source, meta = str(curve), None
+        else:
+            if sensor is not None:
+                raise ConfigError("--sensor belongs to --curve")
+            record = load.load()
+            echo_record(load, record)
+            check_plausible(record)
+            with progress("noise", record.axis_names):
+                axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=model, levels=scales, robust=robust)
+                        for name in record.axis_names]
+            source, meta = str(record.source), record.metadata()
+        print_gmwm((curve or load.file).name, axes)
+        files = write_gmwm_outputs(axes, r.out.path, source=source, record=meta)
+        r.wrote()
+        r.print_json(files["json"])
+
+
+def _allan(load, r):
+    """--method allan: the Allan noise fit of every axis (as 'fogdrift allan'), written as noise.json/noise.png."""
+    from ..pipeline import AnalysisConfig, run_allan
+    from ..report import noise_row, plot_allan, write_json
+    from ._tables import noise_table, print_noise_notes
+
+    record = load.load()
+    echo_record(load, record)
+    check_plausible(record)
+    with progress("noise", record.axis_names) as (allan_cb, _):
+        results = run_allan(record, AnalysisConfig().validate(), progress=allan_cb)
+    console.print(noise_table(f"{load.file.name}: Allan fit, 95 % intervals in brackets",
+                              [[a.name] + noise_row(a.noise) for a in results]))
+    for a in results:
+        print_noise_notes(a.name, a.noise, a.outliers, record.dt_s)
+    path = write_json({"fogdrift_result": "noise", "method": "allan", "source": str(record.source),
+                       "record": record.metadata(), "axes": [a.to_dict() for a in results]}, r.out.path / "noise.json")
+    plot_allan(results, r.out.path / "noise.png")
+    r.wrote()
+    r.print_json(path)

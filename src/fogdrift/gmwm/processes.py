@@ -1,0 +1,542 @@
+"""Latent error processes of a gyro and the composite models built from them (a registry).
+
+Each process is defined per sample (interval ``dt_s``) with its rate in deg/h, so its
+variances are in (deg/h)^2 ([GMWM]_ §2).  ``tau`` is the Haar scale in samples (filter
+width, ``tau = 2^j`` for the WV) and ``m = tau / 2`` the matching Allan averaging factor:
+
+========  ==============================================  ===================================
+process   per-sample definition (parameters)              Haar WV  nu2(tau)
+========  ==============================================  ===================================
+QN        x_t = q (U_t - U_{t-1}) sqrt(12), U ~ U(0,1)     6 q2 / tau^2
+          (``q2`` = Q^2 in (deg/h)^2)
+WN        x_t = e_t, Var e = ``sigma2``                     sigma2 / tau
+RW        x_t = x_{t-1} + e_t, Var e = ``gamma2``           gamma2 (tau^2 + 2) / (12 tau)
+DR        x_t = omega t (``omega`` deg/h per sample)       omega^2 tau^2 / 16
+FLICKER   two-sided SDF b2 / (2 pi |f|), |f| <= 1/2        b2 c(m), c -> ln2 / pi (flat)
+GM        x_t = phi x_{t-1} + e_t, phi = exp(-beta),      stable closed form, see
+          Var e = ``sigma2`` (AR(1), Gauss-Markov)         :func:`ar1_wv`
+========  ==============================================  ===================================
+
+Components are independent, so WVs (and SDFs) add.  The free (optimisation) parameters
+are the logarithms of the natural ones (``log sigma2``, ``log beta`` ...), so every value
+stays positive and ``1 - phi`` is never formed.  FLICKER gives bias instability its own
+flat WV ``0.2206 B^2`` (``b2 = B^2``); alternatively B is represented by one to three GMs
+([GMWM]_ §4), which is what a Kalman filter needs.
+
+IEEE-952 mapping per process ([GMWM]_ §4): N = sqrt(sigma2 dt) (deg/h sqrt(s), /60 ->
+deg/sqrt(h)); Q = sqrt(q2) dt (arcsec); K = sqrt(gamma2 / dt) (x60 -> deg/h/sqrt(h));
+R = omega / dt (x3600 -> deg/h^2); GM: T_c = dt / beta (s), sigma_GM = sqrt(sigma2 / (1 - phi^2))
+(deg/h); FLICKER: B = sqrt(b2) (deg/h).
+
+References
+----------
+.. [GMWM] fogdrift GMWM method notes, ``shared/docs/gmwm-notes.md`` §2 (table, SDFs, the
+   AR(1) numerical trap) and §4 (IEEE mapping).
+.. [PW2000] D. B. Percival, A. T. Walden, *Wavelet Methods for Time Series Analysis* (2000),
+   §8.2 (WV as the integral of the squared Haar gain times the SDF).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import re
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..errors import ConfigError
+
+__all__ = [
+    "Process",
+    "PROCESSES",
+    "ALIASES",
+    "LatentModel",
+    "parse_model",
+    "ar1_wv",
+    "flicker_wv_factor",
+    "haar_gain2",
+    "B_FLAT_WV",
+]
+
+#: Flat Haar WV of flicker noise in units of B^2: ln2 / pi = (2 ln2 / pi) B^2 / 2.
+B_FLAT_WV = math.log(2.0) / math.pi
+
+_SQRT_H = 60.0  # sqrt(3600 s / h)
+
+
+# ----------------------------------------------------------------------------------------
+# Squared gain of the Haar filter
+# ----------------------------------------------------------------------------------------
+def haar_gain2(f, m):
+    """Squared gain ``|H(f)|^2 = sin^4(pi f m) / (m^2 sin^2(pi f))`` of the Haar filter of width 2m.
+
+    ``f`` in cycles per sample, ``m`` the half-width (Allan averaging factor).  The Allan
+    filter's squared gain is twice this.  At ``f = 0`` the value is 0.
+
+    Examples
+    --------
+    >>> round(float(haar_gain2(0.25, 1)), 12)   # sin^2(pi/4)
+    0.5
+    """
+    f = np.asarray(f, dtype=np.float64)
+    s = np.sin(np.pi * f)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = np.sin(np.pi * f * m) ** 4 / (m * m * s * s)
+    return np.where(s == 0.0, 0.0, g)
+
+
+# ----------------------------------------------------------------------------------------
+# AR(1) in beta (stable form)
+# ----------------------------------------------------------------------------------------
+def ar1_wv(beta, sigma2, tau):
+    """Haar WV of an AR(1) with ``phi = exp(-beta)`` and innovation variance ``sigma2``.
+
+    Parameters
+    ----------
+    beta : float or ndarray
+        ``-ln phi`` (> 0), per sample.
+    sigma2 : float or ndarray
+        Innovation variance (rate^2).
+    tau : array_like
+        Haar scales in samples (even integers >= 2).
+
+    Returns
+    -------
+    ndarray
+        ``nu2(tau)`` in rate^2, broadcast over the inputs.
+
+    Notes
+    -----
+    The textbook form ``sigma2 [m(1-phi^2) - 3phi + 4phi^(m+1) - phi^(2m+1)] /
+    [2 m^2 (1-phi)^2 (1-phi^2)]`` loses all digits when ``1 - phi`` is small ([GMWM]_ §2,
+    "numerical trap").  With ``u = -expm1(-beta) = 1 - phi`` and ``v = -expm1(-m beta)``::
+
+        nu2 / sigma2 = [m u (2-u) - (1-u) v (2+v)] / [2 m^2 u^3 (2-u)]
+
+    and for ``m beta < 1e-3`` the series ``(2m^2+1)/(12m) - beta (3m^3-4m^2-2)/(24m)
+    + beta^2 (m-1)(7m^3-8m^2-3m-3)/(120m)``.  Relative error below 1e-9 over
+    ``beta = 1e-7..50`` and ``tau = 2..2^24`` (tested against 50-digit decimal arithmetic).
+
+    Examples
+    --------
+    >>> [round(float(v), 10) for v in ar1_wv(-math.log(0.9), 1.0, [2, 8, 64, 1024])]
+    [0.2631578947, 0.5680840625, 0.9001211711, 0.0949458072]
+    """
+    m = np.asarray(tau, dtype=np.float64) / 2.0
+    if np.ndim(beta) == 0 and np.ndim(sigma2) == 0:  # fast path: one process, many scales
+        b = float(beta)
+        u = -math.expm1(-b)
+        mb = m * b
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            v = -np.expm1(-mb)
+            out = (m * u * (2.0 - u) - (1.0 - u) * v * (2.0 + v)) / (2.0 * m * m * u**3 * (2.0 - u))
+        small = mb < 1e-3
+        if np.any(small):
+            ms = m[small] if np.ndim(m) else m
+            ser = _ar1_series(ms, b)
+            if np.ndim(out):
+                out[small] = ser
+            else:
+                out = ser
+        return float(sigma2) * out
+    beta = np.asarray(beta, dtype=np.float64)
+    sigma2 = np.asarray(sigma2, dtype=np.float64)
+    beta, sigma2, m = np.broadcast_arrays(beta, sigma2, m)
+    mb = m * beta
+    u = -np.expm1(-beta)
+    v = -np.expm1(-mb)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        closed = (m * u * (2.0 - u) - (1.0 - u) * v * (2.0 + v)) / (2.0 * m * m * u**3 * (2.0 - u))
+    return sigma2 * np.where(mb < 1e-3, _ar1_series(m, beta), closed)
+
+
+def _ar1_series(m, beta):
+    """Small-(m beta) expansion of the AR(1) WV per unit innovation variance ([GMWM]_ §2)."""
+    return ((2.0 * m * m + 1.0) / (12.0 * m)
+            - beta * (3.0 * m**3 - 4.0 * m * m - 2.0) / (24.0 * m)
+            + beta * beta * (m - 1.0) * (7.0 * m**3 - 8.0 * m * m - 3.0 * m - 3.0) / (120.0 * m))
+
+
+# ----------------------------------------------------------------------------------------
+# Flicker (1/f) WV factor
+# ----------------------------------------------------------------------------------------
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
+_K_EXACT = 64  # periods integrated exactly before the averaged tail
+
+
+def _gl_panels(a: float, b: float, n: int):
+    """Nodes and weights of n equal Gauss-Legendre(16) panels on [a, b]."""
+    edges = np.linspace(a, b, n + 1)
+    h = np.diff(edges)[:, None] / 2.0
+    c = (edges[:-1] + edges[1:])[:, None] / 2.0
+    return (c + h * _GL_X).ravel(), (h * _GL_W).ravel()
+
+
+def _g_minus_third_over_v(v):
+    """(1/sin^2(pi v) - 1/(pi v)^2 - 1/3) / v, stable near 0 (series below 0.05)."""
+    x = np.pi * v
+    with np.errstate(divide="ignore", invalid="ignore"):
+        direct = (1.0 / np.sin(x) ** 2 - 1.0 / (x * x) - 1.0 / 3.0) / v
+    series = np.pi * x * (1.0 / 15.0 + x * x * (2.0 / 189.0 + x * x / 675.0))
+    return np.where(v < 0.05, series, direct)
+
+
+@functools.lru_cache(maxsize=4096)
+def _flicker_c(m: int) -> float:
+    """c(m) = (1/pi) int_0^{1/2} sin^4(pi f m) / (m^2 sin^2(pi f) f) df (see flicker_wv_factor)."""
+    def env(u):  # E(u) = 1 / (m^2 sin^2(pi u / m) u)
+        return 1.0 / (m * m * np.sin(np.pi * u / m) ** 2 * u)
+
+    if m <= 2 * _K_EXACT:
+        half = m / 2.0
+        n_full = int(math.floor(half))
+        x, w = _gl_panels(0.0, float(n_full), max(n_full, 1)) if n_full else (np.empty(0), np.empty(0))
+        if half > n_full:
+            x2, w2 = _gl_panels(float(n_full), half, 1)
+            x, w = np.concatenate([x, x2]), np.concatenate([w, w2])
+        return float(np.dot(w, np.sin(np.pi * x) ** 4 * env(x))) / math.pi
+    K = _K_EXACT
+    x, w = _gl_panels(0.0, float(K), K)
+    exact = float(np.dot(w, np.sin(np.pi * x) ** 4 * env(x)))
+    a = K / m
+    xv, wv = _gl_panels(a, 0.5, 4)
+    smooth = float(np.dot(wv, _g_minus_third_over_v(xv)))
+    tail = (0.375 / (m * m)) * ((m * m / (K * K) - 4.0) / (2.0 * math.pi**2)
+                                 + math.log(m / (2.0 * K)) / 3.0 + smooth)
+    return (exact + tail) / math.pi
+
+
+def flicker_wv_factor(tau):
+    """Haar WV of flicker noise per unit ``B^2``: ``nu2(tau) = B^2 c(tau/2)``.
+
+    Flicker (bias-instability) noise is taken as the discrete-time process with two-sided
+    SDF ``B^2 / (2 pi |f|)`` on ``|f| <= 1/2`` (cycles/sample), i.e. one-sided PSD
+    ``B^2 / (pi f_hz)`` in (deg/h)^2/Hz whatever the sample rate, which is how
+    :func:`fogdrift.simulate.simulate` generates it.  Then ([PW2000]_ eq. 296)::
+
+        nu2(tau) = int |H(f)|^2 S(f) df = (B^2 / pi) int_0^{1/2} sin^4(pi f m) / (m^2 sin^2(pi f) f) df
+
+    which converges without a low-frequency cutoff (the Haar filter removes the mean) and
+    tends to the flat ``(ln 2 / pi) B^2 = 0.2206 B^2`` for large ``m``.  The integral is
+    evaluated by Gauss-Legendre quadrature over whole periods of ``sin^4`` (all of them
+    for ``m <= 128``; the first 64 periods plus the period-averaged tail, integrated in
+    closed form up to a smooth remainder, beyond; error < 1e-9).
+
+    Examples
+    --------
+    >>> [round(float(c), 5) for c in flicker_wv_factor([2, 4, 2**20])]
+    [0.26233, 0.2402, 0.22064]
+    """
+    t = np.asarray(tau, dtype=np.float64)
+    m = t / 2.0
+    if np.any(m < 1) or np.any(m != np.round(m)):
+        raise ConfigError("flicker WV needs even integer scales tau >= 2")
+    flat = np.ravel(m)
+    out = np.array([_flicker_c(int(v)) for v in flat])
+    return out.reshape(t.shape)
+
+
+# ----------------------------------------------------------------------------------------
+# Registry
+# ----------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Process:
+    """One latent process: parameters, theoretical WV, SDF and IEEE mapping.
+
+    Attributes
+    ----------
+    name : str
+        Registry key (``"WN"``, ``"QN"``, ``"RW"``, ``"DR"``, ``"FLICKER"``, ``"GM"``).
+    long_name : str
+    params : tuple of str
+        Natural parameters, all > 0 (free parameters are their logarithms).
+    param_units : tuple of str
+        Units of ``params`` (``rate`` is deg/h, per sample).
+    wv : callable
+        ``wv(theta, tau) -> nu2`` with ``theta`` of shape ``(len(params),)``.
+    sdf : callable or None
+        ``sdf(theta, f) -> S(f)`` two-sided in rate^2 per cycle/sample, ``|f| <= 1/2``;
+        None for a deterministic process (drift).
+    ieee : callable
+        ``ieee(theta, dt_s) -> {quantity: value}`` (keys carry units).
+    excess_kurtosis : float
+        Excess kurtosis of the iid innovations (0: Gaussian; QN: -1.2, uniform rounding);
+        enters the fourth-cumulant term of the WV covariance.
+    """
+
+    name: str
+    long_name: str
+    params: tuple
+    param_units: tuple
+    wv: Callable
+    sdf: Callable | None
+    ieee: Callable
+    excess_kurtosis: float = 0.0
+
+
+def _gm_ieee(th, dt):
+    beta, s2 = th
+    u = -math.expm1(-beta)
+    return {"tc_s": dt / beta, "sigma_gm_dph": math.sqrt(s2 / (u * (2.0 - u)))}
+
+
+def _gm_sdf(th, f):
+    beta, s2 = th
+    u = -math.expm1(-beta)
+    return s2 / (u * u + 4.0 * (1.0 - u) * np.sin(np.pi * f) ** 2)
+
+
+PROCESSES: dict[str, Process] = {
+    "QN": Process(
+        "QN", "quantization noise", ("q2",), ("rate^2",),
+        wv=lambda th, tau: 6.0 * th[0] / np.asarray(tau, dtype=np.float64) ** 2,
+        sdf=lambda th, f: 4.0 * th[0] * np.sin(np.pi * f) ** 2,
+        ieee=lambda th, dt: {"Q_arcsec": math.sqrt(th[0]) * dt,
+                             "Q_urad": math.sqrt(th[0]) * dt * 1e6 * math.pi / 648000.0},
+        excess_kurtosis=-1.2,
+    ),
+    "WN": Process(
+        "WN", "white noise (angle random walk)", ("sigma2",), ("rate^2",),
+        wv=lambda th, tau: th[0] / np.asarray(tau, dtype=np.float64),
+        sdf=lambda th, f: np.full(np.shape(f), th[0]),
+        ieee=lambda th, dt: {"N_dprh": math.sqrt(th[0] * dt) / _SQRT_H},
+    ),
+    "RW": Process(
+        "RW", "random walk (rate random walk)", ("gamma2",), ("rate^2",),
+        wv=lambda th, tau: th[0] * (np.asarray(tau, dtype=np.float64) ** 2 + 2.0)
+        / (12.0 * np.asarray(tau, dtype=np.float64)),
+        sdf=lambda th, f: th[0] / (4.0 * np.sin(np.pi * f) ** 2),
+        ieee=lambda th, dt: {"K_dphrh": math.sqrt(th[0] / dt) * _SQRT_H},
+    ),
+    "DR": Process(
+        "DR", "drift (rate ramp)", ("omega",), ("rate per sample",),
+        wv=lambda th, tau: th[0] ** 2 * np.asarray(tau, dtype=np.float64) ** 2 / 16.0,
+        sdf=None,
+        ieee=lambda th, dt: {"R_dph2": th[0] / dt * 3600.0},
+    ),
+    "FLICKER": Process(
+        "FLICKER", "flicker noise (bias instability)", ("b2",), ("rate^2",),
+        wv=lambda th, tau: th[0] * flicker_wv_factor(tau),
+        sdf=lambda th, f: th[0] / (2.0 * np.pi * np.abs(f)),
+        ieee=lambda th, dt: {"B_dph": math.sqrt(th[0])},
+    ),
+    "GM": Process(
+        "GM", "Gauss-Markov / AR(1)", ("beta", "sigma2"), ("1/sample", "rate^2"),
+        wv=lambda th, tau: ar1_wv(th[0], th[1], tau),
+        sdf=_gm_sdf,
+        ieee=_gm_ieee,
+    ),
+}
+
+#: Accepted spellings in model strings (upper-cased) -> registry key.
+ALIASES = {"GM": "GM", "AR1": "GM", "AR(1)": "GM", "GAUSSMARKOV": "GM", "WN": "WN", "ARW": "WN",
+           "QN": "QN", "RW": "RW", "RRW": "RW", "DR": "DR", "RAMP": "DR", "FLICKER": "FLICKER",
+           "BI": "FLICKER"}
+_ORDER = ("QN", "WN", "RW", "DR", "FLICKER", "GM")
+_MAX_GM = 6
+
+
+# ----------------------------------------------------------------------------------------
+# Composite model
+# ----------------------------------------------------------------------------------------
+class LatentModel:
+    """A sum of independent latent processes, e.g. ``"QN+WN+RW+2GM"``.
+
+    Parameters are stacked per component in the canonical order QN, WN, RW, DR, FLICKER,
+    GM1, GM2, ... (GMs numbered by decreasing ``beta``, i.e. increasing correlation time).
+
+    Attributes
+    ----------
+    components : tuple of str
+        Registry keys, one per component (``"GM"`` repeated).
+    name : str
+        Canonical model string.
+    param_names : tuple of str
+        ``"WN.sigma2"``, ``"GM1.beta"`` ...
+    n_params : int
+
+    Examples
+    --------
+    >>> m = parse_model("wn+2gm+RW")
+    >>> m.name, m.param_names
+    ('WN+RW+2GM', ('WN.sigma2', 'RW.gamma2', 'GM1.beta', 'GM1.sigma2', 'GM2.beta', 'GM2.sigma2'))
+    >>> [round(float(v), 6) for v in parse_model("WN+RW").wv([1.0, 0.01], [2, 8])]
+    [0.5025, 0.131875]
+    """
+
+    def __init__(self, components):
+        comps = tuple(components)
+        self.components = comps
+        n_gm = comps.count("GM")
+        self.n_gm = n_gm
+        parts = []
+        for key in _ORDER:
+            k = comps.count(key)
+            if k:
+                parts.append(key if k == 1 else f"{k}{key}")
+        self.name = "+".join(parts)
+        names, slices, labels = [], [], []
+        i = gm = 0
+        for key in comps:
+            proc = PROCESSES[key]
+            if key == "GM":
+                gm += 1
+                label = f"GM{gm}"
+            else:
+                label = key
+            labels.append(label)
+            names.extend(f"{label}.{p}" for p in proc.params)
+            slices.append(slice(i, i + len(proc.params)))
+            i += len(proc.params)
+        self.labels = tuple(labels)
+        self.param_names = tuple(names)
+        self.slices = tuple(slices)
+        self.n_params = i
+
+    def __repr__(self) -> str:
+        return f"LatentModel({self.name!r})"
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, LatentModel) and other.components == self.components
+
+    def __hash__(self) -> int:
+        return hash(self.components)
+
+    def has(self, key: str) -> bool:
+        """True if the model contains the process ``key``."""
+        return key in self.components
+
+    def _theta(self, theta) -> np.ndarray:
+        th = np.asarray(theta, dtype=np.float64)
+        if th.shape != (self.n_params,):
+            raise ConfigError(f"{self.name} has {self.n_params} parameters {self.param_names}; got shape {th.shape}")
+        return th
+
+    def wv_components(self, theta, tau) -> np.ndarray:
+        """WV of each component, shape ``(n_components, n_tau)`` in rate^2."""
+        th = self._theta(theta)
+        t = np.asarray(tau, dtype=np.float64)
+        return np.array([PROCESSES[k].wv(th[s], t) for k, s in zip(self.components, self.slices)])
+
+    def wv(self, theta, tau) -> np.ndarray:
+        """Theoretical Haar WV ``sum_k nu2_k(tau; theta_k)`` in rate^2 at scales ``tau`` (samples)."""
+        return self.wv_components(theta, tau).sum(axis=0)
+
+    def wv_jacobian(self, theta, tau) -> np.ndarray:
+        """``d nu2(tau) / d log theta``, shape ``(n_tau, n_params)``.
+
+        Every WV is linear in its variance parameter, so that column is the component's WV
+        (twice it for the drift, quadratic in ``omega``); the GM ``beta`` column is a central
+        difference in ``log beta`` with step 1e-3 (truncation error about 1e-7; where
+        ``m beta`` is small the WV hardly depends on ``beta`` and the column's relative
+        error can reach about 1e-4, which only affects the optimiser's path and the SEs at that
+        level).
+        """
+        th = self._theta(theta)
+        t = np.asarray(tau, dtype=np.float64)
+        cols = []
+        for key, sl in zip(self.components, self.slices):
+            p = th[sl]
+            if key == "GM":
+                h = 1e-3
+                d_beta = (ar1_wv(p[0] * math.exp(h), p[1], t) - ar1_wv(p[0] * math.exp(-h), p[1], t)) / (2.0 * h)
+                cols.extend([d_beta, ar1_wv(p[0], p[1], t)])
+            elif key == "DR":
+                cols.append(2.0 * PROCESSES[key].wv(p, t))
+            else:
+                cols.append(PROCESSES[key].wv(p, t))
+        return np.column_stack(cols)
+
+    def avar(self, theta, m) -> np.ndarray:
+        """Theoretical Allan variance at averaging factors ``m`` (integers >= 1): ``2 nu2(2m)``."""
+        return 2.0 * self.wv(theta, 2.0 * np.asarray(m, dtype=np.float64))
+
+    def sdf(self, theta) -> Callable:
+        """Two-sided SDF ``f -> S(f)`` (rate^2 per cycle/sample) of the stochastic part (DR omitted)."""
+        th = self._theta(theta).copy()
+        parts = [(PROCESSES[k].sdf, th[s]) for k, s in zip(self.components, self.slices)
+                 if PROCESSES[k].sdf is not None]
+
+        def s(f):
+            f = np.asarray(f, dtype=np.float64)
+            out = np.zeros(f.shape)
+            for fn, p in parts:
+                out = out + fn(p, f)
+            return out
+
+        return s
+
+    def to_free(self, theta) -> np.ndarray:
+        """Free parameters ``z = log(theta)`` (every natural parameter is > 0)."""
+        th = self._theta(theta)
+        if np.any(th <= 0):
+            raise ConfigError(f"all parameters of {self.name} must be > 0, got {th.tolist()}")
+        return np.log(th)
+
+    def from_free(self, z) -> np.ndarray:
+        """Natural parameters ``exp(z)``."""
+        return np.exp(np.asarray(z, dtype=np.float64))
+
+    def sort_gm(self, theta, cov=None):
+        """Reorder the GMs by decreasing ``beta`` (increasing T_c); also permute ``cov`` if given."""
+        th = np.asarray(theta, dtype=np.float64)
+        gm_slices = [s for k, s in zip(self.components, self.slices) if k == "GM"]
+        if len(gm_slices) < 2:
+            return (th, cov) if cov is not None else th
+        order = sorted(range(len(gm_slices)), key=lambda i: -th[gm_slices[i].start])
+        perm = np.arange(th.size)
+        for dst, src in zip(gm_slices, (gm_slices[i] for i in order)):
+            perm[dst] = np.arange(src.start, src.stop)
+        th2 = th[perm]
+        if cov is None:
+            return th2
+        return th2, np.asarray(cov)[np.ix_(perm, perm)]
+
+    def ieee(self, theta, dt_s) -> list[dict]:
+        """IEEE-952 quantities per component: ``[{"component": label, key: value, ...}, ...]``."""
+        th = self._theta(theta)
+        return [dict(component=lab, **PROCESSES[k].ieee(th[s], dt_s))
+                for k, lab, s in zip(self.components, self.labels, self.slices)]
+
+
+_TERM = re.compile(r"^\s*(\d*)\s*([A-Za-z][A-Za-z0-9()\-]*)\s*$")
+
+
+def parse_model(model) -> LatentModel:
+    """Parse a model string such as ``"WN+RW"``, ``"QN+WN+RW+2GM"``, ``"WN+AR1"``.
+
+    Terms are separated by ``+``; an integer prefix repeats a GM (``2GM``).  Names are
+    case-insensitive, with aliases (:data:`ALIASES`): GM = AR1, WN = ARW, RW = RRW,
+    DR = RAMP, FLICKER = BI.  A :class:`LatentModel` is returned unchanged.
+
+    Raises
+    ------
+    ConfigError
+        Unknown name, repeated non-GM component, more than 6 GMs or an empty string.
+    """
+    if isinstance(model, LatentModel):
+        return model
+    if not isinstance(model, str) or not model.strip():
+        raise ConfigError(f"model must be a string such as 'WN+RW+GM', got {model!r}")
+    comps: list[str] = []
+    for term in model.split("+"):
+        mt = _TERM.match(term)
+        key = ALIASES.get(mt.group(2).upper().replace("-", "")) if mt else None
+        if key is None:
+            raise ConfigError(
+                f"unknown component {term.strip()!r} in model {model!r}; expected terms from "
+                f"{sorted(set(ALIASES.values()))} (e.g. 'QN+WN+RW+2GM'); check {{opt:model}}"
+            )
+        count = int(mt.group(1)) if mt.group(1) else 1
+        if count < 1:
+            raise ConfigError(f"component count must be >= 1 in {term.strip()!r}")
+        comps.extend([key] * count)
+    for key in _ORDER:
+        if key != "GM" and comps.count(key) > 1:
+            raise ConfigError(f"model {model!r} repeats {key}; only GM may appear more than once")
+    if comps.count("GM") > _MAX_GM:
+        raise ConfigError(f"at most {_MAX_GM} GMs per model, got {comps.count('GM')} in {model!r}")
+    comps.sort(key=_ORDER.index)
+    return LatentModel(comps)

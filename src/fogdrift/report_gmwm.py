@@ -1,0 +1,113 @@
+"""Files and report table of a GMWM noise analysis (:class:`fogdrift.gmwm.analysis.GmwmAxis`).
+
+* :func:`write_gmwm_outputs` - ``noise.json``, ``wvar.csv``, ``noise.png`` (every file through
+  :func:`fogdrift.output.atomic_path`, so inside a run's :class:`~fogdrift.output.OutputDir`).
+* :func:`gmwm_noise_html` - the HTML noise table of the analysis report (``analyze --noise-method gmwm``).
+
+It uses only public names of :mod:`fogdrift.report` (``write_json``).
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .gmwm.analysis import J_CAVEAT, GmwmAxis, ieee_rows
+from .output import atomic_path
+from .report import write_json
+
+__all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
+
+
+def fmt(x, digits=4) -> str:
+    """A number with ``digits`` significant digits ('–' for None/NaN)."""
+    if x is None or not math.isfinite(float(x)):
+        return "–"
+    return f"{float(x):.{digits}g}"
+
+
+def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
+    """Per axis: the WV with its 95 % interval (excluded scales hollow), the fitted model and each component."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    n = len(axes)
+    fig, axs = plt.subplots(1, n, figsize=(5.6 * n, 4.6), squeeze=False)
+    for ax, a in zip(axs[0], axes):
+        wv, sel = a.wvar, a.selection
+        used = np.isin(wv.level, sel.levels_used)
+        yerr = np.vstack([wv.nu2_dph2 - wv.ci_lo95_dph2, wv.ci_hi95_dph2 - wv.nu2_dph2])
+        ax.errorbar(wv.scale_s, wv.nu2_dph2, yerr=yerr, fmt="none", ecolor="0.4", lw=0.8, label="WV (95 % CI)")
+        ax.plot(wv.scale_s[used], wv.nu2_dph2[used], "o", ms=4, color="k", label="used")
+        if np.any(~used):
+            ax.plot(wv.scale_s[~used], wv.nu2_dph2[~used], "o", ms=4, mfc="white", color="k", label="excluded")
+        tau, scale = wv.tau_samples[used], wv.scale_s[used]  # the model over the scales it was fitted to
+        fit = sel.fit
+        ax.loglog(scale, fit.latent_model.wv(fit.theta, tau), "r-", lw=1.6, label=f"GMWM {sel.selected}")
+        for label, comp in zip(fit.latent_model.labels, fit.component_wv(tau)):
+            ok = comp > np.nanmin(wv.nu2_dph2) * 1e-3
+            ax.loglog(scale[ok], comp[ok], "--", lw=0.9, label=label)
+        ax.set_ylim(np.nanmin(wv.ci_lo95_dph2[wv.ci_lo95_dph2 > 0]) / 5, np.nanmax(wv.ci_hi95_dph2) * 3)
+        ax.set_xlabel("scale [s]")
+        ax.set_ylabel("wavelet variance [(deg/h)²]")
+        ax.set_title(f"{a.name}: {sel.selected}{'' if sel.passed_checks else ' (no candidate passed the checks)'}\n"
+                     f"J = {fit.q:.3g}, df {fit.df}, p = {fit.j_pvalue:.2g}", fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    path = Path(path)
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110, bbox_inches="tight")
+    finally:
+        plt.close(fig)
+    return path
+
+
+def write_gmwm_outputs(axes: list[GmwmAxis], out_dir, *, source: str, record: dict | None = None) -> dict:
+    """``noise.json`` (every axis: selection, candidates, IEEE table, J with its caveat), ``wvar.csv`` and
+    ``noise.png`` in ``out_dir``; returns ``{"json", "csv", "png"}`` paths."""
+    out = Path(out_dir)
+    doc = {"fogdrift_result": "noise", "method": "gmwm", "source": str(source), "record": record,
+           "units": {"rate": "deg/h", "wvar": "(deg/h)^2", "scale": "s"},
+           "axes": [a.to_dict() for a in axes]}
+    paths = {"json": out / "noise.json", "csv": out / "wvar.csv", "png": out / "noise.png"}
+    write_json(doc, paths["json"])
+    with atomic_path(paths["csv"]) as tmp, open(tmp, "w", encoding="utf-8") as fh:
+        fh.write("axis,level,scale_s,wvar_dph2,ci_lo95_dph2,ci_hi95_dph2,used,model_wvar_dph2\n")
+        for a in axes:
+            wv, fit = a.wvar, a.selection.fit
+            model = fit.latent_model.wv(fit.theta, wv.tau_samples)
+            used = np.isin(wv.level, a.selection.levels_used)
+            for i in range(len(wv)):
+                fh.write(f"{a.name},{int(wv.level[i])},{float(wv.scale_s[i])!r},{float(wv.nu2_dph2[i])!r},"
+                         f"{float(wv.ci_lo95_dph2[i])!r},{float(wv.ci_hi95_dph2[i])!r},{int(used[i])},"
+                         f"{float(model[i])!r}\n")
+    plot_gmwm(axes, paths["png"])
+    return paths
+
+
+def gmwm_noise_html(axis: GmwmAxis) -> str:
+    """HTML of the GMWM noise table of one axis (selected model, IEEE quantities with 95 % intervals, candidates,
+    excluded scales, the J statistic and its caveat)."""
+    sel = axis.selection
+    e = html.escape
+    head = "".join(f"<th>{h}</th>" for h in ("quantity", "value", "95 % interval", "unit", "from"))
+    body = "".join(f"<tr><td>{e(str(r[0]))}</td><td>{fmt(r[1])}</td><td>[{fmt(r[2])}, {fmt(r[3])}]</td>"
+                   f"<td>{e(str(r[4]))}</td><td>{e(str(r[5]))}</td></tr>" for r in ieee_rows(axis))
+    cands = "".join(f"<tr><td>{e(c.model)}</td><td>{fmt(c.wic)}</td><td>{'yes' if c.passed else 'no'}</td>"
+                    f"<td>{e('; '.join(c.reasons))}</td></tr>" for c in sel.candidates)
+    excl = "".join(f"<li>scale {fmt(x.scale_s)} s: {e(x.reason)}</li>" for x in sel.excluded)
+    fit = sel.fit
+    return (f"<h4>Noise model by GMWM (wavelet variance): {e(sel.selected)}"
+            f"{'' if sel.passed_checks else ' (no candidate passed every check)'}</h4>"
+            f"<table class='gmwm'><tr>{head}</tr>{body}</table>"
+            f"<p class='note'>J = {fmt(fit.q)} with {fit.df} degrees of freedom, p = {fmt(fit.j_pvalue, 2)}: "
+            f"{e(J_CAVEAT)}.</p>"
+            + (f"<ul class='note'>{excl}</ul>" if excl else "")
+            + "<table class='gmwm-candidates'><tr><th>candidate</th><th>WIC</th><th>passed</th><th>why rejected</th>"
+              f"</tr>{cands}</table>")

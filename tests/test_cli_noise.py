@@ -1,0 +1,135 @@
+"""``fogdrift noise`` (GMWM / Allan) and ``analyze --noise-method gmwm`` end to end.
+
+Independent references: the WV the command writes is half the overlapping Allan variance at tau = scale (Haar
+MODWT identity, checked against allantools); the published SMAC KVH DSP-1750 table reproduced exactly after the
+deg/s -> deg/h conversion, and its white-noise coefficient N = 0.003094 deg/sqrt(h) (GMWM notes §8).
+"""
+
+from __future__ import annotations
+
+import csv
+import gzip
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from fogdrift.cli import app
+
+runner = CliRunner()
+SMAC = Path("/work/shared/data/smac_fog_reference_curves/smac_wvar_gyro_reference.csv.gz")
+needs_smac = pytest.mark.skipif(not SMAC.exists(), reason="shared SMAC reference curves not available")
+
+
+def _ok(result):
+    assert result.exit_code == 0, result.output + repr(result.exception)
+    return result.output
+
+
+def _csv(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_noise_gmwm_on_the_bundled_rlg(bundled_path, bundled_record, tmp_path):
+    allantools = pytest.importorskip("allantools")
+    _ok(runner.invoke(app, ["noise", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--out", str(tmp_path)]))
+    assert {p.name for p in tmp_path.iterdir()} >= {"noise.json", "wvar.csv", "noise.png"}
+    doc = json.loads((tmp_path / "noise.json").read_text())
+    assert doc["method"] == "gmwm" and doc["units"]["wvar"] == "(deg/h)^2"
+    (ax,) = doc["axes"]
+    sel = ax["selection"]
+    assert ax["name"] == "gz" and ax["selected"] == sel["selected"]
+    assert [c["model"] for c in sel["candidates"]][:2] == ["WN", "WN+RW"]  # every candidate, with WIC and reasons
+    assert all(np.isfinite(c["wic"]) and (c["passed"] or c["reasons"]) for c in sel["candidates"])
+    assert sel["excluded"] and all("no candidate explains" in e["reason"] for e in sel["excluded"])
+    assert "over-rejects" in ax["j_statistic"]["caveat"] and ax["j_statistic"]["df"] >= 1
+    n = sel["ieee"]["terms"]["N_dprh"]
+    assert n["unit"] == "deg/sqrt(h)" and n["lo95"] < n["value"] < n["hi95"]
+    # wvar.csv: nu^2(scale) = AVAR_overlapping(tau = scale) / 2 (independent: allantools)
+    rows = _csv(tmp_path / "wvar.csv")
+    scale = np.array([float(r["scale_s"]) for r in rows])
+    wv = np.array([float(r["wvar_dph2"]) for r in rows])
+    x = np.asarray(bundled_record.axis("gz"), dtype=float)
+    m = np.rint(scale[:6] / bundled_record.dt_s / 2).astype(int)  # Haar width 2^j = two averages of 2^(j-1)
+    _, adev, _, _ = allantools.oadev(x, rate=1.0 / bundled_record.dt_s, data_type="freq", taus=m * bundled_record.dt_s)
+    np.testing.assert_allclose(wv[:6], adev**2 / 2, rtol=1e-9)
+    used = np.array([r["used"] == "1" for r in rows])
+    assert used.sum() == len(sel["levels_used"]) and not used[0]
+
+
+@needs_smac
+def test_noise_on_the_published_kvh_curve(tmp_path):
+    result = runner.invoke(app, ["noise", "--curve", str(SMAC), "--sensor", "kvh1750", "--columns", "x",
+                                 "--out", str(tmp_path), "--json"])
+    _ok(result)
+    doc = json.loads(result.stdout)  # --json: stdout is the JSON alone
+    assert doc == json.loads((tmp_path / "noise.json").read_text())
+    (ax,) = doc["axes"]
+    n = ax["selection"]["ieee"]["terms"]["N_dprh"]["value"]
+    assert abs(n / 0.003094 - 1.0) < 0.05  # GMWM notes §8
+    with gzip.open(SMAC, "rt") as fh:
+        pub = [float(r["wvar"]) for r in csv.DictReader(fh) if r["sensor_key"] == "kvh1750" and r["axis"] == "x"]
+    rows = _csv(tmp_path / "wvar.csv")
+    np.testing.assert_allclose([float(r["wvar_dph2"]) for r in rows], np.array(pub) * 3600.0**2, rtol=1e-12)
+
+
+@needs_smac
+def test_curve_table_with_several_sensors_needs_sensor(tmp_path):
+    result = runner.invoke(app, ["noise", "--curve", str(SMAC), "--out", str(tmp_path)])
+    assert result.exit_code == 1 and "--sensor" in result.output and "Traceback" not in result.output
+
+
+@pytest.mark.parametrize("model, fragment", [("WN+XX", "unknown component 'XX'"), ("", "pass --model"),
+                                             ("WN+WN", "repeats WN")])
+def test_bad_model_string_is_one_line_naming_the_flag(bundled_path, tmp_path, model, fragment):
+    result = runner.invoke(app, ["noise", str(bundled_path), "--unit", "deg/h", "--model", model,
+                                 "--out", str(tmp_path)])
+    assert result.exit_code == 1, result.output
+    lines = [ln for ln in result.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:") and fragment in lines[0], result.output
+    assert "--model" in lines[0] or model == "WN+WN"
+    assert not (tmp_path / "noise.json").exists()
+
+
+@pytest.mark.slow
+def test_fixed_model_and_allan_method(bundled_path, tmp_path):
+    _ok(runner.invoke(app, ["noise", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--model",
+                            "qn+arw", "--out", str(tmp_path / "g")]))
+    sel = json.loads((tmp_path / "g" / "noise.json").read_text())["axes"][0]["selection"]
+    assert sel["selected"] == "QN+WN" and [c["model"] for c in sel["candidates"]] == ["QN+WN"]
+    _ok(runner.invoke(app, ["noise", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--method", "allan",
+                            "--out", str(tmp_path / "a")]))
+    doc = json.loads((tmp_path / "a" / "noise.json").read_text())
+    assert doc["method"] == "allan" and "N" in doc["axes"][0]["noise"]["terms"]
+    result = runner.invoke(app, ["noise", str(bundled_path), "--unit", "deg/h", "--method", "allan", "--robust",
+                                 "--out", str(tmp_path / "b")])
+    assert result.exit_code == 1 and "--method gmwm" in result.output
+
+
+def test_neither_or_both_inputs_refused(bundled_path, tmp_path):
+    result = runner.invoke(app, ["noise", "--out", str(tmp_path)])
+    assert result.exit_code == 1 and "--curve" in result.output
+
+
+@pytest.mark.slow
+def test_analyze_noise_method_gmwm_end_to_end(bundled_path, tmp_path):
+    _ok(runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models",
+                            "persistence", "--noise-method", "gmwm", "--out", str(tmp_path / "an")]))
+    doc = json.loads((tmp_path / "an" / "analysis.json").read_text())
+    assert doc["config"]["noise_method"] == "gmwm"
+    g = doc["axes"][0]["gmwm"]
+    # the same analysis as 'fogdrift noise' on the same axis
+    _ok(runner.invoke(app, ["noise", str(bundled_path), "--unit", "deg/h", "--columns", "gz",
+                            "--out", str(tmp_path / "n")]))
+    ref = json.loads((tmp_path / "n" / "noise.json").read_text())["axes"][0]
+    assert g["selected"] == ref["selected"]
+    assert g["selection"]["ieee"]["terms"]["N_dprh"]["value"] == pytest.approx(
+        ref["selection"]["ieee"]["terms"]["N_dprh"]["value"], rel=1e-9)
+    html = (tmp_path / "an" / "report.html").read_text()
+    assert "Noise model by GMWM" in html and g["selected"] in html
+    result = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--models", "persistence",
+                                 "--noise-method", "kalman", "--out", str(tmp_path / "bad")])
+    assert result.exit_code == 1 and "--noise-method" in result.output
