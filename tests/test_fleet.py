@@ -176,3 +176,27 @@ def test_analyze_batch_rows_carry_the_verdict(tmp_path):
     block = load(tmp_path / "o" / "a.csv" / "compensated_test_gz.csv")      # as `fogdrift analyze` writes it
     assert block.n_samples > 100
     assert json.loads((tmp_path / "o" / "a.csv" / "analysis.json").read_text())["sha256"] == row["sha256"]
+
+
+@pytest.mark.slow
+def test_noise_command_gmwm_rows_against_the_simulated_white_noise(tmp_path):
+    # white noise of sd s deg/h at 100 Hz: N = s * sqrt(dt) / 60 deg/sqrt(h) (IEEE-952 angle random walk)
+    rng = np.random.default_rng(15)
+    sd = [10.0, 10.0, 30.0]
+    files = []
+    for k, s in enumerate(sd):
+        p = tmp_path / f"u{k}.npy"
+        np.save(p, rng.normal(0.0, s, 40_000))
+        files.append(str(p))
+    out = tmp_path / "o"
+    res = runner.invoke(app, ["batch", *files, "--unit", "deg/h", "--rate", "100", "--command", "noise",
+                              "--scheduler", "serial", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    got = duckdb.sql(f"SELECT file, N_dprh, N_lo95_dprh, N_hi95_dprh, N_status, noise_model, statistic "
+                     f"FROM '{out / 'summary.parquet'}' ORDER BY file").fetchall()
+    assert [g[0] for g in got] == ["u0.npy", "u1.npy", "u2.npy"]
+    for (_, n, lo, hi, status, model, stat), s in zip(got, sd):
+        assert n == pytest.approx(s * 0.1 / 60.0, rel=0.03) and lo < s * 0.1 / 60.0 < hi
+        assert status == "resolved" and "WN" in model and stat == "wvar"
+    assert {"noise.json", "wvar.csv", "noise.png", "batch.json"} <= {p.name for p in (out / "u0.npy").iterdir()}
+    assert (out / "fleet.html").is_file()

@@ -96,7 +96,7 @@ def batch(
     out: Annotated[Path, typer.Option("--out", help="Batch folder: one folder per file, summary.parquet, "
                                                     "fleet.html.")] = DEFAULT_OUT,
 ):
-    """Run allan or analyze over many logs x axes on Dask; write summary.parquet and a fleet page."""
+    """Run allan, noise or analyze over many logs x axes on Dask; write summary.parquet and a fleet page."""
     from ..fleet import BatchOutputDir, command_spec, run_batch
 
     with run("batch", out, default_out=DEFAULT_OUT, inputs=list(inputs), expect=("summary.parquet", "fleet.html"),

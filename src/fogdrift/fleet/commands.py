@@ -141,10 +141,58 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
 
 
 #: The batch commands (``--command``); the GMWM ``noise`` command will be one more row.
+def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
+    """``fogdrift noise`` (GMWM, its defaults: model selection by WIC) on one record: ``noise.json``,
+    ``wvar.csv``, ``noise.png`` and one row per axis.
+
+    The same calls as the ``noise`` command (:func:`fogdrift.gmwm.analysis.analyse_gmwm`,
+    :func:`fogdrift.report_gmwm.write_gmwm_outputs`).  Row: each IEEE-952 coefficient the selected model
+    implies with its 95 % interval (``resolved`` when the interval excludes zero, ``absent`` when the model
+    has no such term), the selected model, the J test's p-value (``fit_quality`` ``good`` when every check
+    passed, else ``poor``) and the bias instability at the AVAR minimum implied by the model.
+    """
+    from ..gmwm.analysis import analyse_gmwm
+    from ..report_gmwm import write_gmwm_outputs
+
+    axes = [analyse_gmwm(name, record.axis(name), record.dt_s) for name in record.axis_names]
+    write_gmwm_outputs(axes, out_dir, source=str(record.source), record=record.metadata())
+    return [{"axis": a.name, **record_columns(record), **gmwm_columns(a)} for a in axes]
+
+
+def gmwm_columns(axis) -> dict:
+    """Summary columns of one GMWM axis (:class:`fogdrift.gmwm.analysis.GmwmAxis`)."""
+    sel = axis.selection
+    ie = sel.ieee
+    row = {"statistic": "wvar"}
+    for name, unit in TERMS:
+        term = ie.terms.get(f"{name}_{unit}")
+        if term is None and name == "B" and ie.b_gm is not None:
+            b = ie.b_gm
+            value, lo, hi = b.value_dph, b.lo95_dph, b.hi95_dph
+        elif term is None:
+            value = lo = hi = None
+        else:
+            value, lo, hi = term.value, term.lo95, term.hi95
+        row[f"{name}_{unit}"] = _f(value)
+        row[f"{name}_lo95_{unit}"] = _f(lo)
+        row[f"{name}_hi95_{unit}"] = _f(hi)
+        row[f"{name}_status"] = ("absent" if value is None else
+                                 "resolved" if lo is not None and lo > 0 else "unresolved")
+    b = ie.b_min
+    fit = sel.fit
+    row.update(noise_model=str(sel.selected), fit_quality="good" if sel.passed_checks else "poor",
+               fit_dof=int(fit.df), fit_p_value=_f(fit.j_pvalue),
+               fit_n_points=int(len(axis.wvar.scale_s) - len(sel.excluded)),
+               b_min_dph=_f(getattr(b, "value_dph", None)), b_min_tau_s=_f(getattr(b, "tau_s", None)),
+               b_min_bound_only=None if b is None else bool(b.flagged))
+    return row
+
+
 COMMANDS: dict[str, CommandSpec] = {
     "allan": CommandSpec("allan", run_allan_command, "Allan variance and IEEE-952 coefficients of every axis"),
     "analyze": CommandSpec("analyze", run_analyze_command,
                            "the whole method (separation, drift models, compensation) with an HTML report"),
+    "noise": CommandSpec("noise", run_noise_command, "GMWM noise model of every axis (fogdrift noise)"),
 }
 
 
