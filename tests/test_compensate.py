@@ -239,3 +239,22 @@ def test_cli_compensate_prints_the_heading_table_and_refuses_in_one_line(bundle_
     assert result.exit_code == 1
     assert "--apply-unit rad/s" in result.output and "Traceback" not in result.output
     assert len([ln for ln in result.output.splitlines() if ln.strip()]) <= 3
+
+
+def test_csv_without_a_declared_unit_takes_the_bundles_and_says_so(bundle_dir, logs, tmp_path):
+    # the ADIS16405 and most logger CSVs declare no unit: compensate reads them in the bundle's unit (a note
+    # names --apply-unit), and the result equals the same numbers in a CSV that declares that unit
+    d, x = logs
+    t = np.arange(x.shape[0]) / FS
+    np.savetxt(tmp_path / "plain.csv", np.column_stack([t, x]), delimiter=",", header="t_s,gx,gz", comments="",
+               fmt="%.17g")
+    res = _run(bundle_dir, tmp_path / "plain.csv", tmp_path / "o1", model="ar")
+    assert res.summary["unit"] == "deg/s"
+    note = next(m for m in res.messages if m.startswith("unit:"))
+    assert "declares none" in note and "{opt:apply_unit}" in note
+    ref = _run(bundle_dir, d / "log.csv", tmp_path / "o2", model="ar")
+    np.testing.assert_array_equal(_npz(tmp_path / "o1")["compensated"], _npz(tmp_path / "o2")["compensated"])
+    assert ref.summary["unit"] == "deg/s"
+    # given explicitly, the unit is the one given (here: the same numbers read as deg/h differ by 3600)
+    res = _run(bundle_dir, tmp_path / "plain.csv", tmp_path / "o3", model="bias", apply_unit="deg/s")
+    assert res.summary["unit"] == "deg/s"

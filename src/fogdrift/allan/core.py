@@ -46,6 +46,12 @@ from .statistics import get_statistic
 
 __all__ = ["allan_variance", "IEEE952_ALPHAS", "FAST_M0"]
 
+#: ``noise_alpha="auto"`` trusts a phase-noise slope (alpha > 0, white PM: EDF ~ N/2 even at long tau) only
+#: where at least this many averaging intervals m fit in the record; below it the smallest EDF among the
+#: IEEE-952 alphas is used (on the PSINS RLG the tau^-1 fall at 328 s -- 5.6 intervals, a bounded platform
+#: disturbance -- was given EDF 72 000 and a +-0.5 % interval).
+AUTO_MIN_INTERVALS = 16
+
 #: Power-law exponents of the IEEE-952 noise terms (Q: +2 white PM, N: 0 white FM,
 #: B: -1 flicker FM, K: -2 random-walk FM), used by ``noise_alpha="auto"``/``"conservative"``.
 IEEE952_ALPHAS = (2, 0, -1, -2)
@@ -96,7 +102,9 @@ def allan_variance(
         log-log slope mu of the deviation (least-squares slope over the taus within a factor 2
         of each tau), mapped to the IEEE-952 type (alpha = +2, 0, -1, -2) whose slope for this
         statistic is nearest; for the Allan deviation mu < -0.75 -> +2 (Q), < -0.25 -> 0 (N),
-        < +0.25 -> -1 (B), otherwise -2 (K; also used for a ramp).
+        < +0.25 -> -1 (B), otherwise -2 (K; also used for a ramp).  A phase-noise type (alpha > 0)
+        is trusted only where at least :data:`AUTO_MIN_INTERVALS` intervals m fit in the record;
+        elsewhere the smallest EDF among the IEEE-952 types is used.
         ``"conservative"``: the smallest EDF among alpha = 2, 0, -1, -2 at each tau.
         An int or an array of shape (n_tau,) fixes alpha (2, 1, 0, -1 or -2).
     max_fraction : float, keyword-only
@@ -205,6 +213,17 @@ def allan_variance(
         edf = cands[np.arange(m.size), pick]
     else:
         edf = np.array([edf_of(i, a) for i, a in enumerate(alphas)], dtype=np.float64)
+        if isinstance(noise_alpha, str):  # auto: a phase-noise slope at long tau is not evidence of phase noise
+            few = np.flatnonzero((alphas > 0) & (n < AUTO_MIN_INTERVALS * m))
+            for i in few:
+                cand = [edf_of(i, a) for a in IEEE952_ALPHAS]
+                k = int(np.nanargmin(cand))
+                if cand[k] < edf[i]:
+                    alphas[i], edf[i] = IEEE952_ALPHAS[k], cand[k]
+            if few.size:
+                rule += (f"; where fewer than {AUTO_MIN_INTERVALS} averaging intervals fit in the record and the "
+                         "slope says phase noise (alpha > 0: a bounded disturbance at long tau looks the same), "
+                         "the smallest EDF among the IEEE-952 alphas")
     if cap_of is not None:  # a strided (fast) sum cannot have more EDF than the full overlapping one
         edf = np.minimum(edf, [cap_of(i, a) for i, a in enumerate(alphas)])
     edf = np.clip(np.nan_to_num(edf, nan=1.0, posinf=float(n_terms.max())), 1.0, np.maximum(n_terms, 1))

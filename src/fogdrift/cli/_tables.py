@@ -5,11 +5,12 @@ from __future__ import annotations
 from ._app import fitted_table, say
 
 
-def noise_table(title, rows):
-    """A Q, N, B, K, R table that fits the terminal (a rich renderable: ``console.print(noise_table(...))``)."""
+def noise_table(title, rows, fit=False):
+    """A Q, N, B, K, R table that fits the terminal (a rich renderable: ``console.print(noise_table(...))``);
+    ``fit=True``: the rows end with a fit-quality cell (:func:`fogdrift.report.fit_cell`)."""
     from ..report import NOISE_HEADERS
 
-    return fitted_table(title, ("signal",) + NOISE_HEADERS, rows)
+    return fitted_table(title, ("signal",) + NOISE_HEADERS + (("fit",) if fit else ()), rows)
 
 
 def metrics_table(title, rows):

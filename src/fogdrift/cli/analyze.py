@@ -72,7 +72,7 @@ def analyze(
 ):
     """The whole method: Allan analysis, separation, drift models, compensation, Table 2 and an HTML report."""
     from ..pipeline import AnalysisConfig, run_analysis
-    from ..report import metrics_rows, noise_row, verdict, write_report
+    from ..report import fit_cell, metrics_rows, noise_row, verdict, write_report
 
     with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to], json_out=json_out,
              expect=("analysis.json", "report.html") + (("report.pdf",) if pdf else ())) as r:
@@ -121,8 +121,11 @@ def analyze(
             for ax in res.axes:
                 console.print(noise_table(f"{title} axis {ax.name}: Table 2 (test block, {ax.models.dt_s:g} s "
                                           "samples; 95 % intervals)",
-                                          [["original (whole record, native rate)"] + noise_row(ax.original.noise)]
-                                          + [[row.label] + noise_row(row.analysis.noise) for row in ax.table2]))
+                                          [["original (whole record, native rate)"] + noise_row(ax.original.noise)
+                                           + [fit_cell(ax.original.noise)]]
+                                          + [[row.label] + noise_row(row.analysis.noise)
+                                             + [fit_cell(row.analysis.noise)] for row in ax.table2],
+                                          fit=True))
                 console.print(metrics_table(f"{title} axis {ax.name}: one-step metrics on the test block",
                                             metrics_rows(ax.models)))
                 for line in verdict(ax.models):

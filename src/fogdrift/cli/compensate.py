@@ -8,7 +8,8 @@ from typing import Annotated, Optional
 import typer
 from rich.text import Text
 
-from ._app import OutOpt, app, console, csv_list, errors, table
+from ..errors import render_options
+from ._app import FLAGS, OutOpt, app, console, csv_list, errors, fitted_table
 
 
 @app.command()
@@ -72,7 +73,7 @@ def compensate(
         console.print(Text(f"compensated {s['n_samples']} samples of {file.name} with {s['model_label']} "
                            f"(unit {s['unit']}, {1 / s['native_dt_s']:g} Hz, models at {1 / s['model_dt_s']:g} Hz)"))
         for line in result.messages:
-            console.print(Text("  " + line), highlight=False)
+            console.print(Text("  " + render_options(line, FLAGS)), highlight=False)
         print_evaluation(result.heading, result.artefacts, result.verdicts)
         console.print(Text(f"wrote {', '.join(str(p) for p in result.files.values())}"))
 
@@ -83,12 +84,12 @@ def print_evaluation(headings, artefacts, verdicts):
 
     for h in headings:
         headers, rows = heading_table(h)
-        console.print(table(f"axis {h.axis}: heading error after a {h.calib_s:g}-s calibration "
+        console.print(fitted_table(f"axis {h.axis}: heading error after a {h.calib_s:g}-s calibration "
                             f"(RMS over origins every {h.step_s:g} s; ratio to constant bias)", headers, rows))
     for a in artefacts:
         headers, rows = artefact_table(a)
-        console.print(table(f"axis {a.axis}: surviving fraction of injected signals "
+        console.print(fitted_table(f"axis {a.axis}: surviving fraction of injected signals "
                             f"(amplitude {a.amplitude_dph:.4g} deg/h)", headers, rows))
     for v in verdicts:
         for line in v.lines:
-            console.print(Text("  " + line), highlight=False)
+            console.print(Text("  " + render_options(line, FLAGS)), highlight=False)

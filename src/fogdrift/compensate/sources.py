@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError, DataFormatError
+from ..errors import ConfigError, DataFormatError, FogdriftError
 from ..units import INCREMENT_UNITS, RATE_UNITS, TIME_UNITS, increment_scale_to_dph, rate_scale_to_dph
 
 __all__ = ["LogSource", "open_log", "match_log", "LogMatch", "unit_scale_to_dph"]
@@ -203,7 +203,17 @@ def _open_loaded(path: Path, columns, time_column, rate_hz, time_unit) -> LogSou
     from ..io import load
 
     tc = None if isinstance(time_column, str) and time_column.strip().lower() == "none" else time_column
-    rec = load(path, columns=columns, time_column=tc, rate_hz=rate_hz, time_unit=time_unit)
+    try:
+        rec = load(path, columns=columns, time_column=tc, rate_hz=rate_hz, time_unit=time_unit)
+    except ConfigError as exc:
+        # a log that declares no unit: read its numbers as they are (deg/h = factor 1); match_log then takes
+        # --apply-unit or the bundle's unit and says so.  Any other configuration error stands.
+        try:
+            rec = load(path, columns=columns, time_column=tc, rate_hz=rate_hz, time_unit=time_unit, unit="deg/h")
+        except FogdriftError:
+            raise exc from None
+        if any(u is not None for u in rec.declared_units):
+            raise exc from None
     declared = {u for u in rec.declared_units}
     if len(declared) > 1:
         raise DataFormatError(f"rate columns declare different units {sorted(map(str, declared))}; expected one "
@@ -311,7 +321,7 @@ def match_log(source: LogSource, bundle, *, apply_unit=None, axis_map=None, acce
                               f"{bundle.input_unit}; pass {{opt:apply_unit}} {unit} to convert it")
     else:
         unit = bundle.input_unit
-        notes.append(f"unit: the log declares none; taking the bundle's {unit} (pass apply_unit to override)")
+        notes.append(f"unit: the log declares none; taking the bundle's {unit} (pass {{opt:apply_unit}} to override)")
     scale = unit_scale_to_dph(unit, source.dt_s)
 
     rel = abs(source.dt_s - bundle.native_dt_s) / bundle.native_dt_s

@@ -23,7 +23,7 @@ from .files import write_json
 from .glossary import glossary_entries
 from .settings import settings_rows
 from .summary import OUTCOME_LABELS, cannot_support, noise_headline, recording_rows, summary_dict, verdict_items
-from .tables import (METRICS_HEADERS, NOISE_HEADERS, _fmt, causal_metrics_rows, metrics_rows, noise_notes, noise_row,
+from .tables import (METRICS_HEADERS, NOISE_HEADERS, _fmt, causal_metrics_rows, fit_cell, metrics_rows, noise_notes, noise_row,
                      readout_text, verdict)
 
 __all__ = ["write_report", "render_report"]
@@ -286,10 +286,10 @@ def _compensation_section(ax, fig_dir, pre, fig_offset, evaluated) -> str:
     rows, rc = [], {}
     for i, r in enumerate(ax.table2):
         mark = marks.get(r.label, "")
-        rows.append([r.label] + noise_row(r.analysis.noise) + [mark or "–"])
+        rows.append([r.label] + noise_row(r.analysis.noise) + [fit_cell(r.analysis.noise), mark or "–"])
         if mark:
             rc[i] = "removes"
-    parts.append(_table(("signal",) + NOISE_HEADERS + ("artefact check",), rows, "table2", rc))
+    parts.append(_table(("signal",) + NOISE_HEADERS + ("fit", "artefact check"), rows, "table2", rc))
     parts.append('<p class="note">“drift residual (paper)”: wavelet drift minus its one-step prediction (the '
                  "paper's Table 2 and Fig. 9); “practical”: gyro output minus the one-step prediction from the "
                  "causal drift. A marked row “improves” a coefficient by removing real rate (artefact check).</p>")

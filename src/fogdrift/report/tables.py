@@ -54,6 +54,15 @@ def noise_row(noise) -> list[str]:
     return [term_text(noise.terms[name]) for name in ("Q", "N", "B", "K", "R")]
 
 
+def fit_cell(noise) -> str:
+    """Short fit-quality cell of a table row: the fit verdict, chi2_red and the fitted tau range
+    (the Table 2 rows are fitted on short blocks and smoothed signals: how well each fits is part of the row)."""
+    if noise.chi2_red is None:
+        return "–"
+    return (f"{noise.quality} (χ²ᵣ {_fmt(noise.chi2_red, 2)}, τ {_fmt(noise.tau_min_s, 2)}–"
+            f"{_fmt(noise.tau_max_s, 2)} s)")
+
+
 def fit_summary(noise) -> str:
     """One line: the selected model, the fit statistic and p-value, the fitted tau range."""
     return (f"model {'+'.join(noise.selected) or '(none)'} selected from {len(noise.candidates)} candidates; "
