@@ -146,8 +146,9 @@ def test_format_and_reader_options(tmp_path):
     assert load(p, dt_s=1.0, format="text").n_samples == 2
     rec = load(p, dt_s=1.0, reader_options={"delimiter": ";"})
     assert rec.axis_names == ("a", "b")
-    with pytest.raises(ConfigError, match=r"unknown format 'hdf5'; expected one of \['npy', 'npz', 'text'\]"):
-        load(p, dt_s=1.0, format="hdf5")
+    with pytest.raises(ConfigError, match=r"unknown format 'xls'; expected one of \['npy', 'npz', 'hdf5', 'mat', "
+                                          r"'rosbag1', 'rosbag2', 'mseed', 'binary', 'text'\]"):
+        load(p, dt_s=1.0, format="xls")
     with pytest.raises(ConfigError, match=r"unknown reader option\(s\) \['dataset'\] for text files"):
         load(p, dt_s=1.0, reader_options={"dataset": "/imu"})
     with pytest.raises(ConfigError, match="delimiter given twice"):

@@ -30,6 +30,8 @@ __all__ = [
     "time_scale_to_s",
     "URAD_PER_ARCSEC",
     "B_FACTOR",
+    "TEMPERATURE_UNITS",
+    "temperature_offset_to_c",
 ]
 
 #: WGS-84 Earth rotation rate 7.2921150e-5 rad/s expressed in deg/h (method notes §6).
@@ -68,6 +70,41 @@ TIME_UNITS: dict[str, float] = {
     "us": 1e-6,
     "ns": 1e-9,
 }
+
+
+#: Add the value to a temperature in the key's unit to get deg C (temperature columns; keys compared
+#: case-insensitively).  Only deg C and kelvin: a Fahrenheit column would need a scale too.
+TEMPERATURE_UNITS: dict[str, float] = {
+    "degc": 0.0,
+    "deg c": 0.0,
+    "c": 0.0,
+    "°c": 0.0,
+    "celsius": 0.0,
+    "k": -273.15,
+    "kelvin": -273.15,
+}
+
+
+def temperature_offset_to_c(unit: str) -> float:
+    """Offset that converts a temperature in ``unit`` to deg C (0 for deg C, -273.15 for K).
+
+    Raises
+    ------
+    ConfigError
+        If ``unit`` is not a key of :data:`TEMPERATURE_UNITS` (any case).
+
+    Examples
+    --------
+    >>> temperature_offset_to_c("degC"), temperature_offset_to_c("K")
+    (0.0, -273.15)
+    """
+    key = unit.strip().lower() if isinstance(unit, str) else unit
+    try:
+        return TEMPERATURE_UNITS[key]
+    except (KeyError, TypeError):
+        raise ConfigError(
+            f"unknown temperature unit {unit!r}; expected one of {sorted(TEMPERATURE_UNITS)} (any case)"
+        ) from None
 
 
 def time_scale_to_s(unit: str) -> float:

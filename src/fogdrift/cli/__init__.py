@@ -1,4 +1,4 @@
-"""Command-line interface: ``fogdrift allan | noise | separate | model | analyze | compensate``.
+"""Command-line interface: ``fogdrift allan | noise | separate | model | analyze | compensate | batch``.
 
 One module per command; :mod:`fogdrift.cli._app` holds the typer application, the shared load options and the
 edge (:func:`~fogdrift.cli._app.run`).  Commands only declare options, call the library (:mod:`fogdrift.pipeline`)
@@ -19,7 +19,7 @@ __all__ = ["app", "main"]
 
 
 def _commands():
-    from . import allan, analyze, compensate, model, noise, separate  # noqa: F401  (register the commands)
+    from . import allan, analyze, batch, compensate, model, noise, separate  # noqa: F401  (register the commands)
     from ._app import app
 
     return app

@@ -70,7 +70,15 @@ FLAGS = {
     "model": "--model", "chunk_samples": "--chunk", "out": "--out", "pdf": "--pdf",
     "method": "--method", "noise_method": "--noise-method", "scales": "--scales", "levels": "--scales",
     "curve": "--curve", "sensor": "--sensor",
+    # reader options (fogdrift.io.registry.READERS) and the temperature column
+    "temperature": "--temperature", "topic": "--topic", "stamp": "--stamp", "dataset": "--dataset",
+    "variable": "--variable", "gain": "--gain", "layout": "--layout", "scale": "--scale",
+    "header_bytes": "--header-bytes", "sequence": "--sequence", "format": "--format",
 }
+
+#: LoadOptions field -> reader option of fogdrift.io.load(reader_options=...); set ones are passed on.
+READER_OPTIONS = {"topic": "topic", "stamp": "stamp", "dataset": "dataset", "variable": "variable", "gain": "gain",
+                  "layout": "layout", "scale": "scale", "header_bytes": "header_bytes", "sequence": "sequence"}
 
 
 def _version(value: bool):
@@ -124,6 +132,27 @@ class LoadOptions:
     columns: Optional[str] = None
     time_column: str = "auto"
     gaps: str = "error"
+    temperature: Optional[str] = None
+    format: Optional[str] = None
+    topic: Optional[str] = None
+    stamp: Optional[str] = None
+    dataset: Optional[str] = None
+    variable: Optional[str] = None
+    gain: Optional[str] = None
+    layout: Optional[str] = None
+    scale: Optional[str] = None
+    header_bytes: Optional[int] = None
+    sequence: Optional[str] = None
+
+    def reader_options(self) -> dict:
+        """The reader options that were set (``--topic``, ``--dataset``, ``--layout`` ...)."""
+        return {opt: getattr(self, f) for f, opt in READER_OPTIONS.items() if getattr(self, f) is not None}
+
+    def load_kwargs(self) -> dict:
+        """Keyword arguments of :func:`fogdrift.io.load` (without ``gaps``)."""
+        return dict(columns=csv_list(self.columns), rate_hz=self.rate, unit=self.unit, time_unit=self.time_unit,
+                    time_column=None if self.time_column.lower() == "none" else self.time_column,
+                    temperature=self.temperature, format=self.format, reader_options=self.reader_options())
 
     def load(self, path=None, *, unit=None, time_unit=None):
         """Load ``path`` (default: ``file``) with these options; ``--gaps longest`` keeps the longest segment.
@@ -132,9 +161,8 @@ class LoadOptions:
         from ..io import load, load_segments
 
         path = self.file if path is None else path
-        kwargs = dict(columns=csv_list(self.columns), rate_hz=self.rate, unit=unit or self.unit,
-                      time_unit=time_unit or self.time_unit,
-                      time_column=None if self.time_column.lower() == "none" else self.time_column)
+        kwargs = self.load_kwargs()
+        kwargs.update(unit=unit or self.unit, time_unit=time_unit or self.time_unit)
         if self.gaps == "error":
             return load(path, **kwargs)
         if self.gaps == "longest":
@@ -148,7 +176,8 @@ class LoadOptions:
 
 #: (name, annotation, default) of the shared load parameters, in the order they appear in --help.
 LOAD_PARAMS = (
-    ("file", Annotated[Path, typer.Argument(help="Gyro log: CSV/TXT (optionally .gz), .npy or .npz.")], inspect.Parameter.empty),
+    ("file", Annotated[Path, typer.Argument(help="Gyro log: CSV/TXT (optionally .gz), .npy, .npz, HDF5, .mat, ROS bag, "
+                                                 "miniSEED or raw binary (docs/formats.md).")], inspect.Parameter.empty),
     ("rate", Annotated[Optional[float], typer.Option("--rate", help="Sample rate [Hz] (if the file has no time column).")], None),
     ("unit", Annotated[Optional[str], typer.Option(
         "--unit", help="Input unit: deg/h, deg/s, rad/s, rad/h, arcsec/s, or angle increments inc:deg, inc:rad, "
@@ -160,6 +189,24 @@ LOAD_PARAMS = (
     ("columns", Annotated[Optional[str], typer.Option("--columns", help="Comma-separated column names or 0-based indices.")], None),
     ("time_column", Annotated[str, typer.Option("--time-column", help="Time column name/index, 'auto' or 'none'.")], "auto"),
     ("gaps", Annotated[str, typer.Option("--gaps", help="Time gaps > 1.5 intervals: 'error' or 'longest' segment.")], "error"),
+    ("temperature", Annotated[Optional[str], typer.Option(
+        "--temperature", help="Temperature column [deg C] carried with the log (bag: a sensor_msgs/Temperature topic; "
+                              "miniSEED: a channel).")], None),
+    ("format", Annotated[Optional[str], typer.Option(
+        "--format", help="Force a reader: text, npy, npz, hdf5, mat, rosbag1, rosbag2, mseed, binary.")], None),
+    ("topic", Annotated[Optional[str], typer.Option("--topic", help="Bag: the sensor_msgs/Imu topic.")], None),
+    ("stamp", Annotated[Optional[str], typer.Option("--stamp", help="Bag: time from 'header' stamps or 'receive' time.")], None),
+    ("dataset", Annotated[Optional[str], typer.Option("--dataset", help="HDF5: dataset or group path, e.g. /imu.")], None),
+    ("variable", Annotated[Optional[str], typer.Option("--variable", help="MATLAB .mat: variable name.")], None),
+    ("gain", Annotated[Optional[str], typer.Option(
+        "--gain", help="miniSEED: counts per unit, or a StationXML/dataless/RESP response file.")], None),
+    ("layout", Annotated[Optional[str], typer.Option(
+        "--layout", help="Raw binary record as NumPy dtype items, e.g. '<u4 seq, <i4 gx, <i4 gy, <i4 gz'.")], None),
+    ("scale", Annotated[Optional[str], typer.Option(
+        "--scale", help="Raw binary: LSB factor for every field, or per field 'gx=1e-4,temp=0.01'.")], None),
+    ("header_bytes", Annotated[Optional[int], typer.Option("--header-bytes", help="Raw binary: bytes before the first record.")], None),
+    ("sequence", Annotated[Optional[str], typer.Option(
+        "--sequence", help="Raw binary: sequence-counter field (default seq/counter/...; 'none').")], None),
 )
 
 
@@ -329,16 +376,19 @@ class Run:
 
 
 @contextlib.contextmanager
-def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool = False, expect=()):
+def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool = False, expect=(),
+        out_class=OutputDir):
     """The frame of every command (see the module docstring): yields a :class:`Run`.
 
     ``--out`` is validated first, so a bad folder is refused before the file is read or anything computed.
+    ``out_class``: an :class:`~fogdrift.output.OutputDir` subclass whose ``summary()`` says more on Ctrl-C
+    (``batch``: which files' folders are finished).
     """
     _configure(json_out)
     _state["finish"] = threading.Lock()
     outdir = None
     with errors(), _warning_lines():
-        outdir = OutputDir(out, command=command, create_parents=Path(out) == Path(default_out),
+        outdir = out_class(out, command=command, create_parents=Path(out) == Path(default_out),
                            protect=[p for p in inputs if p is not None])
         outdir.expect(*expect)
         try:

@@ -47,6 +47,11 @@ def allan(
                                   [[a.name] + noise_row(a.noise) for a in results]))
         for a in results:
             print_noise_notes(a.name, a.noise, a.outliers, record.dt_s)
+        temp = record.metadata()["temperature"]
+        if temp is not None:
+            from ..temperature import summary_line
+
+            console.print("  " + summary_line(temp), highlight=False)
         files = write_allan_outputs(results, record, r.out.path)
         r.wrote()
         r.print_json(files["json"])

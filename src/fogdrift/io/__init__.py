@@ -9,7 +9,20 @@ no analysis.  Supported inputs:
   a comma and the first data row shows it;
 * NumPy ``.npy`` (1-D = one axis, 2-D = columns), opened with ``mmap_mode="r"`` so that a
   float64 deg/h record is never copied;
-* NumPy ``.npz`` (several 1-D arrays = named columns, or a single 2-D array).
+* NumPy ``.npz`` (several 1-D arrays = named columns, or a single 2-D array);
+* HDF5 (h5py) and MATLAB ``.mat`` v4/v5/v7 (SciPy) and v7.3 (h5py): a dataset, group,
+  variable or struct as named columns, HDF5 ``units`` attributes honoured;
+* ROS 1 bags and ROS 2 bag directories (rosbags): ``sensor_msgs/Imu`` angular velocity in rad/s,
+  time from header stamps or receive time;
+* miniSEED (ObsPy): channels as axes, gain as a number or from a response file;
+* raw binary records declared by a NumPy dtype ``layout``, with scale factors and a wrapping
+  sequence counter whose jumps are gaps, read through a memory map.
+
+The optional readers need the extras ``[hdf5]``, ``[ros]``, ``[seismo]``; a missing package is a
+:class:`~fogdrift.io.readers.base.MissingDependencyError` naming the extra.  Any reader can carry a
+temperature column (``load(..., temperature=NAME)``) into ``GyroRecord.temperature_c``.
+:mod:`fogdrift.io.chunked` reads windows of ``.npy``/raw binary/HDF5 files larger than memory.
+User documentation: ``docs/formats.md``.
 
 The format is detected from the file's first bytes, then its name (:mod:`.registry`).  Every
 problem with the input raises :class:`~fogdrift.errors.DataFormatError` located as

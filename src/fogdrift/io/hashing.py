@@ -16,7 +16,7 @@ from typing import Callable
 from ..errors import DataFormatError
 from ._checks import check_path
 
-__all__ = ["file_sha256", "hashing_stream"]
+__all__ = ["file_sha256", "hashing_stream", "path_sha256"]
 
 #: Bytes per read when hashing a whole file (a reused buffer: no large temporaries).
 _CHUNK = 1 << 18
@@ -55,6 +55,26 @@ def file_sha256(path) -> str:
             f"cannot read file; expected a readable file, got {exc.strerror or exc}", path=p
         ) from exc
     return h.hexdigest()
+
+
+def path_sha256(path) -> str:
+    """SHA-256 of a file (as :func:`file_sha256`), or of a directory in a directory format (ROS 2 bag).
+
+    A directory's hash is the SHA-256 of the text ``"<relative path> <file sha256>\n"`` for every
+    file below it, in sorted path order: it changes when any file's name or bytes change.
+
+    Raises
+    ------
+    DataFormatError
+        If the path does not exist or cannot be read.
+    """
+    p = Path(path)
+    if not p.is_dir():
+        return file_sha256(p)
+    lines = []
+    for f in sorted(q for q in p.rglob("*") if q.is_file()):
+        lines.append(f"{f.relative_to(p).as_posix()} {file_sha256(f)}\n")
+    return hashlib.sha256("".join(lines).encode("utf-8")).hexdigest()
 
 
 class _HashingRaw(io.RawIOBase):

@@ -57,14 +57,17 @@ def load(
     min_samples=2,
     format=None,
     reader_options=None,
+    temperature=None,
 ) -> GyroRecord:
     """Load a gyro log into a :class:`~fogdrift.io.GyroRecord` in deg/h.
 
     Parameters
     ----------
     path : str or Path
-        Text (CSV/TXT, optionally gzip), ``.npy`` or ``.npz`` file; the format is detected
-        from the first bytes, then the extension (see :mod:`fogdrift.io.registry`).
+        Text (CSV/TXT, optionally gzip), ``.npy``, ``.npz``, HDF5, MATLAB ``.mat``, ROS 1 bag,
+        ROS 2 bag (directory), miniSEED or raw binary file; the format is detected from the
+        first bytes, then the extension (see :mod:`fogdrift.io.registry`), or implied by a
+        reader option only one format accepts (``layout`` = raw binary).
     columns : None, int, str or sequence of int/str
         Rate columns: names or 0-based indices (ints or digit strings; a string may list
         several separated by commas, e.g. ``"gx,gz"`` or ``"1,2"``).  Default: every column
@@ -103,8 +106,15 @@ def load(
         Force a reader by its name in :data:`fogdrift.io.registry.READERS` (``"text"``,
         ``"npy"``, ``"npz"``) instead of detecting it.
     reader_options : mapping, optional
-        Options for the reader, e.g. ``{"delimiter": ";"}`` for text; each reader lists
-        the ones it accepts in its registry line.
+        Options for the reader, e.g. ``{"delimiter": ";"}`` for text, ``{"dataset": "/imu"}``
+        for HDF5, ``{"topic": "/imu/data"}`` for a bag; each reader lists the ones it accepts
+        in its registry line (:data:`fogdrift.io.registry.READERS`).
+    temperature : None, int or str
+        Column (name or 0-based index) holding the temperature, carried into
+        ``GyroRecord.temperature_c`` in deg C (a declared unit ``K`` is converted; other
+        units are refused).  It is never a rate column.  For formats whose temperature lives
+        apart from the rates (a ``sensor_msgs/Temperature`` topic in a bag, a miniSEED
+        channel at its own rate) the reader interpolates it linearly onto the rate times.
 
     Returns
     -------
@@ -163,7 +173,7 @@ def load(
     if gaps not in ("error", "split"):
         raise ConfigError(f"gaps must be 'error' or 'split'; got {gaps!r}")
     opts = _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
-                    reader_options)
+                    reader_options, temperature)
     records = _load_records(path, opts)
     if len(records) == 1:
         return records[0]
@@ -192,6 +202,7 @@ def load_segments(
     min_samples=2,
     format=None,
     reader_options=None,
+    temperature=None,
 ) -> list[GyroRecord]:
     """Load a gyro log split at time gaps into gap-free :class:`~fogdrift.io.GyroRecord` segments.
 
@@ -218,7 +229,7 @@ def load_segments(
     if gaps not in ("error", "split"):
         raise ConfigError(f"gaps must be 'error' or 'split'; got {gaps!r}")
     opts = _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
-                    reader_options)
+                    reader_options, temperature)
     return _load_records(path, opts)
 
 
@@ -236,10 +247,11 @@ class _Options:
     min_samples: int
     format: str | None
     reader_options: dict
+    temperature: object = None
 
 
 def _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
-             reader_options) -> _Options:
+             reader_options, temperature=None) -> _Options:
     """Validate every option before the file is touched."""
     if unit is not None:
         parse_unit(unit)
@@ -259,9 +271,12 @@ def _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, ga
         if "delimiter" in ropts:
             raise ConfigError("delimiter given twice; expected it as delimiter= or in reader_options, not both")
         ropts["delimiter"] = delimiter
+    if temperature is not None and not (isinstance(temperature, str) and temperature.strip()) and (
+            isinstance(temperature, bool) or not isinstance(temperature, (int, np.integer))):
+        raise ConfigError(f"temperature must be a column name or a 0-based index; got {temperature!r}")
     return _Options(columns=columns, time_column=time_column, dt_s=_interval_option(dt_s, rate_hz), unit=unit,
                     time_unit=time_unit, split=gaps == "split", min_samples=int(min_samples), format=format,
-                    reader_options=ropts)
+                    reader_options=ropts, temperature=temperature)
 
 
 def _interval_option(dt_s, rate_hz):
@@ -281,18 +296,42 @@ def _interval_option(dt_s, rate_hz):
 # --------------------------------------------------------------------------------------------
 def _open(path, opts: _Options) -> Table:
     p = check_path(path, allow_dir=True)
-    spec = reader_by_name(opts.format) if opts.format else select_reader(p)
     ropts = dict(opts.reader_options)
+    spec = reader_by_name(opts.format) if opts.format else (_implied_reader(ropts) or select_reader(p))
     if "delimiter" in ropts and "delimiter" not in spec.options:
         del ropts["delimiter"]  # the top-level text option is ignored for other formats
+    if isinstance(opts.temperature, str) and "temperature" in spec.options:
+        ropts["temperature"] = opts.temperature.strip()  # the reader brings it onto the rate times
     return spec.open_table(p, ropts)
+
+
+def _implied_reader(ropts: dict):
+    """The format that cannot be detected from the file and is the only one to accept every given option, or None.
+
+    Raw binary has no magic bytes, extension or content to recognise it by: giving its ``layout``
+    chooses it, whatever the file's name.  Detectable formats are always detected (a wrong option
+    for them stays an "unknown reader option" error).
+    """
+    from .registry import READERS
+
+    given = set(ropts) - {"delimiter"}
+    if not given:
+        return None
+    fits = [r for r in READERS if given <= set(r.options)]
+    if len(fits) == 1 and not (fits[0].magic or fits[0].sniff or fits[0].directory_marker or fits[0].extensions):
+        return fits[0]
+    return None
 
 
 def _load_records(path, opts: _Options) -> list[GyroRecord]:
     table = _open(path, opts)
     p = table.path
-    t_idx, r_idx, table_time = _resolve_columns(table, opts.columns, opts.time_column)
+    t_idx, r_idx, table_time, tm_idx = _resolve_columns(table, opts.columns, opts.time_column, opts.temperature)
     if t_idx is None and not table_time and opts.dt_s is None:
+        if table.time_ticks is not None:
+            raise ConfigError(
+                f"{p}: the sequence counter counts samples, not seconds; pass the sample rate in Hz as {{opt:rate_hz}}"
+            )
         raise ConfigError(
             f"{p}: cannot tell the sample interval: no time column (none named {' / '.join(TIME_COLUMN_NAMES)}; "
             "name one with {opt:time_column}) and no sample rate given; pass the sample rate in Hz as {opt:rate_hz}"
@@ -300,9 +339,10 @@ def _load_records(path, opts: _Options) -> list[GyroRecord]:
     notes = []
     kind_u, base_u, unit = _rate_unit(table, r_idx, opts.unit, notes)
     t_scale = _time_scale(table, t_idx, opts.time_unit, notes)
+    temp_offset = _temperature_offset(table, tm_idx, notes)
 
     # values: finite in every used column
-    used = [j for j in [t_idx, *r_idx] if j is not None]
+    used = [j for j in [t_idx, *r_idx, tm_idx] if j is not None]
     data = table.read(used)
     n = data.shape[0]
     if n == 0:
@@ -321,14 +361,19 @@ def _load_records(path, opts: _Options) -> list[GyroRecord]:
 
     # sample interval and segments
     notes.insert(0, table.describe(n))
-    t = _time_vector(table, data, t_idx, table_time, t_scale)
+    notes[1:1] = list(table.extra_notes)
+    t = _time_vector(table, data, t_idx, table_time, t_scale, opts.dt_s)
     if t is not None:
-        tname = "the file's time stamps" if t_idx is None else f"time column {table.names[t_idx]!r}"
+        if t_idx is not None:
+            tname = f"time column {table.names[t_idx]!r}"
+        else:
+            tname = "the file's time stamps" if table_time else "the sequence counter"
         if n < 2 and opts.dt_s is None:
             raise InsufficientDataError(
                 f"{n} sample; expected at least 2 to take the sample interval from {tname}", needed=2, got=n, path=p,
             )
-        dt, seg_bounds, gap_info = _check_time(table, t, t_idx, opts.dt_s, opts.split)
+        t_col = t_idx if t_idx is not None or table_time else table.tick_column
+        dt, seg_bounds, gap_info = _check_time(table, t, t_col, opts.dt_s, opts.split)
         if opts.dt_s is None:
             notes.insert(1, f"dt_s {dt:.10g} from the median step of {tname}")
         else:
@@ -339,10 +384,11 @@ def _load_records(path, opts: _Options) -> list[GyroRecord]:
     scale = unit_scale(kind_u, base_u, dt)
     if scale != 1.0:
         notes.append(f"input unit {unit!r} scaled by {scale:.10g} to deg/h")
-    return _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, opts.min_samples)
+    temp = None if tm_idx is None else (tm_idx, temp_offset)
+    return _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, opts.min_samples, temp)
 
 
-def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, min_samples):
+def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, min_samples, temp=None):
     p = table.path
     n = data.shape[0]
     m = len(seg_bounds)
@@ -378,10 +424,14 @@ def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes
                     f"value{table.at(a + i)} overflows in deg/h; expected |value| * {scale:.6g} below "
                     f"{np.finfo(np.float64).max:.3g}, got {float(raw[i, j])!r} {unit}", row=a + i, col=r_idx[j],
                 )
+        temp_c = None
+        if temp is not None:
+            temp_c = np.asarray(data[a:b, temp[0]], dtype=np.float64)
+            temp_c = temp_c + temp[1] if temp[1] else temp_c.copy()
         records.append(GyroRecord(
             rate_dph=rate, dt_s=dt, axis_names=names, source=str(p), input_unit=unit, scale_to_dph=scale,
             t0_s=float(t[a]) if t is not None else 0.0, notes=tuple(seg_notes), sha256=sha256,
-            declared_units=declared,
+            declared_units=declared, temperature_c=temp_c,
         ))
     if dropped:
         if not records:
@@ -400,8 +450,8 @@ def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes
 # --------------------------------------------------------------------------------------------
 # Columns and units
 # --------------------------------------------------------------------------------------------
-def _resolve_columns(table: Table, columns, time_column):
-    """(time column index or None, rate column indices, use the table's own time vector)."""
+def _resolve_columns(table: Table, columns, time_column, temperature=None):
+    """(time column index or None, rate column indices, use the table's own time vector, temperature index or None)."""
     names = table.names
     ncol = len(names)
 
@@ -440,8 +490,13 @@ def _resolve_columns(table: Table, columns, time_column):
     else:
         t_idx = resolve(time_column, "time_column")
 
+    tm_idx = None if temperature is None else resolve(
+        temperature.strip() if isinstance(temperature, str) else temperature, "temperature")
+    if tm_idx is not None and tm_idx == t_idx:
+        raise ConfigError(f"column {names[tm_idx]!r} is the time column; expected another column for "
+                          "{opt:temperature}")
     if columns is None:
-        r_idx = [j for j in range(ncol) if j != t_idx]
+        r_idx = [j for j in range(ncol) if j not in (t_idx, tm_idx) and names[j] not in table.non_rate]
     else:
         r_idx = [resolve(k, "columns") for k in split_keys(columns, "columns")]
         if len(set(r_idx)) != len(r_idx):
@@ -451,12 +506,15 @@ def _resolve_columns(table: Table, columns, time_column):
                 f"column {names[t_idx]!r} is the time column; expected rate columns only, got {columns!r} "
                 "(to read it as rate data, pass {opt:time_column} none)"
             )
+        if tm_idx is not None and tm_idx in r_idx:
+            raise ConfigError(f"column {names[tm_idx]!r} is the temperature column; expected rate columns only, "
+                              f"got {columns!r}")
     if not r_idx:
         raise DataFormatError(
             f"no rate columns; expected at least one column besides the time column, got {names}",
             path=table.path,
         )
-    return t_idx, r_idx, table_time
+    return t_idx, r_idx, table_time, tm_idx
 
 
 def _header_error(table: Table, message: str, col: int) -> DataFormatError:
@@ -466,6 +524,8 @@ def _header_error(table: Table, message: str, col: int) -> DataFormatError:
 def _rate_unit(table: Table, r_idx, unit, notes: list):
     """(kind, base, unit string) for the rate columns: the given unit, else the declared one; never a guess."""
     declared = {j: table.units[j] for j in r_idx}
+    if unit is None and table.unit_hint and set(declared.values()) == {None}:
+        raise ConfigError(f"{table.path}: {table.unit_hint} ({', '.join(valid_units())}; units are never guessed)")
     if unit is not None:
         kind, base = parse_unit(unit)
         other = {table.names[j]: u for j, u in declared.items() if u is not None and u.strip() != unit.strip()}
@@ -496,6 +556,26 @@ def _rate_unit(table: Table, r_idx, unit, notes: list):
         ) from None
     notes.append(f"unit {first!r} declared in the file")
     return kind, base, first
+
+
+def _temperature_offset(table: Table, tm_idx, notes: list) -> float:
+    """Offset from the temperature column's declared unit to deg C (no unit declared: deg C)."""
+    if tm_idx is None:
+        return 0.0
+    declared = table.units[tm_idx]
+    if declared is None:
+        notes.append(f"temperature from column {table.names[tm_idx]!r} in deg C")
+        return 0.0
+    try:
+        offset = units.temperature_offset_to_c(declared)
+    except ConfigError:
+        raise _header_error(
+            table, f"unknown temperature unit {declared!r} declared in the file; expected deg C or K "
+                   f"({sorted(units.TEMPERATURE_UNITS)}), got {declared!r}", tm_idx,
+        ) from None
+    notes.append(f"temperature from column {table.names[tm_idx]!r} ({declared}"
+                 + (", converted to deg C)" if offset else ")"))
+    return offset
 
 
 def _is_time_name(name: str) -> bool:
@@ -552,12 +632,14 @@ def _time_scale(table: Table, t_idx, time_unit, notes: list) -> float:
 # --------------------------------------------------------------------------------------------
 # Time
 # --------------------------------------------------------------------------------------------
-def _time_vector(table: Table, data, t_idx, table_time: bool, t_scale: float):
-    """Time in s (float64), or None without time."""
+def _time_vector(table: Table, data, t_idx, table_time: bool, t_scale: float, dt_s=None):
+    """Time in s (float64), or None without time (a sequence counter gives ``ticks * dt_s``)."""
     if t_idx is not None:
         t = np.asarray(data[:, t_idx], dtype=np.float64)
         return t if t_scale == 1.0 else t * t_scale
     if not table_time:
+        if table.time_ticks is not None and dt_s is not None:
+            return np.asarray(table.time_ticks, dtype=np.float64) * dt_s
         return None
     t = np.asarray(table.time_s, dtype=np.float64)
     if t.shape != (data.shape[0],):

@@ -55,6 +55,10 @@ class GyroRecord:
         file declares none.  Default: None for every axis.
     block_average_factor : int, optional
         Product of the block-averaging factors applied since loading (1 = native rate).
+    temperature_c : ndarray, shape (n_samples,), optional
+        Temperature in deg C carried with the log (``load(..., temperature=NAME)``), one value
+        per sample; kept through :meth:`slice`, :meth:`select` and block averaging (averaged
+        like the rates).  None when the log has none.  Stored read-only.
 
     Notes
     -----
@@ -73,6 +77,7 @@ class GyroRecord:
     sha256: str | None = None
     declared_units: tuple[str | None, ...] = ()
     block_average_factor: int = 1
+    temperature_c: np.ndarray | None = None
 
     def __post_init__(self):
         r = self.rate_dph
@@ -105,6 +110,17 @@ class GyroRecord:
         if factor < 1:
             raise ConfigError(f"block_average_factor must be an integer >= 1; got {factor}")
         object.__setattr__(self, "block_average_factor", factor)
+        if self.temperature_c is not None:
+            temp = np.asarray(self.temperature_c)
+            if temp.dtype != np.float64 or temp.shape != (r.shape[0],):
+                raise ConfigError(
+                    f"temperature_c must be a float64 array of shape ({r.shape[0]},), one value per sample; got "
+                    f"{temp.dtype} {temp.shape}"
+                )
+            if temp.flags.writeable:
+                temp = temp.view()
+                temp.flags.writeable = False
+            object.__setattr__(self, "temperature_c", temp)
 
     # -- sizes ---------------------------------------------------------------------------------
     @property
@@ -206,8 +222,10 @@ class GyroRecord:
                 f"slice({start!r}, {stop!r}) is empty or out of range; expected 0 <= start < stop <= {n}"
             )
         note = f"slice: samples {lo}-{hi - 1} of {n}"
+        temp = None if self.temperature_c is None else self.temperature_c[lo:hi]
         return dataclasses.replace(
-            self, rate_dph=self.rate_dph[lo:hi], t0_s=self.t0_s + lo * self.dt_s, notes=self.notes + (note,)
+            self, rate_dph=self.rate_dph[lo:hi], t0_s=self.t0_s + lo * self.dt_s, notes=self.notes + (note,),
+            temperature_c=temp,
         )
 
     # -- averaging -----------------------------------------------------------------------------
@@ -297,8 +315,9 @@ class GyroRecord:
         avg = block_average(self.rate_dph, m)
         dropped = n - avg.shape[0] * m
         note = f"block-averaged x{m} ({self.dt_s:.10g} s -> {m * self.dt_s:.10g} s), dropped {dropped} trailing samples"
+        temp = None if self.temperature_c is None else block_average(self.temperature_c, m)
         return dataclasses.replace(self, rate_dph=avg, dt_s=m * self.dt_s, notes=self.notes + (note,),
-                                   block_average_factor=self.block_average_factor * m)
+                                   block_average_factor=self.block_average_factor * m, temperature_c=temp)
 
     def metadata(self) -> dict:
         """JSON-serialisable description (no arrays): every field but the data, plus sizes.
@@ -308,9 +327,14 @@ class GyroRecord:
         dict
             ``source, sha256, input_unit, declared_units (list), scale_to_dph, rate_unit
             ("deg/h"), dt_s, fs_hz, native_fs_hz, block_average_factor, t0_s, n_samples,
-            n_axes, duration_s, axis_names (list), notes (list)``.  ``fs_hz`` is the
-            effective rate after block averaging; ``native_fs_hz`` the rate as loaded.
+            n_axes, duration_s, axis_names (list), notes (list), temperature``.  ``fs_hz`` is
+            the effective rate after block averaging; ``native_fs_hz`` the rate as loaded;
+            ``temperature`` is None or the range and drift of the temperature carried with the
+            log (:meth:`fogdrift.temperature.TemperatureSummary.to_dict`, deg C and deg C/h).
         """
+        from ..temperature import temperature_summary
+
+        temp = None if self.temperature_c is None else temperature_summary(self.temperature_c, self.dt_s).to_dict()
         return {
             "source": self.source,
             "sha256": self.sha256,
@@ -328,6 +352,7 @@ class GyroRecord:
             "duration_s": self.duration_s,
             "axis_names": list(self.axis_names),
             "notes": list(self.notes),
+            "temperature": temp,
         }
 
     def __repr__(self) -> str:

@@ -76,12 +76,33 @@ class ReaderSpec:
         return importlib.import_module(name).open_table(path, **options)
 
 
-#: The formats fogdrift reads, in the order magic bytes are tried.
+def _looks_like_mseed(head: bytes) -> bool:
+    """miniSEED 2 fixed header (see :func:`fogdrift.io.readers.mseed.looks_like_mseed`; no import of ObsPy)."""
+    return (len(head) >= 48 and all(c in b"0123456789 " for c in head[:6]) and head[6:7] in (b"D", b"R", b"Q", b"M")
+            and head[7:8] in (b" ", b"\x00"))
+
+
+_BAG_OPTIONS = ("topic", "stamp", "temperature")
+
+#: The formats fogdrift reads, in the order magic bytes (then sniffers) are tried; text is last.
 READERS: tuple[ReaderSpec, ...] = (
     ReaderSpec("npy", "npy", magic=(b"\x93NUMPY",), extensions=(".npy",),
                description="NumPy .npy array"),
     ReaderSpec("npz", "npz", magic=(b"PK\x03\x04", b"PK\x05\x06"), extensions=(".npz",),
                description="NumPy .npz archive"),
+    ReaderSpec("hdf5", "hdf5", magic=(b"\x89HDF\r\n\x1a\n",), extensions=(".h5", ".hdf5", ".hdf", ".he5"),
+               options=("dataset",), description="HDF5 file (h5py, extra [hdf5])"),
+    ReaderSpec("mat", "matlab", magic=(b"MATLAB",), extensions=(".mat",), options=("variable",),
+               description="MATLAB .mat v4/v5/v7 (scipy) or v7.3 (h5py)"),
+    ReaderSpec("rosbag1", "rosbag", magic=(b"#ROSBAG V2.0",), extensions=(".bag",), options=_BAG_OPTIONS,
+               description="ROS 1 bag (rosbags, extra [ros])"),
+    ReaderSpec("rosbag2", "rosbag", magic=(b"\x89MCAP0\r\n", b"SQLite format 3\x00"), extensions=(".db3", ".mcap"),
+               options=_BAG_OPTIONS, directory_marker="metadata.yaml",
+               description="ROS 2 bag directory (rosbags, extra [ros])"),
+    ReaderSpec("mseed", "mseed", extensions=(".mseed", ".miniseed", ".msd"), options=("gain", "temperature"),
+               sniff=_looks_like_mseed, description="miniSEED (ObsPy, extra [seismo])"),
+    ReaderSpec("binary", "binary", options=("layout", "scale", "header_bytes", "sequence"),
+               description="raw binary records, chosen by giving their layout= (or format='binary')"),
     ReaderSpec("text", "text", magic=(b"\x1f\x8b",),
                extensions=(".csv", ".txt", ".tsv", ".dat", ".log", ".gz"), options=("delimiter",),
                sniff=_looks_like_text, description="CSV/TXT text, optionally gzip"),

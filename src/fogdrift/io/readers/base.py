@@ -13,6 +13,7 @@ and the same for every format.
 
 from __future__ import annotations
 
+import importlib
 import re
 import zipfile
 import zlib
@@ -20,9 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import DataFormatError
+from ...errors import ConfigError, DataFormatError
 
-__all__ = ["Table", "split_unit_label", "numeric_column", "describe_exception", "PARSER_ERRORS"]
+__all__ = ["Table", "split_unit_label", "numeric_column", "describe_exception", "PARSER_ERRORS",
+           "require", "MissingDependencyError"]
 
 #: What third-party parsers (numpy.load, zipfile, gzip) raise on corrupt bytes; readers turn
 #: these into a DataFormatError naming the file.  RuntimeError covers zipfile's "encrypted"
@@ -32,6 +34,40 @@ PARSER_ERRORS = (ValueError, TypeError, KeyError, OSError, EOFError, OverflowErr
                  zlib.error, zipfile.BadZipFile)
 
 _UNIT_LABEL = re.compile(r"^(?P<name>.*?)\s*\[\s*(?P<unit>[^\[\]]*?)\s*\]$")
+
+
+class MissingDependencyError(ConfigError):
+    """A reader's optional dependency is not installed; the message names the extra to install."""
+
+
+def require(module: str, extra: str, what: str):
+    """Import ``module`` for a reader, or raise :class:`MissingDependencyError` naming the extra.
+
+    Parameters
+    ----------
+    module : str
+        Module to import (``"h5py"``, ``"rosbags.highlevel"``).
+    extra : str
+        The fogdrift extra that installs it (``"hdf5"``, ``"ros"``, ``"seismo"``, ``"fleet"``).
+    what : str
+        What needs it, for the message (``"reading HDF5 files"``).
+
+    Examples
+    --------
+    >>> require("math", "none", "arithmetic").sqrt(4.0)
+    2.0
+    >>> require("no_such_module_xyz", "hdf5", "reading HDF5 files")
+    Traceback (most recent call last):
+    ...
+    fogdrift.io.readers.base.MissingDependencyError: reading HDF5 files needs the Python package 'no_such_module_xyz', which is not installed; install it with: pip install 'fogdrift[hdf5]'
+    """
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        raise MissingDependencyError(
+            f"{what} needs the Python package {module.split('.')[0]!r}, which is not installed; "
+            f"install it with: pip install 'fogdrift[{extra}]'"
+        ) from exc
 
 
 def split_unit_label(label: str) -> tuple[str, str | None]:
@@ -104,7 +140,24 @@ class Table:
     -----
     Subclasses override :meth:`read` (parse on demand, e.g. only the used columns of a text
     file), :meth:`line_of` (text: physical line of a data row), :meth:`label` and
-    :meth:`describe`.  ``row_kind`` names a row in messages ("sample"; "message" for a bag).
+    :meth:`describe`.  ``row_kind`` names a row in messages ("sample"; "message" for a bag,
+    "record" for raw binary).
+
+    Optional attributes a reader may set after construction:
+
+    ``time_ticks`` : ndarray of int64, shape (n_rows,)
+        Sample counts from a sequence counter (raw binary): the time of row ``i`` is
+        ``time_ticks[i] * dt_s`` once the sample interval is known, so a counter jump is a gap
+        handled like a time gap.  Used when there is no time column and no ``time_s``;
+        ``tick_column`` (the counter's column index) locates time errors found on it.
+    ``non_rate`` : set of str
+        Columns never taken as rate data by default (a sequence counter).
+    ``unit_hint`` : str or None
+        How to supply the rate unit in this format when neither the caller nor the file gives
+        one: :func:`fogdrift.io.load` never guesses it and raises a ConfigError with this text
+        (instead of the text reader's "declare it in the header" advice).
+    ``extra_notes`` : list of str
+        Provenance for the record's notes (absolute start time, gain used, ...).
     """
 
     format = "table"
@@ -122,6 +175,11 @@ class Table:
         self.data = data
         self.time_s = time_s
         self.sha256 = sha256
+        self.time_ticks = None
+        self.tick_column = None
+        self.non_rate = set()
+        self.unit_hint = None
+        self.extra_notes = []
         if len(self.units) != len(self.names):
             raise ValueError(f"reader bug: {len(self.units)} units for {len(self.names)} columns")
         dup = next((a for j, a in enumerate(self.names) if a in self.names[:j]), None)

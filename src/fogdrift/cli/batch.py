@@ -1,0 +1,136 @@
+"""``fogdrift batch``: one command over many logs on Dask, with a Parquet summary and a fleet page.
+
+The library side is :mod:`fogdrift.fleet`; ``--command`` takes a name of its command table
+(:data:`fogdrift.fleet.COMMANDS`), so a new batch command is one row there and needs nothing here.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+import typing
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+from ..errors import ConfigError
+from ._app import (FLAGS, LOAD_PARAMS, EstOpt, FitTausOpt, LoadOptions, OutliersOpt, StatisticOpt, TausOpt, TermsOpt,
+                   app, csv_list, err_console, parse_fit_taus, parse_taus, parse_terms, precheck, run, say)
+
+FLAGS.update({"glob": "--glob", "command": "--command", "scheduler": "--scheduler", "workers": "--workers"})
+
+
+def _with_reader_options(func):
+    """Add the shared reading options (all of LOAD_PARAMS but the file argument); the command gets ``load``."""
+    sig = inspect.signature(func)
+    hints = typing.get_type_hints(func, include_extras=True)
+    own = [p.replace(annotation=hints.get(p.name, p.annotation)) for p in sig.parameters.values() if p.name != "load"]
+    shared = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=ann)
+              for name, ann, default in LOAD_PARAMS[1:]]
+
+    @functools.wraps(func)
+    def wrapper(**kwargs):
+        opts = LoadOptions(file=Path("."), **{name: kwargs.pop(name) for name, _, _ in LOAD_PARAMS[1:]})
+        return func(load=opts, **kwargs)
+
+    wrapper.__signature__ = sig.replace(parameters=[own[0]] + [p.replace(kind=inspect.Parameter.KEYWORD_ONLY)
+                                                               for p in own[1:]] + shared)
+    return wrapper
+
+
+def _set_items(items) -> dict:
+    out = {}
+    for item in items or []:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ConfigError(f"--set must look like NAME=VALUE (an analysis setting), got {item!r}")
+        text = value.strip()
+        for conv in (int, float):
+            try:
+                out[key.strip()] = conv(text)
+                break
+            except ValueError:
+                continue
+        else:
+            out[key.strip()] = None if text.lower() == "none" else text
+    return out
+
+
+DEFAULT_OUT = Path("out/batch")
+
+
+def _command_help() -> str:
+    from ..fleet.commands import COMMANDS  # light: the table, not the commands' libraries
+
+    return "Command per file: " + "; ".join(f"{c.name} ({c.description})" for c in COMMANDS.values()) + "."
+
+
+@app.command()
+@_with_reader_options
+def batch(
+    inputs: Annotated[list[Path], typer.Argument(help="Logs, folders (with --glob), ROS 2 bag folders or wildcards.")],
+    load,
+    glob: Annotated[Optional[str], typer.Option("--glob", help="Files to take inside folders, e.g. '*.csv.gz'.")]
+    = None,
+    command: Annotated[str, typer.Option("--command", help=_command_help())] = "allan",
+    scheduler: Annotated[Optional[str], typer.Option(
+        "--scheduler", help="Dask scheduler address (tcp://host:8786) of an existing cluster; 'serial' for no Dask. "
+                            "Default: a local cluster of worker processes.")] = None,
+    workers: Annotated[Optional[int], typer.Option("--workers", help="Worker processes of the local cluster "
+                                                                     "(default: the machine's cores).")] = None,
+    estimator: EstOpt = "overlapping",
+    taus: TausOpt = "octave",
+    terms: TermsOpt = "",
+    statistic: StatisticOpt = "adev",
+    outliers: OutliersOpt = "warn",
+    fit_taus: FitTausOpt = ":",
+    models: Annotated[Optional[str], typer.Option("--models", help="analyze: drift models (default: all).")] = None,
+    model_rate: Annotated[Optional[float], typer.Option("--model-rate", help="analyze: modelling rate [Hz].")] = None,
+    epochs: Annotated[Optional[int], typer.Option("--epochs", help="analyze: training epochs.")] = None,
+    seed: Annotated[Optional[int], typer.Option("--seed", help="analyze: random seed.")] = None,
+    set_: Annotated[Optional[list[str]], typer.Option(
+        "--set", help="Any other analysis setting NAME=VALUE (fogdrift.pipeline.AnalysisConfig), repeatable.")] = None,
+    fail_on_error: Annotated[bool, typer.Option("--fail-on-error", help="Exit 1 if any file failed.")] = False,
+    out: Annotated[Path, typer.Option("--out", help="Batch folder: one folder per file, summary.parquet, "
+                                                    "fleet.html.")] = DEFAULT_OUT,
+):
+    """Run allan, noise or analyze over many logs x axes on Dask; write summary.parquet and a fleet page."""
+    from ..fleet import BatchOutputDir, command_spec, run_batch
+
+    with run("batch", out, default_out=DEFAULT_OUT, inputs=list(inputs), expect=("summary.parquet", "fleet.html"),
+             out_class=BatchOutputDir):
+        command_spec(command)
+        if load.gaps not in ("error", "longest"):
+            raise ConfigError(f"{{opt:gaps}} must be 'error' or 'longest' in a batch, got {load.gaps!r}")
+        term_list = parse_terms(terms)
+        precheck(estimator=estimator, terms=term_list)
+        analysis = {"taus": parse_taus(taus), "estimator": estimator, "fit_tau_s": list(parse_fit_taus(fit_taus)),
+                    "terms": None if term_list is None else list(term_list), "statistic": statistic,
+                    "outliers": outliers}
+        if command == "analyze":
+            extra = {"models": csv_list(models), "model_rate_hz": model_rate, "epochs": epochs, "seed": seed}
+            analysis.update({k: v for k, v in extra.items() if v is not None})
+        analysis.update(_set_items(set_))
+        kwargs = {k: v for k, v in load.load_kwargs().items() if v not in (None, {})}
+        settings = {"load": kwargs, "gaps": load.gaps, "analysis": analysis}
+        with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                      console=err_console, transient=True) as bar:
+            task = bar.add_task(f"batch {command}", total=None)
+
+            def progress(done, total, name):
+                bar.update(task, completed=done, total=total, description=f"batch {command}: {name}")
+
+            result = run_batch(inputs, out, command=command, settings=settings, pattern=glob, scheduler=scheduler,
+                               workers=workers, progress=progress, flags=FLAGS)
+        say(f"{result.n_files} files on {result.scheduler} in {result.wall_s:.1f} s: {result.n_ok} done, "
+            f"{result.n_cached} unchanged (skipped), {result.n_error} failed")
+        for row in result.rows:
+            if row.get("status") == "error":
+                say(f"  {row['file']}: {row.get('error')}", style="red")
+        say(f"summary: {result.summary_path}")
+        if result.page_path is not None:
+            say(f"fleet page: {result.page_path}")
+        if fail_on_error and result.n_error:
+            raise typer.Exit(code=1)

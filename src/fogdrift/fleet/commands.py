@@ -1,0 +1,211 @@
+"""The commands ``fogdrift batch`` can run over many logs: one row of :data:`COMMANDS` each.
+
+A command is a function ``run(record, settings, out_dir) -> list[dict]`` that calls the same library and
+report functions as the single command (so each file's folder holds what ``fogdrift allan`` or ``fogdrift
+analyze`` would write there) and returns one summary row per axis (:mod:`.summary` names the columns; a
+noise fit fills them with :func:`noise_columns`).  It runs inside the file's own
+:class:`~fogdrift.output.OutputDir`, so every file it writes through :func:`~fogdrift.output.atomic_path`
+(as the report functions do) is complete or absent.  Adding a command (the GMWM ``noise`` command, when it
+lands) is one function and one row of :data:`COMMANDS`::
+
+    def run_noise_command(record, settings, out_dir):
+        results = ...                       # the calls `fogdrift noise` makes, writing into out_dir
+        return [{"axis": a.name, **record_columns(record), **noise_columns(a.noise)} for a in results]
+
+    COMMANDS["noise"] = CommandSpec("noise", run_noise_command, "GMWM noise model of every axis")
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from ..errors import ConfigError
+
+__all__ = ["CommandSpec", "COMMANDS", "command_spec", "noise_columns", "record_columns", "run_allan_command",
+           "run_analyze_command", "TERMS"]
+
+#: IEEE-952 coefficients in the summary, with the unit suffix of their columns.
+TERMS = (("Q", "urad"), ("N", "dprh"), ("B", "dph"), ("K", "dphrh"), ("R", "dph2"))
+
+
+@dataclass(frozen=True)
+class CommandSpec:
+    """One batch command.
+
+    Parameters
+    ----------
+    name : str
+        ``--command`` value.
+    run : callable
+        ``run(record, settings: dict, out_dir: Path) -> list[dict]``: writes the command's files into
+        ``out_dir`` and returns one row per axis (keys: columns of :data:`fogdrift.fleet.summary.COLUMNS`).
+    description : str
+        For ``--help`` and messages.
+    """
+
+    name: str
+    run: Callable
+    description: str = ""
+
+
+def _f(x):
+    if x is None:
+        return None
+    x = float(x)
+    return x if x == x and abs(x) != float("inf") else None
+
+
+def record_columns(record) -> dict:
+    """Summary columns that describe the record (duration, rate, unit, temperature)."""
+    meta = record.metadata()
+    row = {"n_samples": record.n_samples, "duration_s": record.duration_s, "rate_hz": record.fs_hz,
+           "input_unit": record.input_unit, "t0_s": record.t0_s}
+    temp = meta.get("temperature")
+    for key in ("min_c", "max_c", "range_c", "change_c", "slope_c_per_h"):
+        row[f"temperature_{key}"] = None if temp is None else _f(temp[key])
+    return row
+
+
+def noise_columns(noise) -> dict:
+    """Summary columns of one noise fit (:class:`fogdrift.noise.NoiseFit`).
+
+    Each coefficient with its 95 % interval and status (``resolved``, ``unresolved``, ``absent`` with
+    ``hi95`` its upper bound, ``not_estimable``); the selected model (``noise_model``, e.g. ``"N+B+K"``)
+    and the plausible ones; the fit's quality, chi-squared, dof, p-value and tau range; the IEEE reading of
+    the bias instability at the curve's minimum.
+    """
+    row = {}
+    for name, unit in TERMS:
+        term = noise.terms[name]
+        row[f"{name}_{unit}"] = _f(term.value)
+        row[f"{name}_lo95_{unit}"] = _f(term.lo95)
+        row[f"{name}_hi95_{unit}"] = _f(term.hi95)
+        row[f"{name}_status"] = str(term.status)
+    b = noise.b_min or {}
+    row.update(statistic=str(noise.statistic), noise_model="+".join(noise.selected) or "none",
+               plausible_models="; ".join(noise.plausible) or None, fit_quality=str(noise.quality),
+               fit_chi2_red=_f(noise.chi2_red), fit_dof=int(noise.dof), fit_p_value=_f(noise.p_value),
+               fit_n_points=int(len(noise.fit_tau_s)), fit_tau_min_s=_f(noise.tau_min_s),
+               fit_tau_max_s=_f(noise.tau_max_s), b_min_dph=_f(b.get("value")), b_min_tau_s=_f(b.get("tau_s")),
+               b_min_bound_only=None if b.get("value") is None else bool(b.get("bound_only")),
+               outliers=None if not noise.outliers else int(noise.outliers.get("count") or 0))
+    return row
+
+
+def _config(settings: dict):
+    from ..pipeline import AnalysisConfig
+
+    return AnalysisConfig(**settings.get("analysis", {})).validate()
+
+
+def run_allan_command(record, settings: dict, out_dir) -> list[dict]:
+    """``fogdrift allan`` on one record: ``allan.json``, ``allan.csv``, ``allan.png`` and one row per axis.
+
+    The same calls as the ``allan`` command (:func:`fogdrift.pipeline.run_allan`,
+    :func:`fogdrift.report.write_allan_outputs`), so the files are the ones it writes.
+    """
+    from ..pipeline import run_allan
+    from ..report import write_allan_outputs
+
+    results = run_allan(record, _config(settings))
+    write_allan_outputs(results, record, out_dir)
+    return [{"axis": a.name, **record_columns(record), **noise_columns(a.noise)} for a in results]
+
+
+def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
+    """``fogdrift analyze`` on one record: the heading-error and artefact evaluation (on by default, as in the
+    single command), ``report.html``, ``analysis.json``, the model ``bundle/``, the compensated test block per
+    axis (``compensated_test_<axis>.csv``) and one row per axis with the verdicts."""
+    from ..bundle import write_bundle
+    from ..compensate.test_block import write_compensated_test_block
+    from ..evaluation import evaluate_analysis
+    from ..pipeline import run_analysis
+    from ..report import verdict, write_report
+
+    cfg = _config(settings)
+    result = run_analysis(record, cfg)
+    evaluations = {ev.axis: ev for ev in evaluate_analysis(result)}
+    write_report(result, record, out_dir, evaluated=True)
+    write_bundle(Path(out_dir) / "bundle", [ax.models for ax in result.axes], cfg, record)
+    write_compensated_test_block([ax.models for ax in result.axes], out_dir, t0_s=record.t0_s)
+    rows = []
+    for ax in result.axes:
+        ev = evaluations.get(ax.name)
+        rows.append({"axis": ax.name, **record_columns(record), **noise_columns(ax.original.noise),
+                     "verdict": " ".join(verdict(ax.models)),
+                     "compensation_outcome": None if ev is None else str(ev.outcome),
+                     "compensation_headline": None if ev is None else " ".join(ev.headline.lines)})
+    return rows
+
+
+#: The batch commands (``--command``); the GMWM ``noise`` command will be one more row.
+def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
+    """``fogdrift noise`` (GMWM, its defaults: model selection by WIC) on one record: ``noise.json``,
+    ``wvar.csv``, ``noise.png`` and one row per axis.
+
+    The same calls as the ``noise`` command (:func:`fogdrift.gmwm.analysis.analyse_gmwm`,
+    :func:`fogdrift.report_gmwm.write_gmwm_outputs`).  Row: each IEEE-952 coefficient the selected model
+    implies with its 95 % interval (``resolved`` when the interval excludes zero, ``absent`` when the model
+    has no such term), the selected model, the J test's p-value (``fit_quality`` ``good`` when every check
+    passed, else ``poor``) and the bias instability at the AVAR minimum implied by the model.
+    """
+    from ..gmwm.analysis import analyse_gmwm
+    from ..report_gmwm import write_gmwm_outputs
+
+    axes = [analyse_gmwm(name, record.axis(name), record.dt_s) for name in record.axis_names]
+    write_gmwm_outputs(axes, out_dir, source=str(record.source), record=record.metadata())
+    return [{"axis": a.name, **record_columns(record), **gmwm_columns(a)} for a in axes]
+
+
+def gmwm_columns(axis) -> dict:
+    """Summary columns of one GMWM axis (:class:`fogdrift.gmwm.analysis.GmwmAxis`)."""
+    sel = axis.selection
+    ie = sel.ieee
+    row = {"statistic": "wvar"}
+    for name, unit in TERMS:
+        term = ie.terms.get(f"{name}_{unit}")
+        if term is None and name == "B" and ie.b_gm is not None:
+            b = ie.b_gm
+            value, lo, hi = b.value_dph, b.lo95_dph, b.hi95_dph
+        elif term is None:
+            value = lo = hi = None
+        else:
+            value, lo, hi = term.value, term.lo95, term.hi95
+        row[f"{name}_{unit}"] = _f(value)
+        row[f"{name}_lo95_{unit}"] = _f(lo)
+        row[f"{name}_hi95_{unit}"] = _f(hi)
+        row[f"{name}_status"] = ("absent" if value is None else
+                                 "resolved" if lo is not None and lo > 0 else "unresolved")
+    b = ie.b_min
+    fit = sel.fit
+    row.update(noise_model=str(sel.selected), fit_quality="good" if sel.passed_checks else "poor",
+               fit_dof=int(fit.df), fit_p_value=_f(fit.j_pvalue),
+               fit_n_points=int(len(axis.wvar.scale_s) - len(sel.excluded)),
+               b_min_dph=_f(getattr(b, "value_dph", None)), b_min_tau_s=_f(getattr(b, "tau_s", None)),
+               b_min_bound_only=None if b is None else bool(b.flagged))
+    return row
+
+
+COMMANDS: dict[str, CommandSpec] = {
+    "allan": CommandSpec("allan", run_allan_command, "Allan variance and IEEE-952 coefficients of every axis"),
+    "analyze": CommandSpec("analyze", run_analyze_command,
+                           "the whole method (separation, drift models, compensation) with an HTML report"),
+    "noise": CommandSpec("noise", run_noise_command, "GMWM noise model of every axis (fogdrift noise)"),
+}
+
+
+def command_spec(name: str) -> CommandSpec:
+    """The :data:`COMMANDS` row of ``name``; ConfigError listing the commands otherwise.
+
+    Examples
+    --------
+    >>> command_spec("allan").name
+    'allan'
+    """
+    try:
+        return COMMANDS[name]
+    except (KeyError, TypeError):
+        raise ConfigError(f"unknown batch command {name!r}; expected one of {list(COMMANDS)} in {{opt:command}}") \
+            from None

@@ -1,0 +1,468 @@
+"""Run one command over many logs on Dask: inputs, settings hash, scheduling, the summary and the fleet page.
+
+Scheduling (``scheduler``):
+
+* ``None`` (default): a local Dask cluster of worker *processes*, one per core (``workers`` to change it),
+  one thread each; numeric libraries inside a worker get ``cores // workers`` threads so that workers do
+  not oversubscribe the machine.  The cluster listens on 127.0.0.1 only and has no dashboard.
+* ``"tcp://HOST:8786"``: an existing cluster (``dask scheduler`` + ``dask worker`` on other machines); the
+  workers need fogdrift installed and must see the input and output paths (a shared file system).
+* ``"serial"``: no Dask, a loop in this process (debugging; the benchmark's reference).
+
+Each file is one task (:func:`fogdrift.fleet.tasks.run_file`); a task that fails, or a worker that dies,
+becomes an error row, never a crashed batch.  Results are collected as they finish (``progress``).
+
+Outputs: the batch folder is a :class:`BatchOutputDir` (a :class:`fogdrift.output.OutputDir` that also
+counts the files whose folders are finished); each file's folder is its own ``OutputDir`` (written by the
+worker, ``batch.json`` last); ``summary.parquet`` and ``fleet.html`` are written through
+:func:`~fogdrift.output.atomic_path` after every file has finished.  An interruption (Ctrl-C,
+:mod:`fogdrift.interrupt`) stops the batch: finished folders stay complete (a re-run skips them), unfinished
+ones have no ``batch.json``, and no summary or page is written.  Local workers ignore SIGINT (a Ctrl-C in
+the terminal reaches the whole process group): the batch process alone decides, and its workers end with it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import glob as _glob
+import hashlib
+import json
+import logging
+import os
+import re
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from .. import interrupt
+from ..errors import ConfigError
+from ..io.readers.base import require
+from ..output import OutputDir, active
+from .commands import command_spec
+from .summary import COLUMNS, write_summary
+from .tasks import MANIFEST, FileTask, run_file
+
+__all__ = ["BatchResult", "BatchOutputDir", "run_batch", "find_inputs", "settings_sha256", "SUMMARY", "PAGE"]
+
+#: Seconds to wait for an existing cluster's scheduler (``scheduler="tcp://..."``) before giving up.
+CONNECT_TIMEOUT_S = 20.0
+
+#: File names written into the batch folder.
+SUMMARY = "summary.parquet"
+PAGE = "fleet.html"
+
+
+@dataclass
+class BatchResult:
+    """What :func:`run_batch` did."""
+
+    rows: list
+    summary_path: Path
+    page_path: Path | None
+    n_files: int
+    n_ok: int
+    n_cached: int
+    n_error: int
+    wall_s: float
+    scheduler: str
+    notes: list = field(default_factory=list)
+
+
+class BatchOutputDir(OutputDir):
+    """The batch folder: an :class:`~fogdrift.output.OutputDir` whose :meth:`summary` also says which files'
+    folders are finished (the workers write those, each as its own ``OutputDir``).
+
+    :func:`run_batch` calls :meth:`start` with the number of files and :meth:`finished_file` as each
+    file's folder is complete; the CLI's Ctrl-C line is :meth:`summary`.
+    """
+
+    def __init__(self, path, **kwargs):
+        super().__init__(path, **kwargs)
+        self.tasks: list = []
+        self.finished: list[str] = []
+        self._t0 = 0.0
+
+    def start(self, tasks) -> None:
+        """The batch's :class:`~fogdrift.fleet.tasks.FileTask` list (before any is run)."""
+        self.tasks = list(tasks)
+        self.finished = []
+        self._t0 = time.time()
+
+    def finished_file(self, rel_out: str) -> None:
+        """A task's result arrived (its folder holds ``batch.json``, or it was unchanged)."""
+        if rel_out not in self.finished:
+            self.finished.append(rel_out)
+
+    def finished_files(self) -> list[str]:
+        """Folders finished in this run: reported, or holding a ``batch.json`` of these settings written since
+        the batch started (a worker may have finished a file its result has not yet reached us for)."""
+        done = list(self.finished)
+        for t in self.tasks:
+            if t.rel_out in done:
+                continue
+            man = Path(t.out_dir) / MANIFEST
+            try:
+                fresh = man.stat().st_mtime >= self._t0 - 1.0
+                same = fresh and json.loads(man.read_text()).get("settings_sha256") == t.settings_sha256
+            except (OSError, ValueError, AttributeError):
+                same = False
+            if same:
+                done.append(t.rel_out)
+        return done
+
+    def summary(self) -> str:
+        if not self.tasks:
+            return super().summary()
+        finished = self.finished_files()
+        k, n = len(finished), len(self.tasks)
+        shown = ", ".join(finished[:4]) + (f" and {k - 4} more" if k > 4 else "")
+        text = (f"{k} of {n} files finished" + (f" ({shown}: their folders in {self.path} are complete and a "
+                                                   "re-run skips them)" if k else "")
+                + (f"; {n - k} not finished (no batch.json: a re-run computes them)" if k < n else ""))
+        top = [name for name in (SUMMARY, PAGE) if name not in self.written]
+        if top:
+            earlier = " (the earlier run's are unchanged)" if any((self.path / t).exists() for t in top) else ""
+            text += f"; {' and '.join(top)} not written{earlier}"
+        return text + "; no partial file left"
+
+
+def settings_sha256(command: str, settings: dict) -> str:
+    """SHA-256 of the command and its settings as canonical JSON (key order does not matter).
+
+    Examples
+    --------
+    >>> settings_sha256("allan", {"a": 1, "b": 2}) == settings_sha256("allan", {"b": 2, "a": 1})
+    True
+    """
+    text = json.dumps({"command": command, "settings": settings}, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def _is_bag_dir(p: Path) -> bool:
+    return p.is_dir() and (p / "metadata.yaml").is_file()
+
+
+def find_inputs(inputs, pattern: str | None = None) -> list[Path]:
+    """Input files from paths, directories (searched recursively with ``pattern``) and unexpanded wildcards.
+
+    A ROS 2 bag directory (holding ``metadata.yaml``) is one input.  The result is sorted and free of
+    duplicates.
+
+    Raises
+    ------
+    ConfigError
+        No inputs, a path that does not exist, a directory without ``pattern``, or nothing found.
+    """
+    found = []
+    if not inputs:
+        raise ConfigError("no inputs; expected log files, folders (with {opt:glob}) or wildcards")
+    for item in inputs:
+        p = Path(item)
+        if _is_bag_dir(p):
+            found.append(p)
+        elif p.is_dir():
+            if not pattern:
+                raise ConfigError(f"{p} is a folder; pass {{opt:glob}} (e.g. '*.csv.gz') to choose its files")
+            found += [q for q in p.rglob(pattern) if q.is_file() or _is_bag_dir(q)]
+        elif p.exists():
+            if pattern is None or p.match(pattern):
+                found.append(p)
+        elif any(c in str(item) for c in "*?["):
+            found += [Path(q) for q in _glob.glob(str(item), recursive=True)]
+        else:
+            raise ConfigError(f"input {str(item)!r} does not exist; expected a file, a folder or a wildcard")
+    out = sorted({q.resolve() for q in found})
+    if not out:
+        raise ConfigError(f"no input files found in {list(map(str, inputs))}"
+                          + (f" matching {pattern!r}" if pattern else ""))
+    return out
+
+
+def _names(paths: list[Path]) -> list[str]:
+    """Display names relative to the inputs' common folder (unique, as long as the paths are)."""
+    parents = [str(p.parent) for p in paths]
+    common = Path(os.path.commonpath(parents)) if len(paths) > 1 else paths[0].parent
+    return [p.relative_to(common).as_posix() for p in paths]
+
+
+def _folder(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", name.replace("/", "__"))
+
+
+def _worker_env(n_workers: int) -> dict:
+    threads = str(max(1, (os.cpu_count() or 1) // max(1, n_workers)))
+    return {k: threads for k in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
+
+
+def _error_rows(task: FileTask, exc: BaseException) -> list[dict]:
+    return [{"file": task.file, "path": task.path, "command": task.command, "out_dir": task.rel_out,
+             "settings_sha256": task.settings_sha256, "status": "error",
+             "error": f"{type(exc).__name__}: {exc} (the task or its worker failed)", "wall_s": 0.0}]
+
+
+def run_batch(inputs, out_dir, *, command: str = "allan", settings: dict | None = None, pattern: str | None = None,
+              scheduler: str | None = None, workers: int | None = None, page: bool = True,
+              progress: Callable | None = None, flags: dict | None = None) -> BatchResult:
+    """Run ``command`` over every input; write per-file folders, ``summary.parquet`` and ``fleet.html``.
+
+    Parameters
+    ----------
+    inputs : sequence of str or Path
+        Files, folders (with ``pattern``), ROS 2 bag directories or wildcards.
+    out_dir : str or Path
+        Batch folder: ``<out_dir>/<file>/`` per input (as the single command writes it, plus
+        ``batch.json``), ``summary.parquet`` and ``fleet.html``.  Checked before any work; its parent
+        must exist.
+    command : str
+        A name of :data:`fogdrift.fleet.commands.COMMANDS` (``"allan"``, ``"analyze"``).
+    settings : dict, optional
+        ``{"load": {...keywords of fogdrift.io.load...}, "gaps": "error"|"longest", "analysis":
+        {...fields of fogdrift.pipeline.AnalysisConfig...}}``; validated before any work.
+    pattern : str, optional
+        Glob for the files inside folders (``"*.csv.gz"``); also filters explicit files.
+    scheduler : None, "serial" or str
+        See the module docstring: local process cluster, in-process loop, or a scheduler address.
+    workers : int, optional
+        Workers of the local cluster (default: the machine's cores).
+    page : bool
+        Write ``fleet.html``.
+    progress : callable, optional
+        ``progress(done, total, file)`` after each file.
+    flags : dict, optional
+        How error messages spell a setting (``{"unit": "--unit"}``; default ``unit=``).
+
+    Returns
+    -------
+    BatchResult
+
+    Raises
+    ------
+    ConfigError
+        Unknown command, invalid settings, no inputs, a bad output folder, or a scheduler that cannot
+        be reached.
+    fogdrift.interrupt.Interrupted
+        An interruption was requested (see the module docstring for what is left on disk).
+    """
+    t0 = time.perf_counter()
+    spec = command_spec(command)
+    settings = json.loads(json.dumps(settings or {}, default=str))     # plain, picklable, hashable
+    _validate(settings)
+    paths = find_inputs(inputs, pattern)
+    own = active(out_dir)
+    if own is not None and own.path == Path(out_dir).expanduser().absolute():
+        frame = contextlib.nullcontext(own)      # the caller's frame (the CLI) already holds the folder
+    else:
+        frame = BatchOutputDir(out_dir, command=f"batch {spec.name}", create_parents=False, protect=paths)
+    with frame as od:
+        return _run(od, paths, spec, settings, scheduler, workers, page, progress, flags, t0)
+
+
+def _run(od, paths, spec, settings, scheduler, workers, page, progress, flags, t0) -> BatchResult:
+    out = od.path
+    digest = settings_sha256(spec.name, settings)
+    names = _names(paths)
+    tasks = [FileTask(path=str(p), file=n, out_dir=str(out / _folder(n)), rel_out=_folder(n), command=spec.name,
+                      settings=settings, settings_sha256=digest, flags=flags) for p, n in zip(paths, names)]
+    results: dict[int, list] = {}
+    if isinstance(od, BatchOutputDir):
+        od.start(tasks)
+    od.expect(SUMMARY, *((PAGE,) if page else ()))
+
+    def done(i, rows):
+        results[i] = rows
+        if isinstance(od, BatchOutputDir) and (Path(tasks[i].out_dir) / MANIFEST).exists():
+            od.finished_file(tasks[i].rel_out)
+        if progress is not None:
+            progress(len(results), len(tasks), tasks[i].file)
+        interrupt.check()
+
+    interrupt.check()
+    if scheduler == "serial":
+        used = "serial (in-process loop)"
+        for i, task in enumerate(tasks):
+            done(i, run_file(task))
+    else:
+        used = _run_dask(tasks, scheduler, workers, done)
+    rows = [{name: row.get(name) for name, _, _ in COLUMNS} for i in range(len(tasks)) for row in results[i]]
+    summary = write_summary(rows, out / SUMMARY)
+    page_path = None
+    if page:
+        from .page import write_fleet_page
+
+        page_path = write_fleet_page(rows, out / PAGE, command=spec.name, settings=settings)
+    status = [r.get("status") for i in range(len(tasks)) for r in results[i][:1]]
+    return BatchResult(rows=rows, summary_path=summary, page_path=page_path, n_files=len(tasks),
+                       n_ok=status.count("ok"), n_cached=status.count("cached"), n_error=status.count("error"),
+                       wall_s=time.perf_counter() - t0, scheduler=used)
+
+
+def _validate(settings: dict) -> None:
+    unknown = set(settings) - {"load", "gaps", "analysis"}
+    if unknown:
+        raise ConfigError(f"unknown batch settings {sorted(unknown)}; expected load, gaps, analysis")
+    if settings.get("gaps", "error") not in ("error", "longest"):
+        raise ConfigError(f"gaps must be 'error' or 'longest'; got {settings.get('gaps')!r} in {{opt:gaps}}")
+    from ..io.load import _options
+    from ..pipeline import AnalysisConfig
+
+    load = dict(settings.get("load", {}))
+    import inspect
+
+    from ..io import load as load_fn
+
+    allowed = set(inspect.signature(load_fn).parameters) - {"path", "gaps"}
+    if set(load) - allowed:
+        raise ConfigError(f"unknown load settings {sorted(set(load) - allowed)}; expected some of {sorted(allowed)}")
+    try:
+        _options(load.get("columns"), load.get("time_column", "auto"), load.get("dt_s"), load.get("rate_hz"),
+                 load.get("unit"), load.get("time_unit"), load.get("delimiter"), "error", load.get("min_samples", 2),
+                 load.get("format"), load.get("reader_options"), load.get("temperature"))
+    except TypeError as exc:
+        raise ConfigError(f"invalid load settings {load!r}: {exc}") from None
+    try:
+        AnalysisConfig(**settings.get("analysis", {})).validate()
+    except TypeError as exc:
+        raise ConfigError(f"unknown analysis setting: {exc}") from None
+
+
+def _quiet_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker (if this process has none yet) with its leak warning off.
+
+    The local cluster's process handles hold semaphores; when a Ctrl-C ends this process before the cluster
+    has closed, the tracker removes them, as it should, and would print a ``UserWarning`` about "leaked
+    semaphore objects" to the terminal after the one ``interrupted:`` line.  The tracker takes its warning
+    filters from this process's ``sys.warnoptions`` when it starts.
+    """
+    import sys
+    from multiprocessing import resource_tracker
+
+    if getattr(resource_tracker._resource_tracker, "_fd", None) is not None:  # already running: leave it
+        return
+    saved = list(sys.warnoptions)
+    sys.warnoptions.append("ignore:resource_tracker:UserWarning")
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        sys.warnoptions[:] = saved
+
+
+def _ignore_sigint() -> bool:
+    """In a local worker process: ignore SIGINT (the batch process alone handles Ctrl-C; see the module docstring)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        return True
+    return False
+
+
+def _run_dask(tasks, scheduler, workers, done) -> str:
+    distributed = require("distributed", "fleet", "running a batch on Dask")
+    cluster = client = None
+    interrupted = False
+    muted = {}
+    try:
+        if scheduler:
+            try:
+                client = distributed.Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S:g}s")
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise ConfigError(f"cannot reach the Dask scheduler {scheduler!r}: {exc}; check {{opt:scheduler}}") \
+                    from None
+            used = f"Dask cluster at {scheduler}"
+        else:
+            n = int(workers or os.cpu_count() or 1)
+            if n < 1:
+                raise ConfigError(f"workers must be >= 1; got {workers!r} in {{opt:workers}}")
+            with _sigint_blocked_for_children():
+                _quiet_resource_tracker()
+                cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                                   host="127.0.0.1", dashboard_address=None,
+                                                   silence_logs=logging.ERROR, env=_worker_env(n))
+                client = distributed.Client(cluster)
+                client.run(_ignore_sigint)               # each worker process's main thread
+            used = f"local Dask cluster, {n} worker processes"
+        interrupt.check()                                # a Ctrl-C while the cluster started
+        futures = {client.submit(run_file, t, pure=False, key=f"fogdrift-{i}-{t.settings_sha256[:8]}"): i
+                   for i, t in enumerate(tasks)}
+        for fut in distributed.as_completed(futures):
+            i = futures[fut]
+            try:
+                rows = fut.result()
+            except Exception as exc:  # noqa: BLE001 -- a killed worker, a lost task: an error row
+                rows = _error_rows(tasks[i], exc)
+            done(i, rows)
+    except KeyboardInterrupt:
+        interrupted = True
+        # the in-process scheduler would log the gather the interruption cut short ("Couldn't gather keys")
+        # as an ERROR after the one interrupted: line; the batch is over, say nothing more
+        muted = {name: logging.getLogger(name).level for name in ("distributed", "tornado")}
+        for name in muted:
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+        if cluster is not None:                      # our own workers: stop them now, then tidy their folders
+            _kill_workers(cluster)
+            _remove_temporaries(tasks)
+        raise
+    finally:
+        _close(client, cluster, quick=interrupted)
+        for name, level in muted.items():          # closed: a library caller's logging as it was
+            logging.getLogger(name).setLevel(level)
+    return used
+
+
+@contextlib.contextmanager
+def _sigint_blocked_for_children():
+    """Block SIGINT in this thread while the local cluster starts, so that the threads it creates, and the
+    processes they spawn, start with SIGINT blocked: a Ctrl-C in the terminal (sent to the whole process
+    group) then never reaches a worker that is still importing (it would print a traceback).  This process
+    still gets the signal (another thread takes it; the interruption flag is checked right after)."""
+    import signal
+    import threading
+
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _kill_workers(cluster) -> None:
+    """SIGKILL the worker processes of a local cluster (their tasks cannot be stopped any other way)."""
+    import signal
+
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        with contextlib.suppress(Exception):
+            os.kill(nanny.process.process.pid, signal.SIGKILL)
+
+
+def _remove_temporaries(tasks) -> None:
+    """Remove the temporary files killed workers left in the files' folders (never a complete file)."""
+    from ..output import TMP_PREFIX
+
+    for task in tasks:
+        folder = Path(task.out_dir)
+        for tmp in (folder.rglob(TMP_PREFIX + "*") if folder.is_dir() else ()):
+            if tmp.is_file() and not tmp.name.startswith(f"{TMP_PREFIX}{os.getpid()}-"):
+                with contextlib.suppress(OSError):
+                    tmp.unlink()
+
+
+def _close(client, cluster, *, quick: bool) -> None:
+    """Close the client and the local cluster; after an interruption, without waiting for running tasks.
+
+    The local workers are child processes that end when this process does (distributed's parent-alive
+    pipe), so a quick close never leaves a worker behind.
+    """
+    kwargs = {"timeout": 2} if quick else {}
+    if client is not None:
+        with contextlib.suppress(Exception):
+            if quick and client.futures:
+                client.cancel(list(client.futures.values()), force=True)
+            client.close(**kwargs)
+    if cluster is not None:
+        with contextlib.suppress(Exception):
+            cluster.close(**kwargs)

@@ -1,0 +1,131 @@
+"""Ctrl-C during ``fogdrift batch``: one line, exit 130, finished per-file folders complete (a re-run skips
+them), unfinished ones without ``batch.json``, no temporary file, and no new (half-written) summary or page.
+
+In process (serial scheduler, the interruption requested between two files) and, marked slow, a real SIGINT
+to a real ``fogdrift batch`` on a local Dask cluster of two worker processes.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fogdrift import interrupt
+from fogdrift.fleet import run_batch
+from fogdrift.fleet.tasks import MANIFEST as BATCH_JSON
+from fogdrift.interrupt import Interrupted
+from fogdrift.output import MANIFEST, TMP_PREFIX
+
+pytest.importorskip("pyarrow")
+
+
+@pytest.fixture(autouse=True)
+def _clean_flag():
+    interrupt.reset()
+    yield
+    interrupt.reset()
+
+
+def _logs(folder: Path, n: int, samples: int, seed: int) -> list[Path]:
+    rng = np.random.default_rng(seed)
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for k in range(n):
+        p = folder / f"unit{k}.npy"
+        np.save(p, rng.normal(0.0, 1.0, samples))
+        paths.append(p)
+    return paths
+
+
+def _assert_folders_consistent(out: Path) -> list[str]:
+    """No temporary file anywhere; every per-file folder with batch.json holds exactly the files its OutputDir
+    manifest records, each complete.  Returns the finished folders."""
+    assert [p for p in out.rglob("*") if p.name.startswith(TMP_PREFIX)] == []
+    finished = []
+    for folder in sorted(p for p in out.iterdir() if p.is_dir()):
+        if not (folder / BATCH_JSON).exists():
+            continue
+        finished.append(folder.name)
+        recorded = json.loads((folder / MANIFEST).read_text())["files"]
+        on_disk = sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*")
+                         if p.is_file() and p.name != MANIFEST)
+        assert on_disk == sorted(recorded)
+        assert {"allan.json", "allan.csv", "allan.png", BATCH_JSON} <= set(on_disk)
+        json.loads((folder / "allan.json").read_text())
+        assert (folder / "allan.png").read_bytes()[-8:-4] == b"IEND"
+    return finished
+
+
+def test_interruption_between_files_keeps_finished_folders_and_the_earlier_summary(tmp_path):
+    settings = {"load": {"unit": "deg/h", "rate_hz": 100.0}}
+    files = _logs(tmp_path / "in", 3, 4000, seed=31)
+    out = tmp_path / "out"
+    run_batch(files[:2], out, settings=settings, scheduler="serial")
+    summary_before = (out / "summary.parquet").read_bytes()
+    page_before = (out / "fleet.html").read_bytes()
+
+    seen = []
+
+    def progress(done, total, name):
+        seen.append(name)
+        if done == 2:                       # the third file is new: Ctrl-C before it starts
+            interrupt.request()
+
+    with pytest.raises(Interrupted):
+        run_batch(files, out, settings=settings, scheduler="serial", progress=progress)
+    assert seen == ["unit0.npy", "unit1.npy"]
+    assert _assert_folders_consistent(out) == ["unit0.npy", "unit1.npy"]
+    assert not (out / "unit2.npy" / BATCH_JSON).exists()
+    # the summary and the page are the earlier run's, byte for byte (never half-written, never of a partial run)
+    assert (out / "summary.parquet").read_bytes() == summary_before
+    assert (out / "fleet.html").read_bytes() == page_before
+
+    interrupt.reset()
+    res = run_batch(files, out, settings=settings, scheduler="serial")
+    assert {r["file"]: r["status"] for r in res.rows} == {"unit0.npy": "cached", "unit1.npy": "cached",
+                                                          "unit2.npy": "ok"}
+
+
+BOOT = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); sys.argv[0] = 'fogdrift'; "
+        "from fogdrift.cli import main; main()")
+
+
+@pytest.mark.slow
+def test_ctrl_c_during_a_local_dask_batch(tmp_path):
+    files = _logs(tmp_path / "in", 6, 400_000, seed=32)
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-c", BOOT, "batch", *map(str, files), "--unit", "deg/h", "--rate",
+                             "100", "--workers", "2", "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 300
+        while not list(out.glob(f"*/{BATCH_JSON}")) and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert proc.poll() is None, "the batch ended before the signal; the test needs longer files"
+        t0 = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+        seconds = time.monotonic() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 130, err
+    assert seconds < 5.0, seconds                     # measured 0.06 s; the workers are killed, not waited for
+    err_lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(err_lines) == 1, err
+    assert "Traceback" not in err and "leaked" not in err
+    m = re.match(r"interrupted: (\d) of 6 files finished", err_lines[0])
+    assert m, err_lines[0]
+    assert "summary.parquet and fleet.html not written" in err_lines[0]
+    finished = _assert_folders_consistent(out)
+    assert len(finished) == int(m.group(1)) >= 1
+    assert not (out / "summary.parquet").exists() and not (out / "fleet.html").exists()
