@@ -142,8 +142,10 @@ class _Context:
                 # relative to the stand-in random walk's own mean: the stand-in lends the ramp its *relative*
                 # scatter; dividing its variance by the (much smaller, short-tau) ramp mean instead made every
                 # estimate look like ~0.1 EDF, so that any model -- even 10^5 x the data -- "fitted"
-                mu = mu + self.X[:, _NAMES.index("K")] * (extra / TERM_TABLE["K"].avar_coefficient
-                                                         * self.laws["K"].scale(self.dt))
+                # (the mean of the spectrum actually used: the ramp's own part replaced by the stand-in's)
+                ir = _NAMES.index("R")
+                mu = mu - self.X[:, ir] * A[ir] + self.X[:, _NAMES.index("K")] * (
+                    extra / TERM_TABLE["K"].avar_coefficient * self.laws["K"].scale(self.dt))
         spec = ieee_spectrum(a_allan, self.dt)
         V = estimator_covariance(self.m, self.n, spec, statistic=self.statistic)
         if exact_ramp and a_allan[4] > 0 and self.statistic != "hdev":  # per-sample units: A_R dt^2
