@@ -91,12 +91,12 @@ def test_describe_models_lists_every_row_in_order():
 
 def test_removed_alias_modules_are_gone_and_unknown_attributes_raise():
     # fogdrift.grey and fogdrift.baselines were compatibility aliases of fogdrift.models.grey / .ar;
-    # nothing imported them any more, so they were removed (issue 8). fogdrift.elman stays while the
-    # README's example imports it.
+    # nothing imported them any more, so they were removed (issue 8), as was fogdrift.elman.
     import importlib.util
 
     assert importlib.util.find_spec("fogdrift.grey") is None
     assert importlib.util.find_spec("fogdrift.baselines") is None
+    assert importlib.util.find_spec("fogdrift.elman") is None
     with pytest.raises(AttributeError):
         models.NoSuchModel  # noqa: B018
 
