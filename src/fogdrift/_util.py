@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import DataFormatError, InsufficientDataError
+from .errors import ConfigError, DataFormatError, InsufficientDataError
 
 
 def check_series(y, name: str = "y", *, min_length: int = 1, allow_2d: bool = False, needed_by: str = "",
