@@ -145,7 +145,8 @@ def load_model(path) -> DriftModel:
     Raises
     ------
     ModelFileError
-        Missing or corrupt file, another format version, or a class the registry does not know.
+        Missing or corrupt file, another format version, a class the registry does not know, or
+        parameters/state that do not describe a fitted model of that class.
     """
     base = Path(path)
     if base.suffix in (".json", ".npz"):
@@ -174,6 +175,20 @@ def load_model(path) -> DriftModel:
         raise ModelFileError(f"{npz_path}: model array file not found") from None
     except (ValueError, OSError) as exc:
         raise ModelFileError(f"{npz_path}: cannot read arrays ({exc})") from exc
-    model = cls(**doc.get("params", {}))
-    model._set_state(doc.get("state", {}), arrays)
+    params, state = doc.get("params", {}), doc.get("state")
+    if not isinstance(params, dict):
+        raise ModelFileError(f"{json_path}: 'params' must be an object, not {type(params).__name__}")
+    if not isinstance(state, dict):
+        raise ModelFileError(f"{json_path}: no fitted state (the 'state' object is missing or not an object)")
+    try:
+        model = cls(**params)
+    except TypeError as exc:
+        raise ModelFileError(f"{json_path}: parameters do not fit a {cls.__name__} ({exc})") from exc
+    try:
+        model._set_state(state, arrays)
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise ModelFileError(
+            f"{json_path}: the stored state does not describe a fitted {cls.__name__} "
+            f"(missing or malformed {exc!s}); save the model again"
+        ) from exc
     return model
