@@ -23,9 +23,15 @@ def test_boundaries_accepted(n_phase, m):
 
 
 @pytest.mark.parametrize("n_phase, m, what", [
-    (2, 1, "n_phase"), (2.5, 1, "n_phase"), (5, 3, "m must be"), (9, 5, "m must be"), (10, 5, "m must be"),
+    (2, 1, "n_phase"), (2.5, 1, "n_phase"), (10.5, 1, "n_phase must be an integer >= 3, got 10.5"), (5, 3, "m must be"), (9, 5, "m must be"), (10, 5, "m must be"),
     (9, 0, "m must be"), (9, 1.5, "m must be"),
 ])
 def test_boundaries_refused(n_phase, m, what):
     with pytest.raises(ConfigError, match=what):
         edf_simple(n_phase, m, 0)
+
+
+def test_m_refusal_states_the_valid_range():
+    with pytest.raises(ConfigError) as err:
+        edf_simple(10, 5, 0)
+    assert str(err.value) == "m must be an integer in [1, (n_phase-1)/2] = [1, 4.5], got 5"

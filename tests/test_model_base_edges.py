@@ -88,9 +88,20 @@ def test_model_file_holds_exactly_the_documented_keys(tmp_path):
 
 def test_numpy_scalars_in_the_state_are_written_as_json_numbers(tmp_path):
     m = Persistence().fit([1.0])
-    m.last_ = np.float64(0.5)
+    m.last_ = np.float32(0.5)  # not a Python float subclass (np.float64 is): needs the json default hook
     json_path, _ = m.save(tmp_path / "p")
     assert json.loads(json_path.read_text())["state"] == {"last_": 0.5}
+
+
+@pytest.mark.parametrize(
+    ("given", "stem"),
+    [("drift.v2", "drift.v2"), ("drift.v2.json", "drift.v2"), ("drift.npz", "drift"), ("drift", "drift")],
+)
+def test_other_suffixes_are_part_of_the_name(tmp_path, given, stem):
+    json_path, npz_path = Persistence().fit([0.4]).save(tmp_path / given)
+    assert (json_path.name, npz_path.name) == (f"{stem}.json", f"{stem}.npz")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([f"{stem}.json", f"{stem}.npz"])
+    assert load_model(tmp_path / given).last_ == 0.4
 
 
 def test_load_through_the_class_checks_the_stored_class(tmp_path):

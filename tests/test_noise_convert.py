@@ -47,6 +47,10 @@ def test_single_term_conversion(statistic, consts, dt_s, term):
     assert out["Q_arcsec"] == pytest.approx(want_arcsec, rel=1e-12, abs=0.0)
 
 
+def test_default_terms_of_each_statistic():
+    assert default_terms() == default_terms("adev") == ORDER == default_terms("mdev")
+
+
 def test_hadamard_has_no_rate_ramp():
     out = coefficients_from_A([1.0, 1.0, 1.0, 1.0, 1.0], statistic="hdev")
     assert "R" not in out and default_terms("hdev") == ("Q", "N", "B", "K")
@@ -63,7 +67,7 @@ def test_modified_needs_the_sample_interval():
 
 @pytest.mark.parametrize(
     "A",
-    [[0, 0, 0, 0, -1e-12], [0, 0, 0, 0], [0, 0, 0, 0, 0, 0], [0, 0, float("nan"), 0, 0], [0, float("inf"), 0, 0, 0]],
+    [[0, 0, 0, 0, -1e-12], [None, 0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0, 0, 0], [0, 0, float("nan"), 0, 0], [0, float("inf"), 0, 0, 0]],
 )
 def test_bad_A_is_refused(A):
     with pytest.raises(ConfigError, match=r"A must be 5 finite non-negative numbers A_-2..A_2"):

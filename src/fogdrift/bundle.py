@@ -391,6 +391,7 @@ def load_bundle(path) -> Bundle:
     """
     from .lifting import MODES, max_level, wavelist
     from .models import load_model, model_spec
+    from .models.base import model_file_paths
     from .units import INCREMENT_UNITS, RATE_UNITS
 
     p = Path(path)
@@ -462,8 +463,7 @@ def load_bundle(path) -> Bundle:
                 d.fail(f"{wm}class", f"{key!r} is a {spec.cls}, got {cls!r}")
             sums = d.get(entry, "sha256", dict, wm)
             base = root / rel
-            for ext in ("json", "npz"):
-                f = base.with_suffix("." + ext)
+            for ext, f in zip(("json", "npz"), model_file_paths(base)):
                 if not f.is_file():
                     raise ModelFileError(f"{f}: model file of {name}/{key} is missing")
                 if sums.get(ext) != _sha256(f):

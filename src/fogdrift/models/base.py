@@ -34,7 +34,7 @@ from ..errors import ConfigError, ModelFileError, NotFittedError
 from ..output import atomic_path
 from .registry import class_for_file, file_class_names
 
-__all__ = ["DriftModel", "load_model", "check_series", "FORMAT_VERSION"]
+__all__ = ["DriftModel", "load_model", "model_file_paths", "check_series", "FORMAT_VERSION"]
 
 #: Version of the model-file layout (JSON keys and NPZ array names); unchanged since the first release.
 FORMAT_VERSION = 1
@@ -100,9 +100,7 @@ class DriftModel:
     def save(self, path) -> tuple[Path, Path]:
         """Write ``<path>.json`` and ``<path>.npz``; returns both paths."""
         self._check_fitted()
-        base = Path(path)
-        if base.suffix in (".json", ".npz"):
-            base = base.with_suffix("")
+        json_path, npz_path = model_file_paths(path)
         meta, arrays = self._get_state()
         doc = {
             "format": "fogdrift-model",
@@ -111,8 +109,6 @@ class DriftModel:
             "params": self._serialisable_params(),
             "state": meta,
         }
-        json_path = base.with_suffix(".json")
-        npz_path = base.with_suffix(".npz")
         # each file complete or absent (temporary name, renamed when written): fogdrift.output.atomic_path
         with atomic_path(json_path) as tmp:
             tmp.write_text(json.dumps(doc, indent=2, default=json_default))
@@ -127,6 +123,25 @@ class DriftModel:
         if not isinstance(model, cls):
             raise ModelFileError(f"{path}: holds a {type(model).__name__}, not a {cls.__name__}")
         return model
+
+
+def model_file_paths(path) -> tuple[Path, Path]:
+    """The two files of a model saved under ``path``: ``(<base>.json, <base>.npz)``.
+
+    A ``.json`` or ``.npz`` suffix of ``path`` is dropped; any other suffix is part of the name
+    (``drift.v2`` -> ``drift.v2.json``, not ``drift.json``).
+
+    Examples
+    --------
+    >>> [p.name for p in model_file_paths("models/drift.v2")]
+    ['drift.v2.json', 'drift.v2.npz']
+    >>> [p.name for p in model_file_paths("models/drift.npz")]
+    ['drift.json', 'drift.npz']
+    """
+    base = Path(path)
+    if base.suffix in (".json", ".npz"):
+        base = base.with_suffix("")
+    return base.with_name(base.name + ".json"), base.with_name(base.name + ".npz")
 
 
 def load_model(path) -> DriftModel:
@@ -148,10 +163,7 @@ def load_model(path) -> DriftModel:
         Missing or corrupt file, another format version, a class the registry does not know, or
         parameters/state that do not describe a fitted model of that class.
     """
-    base = Path(path)
-    if base.suffix in (".json", ".npz"):
-        base = base.with_suffix("")
-    json_path, npz_path = base.with_suffix(".json"), base.with_suffix(".npz")
+    json_path, npz_path = model_file_paths(path)
     try:
         doc = json.loads(json_path.read_text())
     except FileNotFoundError:
