@@ -200,3 +200,40 @@ def test_noise_command_gmwm_rows_against_the_simulated_white_noise(tmp_path):
         assert status == "resolved" and "WN" in model and stat == "wvar"
     assert {"noise.json", "wvar.csv", "noise.png", "batch.json"} <= {p.name for p in (out / "u0.npy").iterdir()}
     assert (out / "fleet.html").is_file()
+
+
+def test_noise_command_passes_model_scales_and_robust_like_fogdrift_noise(tmp_path):
+    # the batch row and files must be those of `fogdrift noise` with the same --model/--scales/--robust
+    rng = np.random.default_rng(21)
+    x = rng.normal(0.0, 10.0, 20_000) + np.cumsum(rng.normal(0.0, 0.05, 20_000))
+    f = tmp_path / "u.npy"
+    np.save(f, x)
+    opts = ["--model", "WN+RW", "--scales", "8", "--robust"]
+    out = tmp_path / "b"
+    res = runner.invoke(app, ["batch", str(f), "--unit", "deg/h", "--rate", "100", "--command", "noise", *opts,
+                              "--scheduler", "serial", "--out", str(out)])
+    assert res.exit_code == 0, res.output + repr(res.exception)
+    single = tmp_path / "s"
+    res = runner.invoke(app, ["noise", str(f), "--unit", "deg/h", "--rate", "100", *opts, "--out", str(single)])
+    assert res.exit_code == 0, res.output + repr(res.exception)
+    want = json.loads((single / "noise.json").read_text())
+    got = json.loads((out / "u.npy" / "noise.json").read_text())
+    assert got["axes"] == want["axes"]
+    (row,) = duckdb.sql(f"SELECT noise_model, fit_n_points FROM '{out / 'summary.parquet'}'").fetchall()
+    assert row[0] == "WN+RW" and row[1] <= 8
+    manifest = json.loads((out / "u.npy" / "batch.json").read_text())
+    assert manifest["settings"]["gmwm"] == {"model": "WN+RW", "levels": 8, "robust": True}
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--command", "allan", "--model", "WN+RW"], "--model, --scales and --robust are options of --command noise"),
+    (["--command", "analyze", "--robust"], "--model, --scales and --robust are options of --command noise"),
+    (["--command", "noise", "--model", "WN+XX"], "XX"),
+    (["--command", "noise", "--scales", "0"], "--scales must be an integer >= 1; got 0"),
+])
+def test_gmwm_options_refused_in_one_line_before_reading(tmp_path, args, message):
+    out = tmp_path / "o"
+    res = runner.invoke(app, ["batch", str(tmp_path / "missing.npy"), "--unit", "deg/h", "--rate", "100", *args,
+                              "--scheduler", "serial", "--out", str(out)])
+    assert res.exit_code != 0 and message in res.output, res.output
+    assert "Traceback" not in res.output and not (out / "summary.parquet").exists()

@@ -18,6 +18,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from ..errors import ConfigError
 from ._app import (FLAGS, LOAD_PARAMS, EstOpt, FitTausOpt, LoadOptions, OutliersOpt, StatisticOpt, TausOpt, TermsOpt,
                    app, csv_list, err_console, parse_fit_taus, parse_taus, parse_terms, precheck, run, say)
+from .noise import ModelOpt, RobustOpt, ScalesOpt
 
 FLAGS.update({"glob": "--glob", "command": "--command", "scheduler": "--scheduler", "workers": "--workers"})
 
@@ -90,6 +91,9 @@ def batch(
     model_rate: Annotated[Optional[float], typer.Option("--model-rate", help="analyze: modelling rate [Hz].")] = None,
     epochs: Annotated[Optional[int], typer.Option("--epochs", help="analyze: training epochs.")] = None,
     seed: Annotated[Optional[int], typer.Option("--seed", help="analyze: random seed.")] = None,
+    model: ModelOpt = "auto",
+    scales: ScalesOpt = None,
+    robust: RobustOpt = False,
     set_: Annotated[Optional[list[str]], typer.Option(
         "--set", help="Any other analysis setting NAME=VALUE (fogdrift.pipeline.AnalysisConfig), repeatable.")] = None,
     fail_on_error: Annotated[bool, typer.Option("--fail-on-error", help="Exit 1 if any file failed.")] = False,
@@ -113,8 +117,16 @@ def batch(
             extra = {"models": csv_list(models), "model_rate_hz": model_rate, "epochs": epochs, "seed": seed}
             analysis.update({k: v for k, v in extra.items() if v is not None})
         analysis.update(_set_items(set_))
+        gmwm = {"model": model, "levels": scales, "robust": robust}
+        if command != "noise" and (model.lower() != "auto" or scales is not None or robust):
+            raise ConfigError("{opt:model}, {opt:scales} and {opt:robust} are options of --command noise (GMWM); "
+                              f"got --command {command}")
+        if scales is not None and scales < 1:
+            raise ConfigError(f"{{opt:scales}} must be an integer >= 1; got {scales}")
         kwargs = {k: v for k, v in load.load_kwargs().items() if v not in (None, {})}
         settings = {"load": kwargs, "gaps": load.gaps, "analysis": analysis}
+        if command == "noise":  # only what was given: a default run keeps the settings hash of earlier runs
+            settings["gmwm"] = {k: v for k, v in gmwm.items() if v not in (None, False, "auto")}
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                       console=err_console, transient=True) as bar:
             task = bar.add_task(f"batch {command}", total=None)

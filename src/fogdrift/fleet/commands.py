@@ -140,10 +140,12 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     return rows
 
 
-#: The batch commands (``--command``); the GMWM ``noise`` command will be one more row.
 def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
-    """``fogdrift noise`` (GMWM, its defaults: model selection by WIC) on one record: ``noise.json``,
-    ``wvar.csv``, ``noise.png`` and one row per axis.
+    """``fogdrift noise`` (GMWM) on one record: ``noise.json``, ``wvar.csv``, ``noise.png`` and one row per axis.
+
+    ``settings["gmwm"]`` holds the options of ``fogdrift noise`` (``model``: ``"auto"`` = selection by WIC,
+    or a fixed model such as ``"WN+RW+GM"``; ``levels``: the number of scales J; ``robust``: Huber WV);
+    missing keys take that command's defaults.
 
     The same calls as the ``noise`` command (:func:`fogdrift.gmwm.analysis.analyse_gmwm`,
     :func:`fogdrift.report_gmwm.write_gmwm_outputs`).  Row: each IEEE-952 coefficient the selected model
@@ -154,7 +156,10 @@ def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
     from ..gmwm.analysis import analyse_gmwm
     from ..report_gmwm import write_gmwm_outputs
 
-    axes = [analyse_gmwm(name, record.axis(name), record.dt_s) for name in record.axis_names]
+    opts = settings.get("gmwm", {})
+    axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=opts.get("model", "auto"),
+                         levels=opts.get("levels"), robust=bool(opts.get("robust", False)))
+            for name in record.axis_names]
     write_gmwm_outputs(axes, out_dir, source=str(record.source), record=record.metadata())
     return [{"axis": a.name, **record_columns(record), **gmwm_columns(a)} for a in axes]
 

@@ -298,9 +298,20 @@ def _run(od, paths, spec, settings, scheduler, workers, page, progress, flags, t
 
 
 def _validate(settings: dict) -> None:
-    unknown = set(settings) - {"load", "gaps", "analysis"}
+    unknown = set(settings) - {"load", "gaps", "analysis", "gmwm"}
     if unknown:
-        raise ConfigError(f"unknown batch settings {sorted(unknown)}; expected load, gaps, analysis")
+        raise ConfigError(f"unknown batch settings {sorted(unknown)}; expected load, gaps, analysis, gmwm")
+    gmwm = settings.get("gmwm", {})
+    if set(gmwm) - {"model", "levels", "robust"}:
+        raise ConfigError(f"unknown gmwm settings {sorted(set(gmwm) - {'model', 'levels', 'robust'})}; "
+                          "expected some of ['levels', 'model', 'robust']")
+    if gmwm:
+        from ..gmwm.analysis import candidates_for
+
+        candidates_for(gmwm.get("model", "auto"))
+        levels = gmwm.get("levels")
+        if levels is not None and (not isinstance(levels, int) or levels < 1):
+            raise ConfigError(f"{{opt:scales}} must be an integer >= 1; got {levels!r}")
     if settings.get("gaps", "error") not in ("error", "longest"):
         raise ConfigError(f"gaps must be 'error' or 'longest'; got {settings.get('gaps')!r} in {{opt:gaps}}")
     from ..io.load import _options
