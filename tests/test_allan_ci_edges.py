@@ -35,3 +35,13 @@ def test_m_refusal_states_the_valid_range():
     with pytest.raises(ConfigError) as err:
         edf_simple(10, 5, 0)
     assert str(err.value) == "m must be an integer in [1, (n_phase-1)/2] = [1, 4.5], got 5"
+
+
+def test_safe_variant_returns_one_outside_the_table_and_the_formula_inside():
+    from fogdrift.allan.ci import edf_formula, edf_simple_safe
+
+    assert edf_simple_safe(2, 1, 0) == 1.0 and edf_simple_safe(2.9, 0.5, 0) == 1.0   # fewer than 3 phase points
+    assert edf_simple_safe(5, 2.5, 0) == 1.0 and edf_simple_safe(10, 5, -2) == 1.0   # 2m > N - 1
+    assert edf_simple_safe(3, 1, 0) == pytest.approx(28.0 / 27.0, rel=1e-12)         # smallest valid case
+    assert edf_simple_safe(5, 2, 0) == edf_formula(5.0, 2.0, 0)                       # 2m = N - 1 is valid
+    assert edf_simple_safe(10.5, 2.5, -1) == edf_formula(10.5, 2.5, -1)               # non-integer (fast)

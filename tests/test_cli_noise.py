@@ -130,6 +130,14 @@ def test_analyze_noise_method_gmwm_end_to_end(bundled_path, tmp_path):
         ref["selection"]["ieee"]["terms"]["N_dprh"]["value"], rel=1e-9)
     html = (tmp_path / "an" / "report.html").read_text()
     assert "Noise model by GMWM" in html and g["selected"] in html
+    # the first screen's headline is the GMWM model's, with the Allan N beside it as a cross-check
+    head = doc["report_summary"]["noise"]
+    assert head["headers"][0] == "whole record, native rate (GMWM)"
+    rows = {r[0]: r[1] for r in head["rows"]}
+    n_ref = ref["selection"]["ieee"]["terms"]["N_dprh"]
+    assert rows["N angle random walk [deg/√h]"].startswith(f"{n_ref['value']:.4g} [{n_ref['lo95']:.3g}, ")
+    assert rows["selected noise model (WIC)"].startswith(ref["selected"] + " (checks ")
+    assert rows["cross-check: Allan fit N [deg/√h]"] != "–"
     result = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--models", "persistence",
                                  "--noise-method", "kalman", "--out", str(tmp_path / "bad")])
     assert result.exit_code == 1 and "--noise-method" in result.output

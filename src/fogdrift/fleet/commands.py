@@ -169,20 +169,13 @@ def gmwm_columns(axis) -> dict:
     sel = axis.selection
     ie = sel.ieee
     row = {"statistic": "wvar"}
+    terms = axis.ieee_terms()
     for name, unit in TERMS:
-        term = ie.terms.get(f"{name}_{unit}")
-        if term is None and name == "B" and ie.b_gm is not None:
-            b = ie.b_gm
-            value, lo, hi = b.value_dph, b.lo95_dph, b.hi95_dph
-        elif term is None:
-            value = lo = hi = None
-        else:
-            value, lo, hi = term.value, term.lo95, term.hi95
-        row[f"{name}_{unit}"] = _f(value)
-        row[f"{name}_lo95_{unit}"] = _f(lo)
-        row[f"{name}_hi95_{unit}"] = _f(hi)
-        row[f"{name}_status"] = ("absent" if value is None else
-                                 "resolved" if lo is not None and lo > 0 else "unresolved")
+        t = terms[name]
+        row[f"{name}_{unit}"] = _f(t.value)
+        row[f"{name}_lo95_{unit}"] = _f(t.lo95)
+        row[f"{name}_hi95_{unit}"] = _f(t.hi95)
+        row[f"{name}_status"] = t.status
     b = ie.b_min
     fit = sel.fit
     row.update(noise_model=str(sel.selected), fit_quality="good" if sel.passed_checks else "poor",

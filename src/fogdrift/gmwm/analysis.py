@@ -30,7 +30,7 @@ from .processes import parse_model
 from .selection import SelectionResult, select_model
 from .wvar import WvarResult, from_curve, haar_wvar
 
-__all__ = ["J_CAVEAT", "GmwmAxis", "analyse_gmwm", "analyse_wvar", "candidates_for", "read_curve", "ieee_rows"]
+__all__ = ["J_CAVEAT", "GmwmAxis", "GmwmTerm", "analyse_gmwm", "analyse_wvar", "candidates_for", "read_curve", "ieee_rows"]
 
 #: What the J statistic may and may not be read as (shown next to it in every output).
 J_CAVEAT = ("the J test over-rejects (V is evaluated at the step-1 estimate and the asymptotics are "
@@ -42,6 +42,16 @@ _IEEE_ORDER = (("N_dprh", "N"), ("K_dphrh", "K"), ("R_dph2", "R"), ("Q_urad", "Q
                ("B_dph", "B (flicker)"))
 
 
+@dataclass(frozen=True)
+class GmwmTerm:
+    """One IEEE-952 term as a GMWM model implies it (the fields a report cell and a summary row need)."""
+
+    value: float | None
+    lo95: float | None
+    hi95: float | None
+    status: str
+
+
 @dataclass
 class GmwmAxis:
     """GMWM analysis of one axis: the wavelet variance and the model selection on it."""
@@ -49,6 +59,30 @@ class GmwmAxis:
     name: str
     wvar: WvarResult
     selection: SelectionResult
+
+    def ieee_terms(self) -> dict:
+        """The five IEEE-952 terms the selected model implies, as :class:`GmwmTerm` keyed Q, N, B, K, R.
+
+        Units as :data:`fogdrift.noise.TERM_UNITS` (Q urad, N deg/sqrt(h), B deg/h, K deg/h^1.5, R deg/h^2).
+        B is the flicker term when the model has one, else the Gauss-Markov reading (rule a of
+        :mod:`fogdrift.gmwm.ieee`) when it has a GM; ``status`` is ``resolved`` when the 95 % interval
+        excludes zero, ``unresolved`` when it does not, ``absent`` when the model has no such term.
+        """
+        from ..noise.terms import TERM_TABLE
+
+        ie = self.selection.ieee
+        out = {}
+        for name, spec in TERM_TABLE.items():
+            term = ie.terms.get(name + spec.suffix)
+            if term is None and name == "B" and ie.b_gm is not None:
+                value, lo, hi = ie.b_gm.value_dph, ie.b_gm.lo95_dph, ie.b_gm.hi95_dph
+            elif term is None:
+                value = lo = hi = None
+            else:
+                value, lo, hi = term.value, term.lo95, term.hi95
+            status = "absent" if value is None else "resolved" if lo is not None and lo > 0 else "unresolved"
+            out[name] = GmwmTerm(value, lo, hi, status)
+        return out
 
     def to_dict(self) -> dict:
         sel = self.selection

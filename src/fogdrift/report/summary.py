@@ -71,7 +71,9 @@ def noise_headline(result) -> tuple:
     from ..noise import TERM_TABLE
 
     axes = list(result.axes)
-    headers = ["whole record, native rate"] + [f"axis {ax.name}" for ax in axes]
+    if axes and all(getattr(ax, "gmwm", None) is not None for ax in axes):
+        return _gmwm_headline(axes)
+    headers = ["whole record, native rate (Allan fit)"] + [f"axis {ax.name}" for ax in axes]
     fits = [ax.original.noise for ax in axes]
     rows = []
     for name in HEADLINE_TERMS:
@@ -84,6 +86,48 @@ def noise_headline(result) -> tuple:
                                                for f in fits])
     rows.append(["fitted τ range [s]"] + [f"{_fmt(f.tau_min_s, 3)} – {_fmt(f.tau_max_s, 3)}" for f in fits])
     return headers, rows
+
+
+def _gmwm_headline(axes) -> tuple:
+    """The headline table of ``analyze --noise-method gmwm``: the terms the selected GMWM model implies, its
+    checks and J test, the scales it used, and the Allan fit's N beside it as a cross-check."""
+    from ..noise import TERM_TABLE
+
+    headers = ["whole record, native rate (GMWM)"] + [f"axis {ax.name}" for ax in axes]
+    terms = [ax.gmwm.ieee_terms() for ax in axes]
+    rows = []
+    for name in HEADLINE_TERMS:
+        spec = TERM_TABLE[name]
+        label = f"{spec.header.split(' [')[0]} {spec.long_name} [{spec.header.split('[')[1]}"
+        if name == "B":
+            label = "B bias instability (flicker term, else the GM reading) [deg/h]"
+        rows.append([label] + [term_text(t[name]) for t in terms])
+    cells = []
+    for ax in axes:
+        b = ax.gmwm.selection.ieee.b_min
+        cells.append("–" if b is None else f"{_fmt(b.value_dph, 3)} at τ = {_fmt(b.tau_s, 3)} s"
+                     + (" (beyond N·dt/4: extrapolated)" if b.flagged else ""))
+    rows.append(["B_min, ADEV minimum of the fitted model [deg/h]"] + cells)
+    rows.append(["selected noise model (WIC)"] + [f"{ax.gmwm.selection.selected} ("
+                                                   + ("checks passed" if ax.gmwm.selection.passed_checks
+                                                      else "checks failed: see the axis section") + ")"
+                                                   for ax in axes])
+    rows.append(["J test (q, dof, p)"] + [f"{_fmt(ax.gmwm.selection.fit.q, 3)}, {int(ax.gmwm.selection.fit.df)}, "
+                                           f"p = {ax.gmwm.selection.fit.j_pvalue:.2g}" for ax in axes])
+    rows.append(["wavelet scales used [s]"] + [_scales_used(ax.gmwm) for ax in axes])
+    rows.append(["cross-check: Allan fit N [deg/√h]"] + [term_text(ax.original.noise.terms["N"]) for ax in axes])
+    return headers, rows
+
+
+def _scales_used(g) -> str:
+    import numpy as np
+
+    excluded = {e.level for e in g.selection.excluded}
+    used = [s for lv, s in zip(np.asarray(g.wvar.level), np.asarray(g.wvar.scale_s)) if int(lv) not in excluded]
+    if not used:
+        return "–"
+    text = f"{_fmt(min(used), 3)} – {_fmt(max(used), 3)} ({len(used)} scales)"
+    return text + (f", {len(excluded)} short excluded" if excluded else "")
 
 
 def _b_min(noise) -> str:
