@@ -43,7 +43,7 @@ from ..units import B_FACTOR
 from .covariance import estimator_covariance, expected_variance, ieee_spectrum, ramp_cross_variance
 from .engine import ScoreProblem, all_subsets, fit_subsets, profile_interval
 from .result import NoiseFit, NoiseTerm
-from .terms import TERM_TABLE, TERMS, UNESTIMABLE, laws_of
+from .terms import DISPLAY_UNITS, TERM_TABLE, TERMS, UNESTIMABLE, laws_of
 
 __all__ = ["identify", "thin_taus", "POOR_CHI2_RED"]
 
@@ -506,6 +506,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     # a flat floor must not sit above the measured curve
     if "B" in laws and out_terms["B"].value is not None:
         _check_floor(out_terms, c, A)
+    notes.extend(_at_bound_notes(prob, A, best, c.tau, out_terms))
     if quality != "good":
         i01 = _worst_region(c.tau, z)
         if i01 is not None:
@@ -529,6 +530,28 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         quality=quality, inflation=float(infl), excluded=excluded, notes=notes, b_min=b_min,
         n_samples=int(n_samples),
     )
+
+
+def _at_bound_notes(prob, A, best, tau, out_terms) -> list:
+    """A selected term whose estimate sits at its upper bound (:meth:`_Context._upper`): the value is set by one
+    point of the curve (the term alone would exceed that point's ~4-sigma upper limit), not by the fit."""
+    notes = []
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ub_pt = prob.y * prob.nu / chi2.ppf(3.17e-5, prob.nu)
+    for i in best:
+        u = float(prob.upper[i])
+        if not (u > 0 and A[i] >= (1.0 - 1e-3) * u):
+            continue
+        name = _NAMES[i]
+        t = out_terms[name]
+        if t.value is None:  # refused afterwards (a floor above the measured curve): its reason says why
+            continue
+        k = int(np.nanargmin(ub_pt / prob.X[:, i]))
+        notes.append(
+            f"{name} = {t.value:.4g} {DISPLAY_UNITS[name]} sits at its data bound: a larger {name} alone would "
+            f"exceed the measured curve's ~4-sigma upper limit at tau = {tau[k]:.3g} s, so that one point sets the "
+            f"value, not the fit as a whole; read it as the largest {name} the data allow")
+    return notes
 
 
 def _shape_hint(tau, y, dev) -> str:

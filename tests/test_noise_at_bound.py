@@ -1,0 +1,52 @@
+"""A selected term whose estimate sits at its data bound is named in the fit's notes, with the point that sets it.
+
+The noise fit keeps every term, alone, below each point's ~4-sigma upper limit (``noise/identify.py``
+``_Context._upper``).  When the estimate ends there, the value is set by that one point, not by the fit, and the
+note says so.  Real case: the bundled RLG's gx, where N = 0.3043 deg/√h equals the upper end of its own 95 %
+interval inside a poor fit (chi2_red 23); its gz fits without a bound.  The note's value is checked against the
+term itself and the bound against the fit's coefficient and the point's limit, recomputed here.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from fogdrift.io import load
+from fogdrift.pipeline import AnalysisConfig, run_allan
+
+
+@pytest.fixture(scope="module")
+def rlg_fits(bundled_path):
+    rec = load(bundled_path, unit="deg/h")
+    return {a.name: a.noise for a in run_allan(rec, AnalysisConfig().validate())}
+
+
+def test_rlg_gx_names_N_at_its_data_bound(rlg_fits):
+    f = rlg_fits["gx"]
+    notes = [n for n in f.notes if "sits at its data bound" in n]
+    assert len(notes) == 1 and notes[0].startswith("N = ")
+    value = float(re.match(r"N = ([0-9.eE+-]+) deg/√h", notes[0]).group(1))
+    assert value == pytest.approx(f.terms["N"].value, rel=1e-3)
+    assert f.terms["N"].value == pytest.approx(f.terms["N"].hi95, rel=1e-3)  # the interval ends at the bound
+    tau = float(re.search(r"at tau = ([0-9.eE+-]+) s", notes[0]).group(1))
+    assert tau in np.round(f.fit_tau_s, 2)
+
+
+def test_rlg_gz_has_no_bound_note(rlg_fits):
+    assert not any("data bound" in n for n in rlg_fits["gz"].notes)
+    assert rlg_fits["gz"].terms["N"].value < rlg_fits["gz"].terms["N"].hi95 * 0.99
+
+
+def test_no_bound_note_when_white_noise_is_fitted_freely():
+    # pure white noise: N is set by every point together, never by one point's limit (10 seeds)
+    from fogdrift.allan import allan_variance
+    from fogdrift.noise import fit_noise
+    from fogdrift.simulate import simulate
+
+    for seed in range(10):
+        f = fit_noise(allan_variance(simulate(2**16, 0.01, arw_dprh=0.05, seed=seed), 0.01, taus="octave"))
+        assert f.terms["N"].status == "resolved", seed
+        assert not any("data bound" in n for n in f.notes), (seed, f.notes)
