@@ -174,6 +174,35 @@ def test_short_signals_equal_reference(n, wavelet, backend):
             np.testing.assert_allclose(got, want, atol=1e-12 * max(np.abs(b).max() for b in ref), rtol=0)
 
 
+@pytest.mark.parametrize("periodic", [False, True])
+@pytest.mark.parametrize(("n_t", "m", "offs"), [(3, 1, [2]), (2, 2, [2, 3]), (4, 3, [-1, 3]), (5, 2, [-4, 0, 1])])
+def test_step_kernels_when_every_sample_is_an_edge_sample(n_t, m, offs, periodic):
+    # offsets at least the other channel's length: no interior sample (a case max_level keeps the public API
+    # out of); both step appliers against the rule written out here (whole-sample reflection or wrap-around)
+    from fogdrift.lifting import _kernels as K
+
+    def idx(j):
+        if periodic:
+            return j % m
+        if m == 1:
+            return 0
+        p = 2 * (m - 1)
+        j %= p
+        return p - j if j > m - 1 else j
+
+    rng = np.random.default_rng(n_t * 10 + m)
+    other, target = rng.standard_normal(m), rng.standard_normal(n_t)
+    coefs = rng.standard_normal(len(offs))
+    want = target + [sum(c * other[idx(l + o)] for o, c in zip(offs, coefs)) for l in range(n_t)]
+    offs_a = np.array(offs, dtype=np.int64)
+    got_np = target.copy()
+    K._np_step(got_np, other, offs_a, coefs, periodic)
+    got_nb = target.copy()
+    K._numba_kernels()[0](got_nb, other, offs_a, coefs, periodic)
+    np.testing.assert_allclose(got_np, want, rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(got_nb, want, rtol=1e-14, atol=1e-14)
+
+
 def test_symmetric_differs_from_pywt_symmetric():
     pywt = pytest.importorskip("pywt")
     x = np.random.default_rng(0).standard_normal(256)
