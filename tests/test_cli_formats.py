@@ -68,3 +68,23 @@ def test_bag_topic_flag(tmp_path):
     doc = json.loads((tmp_path / "o" / "allan.json").read_text())
     assert doc["record"]["input_unit"] == "rad/s"
     assert doc["record"]["scale_to_dph"] == pytest.approx(180 / math.pi * 3600)
+
+
+def test_analyze_report_shows_rate_and_temperature(tmp_path):
+    # a log with a temperature column: the report's Recording section has the rate + temperature figure
+    # (its PNG written through the atomic outputs) and the range/drift line computed from the column
+    rng = np.random.default_rng(5)
+    n = 20_000
+    lines = ["t_s,gz,temp"] + [f"{i / 10:.1f},{float(v)!r},{20 + i / 5000:.4f}"
+                               for i, v in enumerate(rng.normal(size=n) + np.linspace(0, 3, n))]
+    p = tmp_path / "log.csv"
+    p.write_text("\n".join(lines) + "\n")
+    _ok(runner.invoke(app, ["analyze", str(p), "--unit", "deg/h", "--temperature", "temp", "--models",
+                            "persistence", "--no-heading", "--out", str(tmp_path / "o")]))
+    html = (tmp_path / "o" / "report.html").read_text()
+    assert "<h3>Temperature</h3>" in html
+    # by hand: 20 + i/5000 at 10 Hz -> 20.00 to 24.00 deg C over 2000 s = 0.556 h, slope 7.2 deg C/h
+    assert "temperature 20.00 to 24.00 deg C (range 4.00)" in html and "(slope +7.200 deg C/h)" in html
+    png = tmp_path / "o" / "figures" / "fig_temperature.png"
+    assert png.is_file() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not list((tmp_path / "o").rglob("*.tmp*"))

@@ -1,6 +1,7 @@
 """Figure of the rate beside the temperature carried with the log (for the report; matplotlib, PNG).
 
-The report calls :func:`plot_rate_and_temperature` when ``record.temperature_c`` is not None.
+The report (:func:`fogdrift.report.render_report`, section "Recording") calls :func:`plot_rate_and_temperature`
+when ``record.temperature_c`` is not None.
 This module only draws; the numbers come from :mod:`fogdrift.temperature`.
 """
 
@@ -11,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ConfigError
+from .output import atomic_path
 from .temperature import summary_line, temperature_summary
 
 __all__ = ["plot_rate_and_temperature", "MAX_POINTS"]
@@ -81,6 +83,9 @@ def plot_rate_and_temperature(record, path) -> Path:
         fig.suptitle(f"Rate and temperature (block means of {k} samples)", fontsize=9)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
+    try:
+        with atomic_path(path) as tmp:  # complete or absent (fogdrift.output)
+            fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
+    finally:
+        plt.close(fig)
     return path

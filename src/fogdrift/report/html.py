@@ -341,6 +341,21 @@ def _glossary_section() -> str:
     return f'<section id="glossary"><h2>Glossary</h2><dl class="glossary">{items}</dl></section>'
 
 
+def _temperature_block(record, fig_dir) -> str:
+    """Rate and temperature against time, with the temperature's range and drift, when the log carries one."""
+    temp = getattr(record, "temperature_c", None)
+    if temp is None:
+        return ""
+    from ..temperature import summary_line, temperature_summary
+    from ..temperature_plot import plot_rate_and_temperature
+
+    line = summary_line(temperature_summary(temp, record.dt_s))
+    return (f'<h3>Temperature</h3><p class="note">{_e(line)}. The noise fit and the drift models use the '
+            "rate only, not the temperature: a drift that follows this temperature history need not repeat "
+            "under another.</p>"
+            + _img(plot_rate_and_temperature(record, fig_dir / "fig_temperature.png")))
+
+
 def render_report(result, record, fig_dir, *, sensor=None, evaluated=True, generated=None) -> str:
     """The report's HTML text (figures written to ``fig_dir`` and embedded)."""
     fig_dir = Path(fig_dir)
@@ -361,7 +376,7 @@ def render_report(result, record, fig_dir, *, sensor=None, evaluated=True, gener
             "quantization relation (the paper's Table 1 Q formula is 3·3600² too large). The drift is separated "
             "inside each block, so no test information leaks into training.</p>",
             _img(plot_signal(record, fig_dir / "fig1_signal.png", _split_seconds(result))),
-            _img(plot_spectrum(record, fig_dir / "fig2_spectrum.png")), "</section>"]
+            _img(plot_spectrum(record, fig_dir / "fig2_spectrum.png")), _temperature_block(record, fig_dir), "</section>"]
     body += [_axis_section(ax, result, fig_dir, "", 0, evaluated) for ax in result.axes]
     if result.apply_to is not None:
         body.append(f'<section id="applied"><h2>Generalisation: fitted models applied unchanged to '
