@@ -80,8 +80,11 @@ def test_analyze_report_shows_rate_and_temperature(tmp_path):
     p = tmp_path / "log.csv"
     p.write_text("\n".join(lines) + "\n")
     _ok(runner.invoke(app, ["analyze", str(p), "--unit", "deg/h", "--temperature", "temp", "--models",
-                            "persistence", "--no-heading", "--out", str(tmp_path / "o")]))
+                            "persistence", "--no-heading", "--sensor", "LAB FOG #3", "--out", str(tmp_path / "o")]))
     html = (tmp_path / "o" / "report.html").read_text()
+    # --sensor: named on the first screen and in analysis.json (a log does not carry it)
+    doc = json.loads((tmp_path / "o" / "analysis.json").read_text())
+    assert doc["report_summary"]["recording"]["sensor"] == "LAB FOG #3" and "LAB FOG #3" in html
     assert "<h3>Temperature</h3>" in html
     # by hand: 20 + i/5000 at 10 Hz -> 20.00 to 24.00 deg C over 2000 s = 0.556 h, slope 7.2 deg C/h
     assert "temperature 20.00 to 24.00 deg C (range 4.00)" in html and "(slope +7.200 deg C/h)" in html

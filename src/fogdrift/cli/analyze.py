@@ -67,6 +67,9 @@ def analyze(
         "--noise-method", help="Noise model of the original output: allan (the Allan fit) or gmwm (also the GMWM "
                                "model selection on the wavelet variance; the report shows its table first).")]
     = "allan",
+    sensor: Annotated[Optional[str], typer.Option(
+        "--sensor", help="Sensor make, model and serial number for the report's first screen and analysis.json "
+                         "(logs do not carry it), e.g. 'KVH DSP-1750 s/n 1234'.")] = None,
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
 ):
@@ -144,7 +147,8 @@ def analyze(
                 print_evaluation([ev.heading] if ev.heading else [], [ev.artefacts] if ev.artefacts else [],
                                  ev.verdicts)
                 say(ev.headline.lines[0])
-        path = write_report(result, record, r.out.path, evaluated=heading, pdf=pdf)
+        path = write_report(result, record, r.out.path, evaluated=heading, pdf=pdf,
+                            sensor=None if sensor is None or not sensor.strip() else sensor.strip())
         # the self-describing bundle 'fogdrift compensate' applies to other logs
         from ..bundle import write_bundle
 

@@ -56,7 +56,7 @@ def recording_rows(result, sensor: str | None = None) -> list:
     fs = rec.get("native_fs_hz") or rec.get("fs_hz")
     return [
         ["file", Path(str(result.source)).name],
-        ["sensor", sensor or "not stated in the file"],
+        ["sensor", sensor or "not stated (the log does not carry it; analyze --sensor names it)"],
         ["duration", f"{_duration(rec.get('duration_s'))}, {rec.get('n_samples')} samples"],
         ["sample rate", f"{fs:.6g} Hz (dt {rec.get('dt_s'):.6g} s)" if fs else "–"],
         ["axes", ", ".join(rec.get("axis_names", []))],
