@@ -168,6 +168,24 @@ def test_pdf_is_written_with_the_report(report_dir):
     manifest = json.loads((out / ".fogdrift-manifest.json").read_text())
     assert "report.pdf" in manifest["files"]
     assert not [p for p in out.iterdir() if p.name.startswith(".fogdrift-tmp-")]  # no temporary left behind
+    # the pages themselves (PDFium, the renderer of Chromium's own PDF viewer): the first screen's text on
+    # page 1, and pages with figures carry coloured pixels (a blank or text-only print has none)
+    pdfium = pytest.importorskip("pypdfium2")
+    import numpy as np
+
+    doc = pdfium.PdfDocument(str(pdf))
+    try:
+        assert len(doc) >= 3
+        first = doc[0].get_textpage().get_text_range()
+        assert "Summary" in first and "How noisy is this gyro?" in first and "deg/√h" in first
+        coloured = 0
+        for i in range(len(doc)):
+            px = np.asarray(doc[i].render(scale=0.5).to_pil().convert("RGB"), dtype=np.int16)
+            assert px.std() > 0, i  # not a blank page
+            coloured += int((np.ptp(px, axis=2) > 60).mean() > 0.002)  # saturated plot lines, not grey text
+        assert coloured >= 3, coloured
+    finally:
+        doc.close()
 
 
 def test_pdf_without_chromium_is_one_line_naming_how_to_install(bundled_path, tmp_path, monkeypatch):
