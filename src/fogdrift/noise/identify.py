@@ -106,9 +106,7 @@ class _Context:
         if C is None:
             ub_pt = self.y * (self.y_hi / self.y) ** (4.0 / 1.96)
         else:
-            nu = 2.0 / np.diag(C)
-            with np.errstate(divide="ignore", over="ignore"):  # nu << 1: the quantile is 0 and the point bounds nothing
-                ub_pt = self.y * nu / chi2.ppf(3.17e-5, nu)
+            ub_pt = _point_limits(self.y, 2.0 / np.diag(C))
         return np.array([np.min(ub_pt / self.X[:, i]) if np.all(self.X[:, i] > 0) else 0.0 for i in range(5)])
 
     def sub(self, start):
@@ -532,12 +530,18 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     )
 
 
+def _point_limits(y, nu) -> np.ndarray:
+    """Each point's ~4-sigma upper limit ``y nu / chi2_nu(3.17e-5)`` (the 4-sigma lower quantile of chi2_nu / nu);
+    inf where nu << 1 (the quantile is 0: the point bounds nothing)."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return y * nu / chi2.ppf(3.17e-5, nu)
+
+
 def _at_bound_notes(prob, A, best, tau, out_terms) -> list:
     """A selected term whose estimate sits at its upper bound (:meth:`_Context._upper`): the value is set by one
     point of the curve (the term alone would exceed that point's ~4-sigma upper limit), not by the fit."""
     notes = []
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # nu << 1: no bound (inf)
-        ub_pt = prob.y * prob.nu / chi2.ppf(3.17e-5, prob.nu)
+    ub_pt = _point_limits(prob.y, prob.nu)
     for i in best:
         u = float(prob.upper[i])
         if not (u > 0 and A[i] >= (1.0 - 1e-3) * u):

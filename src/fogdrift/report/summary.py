@@ -68,8 +68,6 @@ def recording_rows(result, sensor: str | None = None) -> list:
 def noise_headline(result) -> tuple:
     """``(headers, rows)``: one column per axis; rows N, B, K, R, Q (value [95 % interval]), the IEEE B_min
     reading, the selected model, chi2_red with the fit quality, and the fitted tau range."""
-    from ..noise import TERM_TABLE
-
     axes = list(result.axes)
     if axes and all(getattr(ax, "gmwm", None) is not None for ax in axes):
         return _gmwm_headline(axes)
@@ -77,9 +75,7 @@ def noise_headline(result) -> tuple:
     fits = [ax.original.noise for ax in axes]
     rows = []
     for name in HEADLINE_TERMS:
-        spec = TERM_TABLE[name]
-        rows.append([f"{spec.header.split(' [')[0]} {spec.long_name} [{spec.header.split('[')[1]}"]
-                    + [term_text(f.terms[name]) for f in fits])
+        rows.append([_term_label(name)] + [term_text(f.terms[name]) for f in fits])
     rows.append(["B_min, IEEE reading at the ADEV minimum [deg/h]"] + [_b_min(f) for f in fits])
     rows.append(["selected noise model"] + ["+".join(f.selected) or "(none)" for f in fits])
     rows.append(["χ²_red (fit quality, p)"] + [f"{_fmt(f.chi2_red, 3)} ({f.quality}, p = {f.p_value:.2g})"
@@ -88,19 +84,23 @@ def noise_headline(result) -> tuple:
     return headers, rows
 
 
+def _term_label(name) -> str:
+    """``"N angle random walk [deg/√h]"``: symbol, long name and displayed unit of a term."""
+    from ..noise import TERM_TABLE
+
+    spec = TERM_TABLE[name]
+    return f"{spec.header.split(' [')[0]} {spec.long_name} [{spec.header.split('[')[1]}"
+
+
 def _gmwm_headline(axes) -> tuple:
     """The headline table of ``analyze --noise-method gmwm``: the terms the selected GMWM model implies, its
     checks and J test, the scales it used, and the Allan fit's N beside it as a cross-check."""
-    from ..noise import TERM_TABLE
-
     headers = ["whole record, native rate (GMWM)"] + [f"axis {ax.name}" for ax in axes]
     terms = [ax.gmwm.ieee_terms() for ax in axes]
     rows = []
     for name in HEADLINE_TERMS:
-        spec = TERM_TABLE[name]
-        label = f"{spec.header.split(' [')[0]} {spec.long_name} [{spec.header.split('[')[1]}"
-        if name == "B":
-            label = "B bias instability (flicker term, else the GM reading) [deg/h]"
+        label = ("B bias instability (flicker term, else the GM reading) [deg/h]" if name == "B"
+                 else _term_label(name))
         rows.append([label] + [term_text(t[name]) for t in terms])
     cells = []
     for ax in axes:
