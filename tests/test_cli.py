@@ -38,6 +38,13 @@ def test_allan_on_bundled_recording(bundled_path, tmp_path):
     header = (tmp_path / "allan.csv").read_text().splitlines()[0]
     assert "tau_s" in header and "adev_dph" in header
     assert (tmp_path / "allan.png").stat().st_size > 10_000
+    # the console table carries the IEEE B_min reading and the fit quality of each axis, as stored in the JSON
+    assert "B_min IEEE [deg/h]" in out and "fit" in out
+    for a in doc["axes"]:
+        b = a["noise"]["b_min"]
+        if b.get("value") is not None:
+            assert f"{b['value']:.3g}" in out, (a["name"], b)
+        assert a["noise"]["fit"]["quality"] in out
     # The JSON's ADEV at tau = 1 s matches the data README's sanity table (gz: 8.706 deg/h).
     gz = doc["axes"][2]["allan"]
     i = int(np.argmin(np.abs(np.asarray(gz["tau_s"]) - 1.28)))

@@ -5,12 +5,13 @@ from __future__ import annotations
 from ._app import fitted_table, say
 
 
-def noise_table(title, rows, fit=False):
+def noise_table(title, rows, fit=False, extra=()):
     """A Q, N, B, K, R table that fits the terminal (a rich renderable: ``console.print(noise_table(...))``);
-    ``fit=True``: the rows end with a fit-quality cell (:func:`fogdrift.report.fit_cell`)."""
+    ``extra``: headers of further cells after R; ``fit=True``: the rows end with a fit-quality cell
+    (:func:`fogdrift.report.fit_cell`)."""
     from ..report import NOISE_HEADERS
 
-    return fitted_table(title, ("signal",) + NOISE_HEADERS + (("fit",) if fit else ()), rows)
+    return fitted_table(title, ("signal",) + NOISE_HEADERS + tuple(extra) + (("fit",) if fit else ()), rows)
 
 
 def metrics_table(title, rows):

@@ -28,7 +28,7 @@ def allan(
     """Allan variance and IEEE-952 noise coefficients Q, N, B, K, R of every axis: the terms are selected from
     the data, with 95 % intervals, the fit's chi-squared and p-value, and what was left out and why."""
     from ..pipeline import AnalysisConfig, run_allan
-    from ..report import noise_row, write_allan_outputs
+    from ..report import b_min_cell, fit_cell, noise_row, write_allan_outputs
 
     with run("allan", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
              expect=("allan.json", "allan.csv", "allan.png")) as r:
@@ -43,8 +43,10 @@ def allan(
             results = run_allan(record, cfg, progress=allan_cb)
         name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}[statistic]
         console.print(noise_table(f"{load.file.name}: {estimator} {name}, 95 % intervals in brackets "
-                                  "(– (< x): not in the selected model, x its upper bound)",
-                                  [[a.name] + noise_row(a.noise) for a in results]))
+                                  "(– (< x): not in the selected model, x its upper bound; [0, x]: in the "
+                                  "model but not resolved from zero)",
+                                  [[a.name] + noise_row(a.noise) + [b_min_cell(a.noise), fit_cell(a.noise)]
+                                   for a in results], fit=True, extra=("B_min IEEE [deg/h]",)))
         for a in results:
             print_noise_notes(a.name, a.noise, a.outliers, record.dt_s)
         temp = record.metadata()["temperature"]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .tables import _fmt, term_text
+from .tables import _fmt, b_min_cell, term_text
 
 __all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "recording_rows", "noise_headline", "verdict_items",
            "cannot_support", "summary_dict"]
@@ -76,7 +76,7 @@ def noise_headline(result) -> tuple:
     rows = []
     for name in HEADLINE_TERMS:
         rows.append([_term_label(name)] + [term_text(f.terms[name]) for f in fits])
-    rows.append(["B_min, IEEE reading at the ADEV minimum [deg/h]"] + [_b_min(f) for f in fits])
+    rows.append(["B_min, IEEE reading at the ADEV minimum [deg/h]"] + [b_min_cell(f) for f in fits])
     rows.append(["selected noise model"] + ["+".join(f.selected) or "(none)" for f in fits])
     rows.append(["χ²_red (fit quality, p)"] + [f"{_fmt(f.chi2_red, 3)} ({f.quality}, p = {f.p_value:.2g})"
                                                for f in fits])
@@ -128,17 +128,6 @@ def _scales_used(g) -> str:
         return "–"
     text = f"{_fmt(min(used), 3)} – {_fmt(max(used), 3)} ({len(used)} scales)"
     return text + (f", {len(excluded)} short excluded" if excluded else "")
-
-
-def _b_min(noise) -> str:
-    b = noise.b_min or {}
-    if b.get("value") is None:
-        return "–"
-    if b.get("bound_only"):
-        why = "fitted floor above the measured curve" if "measured curve" in b.get("rule", "") else \
-            "curve still falling"
-        return f"< {_fmt(b['value'], 3)} ({why})"
-    return f"{_fmt(b['value'], 3)} at τ = {_fmt(b.get('tau_s'), 3)} s"
 
 
 def verdict_items(result, *, evaluated: bool = True) -> list:

@@ -54,6 +54,19 @@ def noise_row(noise) -> list[str]:
     return [term_text(noise.terms[name]) for name in ("Q", "N", "B", "K", "R")]
 
 
+def b_min_cell(noise) -> str:
+    """The IEEE bias-instability reading (min of the fitted ADEV / 0.664) as a cell: ``39.2 at τ = 117 s``, or
+    ``< x (why)`` when the value is only an upper bound; ``–`` when the statistic has no such reading."""
+    b = noise.b_min or {}
+    if b.get("value") is None:
+        return "–"
+    if b.get("bound_only"):
+        why = "fitted floor above the measured curve" if "measured curve" in b.get("rule", "") else \
+            "curve still falling"
+        return f"< {_fmt(b['value'], 3)} ({why})"
+    return f"{_fmt(b['value'], 3)} at τ = {_fmt(b.get('tau_s'), 3)} s"
+
+
 def fit_cell(noise) -> str:
     """Short fit-quality cell of a table row: the fit verdict, chi2_red and the fitted tau range
     (the Table 2 rows are fitted on short blocks and smoothed signals: how well each fits is part of the row)."""
