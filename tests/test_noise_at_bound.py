@@ -1,4 +1,6 @@
-"""A selected term whose estimate sits at its data bound is named in the fit's notes, with the point that sets it.
+"""A selected term whose estimate sits at its data bound is named in the fit's notes, with the point that sets it;
+and the point where the model is farthest (>= 2x in deviation) from the measured curve is named, with whether
+that gap is inside the point's own 95 % interval.
 
 The noise fit keeps every term, alone, below each point's ~4-sigma upper limit (``noise/identify.py``
 ``_Context._upper``).  When the estimate ends there, the value is set by that one point, not by the fit, and the
@@ -50,3 +52,17 @@ def test_no_bound_note_when_white_noise_is_fitted_freely():
         f = fit_noise(allan_variance(simulate(2**16, 0.01, arw_dprh=0.05, seed=seed), 0.01, taus="octave"))
         assert f.terms["N"].status == "resolved", seed
         assert not any("data bound" in n for n in f.notes), (seed, f.notes)
+        assert not any("outside that point's own 95 % interval" in n for n in f.notes), (seed, f.notes)
+
+
+def test_rlg_largest_gap_is_named_with_the_ratio_the_fit_stores(rlg_fits):
+    # the RLG's gx model keeps a flat floor the curve contradicts: at long tau the model lies far above the data
+    f = rlg_fits["gx"]
+    (note,) = [n for n in f.notes if n.startswith("largest gap")]
+    m = re.match(r"largest gap: at tau = ([0-9.eE+]+) s the model's deviation is ([0-9.]+)x the measured one "
+                 r"\(above it; ~([0-9.eE+-]+) degrees of freedom\), outside that point's own 95 % interval", note)
+    assert m, note
+    k = int(np.argmin(np.abs(np.asarray(f.fit_tau_s) - float(m.group(1)))))
+    ratio = np.sqrt(np.asarray(f.model_var) / np.asarray(f.fit_var))
+    assert float(m.group(2)) == pytest.approx(ratio[k], abs=0.006) and ratio[k] >= 2.0
+    assert k == int(np.argmax(np.abs(np.log(ratio))))  # the farthest point of the fitted range

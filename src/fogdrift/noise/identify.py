@@ -518,6 +518,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
                 f"{100 * abs(dev[k]):.0f} %" + _shape_hint(c.tau[i0:i1 + 1], c.y[i0:i1 + 1], dev))
         if infl > 1:
             notes.append(f"intervals widened by sqrt(chi2_red) = {math.sqrt(infl):.3g} for the misfit")
+    notes.extend(_largest_gap_note(c.tau, c.y, mu, prob.nu))
     b_min = _classical_b(c, A, floor_refused=out_terms.get("B") is not None and out_terms["B"].status ==
                          "not_estimable" and "contradicted" in (out_terms["B"].reason or "")) \
         if statistic == "adev" else {}
@@ -535,6 +536,31 @@ def _point_limits(y, nu) -> np.ndarray:
     inf where nu << 1 (the quantile is 0: the point bounds nothing)."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         return y * nu / chi2.ppf(3.17e-5, nu)
+
+
+#: A model deviation at least this many times the measured one (or below 1/this) at one point is named in the
+#: notes whatever the fit statistic says.
+GAP_NOTE_RATIO = 2.0
+
+
+def _largest_gap_note(tau, y, mu, nu) -> list:
+    """The point where the model's deviation is farthest, as a ratio, from the measured one, when that ratio is
+    at least :data:`GAP_NOTE_RATIO` either way.  Chi-squared weighs each point by its EDF, so a long-tau point
+    with few averaging intervals can sit 2x off and count little; a reader of the plot sees it at once, and the
+    note says whether the gap is inside that point's own 95 % interval (chance) or not."""
+    ratio = np.sqrt(mu / y)
+    k = int(np.argmax(np.abs(np.log(ratio))))
+    r, v = float(ratio[k]), float(nu[k])
+    if max(r, 1.0 / r) < GAP_NOTE_RATIO or not np.isfinite(v) or v <= 0:
+        return []
+    lo, hi = chi2.ppf(0.025, v) / v, chi2.ppf(0.975, v) / v  # measured/true variance, 95 %
+    inside = lo <= 1.0 / r**2 <= hi
+    side = "above" if r > 1 else "below"
+    verdict = ("inside that point's own 95 % interval: with so few averaging intervals the data cannot tell, so "
+               "terms acting there rest on little" if inside else
+               "outside that point's own 95 % interval: the model's shape is wrong there")
+    return [f"largest gap: at tau = {tau[k]:.3g} s the model's deviation is {r:.2f}x the measured one ({side} it; "
+            f"~{v:.2g} degrees of freedom), {verdict}"]
 
 
 def _at_bound_notes(prob, A, best, tau, out_terms) -> list:
