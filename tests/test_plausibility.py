@@ -10,6 +10,7 @@ exists (FOGDRIFT_SHARED_DATA, default /work/shared/data), a simulated ADIS-like 
 from __future__ import annotations
 
 import os
+import re
 import warnings
 from pathlib import Path
 
@@ -18,7 +19,8 @@ import pytest
 
 from fogdrift.errors import FogdriftWarning
 from fogdrift.io import from_array, load
-from fogdrift.plausibility import (ARW_MAX_DPRH, ARW_MIN_DPRH, check_record, noise_floor, warn_implausible)
+from fogdrift.plausibility import (ARW_MAX_DPRH, ARW_MIN_DPRH, check_record, gyro_class, noise_floor,
+                                   warn_implausible)
 from fogdrift.simulate import simulate
 
 SHARED = Path(os.environ.get("FOGDRIFT_SHARED_DATA", "/work/shared/data"))
@@ -125,7 +127,71 @@ def test_real_adis16405_log_read_with_the_wrong_unit():
 
 @needs_shared
 def test_real_mtig_log_read_as_deg_h():
+    # a limitation, stated: the single-axis MEMS log (rad/s) read as deg/h has a floor of 9.4e-6 deg/sqrt(h), the
+    # figure of a seismic-grade FOG; with one axis no Earth-rate check applies, so no unit can be ruled out
     found = check_record(load(MTIG, unit="deg/h"))
-    assert rules(found) == ["white-noise"]
-    assert "rad/s" in found[0].likely_units  # the README's unit (ARW ~ 2 deg/sqrt(h))
+    assert found == []
+    assert gyro_class(noise_floor(load(MTIG, unit="deg/h").axis("gx"), 0.01).estimate) == "seismic / strategic grade"
     assert check_record(load(MTIG, unit="rad/s")) == []
+
+
+# Seismic / strategic grade (issue 20).  A rotational-seismology FOG has N ~ 1e-5..1e-4 deg/sqrt(h) (module
+# docstring of fogdrift.plausibility); only a floor quieter than any portable gyro (< 1e-6 deg/sqrt(h)) or a
+# contradicting fact (a quiet triad without the Earth rate) is warned.  1 rad/s = 180/pi * 3600 deg/h by hand.
+DPH_PER_RAD_S = 180.0 / np.pi * 3600.0
+
+
+def _seismic_triad_rad_s(arw_dprh=5.5e-5, seed=0):
+    """A static seismic-grade FOG triad at 48 deg N (Earth rate on north and up, a 1e-3 deg/h bias), in rad/s."""
+    earth_dph = 15.041067 * np.array([0.0, np.cos(np.radians(48.0)), np.sin(np.radians(48.0))])  # E, N, U
+    cols = [simulate(60_000, 0.01, arw_dprh=arw_dprh, bias_dph=e + 1e-3, seed=seed + k)
+            for k, e in enumerate(earth_dph)]
+    return np.column_stack(cols) / DPH_PER_RAD_S
+
+
+def test_seismic_grade_triad_in_its_unit_is_plausible():
+    x = _seismic_triad_rad_s()
+    assert check_record(from_array(x, dt_s=0.01, unit="rad/s", axis_names=("gx", "gy", "gz"))) == []
+    # one axis alone (the east one, no Earth rate) is plausible too
+    assert check_record(from_array(x[:, 0], dt_s=0.01, unit="rad/s")) == []
+
+
+def test_seismic_grade_triad_read_in_a_smaller_unit_is_caught():
+    x = _seismic_triad_rad_s()
+    # rad/s read as deg/h: 206265 times quieter, 2.7e-10 deg/sqrt(h), below every gyro built
+    as_dph = check_record(from_array(x, dt_s=0.01, unit="deg/h", axis_names=("gx", "gy", "gz")))
+    assert "white-noise" in rules(as_dph)
+    quiet = next(f for f in as_dph if f.rule == "white-noise")
+    assert "quieter than any gyro built" in quiet.message and "implausibly" not in quiet.message
+    assert "rad/s" in quiet.likely_units
+    # rad/s read as deg/s: 57 times quieter and the Earth rate 57 times too small: the triad rule fires
+    as_dps = check_record(from_array(x, dt_s=0.01, unit="deg/s", axis_names=("gx", "gy", "gz")))
+    assert "earth-rate" in rules(as_dps)
+    assert all("rad/s" in f.likely_units for f in as_dps)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_quiet_warning_starts_a_decade_below_seismic_grade(seed):
+    # single axes (no Earth-rate rule): 3e-6 deg/sqrt(h) is a portable gyro's class, 3e-7 is not
+    portable = simulate(60_000, 0.01, arw_dprh=3e-6, seed=seed)
+    ring_laser = simulate(60_000, 0.01, arw_dprh=3e-7, seed=seed)
+    assert check_record(from_array(portable, dt_s=0.01)) == []
+    found = check_record(from_array(ring_laser, dt_s=0.01))
+    assert rules(found) == ["white-noise"]
+    assert "metre-scale ring lasers" in found[0].message and "implausibly" not in found[0].message
+
+
+def test_tactical_fog_in_rad_s_read_as_deg_h_names_the_unit_and_its_class():
+    numbers = simulate(60_000, 0.01, arw_dprh=0.06, seed=7) / DPH_PER_RAD_S  # 2.9e-7 deg/sqrt(h) as deg/h
+    found = check_record(from_array(numbers, dt_s=0.01, unit="deg/h"))
+    assert rules(found) == ["white-noise"] and "rad/s" in found[0].likely_units
+    named = re.search(r"rad/s \(N <= ([0-9.]+) deg/√h, tactical grade\)", found[0].message)
+    assert named and float(named.group(1)) == pytest.approx(0.06, rel=0.1)
+
+
+@pytest.mark.parametrize("n_dprh, name", [
+    (5e-9, "quieter than any gyro built"), (2e-8, "metre-scale ring lasers"), (5.5e-5, "seismic / strategic grade"),
+    (5e-4, "seismic / strategic grade"), (5e-3, "navigation grade"), (0.05, "tactical grade"),
+    (0.3, "tactical grade"), (2.4, "industrial / consumer grade"), (500.0, "noisier than any gyro")])
+def test_gyro_class_edges(n_dprh, name):
+    assert name in gyro_class(n_dprh)

@@ -8,9 +8,11 @@ the units under which the numbers would be plausible:
     The white-noise floor ``N_floor = min over tau of sigma(tau) sqrt(tau) / 60`` [deg/sqrt(h)] (sigma the
     overlapping Allan deviation in deg/h, tau in s) is an upper bound of the angle random walk N: every
     IEEE-952 term adds to sigma^2(tau), and the N term alone is N^2 3600 / tau (method notes §2.2, §2.3).
-    A floor whose 68 % upper bound is below :data:`ARW_MIN_DPRH` (1e-4 deg/sqrt(h), quieter than the best
-    strategic-grade gyro) or whose 68 % lower bound is above :data:`ARW_MAX_DPRH` (100 deg/sqrt(h), noisier
-    than any gyro at every tau) is implausible.
+    A floor whose 68 % upper bound is below :data:`ARW_MIN_DPRH` (1e-6 deg/sqrt(h): quieter than any portable
+    gyro, see *Gyro classes*) or whose 68 % lower bound is above :data:`ARW_MAX_DPRH` (100 deg/sqrt(h), noisier
+    than any gyro at every tau) is implausible.  A quiet floor inside the seismic / strategic class
+    (1e-6 to 1e-3 deg/sqrt(h)) is not warned on its own: a 3-axis record of that grade is still checked by the
+    Earth-rate rule.
 ``range``
     ``max |rate|`` above :data:`RANGE_MAX_DPH` (1e4 deg/s) is beyond the range of any gyro.
 ``earth-rate``
@@ -23,7 +25,29 @@ the units under which the numbers would be plausible:
     column read in the wrong unit (a 100 Hz log with its time in ms read as s comes out at 0.1 Hz).
 
 A unit is "likely" when the record rescaled to it passes the first three rules; candidates are tried in
-:data:`CANDIDATE_UNITS` order (the common gyro output units first) and at most two are named.
+:data:`CANDIDATE_UNITS` order (the common gyro output units first) and at most two are named, each with the
+gyro class its figure corresponds to.
+
+Gyro classes
+------------
+:data:`GYRO_CLASSES` names the class a white-noise floor corresponds to (:func:`gyro_class`); the messages name
+it instead of calling a figure impossible.  The edges are conventional and approximate (texts differ by a
+factor of a few; grades are often defined by bias stability rather than N).  The quiet end relies on:
+
+* portable seismic-grade FOGs: the three-axis fibre-optic rotational seismograph FORS, ARW 35-45 nrad/s/sqrt(Hz)
+  = 1.2e-4 to 1.5e-4 deg/sqrt(h) (A. T. Kurzych, L. R. Jaroszewicz, M. Dudek, "Rotational motion investigation
+  in seismology - remote sensing by an optical fiber seismograph", *Adv. Opt. Technol.* 2024,
+  doi:10.3389/aot.2024.1494705); the issue quotes datasheet-class values near 1.8e-5 deg/sqrt(h) for the
+  blueSeis-3A (not checked here).  Hence the seismic / strategic class reaches down to about 1e-5 and the
+  warning starts a decade lower, at 1e-6 deg/sqrt(h);
+* a 1.6 m x 1.6 m ring laser in a laboratory: about 2 nrad/s/sqrt(Hz) = 7e-6 deg/sqrt(h) (arXiv:2207.04942);
+* the metre-scale geodetic ring laser G (Wettzell): an Allan deviation below 1e-9 of the Earth rate
+  (1.5e-8 deg/h) at about 1e4 s (arXiv:2208.09134), i.e. a white-noise floor of at most about 2.5e-8
+  deg/sqrt(h) - the quietest Sagnac gyro reported.  Below :data:`QUIETEST_DPRH` (1e-8 deg/sqrt(h)) no gyro
+  built is that quiet.
+
+A density in rad/s/sqrt(Hz) is converted as N [deg/sqrt(h)] = density x 206265 / 60 (1 deg/h/sqrt(Hz) =
+1/60 deg/sqrt(h)); a one-sided density would give N smaller by sqrt(2), well inside the class edges.
 
 The checks warn; they never change the data.  Messages name settings as ``{opt:unit}`` (see
 :mod:`fogdrift.errors`).
@@ -44,10 +68,13 @@ __all__ = [
     "Finding",
     "NoiseFloor",
     "check_record",
+    "gyro_class",
     "noise_floor",
     "warn_implausible",
     "ARW_MIN_DPRH",
     "ARW_MAX_DPRH",
+    "QUIETEST_DPRH",
+    "GYRO_CLASSES",
     "RANGE_MAX_DPH",
     "NAV_GRADE_DPRH",
     "EARTH_FRACTION",
@@ -58,8 +85,11 @@ __all__ = [
     "MIN_CLUSTERS",
 ]
 
-#: Quieter than the best strategic-grade gyro [deg/sqrt(h)].
-ARW_MIN_DPRH = 1e-4
+#: Quieter than any portable gyro: seismic / strategic-grade FOGs reach about 1e-5 [deg/sqrt(h)]; only
+#: metre-scale ring lasers in geodetic observatories go below (module docstring, *Gyro classes*).
+ARW_MIN_DPRH = 1e-6
+#: Quieter than any gyro built: the ring laser G (Wettzell) reaches about 2.5e-8 [deg/sqrt(h)].
+QUIETEST_DPRH = 1e-8
 #: Noisier than any gyro [deg/sqrt(h)].
 ARW_MAX_DPRH = 100.0
 #: Beyond the measurement range of any gyro: 1e4 deg/s [deg/h].
@@ -68,6 +98,19 @@ RANGE_MAX_DPH = 1e4 * 3600.0
 NAV_GRADE_DPRH = 0.01
 #: A static navigation-grade triad's mean vector is at least this fraction of the Earth rate.
 EARTH_FRACTION = 0.2
+#: Gyro classes by white-noise floor N: (upper edge [deg/sqrt(h)], name), quietest first; conventional,
+#: approximate edges (module docstring, *Gyro classes*).  :func:`gyro_class` reads it.
+GYRO_CLASSES = (
+    (QUIETEST_DPRH, "quieter than any gyro built (the quietest, the metre-scale ring laser G, reaches about "
+                    "2.5e-8 deg/√h)"),
+    (ARW_MIN_DPRH, "the class of metre-scale ring lasers in geodetic observatories, quieter than any portable "
+                   "gyro (seismic / strategic-grade FOGs reach about 1e-5 deg/√h)"),
+    (1e-3, "seismic / strategic grade"),
+    (NAV_GRADE_DPRH, "navigation grade"),
+    (0.5, "tactical grade"),
+    (ARW_MAX_DPRH, "industrial / consumer grade (MEMS)"),
+    (math.inf, "noisier than any gyro"),
+)
 #: Sample rates at or below / above these [Hz] suggest a time column read in the wrong unit.
 RATE_MIN_HZ = 0.1
 RATE_MAX_HZ = 2e5
@@ -146,6 +189,19 @@ def noise_floor(rate_dph, dt_s) -> NoiseFloor:
                       float(np.min(res.adev_hi68_dph[keep] * root)))
 
 
+def gyro_class(n_dprh: float) -> str:
+    """The gyro class whose white-noise floor is ``n_dprh`` [deg/sqrt(h)] (:data:`GYRO_CLASSES`).
+
+    Examples
+    --------
+    >>> gyro_class(5.5e-5), gyro_class(2.4), gyro_class(3e-7).split(",")[0]
+    ('seismic / strategic grade', 'industrial / consumer grade (MEMS)', 'the class of metre-scale ring lasers in geodetic observatories')
+    """
+    if not math.isfinite(n_dprh):
+        return "class unknown"
+    return next(name for edge, name in GYRO_CLASSES if n_dprh < edge)
+
+
 def _factor(unit: str, record) -> float:
     """Multiply the record's deg/h values by this to get what they would be were the file in ``unit``."""
     if unit.startswith("inc:"):
@@ -218,8 +274,9 @@ def check_record(record) -> list[Finding]:
             high = [n for n, f in zip(names, floors) if f.lo68 > ARW_MAX_DPRH]
             axes = tuple(low or high)
             levels = ", ".join(f"{n} {_fmt(f.estimate)}" for n, f in zip(names, floors) if n in axes)
-            what = (f"implausibly quiet for any gyro: white-noise floor N <= {levels} deg/√h with the rate read as "
-                    f"{unit}, below the {ARW_MIN_DPRH:g} deg/√h of the best gyros") if low else \
+            quietest = min(f.estimate for n, f in zip(names, floors) if n in axes)
+            what = (f"white-noise floor N <= {levels} deg/√h with the rate read as {unit}: "
+                    f"{gyro_class(quietest)}") if low else \
                    (f"implausibly noisy for any gyro: white-noise floor N = {levels} deg/√h at every τ with the rate "
                     f"read as {unit}, above {ARW_MAX_DPRH:g} deg/√h")
             findings.append(Finding("white-noise", axes, f"{what}; {hint}", likely))
@@ -231,10 +288,11 @@ def check_record(record) -> list[Finding]:
                                     likely))
         if "earth-rate" in broken:
             norm = float(np.linalg.norm(means))
+            worst = max(f.estimate for f in floors)
             findings.append(Finding(
                 "earth-rate", names,
-                f"with the rate read as {unit} these 3 axes are navigation grade (white-noise floor N <= "
-                f"{_fmt(max(f.estimate for f in floors))} deg/√h) yet their mean vector is {norm:.3g} deg/h; a static "
+                f"with the rate read as {unit} these 3 axes are {gyro_class(worst)} or better (white-noise floor "
+                f"N <= {_fmt(worst)} deg/√h) yet their mean vector is {norm:.3g} deg/h; a static "
                 f"gyro of that grade shows the Earth rate, {EARTH_RATE_DPH:.2f} deg/h (unless bias and Earth rate were "
                 f"removed before, or the base moved); {hint}", likely))
     fs = record.fs_hz
@@ -252,7 +310,8 @@ def _hint(likely, floors, record) -> str:
     if not likely:
         return "check {opt:unit}"
     worst = max((f.estimate for f in floors if math.isfinite(f.estimate)), default=math.nan)
-    named = " or ".join(f"{u} (N <= {_fmt(worst * _factor(u, record))} deg/√h)" for u in likely)
+    named = " or ".join(f"{u} (N <= {_fmt(worst * _factor(u, record))} deg/√h, "
+                        f"{gyro_class(worst * _factor(u, record))})" for u in likely)
     return f"the numbers fit {named}: check {{opt:unit}}"
 
 
