@@ -52,30 +52,34 @@ def test_critical_section_defers_the_interruption_to_its_end():
     assert done == ["renamed and recorded"]
 
 
-def _run_as(module: str, source: str):
-    """Run ``source`` as if it were code of ``module`` (the handler decides by the frame's module)."""
-    exec(compile(source, f"<{module}>", "exec"), {"__name__": module})
+def _run_as(module: str, source: str, steps: list | None = None):
+    """Run ``source`` as if it were code of ``module`` (the handler decides by the frame's module); ``steps``
+    collects the loop steps that ran after the signal."""
+    exec(compile(source, f"<{module}>", "exec"), {"__name__": module, "steps": [] if steps is None else steps})
 
 
-WAIT = "import os, signal, time\nos.kill(os.getpid(), signal.SIGINT)\nfor _ in range(50):\n    time.sleep(0.01)\n"
+WAIT = ("import os, signal, time\nos.kill(os.getpid(), signal.SIGINT)\nfor _ in range(50):\n    steps.append(1)\n"
+        "    time.sleep(0.01)\n")
 
 
 @pytest.mark.parametrize("module", ["fogdrift.pipeline_like", "matplotlib.figure_like"])
 def test_sigint_in_plain_python_raises_at_once_and_the_handler_is_restored(module):
     before = signal.getsignal(signal.SIGINT)
-    t0 = time.monotonic()
+    steps = []
     with pytest.raises(Interrupted):
         with SigintGuard():
-            _run_as(module, WAIT)
-    assert time.monotonic() - t0 < 0.3  # did not sleep the 0.5 s
+            _run_as(module, WAIT, steps)
+    assert len(steps) <= 1  # raised at the first step after the signal, not after the 50 steps
     assert interrupt.requested()
     assert signal.getsignal(signal.SIGINT) is before
 
 
 @pytest.mark.parametrize("module", ["jax._src.interpreters.mlir", "numba.core.compiler", "llvmlite.binding"])
 def test_sigint_elsewhere_only_sets_the_flag_for_the_next_checkpoint(module):
+    steps = []
     with SigintGuard():
-        _run_as(module, WAIT)  # runs to its end: nothing is unwound through foreign (compiled) code
+        _run_as(module, WAIT, steps)  # runs to its end: nothing is unwound through foreign (compiled) code
+        assert len(steps) == 50
         assert interrupt.requested()
         with pytest.raises(Interrupted):
             checkpoint("next stage")
@@ -122,13 +126,12 @@ def test_unraisable_keyboard_interrupt_is_silent_while_interrupted(capsys):
 
 def test_watchdog_ends_a_run_stuck_after_sigint():
     fired = threading.Event()
-    t0 = time.monotonic()
     with SigintGuard(on_timeout=fired.set, grace_s=0.3):
         with pytest.raises(Interrupted):
             with critical():  # stands for compiled code that never returns to a checkpoint in time
                 os.kill(os.getpid(), signal.SIGINT)
-                fired.wait(3.0)
-    assert fired.is_set() and time.monotonic() - t0 < 2.0
+                stuck = fired.wait(60.0)  # a hang guard only: returns as soon as the watchdog acts
+    assert stuck  # the watchdog acted while the main thread was still stuck
 
 
 def test_watchdog_stays_quiet_when_the_run_stops_in_time():
@@ -182,14 +185,21 @@ def test_pipeline_reports_its_stages_and_stops_between_models():
     assert seen == [("separation", "gx", None), ("fitting", "gx", "ar"), ("fitting", "gx", "gm11")]
 
 
-def _sigint_after(event: threading.Event, sent: list, pause: float = 0.05):
-    """A thread that sends this process a real SIGINT once ``event`` is set (compiled code is running by then)."""
+def _sigint_after(event: threading.Event, events: list, pause: float = 0.05):
+    """A thread that sends this process a real SIGINT once ``event`` is set (compiled code is running by then),
+    first appending "SIGINT" to ``events``: the steps the run logs there after it are the steps it took after the
+    signal (at most the one in flight), whatever the machine's load."""
     def run():
         if event.wait(120):
             time.sleep(pause)
-            sent.append(time.monotonic())
+            events.append("SIGINT")
             os.kill(os.getpid(), signal.SIGINT)
     threading.Thread(target=run, daemon=True).start()
+
+
+def _steps_after_the_signal(events: list) -> int:
+    assert "SIGINT" in events, "the signal was never sent"
+    return len(events) - 1 - events.index("SIGINT")
 
 
 @pytest.mark.slow
@@ -199,17 +209,18 @@ def test_real_sigint_during_numba_allan_kernels_stops_at_the_next_tau_group():
     from fogdrift.allan import allan_variance
 
     x = np.random.default_rng(3).normal(size=6_000_000)
-    started, sent, calls = threading.Event(), [], []
+    started, events = threading.Event(), []
 
     def progress(done, total):  # what the CLI's progress callback does
         check()
-        calls.append(done)
+        events.append(done)
         started.set()
 
-    _sigint_after(started, sent)
+    _sigint_after(started, events)
     with SigintGuard(), pytest.raises(Interrupted):
         allan_variance(x, 0.01, taus=400, progress=progress)
-    assert time.monotonic() - sent[0] < 1.0 and 0 < len(calls)
+    assert events[0] != "SIGINT"  # the kernels were running
+    assert _steps_after_the_signal(events) <= 1  # stopped at the next tau group (the one in flight at most)
 
 
 @pytest.mark.slow
@@ -221,16 +232,17 @@ def test_real_sigint_during_jax_training_stops_at_the_next_epoch():
 
     t = np.arange(3000.0)
     y = np.sin(2 * np.pi * t / 300) + 0.3 * np.sin(2 * np.pi * t / 47) + np.random.default_rng(4).normal(0, 0.05, t.size)
-    started, sent, epochs = threading.Event(), [], []
+    started, events = threading.Event(), []
 
     def epoch_cb(epoch, n_epochs, train_loss, val_loss):  # what the CLI's epoch callback does
         check()
-        epochs.append(epoch)
+        events.append(epoch)
         started.set()
 
     model = build_model("elman", AnalysisConfig(epochs=200_000, hidden=8), epoch_cb)
-    _sigint_after(started, sent)
+    _sigint_after(started, events)
     with SigintGuard(), pytest.raises(Interrupted):
         model.fit(y[:2000], y[2000:])
-    assert time.monotonic() - sent[0] < 1.0
-    assert 0 < len(epochs) < 200_000
+    assert events[0] != "SIGINT"  # training was running
+    assert _steps_after_the_signal(events) <= 1  # stopped at the next epoch (the one in flight at most)
+    assert len(events) - 1 < 200_000

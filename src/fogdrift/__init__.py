@@ -6,16 +6,6 @@ Heavy dependencies (JAX, matplotlib) are imported only by the modules that need 
 
 __version__ = "0.1.0"
 
-from .errors import (  # noqa: F401
-    ConfigError,
-    DataFormatError,
-    FogdriftError,
-    FogdriftWarning,
-    InsufficientDataError,
-    ModelFileError,
-    NotFittedError,
-)
-
 __all__ = [
     "__version__",
     "FogdriftError",
@@ -26,3 +16,13 @@ __all__ = [
     "ModelFileError",
     "FogdriftWarning",
 ]
+
+
+def __getattr__(name):
+    """The error classes of :mod:`fogdrift.errors`, imported on first use: ``import fogdrift`` stays free, so the
+    CLI's entry point (:func:`fogdrift.cli.main`) owns SIGINT before anything is imported."""
+    if name in __all__[1:]:
+        from . import errors
+
+        return getattr(errors, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -6,8 +6,12 @@ and the renderer (:mod:`fogdrift.report`), and print rich tables.  A :class:`~fo
 printed as one red line with settings spelled as CLI flags, and exits 1 (``--traceback`` re-raises it); usage
 errors keep typer's exit 2; Ctrl-C prints one line saying what was and was not written, and exits 130.
 
-:func:`main` installs the SIGINT guard (:class:`fogdrift.interrupt.SigintGuard`) before the heavy imports, so
-Ctrl-C at any point, the start included, ends the run within a second.  ``app`` is imported on first use.
+:func:`main` takes SIGINT over as its first statement, with nothing imported but what the interpreter itself loaded
+(``_signal``, ``os``): until the SIGINT guard (:class:`fogdrift.interrupt.SigintGuard`) is in place, a Ctrl-C
+prints ``interrupted: nothing was written`` and exits 130 at once (no command has started, so nothing can have
+been written); the guard then covers the heavy imports, option parsing and the work; after it, a Ctrl-C only
+sets the flag, so the run ends with its own status or 130, never a traceback.  ``app`` is imported on first use.
+(A Ctrl-C during the interpreter's own start-up, before any fogdrift code runs, is Python's.)
 """
 
 from __future__ import annotations
@@ -31,35 +35,69 @@ def __getattr__(name):  # ``from fogdrift.cli import app`` imports the commands 
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+NOTHING_WRITTEN = b"interrupted: nothing was written\n"
+
+
 def _on_timeout():
-    """Watchdog (another thread): the main thread did not stop within the grace time after Ctrl-C."""
-    try:
-        from ._app import emergency_exit
-    except BaseException:  # still importing: nothing can have been written
-        os.write(2, b"interrupted: nothing was written\n")
+    """Watchdog (another thread): the main thread did not stop within the grace time after Ctrl-C.
+
+    Never imports: the main thread may hold an import lock (a Ctrl-C during the heavy imports), and a run whose
+    edge (:mod:`fogdrift.cli._app`) is not loaded yet cannot have written anything."""
+    exit_now = getattr(sys.modules.get(f"{__name__}._app"), "emergency_exit", None)
+    if exit_now is None:
+        os.write(2, NOTHING_WRITTEN)
         os._exit(130)
-    emergency_exit()
+    exit_now()
+
+
+_phase = {"command_over": False}
+
+
+def _outside_the_guard(signum, frame):
+    """SIGINT handler of :func:`main` outside the guard: before it nothing was written (exit 130 now); after the
+    command only the flag is set (main() turns it into one line and exit 130)."""
+    if not _phase["command_over"]:
+        os.write(2, NOTHING_WRITTEN)
+        os._exit(130)
+    interrupt = sys.modules.get("fogdrift.interrupt")
+    if interrupt is not None:
+        interrupt.request()
+
+
+def _after_the_run(code: int) -> bytes:
+    return (b"interrupted: after the run had finished (its files were all written)\n" if code == 0
+            else b"interrupted: after the run had ended\n")
 
 
 def main():  # console-script entry point
+    import _signal  # loaded by the interpreter itself; ``signal`` (the enum wrapper) would import enum first
+
+    _phase["command_over"] = False
+    if _signal.getsignal(_signal.SIGINT) is not _signal.SIG_IGN:  # ignored: a background job asked for no Ctrl-C
+        try:
+            _signal.signal(_signal.SIGINT, _outside_the_guard)
+        except ValueError:  # not the main thread: no handler can be set there
+            pass
     from .. import interrupt
 
     code = 0
-    try:  # outside the guard too: a Ctrl-C while the guard itself starts (handler set, watchdog not yet running)
+    try:  # outside the guard too: a Ctrl-C while the guard itself starts or stops
         with interrupt.SigintGuard(on_timeout=_on_timeout, grace_s=0.6):
             try:
                 _commands()(prog_name="fogdrift")
             except SystemExit as exc:
                 code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
             except KeyboardInterrupt:  # before a command's frame took over (imports, option parsing)
-                os.write(2, b"interrupted: nothing was written\n")
+                os.write(2, NOTHING_WRITTEN)
                 code = 130
+            finally:
+                _phase["command_over"] = True  # from here on a Ctrl-C cannot mean "nothing was written"
     except KeyboardInterrupt:
         if code != 130:
-            os.write(2, b"interrupted: nothing was written\n")
+            os.write(2, _after_the_run(code) if _phase["command_over"] else NOTHING_WRITTEN)
         code = 130
     if interrupt.requested() and code != 130:  # Ctrl-C after the command's frame had finished
-        os.write(2, b"interrupted: after the run had finished (its files were all written)\n")
+        os.write(2, _after_the_run(code))
         code = 130
     if code == 130:
         # skip interpreter teardown: compiler threads (XLA, numba) still running can crash it; all files are closed
