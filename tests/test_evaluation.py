@@ -131,7 +131,7 @@ def test_analyze_heading_prints_the_evaluation_and_writes_a_bundle(bundled_path,
 
     result = CliRunner().invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models", "ar,persistence",
                                       "--train-fraction", "0.4", "--val-fraction", "0.1", "--heading",
-                                      "--out", str(tmp_path)])
+                                      "--details", "--out", str(tmp_path)])
     assert result.exit_code == 0, result.output
     out = result.output
     assert "heading error after a 300-s calibration" in out and "surviving fraction" in out

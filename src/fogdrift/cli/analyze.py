@@ -10,8 +10,8 @@ import typer
 from ..errors import ConfigError
 from ._app import (EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutliersOpt, OutOpt,
                    StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_model_rate, check_plausible, console,
-                   csv_list, echo_record, parse_fit_taus, parse_level, parse_taus, parse_terms, precheck, progress,
-                   run, say, with_load_options)
+                   csv_list, echo_record, fitted_table, parse_fit_taus, parse_level, parse_taus, parse_terms,
+                   precheck, progress, run, say, with_load_options)
 from ._tables import metrics_table, noise_table
 from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt, model_axes_text
 
@@ -61,6 +61,16 @@ def analyze(
                                        "forecasts) and filtering-artefact check of every model on the test block: "
                                        "printed, stored in analysis.json and leading the report's compensation "
                                        "verdicts (--no-heading skips it).")] = True,
+    calibration: Annotated[float, typer.Option(
+        "--calibration", help="Heading evaluation: calibration window [s] before each rolling origin.")] = 300.0,
+    origin_step: Annotated[float, typer.Option(
+        "--origin-step", help="Heading evaluation: spacing of the rolling origins [s].")] = 60.0,
+    horizons: Annotated[str, typer.Option(
+        "--horizons", help="Heading evaluation: free-run horizons [s], comma-separated.")] = "60,600,3600",
+    details: Annotated[bool, typer.Option(
+        "--details", help="Also print every table on the console (Table 2, one-step metrics, heading-error and "
+                          "artefact tables); by default the console shows the summary and the files hold the rest.")]
+    = False,
     pdf: Annotated[bool, typer.Option("--pdf", help="Also write report.pdf (the same HTML printed by headless "
                                                     "Chromium).")] = False,
     noise_method: Annotated[str, typer.Option(
@@ -75,7 +85,7 @@ def analyze(
 ):
     """The whole method: Allan analysis, separation, drift models, compensation, Table 2 and an HTML report."""
     from ..pipeline import AnalysisConfig, run_analysis
-    from ..report import fit_cell, metrics_rows, noise_row, verdict, write_report
+    from ..report import write_report
 
     with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to], json_out=json_out,
              expect=("analysis.json", "report.html") + (("report.pdf",) if pdf else ())) as r:
@@ -98,6 +108,7 @@ def analyze(
                              earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), train_fraction=train_fraction,
                              val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window,
                              noise_method=noise_method).validate()
+        hs = parse_heading_options(calibration, origin_step, horizons)
         if apply_to is not None and not apply_to.is_file():
             raise ConfigError(f"--apply-to {apply_to}: no such file")
         record = load.load()
@@ -115,38 +126,17 @@ def analyze(
             raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
         with progress("analyze", record.axis_names) as (_, epoch_cb):
             result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb)
-        say(model_axes_text([ax.models for ax in result.axes], record))
+        evaluations = []
+        if heading:  # compensation evidence on the held-out test block, stored in the result (fogdrift.evaluation)
+            from ..evaluation import evaluate_analysis
+
+            evaluations = evaluate_analysis(result, calib_s=calibration, step_s=origin_step, horizons_s=hs)
         if result.apply_to is not None:
             say(apply_note(result, apply_to))
-        for res, title in ((result, load.file.name), (result.apply_to, apply_to.name if apply_to else "")):
-            if res is None:
-                continue
-            for ax in res.axes:
-                console.print(noise_table(f"{title} axis {ax.name}: Table 2 (test block, {ax.models.dt_s:g} s "
-                                          "samples; 95 % intervals)",
-                                          [["original (whole record, native rate)"] + noise_row(ax.original.noise)
-                                           + [fit_cell(ax.original.noise)]]
-                                          + [[row.label] + noise_row(row.analysis.noise)
-                                             + [fit_cell(row.analysis.noise)] for row in ax.table2],
-                                          fit=True))
-                console.print(metrics_table(f"{title} axis {ax.name}: one-step metrics on the test block",
-                                            metrics_rows(ax.models)))
-                for line in verdict(ax.models):
-                    say("  " + line)
-                if ax.gmwm is not None:
-                    from .noise import print_gmwm
-
-                    print_gmwm(f"{title} (whole record, native rate)", [ax.gmwm])
-        if heading:  # compensation evidence on the test block, stored in the result (fogdrift.evaluation)
-            from ..evaluation import evaluate_analysis
-            from .compensate import print_evaluation
-
-            for ev in evaluate_analysis(result):
-                for note in ev.notes:
-                    say("  " + note)
-                print_evaluation([ev.heading] if ev.heading else [], [ev.artefacts] if ev.artefacts else [],
-                                 ev.verdicts)
-                say(ev.headline.lines[0])
+        if details:
+            say(model_axes_text([ax.models for ax in result.axes], record))
+            _print_details(result, load.file.name, apply_to.name if apply_to else "", evaluations)
+        print_summary(result, record, evaluated=heading, apply_name=apply_to.name if apply_to else "")
         path = write_report(result, record, r.out.path, evaluated=heading, pdf=pdf,
                             sensor=None if sensor is None or not sensor.strip() else sensor.strip())
         # the self-describing bundle 'fogdrift compensate' applies to other logs
@@ -159,8 +149,11 @@ def analyze(
         comp = write_compensated_test_block([ax.models for ax in result.axes], r.out.path, t0_s=record.t0_s)
         r.wrote()
         say(f"report: {path.resolve()}{'  (+ report.pdf)' if pdf else ''}  ({result.wall_s:.1f} s)")
-        say(f"bundle: {bundle.path}")
+        say(f"bundle: {bundle.path}   (apply it to another log: fogdrift compensate {bundle.path} LOG)")
         say(f"compensated test block: {', '.join(p.name for p in comp)} (modelling rate, deg/h)")
+        if not details:
+            say("every table (Table 2, one-step metrics, heading error, artefacts): the report, analysis.json, "
+                "or --details", style="dim")
         r.print_json(r.out.path / "analysis.json")
 
 
@@ -190,3 +183,107 @@ def apply_note(result, path) -> str:
     return (f"--apply-to {path.name}: models applied unchanged (axes by name); bias re-estimated on its own "
             f"training share ({cfg.train_fraction:g}): " + "; ".join(parts)
             + "; Earth rate, wavelet, level and modelling rate as for the fitted recording")
+
+
+def parse_heading_options(calibration: float, origin_step: float, horizons: str) -> tuple:
+    """The heading-evaluation settings checked before any work; returns the horizons [s]."""
+    import math
+
+    for flag, v in (("--calibration", calibration), ("--origin-step", origin_step)):
+        if not (math.isfinite(v) and v > 0):
+            raise ConfigError(f"{flag} must be a positive number of seconds, got {v!r}")
+    try:
+        hs = tuple(float(h) for h in csv_list(horizons))
+    except ValueError:
+        raise ConfigError(f"--horizons must be numbers of seconds separated by commas, got {horizons!r}") from None
+    if not hs or not all(math.isfinite(h) and h > 0 for h in hs):
+        raise ConfigError(f"--horizons must be positive numbers of seconds separated by commas, got {horizons!r}")
+    return hs
+
+
+def _print_details(result, title, apply_title, evaluations) -> None:
+    """Every table of the run on the console (``--details``): Table 2, one-step metrics, GMWM, heading error,
+    artefacts and every verdict line."""
+    from ..report import fit_cell, metrics_rows, noise_row, verdict
+    from .compensate import print_evaluation
+
+    for res, name in ((result, title), (result.apply_to, apply_title)):
+        if res is None:
+            continue
+        for ax in res.axes:
+            console.print(noise_table(f"{name} axis {ax.name}: Table 2 (test block, {ax.models.dt_s:g} s "
+                                      "samples; 95 % intervals)",
+                                      [["original (whole record, native rate)"] + noise_row(ax.original.noise)
+                                       + [fit_cell(ax.original.noise)]]
+                                      + [[row.label] + noise_row(row.analysis.noise)
+                                         + [fit_cell(row.analysis.noise)] for row in ax.table2],
+                                      fit=True))
+            console.print(metrics_table(f"{name} axis {ax.name}: one-step metrics on the test block",
+                                        metrics_rows(ax.models)))
+            for line in verdict(ax.models):
+                say("  " + line)
+            if ax.gmwm is not None:
+                from .noise import print_gmwm
+
+                print_gmwm(f"{name} (whole record, native rate)", [ax.gmwm])
+    for ev in evaluations:
+        for note in ev.notes:
+            say("  " + note)
+        print_evaluation([ev.heading] if ev.heading else [], [ev.artefacts] if ev.artefacts else [], ev.verdicts)
+
+
+#: Short console labels of the report's headline rows (the report keeps the long ones).
+_SHORT_LABELS = {"selected noise model": "model", "selected noise model (WIC)": "model (WIC)",
+                 "χ²_red (fit quality, p)": "fit χ²_red", "fitted τ range [s]": "fitted τ [s]"}
+
+
+def _short_label(label: str) -> str:
+    """``"N angle random walk [deg/√h]"`` -> ``"N [deg/√h]"``; other rows by :data:`_SHORT_LABELS`."""
+    if label in _SHORT_LABELS:
+        return _SHORT_LABELS[label]
+    head, _, unit = label.rpartition(" [")
+    sym = head.split(" ")[0].rstrip(",")
+    return f"{sym} [{unit}" if unit and head else label
+
+
+def _stacked(cell: str) -> str:
+    """A cell's interval or remark on a second line, so that three axes fit an 80-column terminal."""
+    for sep in (" [", " (", " at "):
+        head, found, tail = cell.partition(sep)
+        if found and head:
+            return f"{head}\n{cell[len(head) + 1:]}"
+    return cell
+
+
+def print_summary(result, record, *, evaluated: bool, apply_name: str = "") -> None:
+    """The console's summary, the report's first screen in short: the noise headline of every axis (terms that
+    no axis resolves are left to the report), then one compensation verdict per axis, judged in heading error on
+    held-out data."""
+    from ..report.summary import OUTCOME_LABELS, noise_headline, verdict_items
+
+    headers, rows = noise_headline(result)
+    keep = []
+    for row in rows:
+        sym = row[0].split(" ")[0]
+        optional = sym in ("K", "R", "Q") and all(c.startswith(("–", "n/e")) for c in row[1:])
+        if not optional:
+            keep.append([_short_label(row[0])] + list(row[1:]))
+    keep = [[row[0]] + [_stacked(c) for c in row[1:]] for row in keep]
+    console.print(fitted_table(f"Noise of the original output ({headers[0]}; 95 % intervals)",
+                               [""] + [h.replace("axis ", "") for h in headers[1:]], keep))
+    say("  – (< x): not in the selected model, x its 95 % upper bound; n/e: not estimable (the report says why)",
+        style="dim")
+    for res, name in ((result, ""), (getattr(result, "apply_to", None), apply_name)):
+        if res is None:
+            continue
+        ev = next((ax.evaluation for ax in res.axes if getattr(ax, "evaluation", None) is not None), None)
+        if ev is not None:
+            st = ev.settings
+            e, f = res.axes[0].models.split["test"]
+            block = (f - e) * res.axes[0].models.dt_s
+            say(f"compensation verdict{' on ' + name if name else ''}: heading error on the held-out test block "
+                f"({block:.4g} s, last {100 * (1 - res.config.train_fraction - res.config.val_fraction):.0f} % of "
+                f"the record), {st['calibration_window_s']:g}-s calibrations every {st['origin_step_s']:g} s, "
+                "judged against constant bias:", style="bold")
+        for item in verdict_items(res, evaluated=evaluated):
+            say(f"  [{OUTCOME_LABELS.get(item['outcome'], item['outcome'])}] {item['sentence']}")

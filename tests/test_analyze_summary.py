@@ -1,0 +1,88 @@
+"""``fogdrift analyze``'s console: the summary first, short, fitting 80 columns, with a judged verdict when the
+held-out block holds enough origins (the ``make demo`` protocol), and every table behind ``--details``."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+from typer.testing import CliRunner
+
+from fogdrift.cli import app
+
+runner = CliRunner()
+
+#: The ``make demo`` protocol (Makefile DEMO_ARGS): first half fitted, second half judged, 150-s calibrations
+#: every 30 s, 30- and 60-s horizons.
+DEMO = ["--train-fraction", "0.4", "--val-fraction", "0.1", "--calibration", "150", "--origin-step", "30",
+        "--horizons", "30,60"]
+
+
+@pytest.fixture(scope="module")
+def demo_run(bundled_path, tmp_path_factory):
+    out = tmp_path_factory.mktemp("demo")
+    res = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models",
+                              "ar,persistence", *DEMO, "--out", str(out)], env={"COLUMNS": "80"})
+    assert res.exit_code == 0, res.output
+    return res.stdout, out
+
+
+def test_the_summary_is_short_and_its_tables_fit_80_columns(demo_run):
+    out, _ = demo_run
+    lines = out.splitlines()
+    table = [ln for ln in lines if ln[:1] in "┏┃┡│└"]
+    assert table and max(len(ln) for ln in table) <= 80
+    assert len(lines) <= 40
+    assert "Table 2 (test block" not in out and "one-step metrics on the test block" not in out  # in the files
+    assert "--details" in out
+    # the summary comes before the file list
+    assert out.index("Noise of the original output") < out.index("compensation verdict") < out.index("report:")
+
+
+def test_the_demo_protocol_gives_a_judged_verdict(demo_run):
+    out, folder = demo_run
+    verdict = [ln for ln in out.splitlines() if ln.startswith("  [")]
+    assert len(verdict) == 1 and verdict[0].startswith("  [") and "gz:" in verdict[0]
+    assert "CANNOT JUDGE" not in verdict[0]
+    doc = json.loads((folder / "analysis.json").read_text())
+    ev = doc["axes"][0]["evaluation"]
+    assert ev["settings"]["calibration_window_s"] == 150.0 and ev["settings"]["origin_step_s"] == 30.0
+    assert ev["settings"]["horizons_s"] == [30.0, 60.0]
+    assert ev["headline"]["data"]["outcome"] in ("reduces", "mixed", "none")
+    # the held-out block is the second half: 923 samples at 1 Hz; at 60 s with 30-s steps the non-overlapping
+    # origins are 1 + floor((n - 1) * 30 / 60), n = (923 - 150 - 60) // 30 + 1
+    n = (923 - 150 - 60) // 30 + 1
+    assert 60.0 in ev["headline"]["data"]["judged_horizons_s"] and 1 + (n - 1) * 30 // 60 >= 10
+
+
+def test_details_prints_every_table(bundled_path, tmp_path):
+    res = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models",
+                              "persistence", "--no-heading", "--details", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert "Table 2" in res.stdout and "one-step metrics on the test block" in res.stdout
+    assert "heading error not evaluated (--no-heading)" in res.stdout
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--horizons", "60,x"], "--horizons must be numbers of seconds"),
+    (["--horizons", "0"], "--horizons must be positive"),
+    (["--calibration", "0"], "--calibration must be a positive number of seconds"),
+    (["--origin-step", "nan"], "--origin-step must be a positive number of seconds"),
+])
+def test_heading_options_are_checked_before_the_work(bundled_path, tmp_path, args, message):
+    res = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", *args, "--out", str(tmp_path / "o")])
+    assert res.exit_code != 0
+    assert message in res.output and "Traceback" not in res.output
+    assert "samples x" not in res.output  # refused before the log was read
+    assert not (tmp_path / "o").exists()
+
+
+def test_stacked_cells_keep_the_whole_text():
+    from fogdrift.cli.analyze import _short_label, _stacked
+
+    for cell in ("0.3043 [0.237, 0.304]", "n/e (< 1.14)", "39.2 at τ = 117 s", "Q+N", "–"):
+        assert re.sub(r"\s+", " ", _stacked(cell)) == cell
+    assert _stacked("0.3043 [0.237, 0.304]") == "0.3043\n[0.237, 0.304]"
+    assert _short_label("N angle random walk [deg/√h]") == "N [deg/√h]"
+    assert _short_label("selected noise model") == "model"
