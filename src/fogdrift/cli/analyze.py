@@ -57,8 +57,8 @@ def analyze(
     gm_window: Annotated[int, typer.Option("--gm-window", help="Rolling window [samples] of the one-step GM(1,1).")]
     = 8,
     heading: Annotated[bool, typer.Option(
-        "--heading/--no-heading", help="Heading-error evaluation (rolling 300-s calibrations every 60 s, free-run "
-                                       "forecasts) and filtering-artefact check of every model on the test block: "
+        "--heading/--no-heading", help="Heading-error evaluation (rolling calibrations: --calibration, "
+                                       "--origin-step, --horizons; free-run forecasts) and filtering-artefact check of every model on the test block: "
                                        "printed, stored in analysis.json and leading the report's compensation "
                                        "verdicts (--no-heading skips it).")] = True,
     calibration: Annotated[float, typer.Option(
