@@ -110,16 +110,13 @@ def test_ctrl_c_during_a_local_dask_batch(tmp_path):
         while not list(out.glob(f"*/{BATCH_JSON}")) and proc.poll() is None and time.monotonic() < deadline:
             time.sleep(0.01)
         assert proc.poll() is None, "the batch ended before the signal; the test needs longer files"
-        t0 = time.monotonic()
         proc.send_signal(signal.SIGINT)
-        _, err = proc.communicate(timeout=60)
-        seconds = time.monotonic() - t0
+        _, err = proc.communicate(timeout=120)  # a hang guard only (measured 0.06 s when idle)
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.communicate()
     assert proc.returncode == 130, err
-    assert seconds < 5.0, seconds                     # measured 0.06 s; the workers are killed, not waited for
     err_lines = [ln for ln in err.splitlines() if ln.strip()]
     assert len(err_lines) == 1, err
     assert "Traceback" not in err and "leaked" not in err
@@ -128,4 +125,5 @@ def test_ctrl_c_during_a_local_dask_batch(tmp_path):
     assert "summary.parquet and fleet.html not written" in err_lines[0]
     finished = _assert_folders_consistent(out)
     assert len(finished) == int(m.group(1)) >= 1
+    assert len(finished) < 6  # the workers were killed, not waited for: the batch did not run on to its end
     assert not (out / "summary.parquet").exists() and not (out / "fleet.html").exists()
