@@ -374,28 +374,56 @@ def library_versions() -> dict:
     return out
 
 
-def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False) -> AllanAxis:
+def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False,
+                  spectrum="auto") -> AllanAxis:
     """Allan-family variance and noise identification of one 1-D rate series.
 
     The curve is computed on the configured grid (``cfg.taus``) for display; the noise fit always uses an octave
     grid of the same data, so its numbers do not depend on the display grid.  With ``check_outliers`` the rate is
     checked for samples beyond 6 robust sigma and, if ``cfg.outliers`` says so, clipped or replaced first.
+
+    ``spectrum``: the :class:`~fogdrift.noise.spectral.SpectrumSummary` of this rate, ``"auto"`` (default:
+    computed here, once, from the rate that is analysed) or None (no spectrum).  Its lines become the S term of
+    the fit; the fit curve then also holds the taus at whole multiples of each period (a sinusoid vanishes there,
+    so quantization and a periodic error are told apart), and no tau gets a phase-noise (white-PM) EDF
+    (:func:`fogdrift.allan.ci.periodic_alpha`).
     """
     from .allan import allan_variance
+    from .allan.ci import periodic_alpha
     from .noise import fit_noise
+    from .noise.periodic import null_taus, periodic_content
 
     outliers = None
     if check_outliers:
         from .outliers import treat_outliers
 
         rate_dph, outliers = treat_outliers(rate_dph, cfg.outliers)
+    if isinstance(spectrum, str) and spectrum == "auto":
+        from .noise.spectral import analyse_spectrum
+
+        spectrum = analyse_spectrum(rate_dph, dt_s)
+    content = periodic_content(spectrum)
     res = allan_variance(rate_dph, dt_s, taus=cfg.taus, estimator=cfg.estimator, statistic=cfg.statistic,
                          progress=progress)
+    if content is not None:
+        alphas, _ = periodic_alpha(res.noise_alpha, True)
+        if np.any(alphas != res.noise_alpha):
+            res = allan_variance(rate_dph, dt_s, taus=res.tau_s, estimator=cfg.estimator, statistic=cfg.statistic,
+                                 noise_alpha=alphas)
     fit_curve = res if cfg.taus == "octave" else allan_variance(rate_dph, dt_s, taus="octave",
                                                                 estimator=cfg.estimator, statistic=cfg.statistic)
+    if content is not None:  # the taus at whole multiples of each period, beside the octave grid
+        extra = null_taus(content.periods_s, dt_s, float(fit_curve.tau_s[0]), float(fit_curve.tau_s[-1]))
+        taus = np.union1d(fit_curve.tau_s, extra)
+        if taus.size != fit_curve.tau_s.size or not np.all(fit_curve.noise_alpha <= 0):
+            fc = allan_variance(rate_dph, dt_s, taus=taus, estimator=cfg.estimator, statistic=cfg.statistic)
+            alphas, _ = periodic_alpha(fc.noise_alpha, True)
+            fit_curve = allan_variance(rate_dph, dt_s, taus=taus, estimator=cfg.estimator, statistic=cfg.statistic,
+                                       noise_alpha=alphas) if np.any(alphas != fc.noise_alpha) else fc
     lo, hi = cfg.fit_tau_s
     tau_range = None if lo is None and hi is None else (lo, hi)
-    noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range)
+    noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range,
+                      spectrum=spectrum)
     if outliers is not None:
         noise.outliers = outliers.to_dict()
     return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers)

@@ -22,7 +22,10 @@ Kept apart, as in allantools' ``ci.py``:
 * :func:`chi2_bounds` -- ``[var edf / chi2_{1-q/2}(edf), var edf / chi2_{q/2}(edf)]``,
   [SP1065]_ Sec. 5.3 (eqs. 44-45);
 * :func:`resolve_alpha` -- the power-law alpha assumed at each tau (given, from the local
-  log-log slope of the deviation, or the most conservative one).
+  log-log slope of the deviation, or the most conservative one);
+* :func:`periodic_alpha` -- no phase-noise (white/flicker PM) alpha where the spectrum found a
+  periodic error: a sinusoid's Allan deviation falls like tau^-1 and looks like white PM, whose
+  EDF (tens of thousands at short tau) would make its bounds ~1 % wide.
 
 References
 ----------
@@ -52,6 +55,7 @@ __all__ = [
     "chi2_bounds",
     "resolve_alpha",
     "alpha_from_slope",
+    "periodic_alpha",
     "POWER_LAW_ALPHAS",
     "P68",
 ]
@@ -533,3 +537,31 @@ def resolve_alpha(noise_alpha, tau_s, var, *, slopes, candidates):
     if not np.all(np.isin(arr, POWER_LAW_ALPHAS)):
         raise ConfigError(f"noise_alpha values must be in (2, 1, 0, -1, -2), got {np.unique(arr).tolist()}")
     return arr.astype(np.int64), "alpha given by the caller"
+
+
+def periodic_alpha(alphas, periodic) -> tuple[np.ndarray, str]:
+    """``(alphas, rule)`` with every phase-noise alpha (+2 white PM, +1 flicker PM) replaced by 0 (white FM) when the
+    series holds periodic content (``periodic`` true: the spectrum found a line).
+
+    A periodic error's Allan variance ``Omega0^2 sin^4(pi f tau) / (pi f tau)^2`` (IEEE Std 952-1997 Annex C) falls
+    like tau^-2, the slope of quantization; the slope rule would then give those taus the white-PM EDF (about
+    ``N / m``: tens of thousands), i.e. intervals of ~1 %, although the estimate of a line's contribution is far
+    less certain (its amplitude wanders; the curve oscillates between the line's nulls).  White FM's EDF (the
+    simple EDF at alpha = 0, well below white PM's once m > 1) is the conservative choice; the noise fit's
+    covariance makes the same one for its S term (white rate noise as the stand-in).
+    Where ``periodic`` is false the alphas are returned unchanged.
+
+    Examples
+    --------
+    >>> periodic_alpha(np.array([2, 0, -1]), True)[0].tolist()
+    [0, 0, -1]
+    >>> periodic_alpha(np.array([2, 0, -1]), False)[0].tolist()
+    [2, 0, -1]
+    """
+    a = np.asarray(alphas, dtype=np.int64).copy()
+    if not periodic:
+        return a, ""
+    hit = a > 0
+    a[hit] = 0
+    return a, ("; periodic content in the spectrum: white FM (alpha 0) instead of a phase-noise alpha at "
+               f"{int(hit.sum())} tau(s) whose slope a spectral line explains")

@@ -111,7 +111,7 @@ def _inflation(allan):
 
 
 def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penalty=2.0,
-              plausible_delta=6.0) -> NoiseFit:
+              plausible_delta=6.0, spectrum=None, markov=True) -> NoiseFit:
     """Identify the IEEE-952 noise terms of an Allan-family curve.
 
     Parameters
@@ -128,6 +128,14 @@ def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penal
     max_per_octave, ic_penalty, plausible_delta : keyword-only
         Working points per octave, IC penalty per term, IC window of the plausible models (see
         :func:`fogdrift.noise.identify`).
+    spectrum : SpectrumSummary or None, keyword-only
+        The spectrum of the same rate series (:func:`fogdrift.noise.spectral.analyse_spectrum`): its lines become
+        the candidate S term (one fitted scale, the lines' relative powers fixed from the spectrum), the curve's
+        taus at whole multiples of each period are fitted too (where ``allan`` holds them), notes name the real
+        frequencies, and a short-tau shape is called an output filter only where it shows a roll-off.  None (a
+        published curve): no S term, and no shape is called a filter.
+    markov : bool, keyword-only
+        Try the exponentially correlated (Gauss-Markov) term M (default True; only without fixed ``terms``).
 
     Returns
     -------
@@ -164,10 +172,19 @@ def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penal
         terms = tuple(t for t in TERMS if t in terms)
     var = np.asarray(allan.var_dph2, dtype=np.float64)
     hi = np.asarray(allan.dev_hi95_dph, dtype=np.float64) ** 2
+    from .periodic import null_taus, periodic_content
+
+    content = periodic_content(spectrum)
+    keep = None
+    if content is not None:
+        t = np.asarray(allan.tau_s, dtype=np.float64)
+        keep = null_taus(content.periods_s, float(allan.dt_s), float(t.min()), float(t.max()))
     fit = identify(allan.tau_s, var, int(allan.n_samples), float(allan.dt_s), var_hi95=hi,
                    m=getattr(allan, "m", None), statistic=statistic, terms=terms, tau_range_s=tau_range_s,
                    max_per_octave=max_per_octave, ic_penalty=ic_penalty, plausible_delta=plausible_delta,
-                   var_inflation=_inflation(allan), strides=_strides(allan))
+                   var_inflation=_inflation(allan), strides=_strides(allan), periodic=content, keep_tau_s=keep,
+                   markov=markov, spectrum_given=spectrum is not None,
+                   rolloff_hz=None if spectrum is None else getattr(spectrum, "rolloff_hz", None))
     if statistic == "adev":
         fit.readouts = slope_readouts(allan.tau_s, np.sqrt(var), fit)
     del laws

@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import brentq
 from scipy.stats import chi2, t as student_t
 
 from ..errors import ConfigError, InsufficientDataError
@@ -43,11 +44,12 @@ from ..units import B_FACTOR
 from .covariance import estimator_covariance, expected_variance, ieee_spectrum, ramp_cross_variance
 from .engine import ScoreProblem, all_subsets, fit_subsets, profile_interval
 from .result import NoiseFit, NoiseTerm
-from .terms import DISPLAY_UNITS, TERM_TABLE, TERMS, UNESTIMABLE, laws_of
+from .terms import ALL_TERMS, DISPLAY_UNITS, TERM_TABLE, TERMS, UNESTIMABLE, laws_of, markov_shape, periodic_shape
 
 __all__ = ["identify", "thin_taus", "POOR_CHI2_RED"]
 
-_NAMES = TERMS
+_NAMES = ALL_TERMS  # Q N B K R, then the shaped Annex C terms S (periodic) and M (Gauss-Markov)
+_NP = len(TERMS)
 #: A fit whose reduced chi-squared exceeds this is "poor" (the misfit is several times the statistical error).
 POOR_CHI2_RED = 4.0
 
@@ -80,7 +82,8 @@ def thin_taus(tau_s, per_octave: int) -> np.ndarray:
 class _Context:
     """Data of one fit: working points, the statistic's laws, sample interval, record length."""
 
-    def __init__(self, tau, m, y, y_hi, n, dt, statistic, names, inflation=None, strides=None):
+    def __init__(self, tau, m, y, y_hi, n, dt, statistic, names, inflation=None, strides=None, lines=(),
+                 tc_s=None):
         self.tau, self.m, self.y, self.y_hi = tau, m, y, y_hi
         self.inflation = np.ones(tau.size) if inflation is None else inflation
         self.strides = np.ones(tau.size) if strides is None else strides
@@ -89,11 +92,22 @@ class _Context:
         self.names = names  # allowed terms, in TERMS order
         self.cols = tuple(_NAMES.index(t) for t in names)
         # design column of each term (the law's tau shape; its constant is part of the fitted A)
-        self.X = np.stack([self.laws[t].shape(tau, dt) if t in self.laws else np.zeros_like(tau) for t in _NAMES],
-                          axis=1)
+        self.X = np.stack([self.laws[t].shape(tau, dt) if t in self.laws else np.zeros_like(tau) for t in TERMS]
+                          + [np.zeros_like(tau), np.zeros_like(tau)], axis=1)
+        self.lines = tuple(lines)  # [(freq_hz, relative power)] of the periodic error (S), from the spectrum
+        self.tc_s = None
+        if self.lines:
+            self.X[:, _NAMES.index("S")] = periodic_shape(tau, self.lines, dt, statistic)
+        if tc_s is not None:
+            self.set_tc(tc_s)
         if "B" in self.laws:  # flicker: the sampled process is not flat at small m (+19 % at m = 1 for ADEV)
             self.X[:, _NAMES.index("B")] *= flicker_shape(m, statistic)
         self.upper = self._upper()
+
+    def set_tc(self, tc_s):
+        """Set the Gauss-Markov correlation time [s] of the M column (the column of the shape at ``tc_s``)."""
+        self.tc_s = float(tc_s)
+        self.X[:, _NAMES.index("M")] = markov_shape(self.tau, self.tc_s, self.statistic, self.dt)
 
     def _upper(self, C=None):
         """Largest coefficient of each term that keeps it, alone, below every point's ~4-sigma upper bound.
@@ -107,13 +121,18 @@ class _Context:
             ub_pt = self.y * (self.y_hi / self.y) ** (4.0 / 1.96)
         else:
             ub_pt = _point_limits(self.y, 2.0 / np.diag(C))
-        return np.array([np.min(ub_pt / self.X[:, i]) if np.all(self.X[:, i] > 0) else 0.0 for i in range(5)])
+        out = np.array([np.min(ub_pt / self.X[:, i]) if np.all(self.X[:, i] > 0) else 0.0 for i in range(_NP)])
+        # a shaped column can vanish at single taus (S at multiples of its period): bound it where it is non-zero
+        shaped = [np.min(ub_pt[self.X[:, i] > 0] / self.X[self.X[:, i] > 0, i]) if np.any(self.X[:, i] > 0) else 0.0
+                  for i in range(_NP, len(_NAMES))]
+        return np.concatenate([out, shaped])
 
     def sub(self, start):
         c = _Context.__new__(_Context)
         c.__dict__.update(self.__dict__)
         for k in ("tau", "m", "y", "y_hi", "X", "inflation", "strides"):
             setattr(c, k, getattr(self, k)[start:])
+        c.X = c.X.copy()  # its M column is set per correlation time: never share it with another context
         c.upper = c._upper()
         return c
 
@@ -131,7 +150,13 @@ class _Context:
         (:func:`~fogdrift.noise.covariance.ramp_cross_variance`), which keeps the ramp estimate unbiased.
         """
         x2 = self.x2(A)
-        a_allan = [TERM_TABLE[t].avar_coefficient * x2.get(t, 0.0) for t in _NAMES]
+        a_allan = [TERM_TABLE[t].avar_coefficient * x2.get(t, 0.0) for t in TERMS]
+        # a periodic error enters the estimates' covariance as white rate noise at the level of its Allan envelope
+        # at each line's own period (a stand-in: a line's amplitude wanders, and a deterministic sinusoid would
+        # otherwise lend the points it dominates a white-PM-like EDF of thousands)
+        i_s = _NAMES.index("S")
+        if A[i_s] > 0 and self.lines:
+            a_allan[1] += A[i_s] * sum(r / (math.pi**2 * f) for f, r in self.lines)
         mu = self.X @ A
         if not exact_ramp and a_allan[4] > 0:
             extra = 1.5 * a_allan[4] * float(self.tau[-1])
@@ -145,6 +170,13 @@ class _Context:
                 mu = mu - self.X[:, ir] * A[ir] + self.X[:, _NAMES.index("K")] * (
                     extra / TERM_TABLE["K"].avar_coefficient * self.laws["K"].scale(self.dt))
         spec = ieee_spectrum(a_allan, self.dt)
+        i_m = _NAMES.index("M")
+        if A[i_m] > 0 and self.tc_s is not None:  # exact spectrum of the sampled Gauss-Markov process (AR(1))
+            phi, s2 = math.exp(-self.dt / self.tc_s), A[i_m] / (2.0 * self.tc_s)
+            base = spec
+
+            def spec(f, base=base, phi=phi, s2=s2):
+                return base(f) + s2 * (1 - phi * phi) / (1 - 2 * phi * np.cos(2 * np.pi * np.asarray(f)) + phi * phi)
         V = estimator_covariance(self.m, self.n, spec, statistic=self.statistic)
         if exact_ramp and a_allan[4] > 0 and self.statistic != "hdev":  # per-sample units: A_R dt^2
             # a strided sum (fast / non-overlapping sampling) no longer telescopes: about `stride` boundary blocks
@@ -198,7 +230,7 @@ def _select(ctx: _Context, penalty: float, iters: int = 2, C=None):
         from scipy.optimize import lsq_linear
 
         a = lsq_linear(Xw / sc, ctx.y * w, bounds=(0.0, np.inf)).x
-    A = np.zeros(5)
+    A = np.zeros(len(_NAMES))
     A[list(cols)] = np.minimum(a / sc, ctx.upper[list(cols)])
     if not np.any(A > 0):
         A[list(cols)] = ctx.upper[list(cols)] * 1e-3
@@ -206,7 +238,7 @@ def _select(ctx: _Context, penalty: float, iters: int = 2, C=None):
         C = ctx.relcov(A)
         prob = ScoreProblem(ctx.X, ctx.y, C, ctx._upper(C))
         a, _q = prob.fit(cols)
-        newA = np.zeros(5)
+        newA = np.zeros(len(_NAMES))
         newA[list(cols)] = a
         done = np.allclose(newA, A, rtol=2e-2, atol=0.0)
         A = newA
@@ -279,7 +311,7 @@ def _choose_start(ctx: _Context, penalty: float, max_fraction: float = 0.5, thre
         a_here = here["res"][here["best"]]["a"]
         i_n = _NAMES.index("N")
         if from_white and a_here[i_n] > 0 and _reduced(here, tau.size - s) <= POOR_CHI2_RED:
-            white = np.zeros(5)
+            white = np.zeros(len(_NAMES))
             white[i_n] = a_here[i_n]
             line = float(ctx.X[s - 1] @ white)
             if ctx.y[s - 1] < line:
@@ -301,8 +333,12 @@ def _slope(tau, var):
     return float(np.polyfit(lt, ls, 1)[0])
 
 
-def _describe_excluded(ctx: _Context, start: int, sel) -> str:
-    """Why the short taus [0, start) were left out, in words."""
+def _describe_excluded(ctx: _Context, start: int, sel, periodic=None, spectrum_given=False, rolloff_hz=None) -> str:
+    """Why the short taus [0, start) were left out, in words.
+
+    An oscillation is named by the real frequency of the spectral lines when the spectrum found any (the tau of a
+    bump is no frequency estimate: a line at 72 Hz in a 100-Hz log puts it anywhere); a curve below the model is
+    called an output filter only where the spectrum shows a roll-off (``rolloff_hz``)."""
     tau, y = ctx.tau[: start + 1], ctx.y[: start + 1]
     model = (ctx.X[: start + 1] @ sel["res"][sel["best"]]["a"])
     ratio = np.sqrt(y / model)  # ADEV data / model
@@ -313,13 +349,22 @@ def _describe_excluded(ctx: _Context, start: int, sel) -> str:
     interior = [k for k in range(1, start) if g[k] > g[k - 1] and g[k] >= g[k + 1]
                 and g[k] > g[start] * (1 + 2 * max(sd[k], 0.01))]
     i_max = max(interior, key=lambda k: g[k]) if interior else -1
+    if periodic is not None:
+        return f"{periodic.text()} (periodic content the fitted terms do not describe there), not a noise term"
     if i_max > 0:
-        f_hz = 1.0 / (2.0 * tau[i_max])
-        return (f"a bump in the curve near tau = {tau[i_max]:.3g} s (an oscillation or vibration near {f_hz:.3g} Hz), "
-                "not a noise term")
+        what = ("an oscillation, but the spectrum shows no line: not a noise term" if spectrum_given else
+                "an oscillation or vibration; its frequency needs the spectrum of the series, not the tau of the "
+                "bump")
+        return f"a bump in the curve near tau = {tau[i_max]:.3g} s ({what})"
     if np.all(ratio[:-1] < 1.0) and slope > -0.5:
-        kind = (f"ADEV below the model with a slope of {slope:+.2f} (flatter than white noise's -0.5): an output "
-                "low-pass / anti-alias filter or correlated samples, not a noise term")
+        if rolloff_hz is not None:
+            why = f"an output low-pass / anti-alias filter (the spectrum rolls off above {rolloff_hz:.3g} Hz)"
+        elif spectrum_given:
+            why = "correlated samples (the spectrum shows no output-filter roll-off)"
+        else:
+            why = "correlated samples (no spectrum to tell an output filter)"
+        kind = (f"ADEV below the model with a slope of {slope:+.2f} (flatter than white noise's -0.5): {why}, "
+                "not a noise term")
     elif slope < -1.0:
         kind = f"a slope of {slope:+.2f}, steeper than quantization's -1: not an IEEE-952 term"
     else:
@@ -352,7 +397,8 @@ def _worst_region(tau, z):
 
 
 def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev", terms=None, tau_range_s=None,
-             max_per_octave=1, ic_penalty=2.0, plausible_delta=6.0, var_inflation=None, strides=None) -> NoiseFit:
+             max_per_octave=1, ic_penalty=2.0, plausible_delta=6.0, var_inflation=None, strides=None,
+             periodic=None, keep_tau_s=None, markov=True, spectrum_given=False, rolloff_hz=None) -> NoiseFit:
     """Identify the IEEE-952 noise terms of one Allan-family curve (see the module docstring).
 
     Parameters
@@ -382,6 +428,18 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         sampling); the model covariance is scaled by ``sqrt(f_i f_j)``.
     strides : array_like, shape (n_tau,), optional
         Start-index stride of each estimate (1 overlapping, ``m`` non-overlapping, ``b`` fast).
+    periodic : PeriodicContent or None
+        Spectral lines of the same rate series (:func:`fogdrift.noise.periodic.periodic_content`): they become the
+        candidate S term and name the real frequency wherever the notes speak of an oscillation.
+    keep_tau_s : array_like, optional
+        Taus [s] kept besides the thinned working points (whole multiples of a period: a sinusoid vanishes there).
+    markov : bool
+        Try the exponentially correlated term M (its correlation time profiled on the fitted range).
+    spectrum_given : bool
+        True when the spectrum of the series was examined.
+    rolloff_hz : float or None
+        Where that spectrum shows an output low-pass roll-off [Hz].  A short-tau shape below the white-noise line
+        is called an output filter only with one; without a spectrum or without a roll-off it never is.
 
     Returns
     -------
@@ -403,8 +461,12 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     strd = np.ones(tau.size) if strides is None else np.asarray(strides, dtype=np.float64)
     tau, y, y_hi, mm, infl_pt, strd = tau[ok], y[ok], y_hi[ok], mm[ok], infl_pt[ok], strd[ok]
     idx = thin_taus(tau, max_per_octave)
+    if keep_tau_s is not None and len(keep_tau_s):  # whole multiples of a period: Q and S are told apart there
+        kt = np.asarray(keep_tau_s, dtype=np.float64)
+        near = np.any(np.abs(tau[:, None] / kt[None, :] - 1.0) < 1e-9, axis=1)
+        idx = np.union1d(idx, np.flatnonzero(near)).astype(np.int64)
     tau, y, y_hi, mm, infl_pt, strd = tau[idx], y[idx], y_hi[idx], mm[idx], infl_pt[idx], strd[idx]
-    allowed = tuple(t for t in _NAMES if t in laws) if terms is None else tuple(terms)
+    allowed = tuple(t for t in TERMS if t in laws) if terms is None else tuple(terms)
     bad = [t for t in allowed if t not in laws]
     if bad:
         why = "; ".join(UNESTIMABLE.get((statistic, t), f"{statistic} has no law for {t}") for t in bad)
@@ -415,7 +477,10 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         raise InsufficientDataError(
             f"the noise fit needs at least {need} taus at least 1/{max_per_octave} octave apart in the fit range; "
             f"got {tau.size} (widen {{opt:fit_taus}} or fit fewer {{opt:terms}})", needed=need, got=int(tau.size))
-    ctx = _Context(tau, mm, y, y_hi, int(n_samples), float(dt_s), statistic, allowed, infl_pt, strd)
+    lines = tuple(periodic.lines) if periodic is not None else ()
+    if lines and terms is None:
+        allowed = allowed + ("S",)
+    ctx = _Context(tau, mm, y, y_hi, int(n_samples), float(dt_s), statistic, allowed, infl_pt, strd, lines=lines)
 
     excluded, notes = [], []
     if tau_range_s is None and terms is None:
@@ -425,19 +490,37 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         sel = _select(ctx, ic_penalty)
     if start > 0:
         excluded.append({"tau_min_s": float(tau[0]), "tau_max_s": float(tau[start - 1]),
-                         "reason": _describe_excluded(ctx, start, sel)})
+                         "reason": _describe_excluded(ctx, start, sel, periodic, spectrum_given, rolloff_hz)})
     c = ctx.sub(start)
     if terms is not None:
         sel["best"] = tuple(_NAMES.index(t) for t in allowed)
     prob, res = sel["prob"], sel["res"]
-    sel_res = res  # the selection stage's fits (one common covariance): what the candidate table reports
     best = sel["best"]
     if terms is None:  # a term at exactly zero is not in the model: use the subset without it
         nz = tuple(i for i in best if res[best]["a"][i] > 0)
         if nz and nz != best and nz in res:
             best = nz
+    # the exponentially correlated (Gauss-Markov) term: its correlation time is profiled on the fitted range
+    markov_info = None
+    if markov and terms is None and c.tau.size >= 6:
+        mk = _markov_stage(c, sel["C"], res, best, ic_penalty)
+        if mk is not None:
+            prob, res, best, markov_info = mk
+            if markov_info is not None:
+                allowed = allowed + ("M",)
+    sel_res = res  # the selection stage's fits (one common covariance): what the candidate table reports
+    # a selected model never holds a term its own checks reject: a flat floor above the measured curve or a term at
+    # its ~4-sigma data bound is dropped and the model re-selected without it
+    dropped = {}
+    if terms is None:
+        best, dropped = _drop_rejected(c, prob, res, best, plausible_delta)
     ic_best = res[best]["ic"]
-    plaus = [best] if terms is not None else [k for k, v in res.items() if v["ic"] <= ic_best + plausible_delta]
+
+    def _ok(k):
+        return not any(i in k for i in dropped)
+
+    plaus = [best] if terms is not None else [k for k, v in res.items()
+                                             if v["ic"] <= ic_best + plausible_delta and _ok(k)]
     # (problem, fits) pairs whose intervals are united: the selection's conservative covariance, and -- when the
     # selected model holds a ramp -- the ramp's real (much smaller) covariance, which gives the estimate.  A ramp
     # that really is a random walk in disguise keeps the wide interval; a real ramp gets an unbiased value.
@@ -449,7 +532,8 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         views.append((prob, res))
     A = res[best]["a"]
     q = res[best]["q"]
-    dof = max(1, c.tau.size - len(best))
+    n_par = len(best) + (1 if _NAMES.index("M") in best else 0)
+    dof = max(1, c.tau.size - n_par)
     chi2_red = q / dof
     p = float(chi2.sf(q, dof))
     quality = "good" if p >= 0.01 else "acceptable" if chi2_red <= POOR_CHI2_RED else "poor"
@@ -464,16 +548,31 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
                   for k, v in sorted(sel_res.items(), key=lambda kv: kv[1]["ic"])]
 
     out_terms = {}
+    shaped = {}
     for i, name in enumerate(_NAMES):
-        spec = TERM_TABLE[name]
-        if name not in laws:
-            out_terms[name] = NoiseTerm(name, None, spec.unit, None, None, "not_estimable",
-                                        UNESTIMABLE.get((statistic, name), f"{statistic} has no law for {name}"))
-            continue
-        conv = spec.to_unit / math.sqrt(laws[name].scale(dt_s))
+        if name in ("S", "M"):
+            if name not in allowed:
+                continue
+            spec_unit = "deg/h" if name == "S" else "deg/h/sqrt(s)"
+        else:
+            spec = TERM_TABLE[name]
+            spec_unit = spec.unit
+            if name not in laws:
+                out_terms[name] = NoiseTerm(name, None, spec.unit, None, None, "not_estimable",
+                                            UNESTIMABLE.get((statistic, name), f"{statistic} has no law for {name}"))
+                continue
+        if name == "S":
+            conv = 1.0
+        elif name == "M":
+            conv = 1.0 / markov_info["tc_s"]
+        else:
+            conv = spec.to_unit / math.sqrt(laws[name].scale(dt_s))
         if name not in allowed:
-            out_terms[name] = NoiseTerm(name, None, spec.unit, None, None, "absent",
+            out_terms[name] = NoiseTerm(name, None, spec_unit, None, None, "absent",
                                         f"not fitted (terms={'+'.join(allowed)})")
+            continue
+        if i in dropped:
+            out_terms[name] = dropped[i]
             continue
         los, his, lacking = [], [], []
         for mod in plaus:
@@ -490,6 +589,8 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
                 los.append(lo)
                 his.append(hi)
         lo_v, hi_v = conv * math.sqrt(min(los)), conv * math.sqrt(max(his))
+        if name == "M" and i in best:  # q_c = sqrt(A_M) / T_c over the T_c interval too
+            lo_v, hi_v = _markov_qc_interval(c, prob, best, markov_info, q, d2, lo_v, hi_v)
         if i in best:
             val = conv * math.sqrt(A[i])
             if min(los) > 0:
@@ -497,13 +598,30 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             else:
                 status = "unresolved"
                 reason = _unresolved_reason(name, lacking, plaus, res, ic_best)
-            out_terms[name] = NoiseTerm(name, val, spec.unit, lo_v, hi_v, status, reason)
+            out_terms[name] = NoiseTerm(name, val, spec_unit, lo_v, hi_v, status, reason)
         else:
-            out_terms[name] = NoiseTerm(name, None, spec.unit, 0.0, hi_v, "absent",
-                                        _absent_reason(c, name, A, max(his)))
-    # a flat floor must not sit above the measured curve
-    if "B" in laws and out_terms["B"].value is not None:
-        _check_floor(out_terms, c, A)
+            out_terms[name] = NoiseTerm(name, None, spec_unit, 0.0, hi_v, "absent",
+                                        _absent_reason(c, name, A, max(his)) if name in laws else
+                                        "not in the model: the curve is described as well without it")
+    if terms is not None and "B" in laws and out_terms.get("B") is not None and out_terms["B"].value is not None:
+        _check_floor(out_terms, c, A)  # a fixed model keeps its terms; a floor above the curve is still refused
+    if "S" in allowed:
+        shaped["S"] = {"A": float(A[_NAMES.index("S")]), "lines": [list(x) for x in lines],
+                       "freq_hz": float(periodic.ref_freq_hz), "spectrum_amplitude_dph": periodic.ref_amplitude_dph,
+                       "description": periodic.text()}
+        t_s = out_terms["S"]
+        notes.append(f"{periodic.text()}: " + (
+            f"modelled as S, amplitude {t_s.value:.3g} deg/h at {periodic.ref_freq_hz:.4g} Hz" if t_s.value else
+            "not needed by the model in the fitted range (S absent)"))
+    if markov_info is not None:
+        iM = _NAMES.index("M")
+        tc = markov_info["tc_s"]
+        shaped["M"] = {"A": float(A[iM]), "tc_s": tc, "tc_lo95_s": markov_info["tc_lo95_s"],
+                       "tc_hi95_s": markov_info["tc_hi95_s"],
+                       "sigma_dph": (math.sqrt(A[iM]) / tc) * math.sqrt(tc / 2.0) if A[iM] > 0 else None,
+                       "q_unit": "deg/h/sqrt(s)"}
+        if iM not in best:
+            shaped["M"].update(tc_s=None, tc_lo95_s=None, tc_hi95_s=None, sigma_dph=None)
     notes.extend(_at_bound_notes(prob, A, best, c.tau, out_terms))
     if quality != "good":
         i01 = _worst_region(c.tau, z)
@@ -519,16 +637,229 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         if infl > 1:
             notes.append(f"intervals widened by sqrt(chi2_red) = {math.sqrt(infl):.3g} for the misfit")
     notes.extend(_largest_gap_note(c.tau, c.y, mu, prob.nu))
+    no_fit = None
+    if chi2_red > POOR_CHI2_RED:
+        miss = _points_outside(c.y, mu, prob.nu)
+        if miss.size:
+            no_fit = {"tau_min_s": float(c.tau[0]), "tau_max_s": float(c.tau[-1]),
+                      "miss_tau_s": [float(t) for t in c.tau[miss]],
+                      "best_candidate": "+".join(_NAMES[i] for i in best)}
+            notes.insert(0, f"no model fits tau {c.tau[0]:.3g}-{c.tau[-1]:.3g} s: the best candidate "
+                            f"({no_fit['best_candidate']}, chi2_red {chi2_red:.3g}) misses the measured curve outside "
+                            f"its 95 % intervals at tau = {', '.join(f'{t:.3g}' for t in c.tau[miss])} s; the "
+                            "coefficients are not a result (the table shows their upper bounds only)")
     b_min = _classical_b(c, A, floor_refused=out_terms.get("B") is not None and out_terms["B"].status ==
                          "not_estimable" and "contradicted" in (out_terms["B"].reason or "")) \
         if statistic == "adev" else {}
+    A5 = np.asarray(A[:_NP], dtype=np.float64)
     return NoiseFit(
-        statistic=statistic, dt_s=float(dt_s), terms=out_terms, selected=tuple(_NAMES[i] for i in best), A=A,
+        statistic=statistic, dt_s=float(dt_s), terms=out_terms, selected=tuple(_NAMES[i] for i in best), A=A5,
         candidates=candidates, plausible=["+".join(_NAMES[i] for i in k) for k in plaus], fit_tau_s=c.tau,
         fit_var=c.y, model_var=mu, z=z, chi2=float(q), dof=int(dof), chi2_red=float(chi2_red), p_value=p,
         quality=quality, inflation=float(infl), excluded=excluded, notes=notes, b_min=b_min,
-        n_samples=int(n_samples),
+        n_samples=int(n_samples), shaped=shaped, no_fit=no_fit,
     )
+
+
+def _points_outside(y, mu, nu) -> np.ndarray:
+    """Indices of the points whose own 95 % chi-squared interval (EDF ``nu``) does not hold the model value."""
+    nu = np.maximum(np.asarray(nu, dtype=np.float64), 1e-6)
+    lo = y * nu / chi2.ppf(0.975, nu)
+    hi = y * nu / chi2.ppf(0.025, nu)
+    return np.flatnonzero((mu < lo) | (mu > hi))
+
+
+def _drop_rejected(c: _Context, prob, res, best, plausible_delta=6.0):
+    """Re-select without every selected term its own checks reject.  Returns ``(best, {index: NoiseTerm})`` with
+    the dropped terms' entries (status ``not_estimable``, the bound and the reason).
+
+    * A flat B floor above the measured curve's minimum (:func:`_check_floor`) is always dropped: the data
+      contradict it.
+    * A term at its ~4-sigma data bound (one point sets it) is dropped when a model without it is plausible (IC
+      within ``plausible_delta`` of the current one): then nothing but that one point asks for the value.  When
+      every model without it is far worse the term stays, named in the notes (:func:`_at_bound_notes`): the data
+      need it, and its value is the largest they allow.
+    """
+    dropped = {}
+    ic_now = res[best]["ic"]
+    for _ in range(len(_NAMES)):
+        a = res[best]["a"]
+        bad = None
+        iB = _NAMES.index("B")
+        if iB in best and "B" in c.laws:
+            tmp = {}
+            _check_floor(tmp, c, a)
+            if "B" in tmp:
+                bad = (iB, tmp["B"])
+        if bad is None:
+            for i in best:
+                u = float(prob.upper[i])
+                if u > 0 and a[i] >= (1.0 - 1e-3) * u and len(best) > 1:
+                    name = _NAMES[i]
+                    ub_pt = _point_limits(prob.y, prob.nu)
+                    k = int(np.nanargmin(np.where(prob.X[:, i] > 0, ub_pt / np.where(prob.X[:, i] > 0, prob.X[:, i], 1),
+                                                  np.inf)))
+                    if name in c.laws:
+                        conv = TERM_TABLE[name].to_unit / math.sqrt(c.laws[name].scale(c.dt))
+                        bound, unit = conv * math.sqrt(u), DISPLAY_UNITS[name]
+                    elif name == "S":
+                        bound, unit = math.sqrt(u), "deg/h"
+                    else:
+                        bound, unit = math.sqrt(u) / max(c.tc_s or 1.0, 1e-300), "deg/h/√s"
+                    bad = (i, NoiseTerm(
+                        name, None, TERM_TABLE[name].unit if name in TERM_TABLE else unit, None, bound,
+                        "not_estimable",
+                        f"left out of the model: its fit ran into its data bound ({bound:.4g} {unit}, set by the "
+                        f"point at tau = {c.tau[k]:.3g} s alone), so the data bound it but do not measure it; "
+                        f"the model was re-selected without it"))
+                    break
+        if bad is None:
+            break
+        i, term = bad
+        keep = [k for k in res if not any(j in k for j in dropped) and i not in k]
+        if not keep:
+            break
+        alt = min(keep, key=lambda k: res[k]["ic"])
+        if _NAMES[i] != "B" and res[alt]["ic"] > ic_now + plausible_delta:
+            break  # the data need the term: it stays at its bound (noted)
+        dropped[i] = term
+        best = alt
+        nz = tuple(j for j in best if res[best]["a"][j] > 0)
+        if nz and nz != best and nz in res:
+            best = nz
+    return best, dropped
+
+
+def _markov_fits(c: _Context, C, base_cols, tc, penalty):
+    """Fits of every model ``subset + M`` at one correlation time ``tc`` [s] under the fixed relative covariance C."""
+    c.set_tc(tc)
+    prob = ScoreProblem(c.X, c.y, C, c._upper(C))
+    iM = _NAMES.index("M")
+    subs = [()] + all_subsets(base_cols)
+    out = fit_subsets(prob, [tuple(sorted(s + (iM,))) for s in subs], penalty)
+    for v in out.values():
+        v["ic"] += penalty  # T_c is a parameter too
+    return prob, out
+
+
+def _markov_stage(c: _Context, C, res, best, penalty):
+    """Try the exponentially correlated term M: profile ``T_c`` on a log grid over the fitted tau range (refined by
+    a bounded search), with ``(q_c T_c)^2`` linear given ``T_c``; M enters the model only if its best model's IC
+    (``T_c`` counted as a parameter) beats the best model without it.  Returns ``(prob, res, best, info)`` or None.
+
+    ``info``: ``tc_s`` and the profile-likelihood 95 % interval ``tc_lo95_s``/``tc_hi95_s`` (None where it reaches
+    the edge of the searched range: the data bound T_c only on one side).
+    """
+    from scipy.optimize import minimize_scalar
+
+    if "M" in _NAMES and c.statistic not in ("adev", "hdev", "mdev"):
+        return None
+    iM = _NAMES.index("M")
+    base_cols = tuple(i for i in c.cols if i != iM)
+    lo_t, hi_t = math.log(c.tau[0] / 2.0), math.log(c.tau[-1] * 2.0)
+    grid = np.linspace(lo_t, hi_t, 14)
+    ic0 = res[best]["ic"]
+    scan = []
+    for lt in grid:
+        _, fits = _markov_fits(c, C, base_cols, math.exp(lt), penalty)
+        k = min(fits, key=lambda s: fits[s]["ic"])
+        scan.append((fits[k]["ic"], lt, k))
+    ic_m, lt_m, sub = min(scan)
+    if not ic_m < ic0:
+        c.set_tc(math.exp(lt_m))
+        c.X[:, iM] = 0.0
+        c.tc_s = None
+        return None
+    j = int(np.argmin([s[0] for s in scan]))
+    a, b = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
+
+    def q_at(lt, sub=sub):
+        c.set_tc(math.exp(lt))
+        prob = ScoreProblem(c.X, c.y, C, c._upper(C))
+        return prob.fit(sub)[1]
+
+    r = minimize_scalar(q_at, bounds=(a, b), method="bounded", options={"xatol": 1e-3})
+    lt_best = float(r.x) if r.fun <= q_at(lt_m) else lt_m
+    tc = math.exp(lt_best)
+    # the final covariance: that of the selected M model
+    c.set_tc(tc)
+    prob0 = ScoreProblem(c.X, c.y, C, c._upper(C))
+    a_sel, _ = prob0.fit(sub)
+    A = np.zeros(len(_NAMES))
+    A[list(sub)] = a_sel
+    C2 = c.relcov(A)
+    prob = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+    non_m = fit_subsets(prob, all_subsets(base_cols), penalty)
+    _, with_m = _markov_fits(c, C2, base_cols, tc, penalty)
+    prob = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+    res2 = {**non_m, **with_m}
+    best2 = min(res2, key=lambda s: res2[s]["ic"])
+    if iM not in best2:  # under its own covariance M is no longer needed
+        c.X[:, iM] = 0.0
+        c.tc_s = None
+        prob = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+        return prob, non_m, best2, None
+    # profile-likelihood interval of T_c: {T : min_q(T) <= q_min + t^2 chi2_red}
+    q_min = res2[best2]["q"]
+    dof = max(1, c.tau.size - len(best2) - 1)
+    d2 = float(student_t.ppf(0.975, dof) ** 2) * max(1.0, q_min / dof)
+    lt_lo, lt_hi = lo_t - math.log(4.0), hi_t + math.log(4.0)  # the searched range: tau/8 .. 8 tau_max
+    cache = {}
+
+    def q_prof(lt):
+        if lt not in cache:
+            c.set_tc(math.exp(lt))
+            pr = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+            cache[lt] = pr.fit(best2)[1]
+        return cache[lt]
+
+    lt0 = math.log(tc)
+    target = q_min + d2
+
+    def edge(direction):
+        """The T_c where the profile crosses the threshold on one side (None: not within the searched range)."""
+        step = math.log(2.0) / 2.0
+        a_, b_ = lt0, lt0
+        while True:
+            b_ = a_ + direction * step
+            if not lt_lo <= b_ <= lt_hi:
+                return None
+            if q_prof(b_) > target:
+                break
+            a_ = b_
+        lo_, hi_ = sorted((a_, b_))
+        return math.exp(brentq(lambda x: q_prof(x) - target, lo_, hi_, xtol=1e-3))
+
+    tc_lo, tc_hi = edge(-1), edge(+1)
+    fine = np.array(sorted(cache))
+    qs = np.array([cache[k] for k in fine])
+    c.set_tc(tc)
+    return prob, res2, best2, {"tc_s": tc, "tc_lo95_s": tc_lo, "tc_hi95_s": tc_hi, "grid_log_tc": fine, "q": qs,
+                               "C": C2, "q_min": q_min, "d2": d2}
+
+
+def _markov_qc_interval(c: _Context, prob, best, info, q_min, d2, lo_v, hi_v):
+    """``q_c = sqrt(A_M) / T_c`` 95 % interval: the union over the T_c values inside the T_c interval of the
+    profile interval of ``A_M`` at each (threshold: the global minimum plus the same ``d2``)."""
+    iM = _NAMES.index("M")
+    C2 = info["C"]
+    tc0 = c.tc_s
+    los, his = [lo_v], [hi_v]
+    ok = np.flatnonzero(info["q"] <= info["q_min"] + info["d2"])
+    for j in ok[:: max(1, ok.size // 6)]:
+        tc = float(np.exp(info["grid_log_tc"][j]))
+        c.set_tc(tc)
+        pr = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+        a, qq = pr.fit(best)
+        full = np.zeros(len(_NAMES))
+        full[list(best)] = a
+        if full[iM] <= 0:
+            continue
+        lo, hi = profile_interval(pr, best, full, iM, q_min, d2)
+        los.append(math.sqrt(lo) / tc)
+        his.append(math.sqrt(hi) / tc)
+    c.set_tc(tc0)
+    return min(los), max(his)
 
 
 def _point_limits(y, nu) -> np.ndarray:
@@ -578,7 +909,7 @@ def _at_bound_notes(prob, A, best, tau, out_terms) -> list:
             continue
         k = int(np.nanargmin(ub_pt / prob.X[:, i]))
         notes.append(
-            f"{name} = {t.value:.4g} {DISPLAY_UNITS[name]} sits at its data bound: a larger {name} alone would "
+            f"{name} = {t.value:.4g} {DISPLAY_UNITS.get(name, t.unit)} sits at its data bound: a larger {name} alone would "
             f"exceed the measured curve's ~4-sigma upper limit at tau = {tau[k]:.3g} s, so that one point sets the "
             f"value, not the fit as a whole; read it as the largest {name} the data allow")
     return notes

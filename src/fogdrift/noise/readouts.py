@@ -92,7 +92,7 @@ def slope_readouts(tau_s, adev_dph, fit=None) -> dict:
 def _judge(term, value, unit, tau, slope, fit) -> Readout:
     if fit is None or fit.statistic != "adev":
         return Readout(term, value, unit, tau, slope, None, "")
-    parts = {n: float(fit.term_dev_dph(n, [tau])[0]) ** 2 for n in ("Q", "N", "B", "K", "R")}
+    parts = {n: float(fit.term_dev_dph(n, [tau])[0]) ** 2 for n in ("Q", "N", "B", "K", "R", "S", "M")}
     total = sum(parts.values())
     share = parts[term] / total if total > 0 else 0.0
     dominated = share >= 0.5
@@ -100,7 +100,7 @@ def _judge(term, value, unit, tau, slope, fit) -> Readout:
     note = ""
     lo, hi = (t.lo95 or 0.0), t.hi95
     if hi is not None and not (lo <= value <= hi):
-        if not dominated:
+        if not dominated and total > 0:
             top = max(parts, key=parts.get)
             note = f"differs from the fit: {top} makes up {100 * parts[top] / total:.0f} % of the model there"
         elif fit.fit_tau_s[0] > tau or tau > fit.fit_tau_s[-1]:

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .terms import TERM_TABLE, TERMS, laws_of
+from .terms import TERM_TABLE, TERMS, laws_of, markov_shape, periodic_shape
 
 __all__ = ["NoiseTerm", "NoiseFit", "TERM_STATUSES"]
 
@@ -105,6 +105,16 @@ class NoiseFit:
         Record length the curve came from.
     outliers : dict or None
         The outlier report of the rate that was analysed, when the caller attached it.
+    shaped : dict
+        The Annex C terms that are not power laws, when they were candidates: ``"S"`` (``A`` = Omega0^2
+        [(deg/h)^2], ``lines`` [(Hz, relative power)], ``freq_hz`` of the reference line, ``description``) and
+        ``"M"`` (``A`` = (q_c T_c)^2 [(deg/h)^2 s], ``tc_s`` with its 95 % interval ``tc_lo95_s``/``tc_hi95_s``
+        [s], ``sigma_dph`` = q_c sqrt(T_c/2) [deg/h]).  Their coefficients are ``terms["S"]`` (Omega0 [deg/h]) and
+        ``terms["M"]`` (q_c [deg/h/sqrt(s)]).
+    no_fit : dict or None
+        Set when no candidate fits (chi2_red above :data:`~fogdrift.noise.POOR_CHI2_RED` and the model misses
+        points outside their own 95 % intervals): ``tau_min_s``, ``tau_max_s``, ``miss_tau_s``,
+        ``best_candidate``.  The coefficients are then no result: tables show their upper bounds only.
     """
 
     statistic: str
@@ -130,6 +140,8 @@ class NoiseFit:
     readouts: dict = field(default_factory=dict)
     n_samples: int = 0
     outliers: dict | None = None
+    shaped: dict = field(default_factory=dict)
+    no_fit: dict | None = None
 
     # -- the fitted curve ------------------------------------------------------------------------------------
     @property
@@ -158,13 +170,27 @@ class NoiseFit:
             return np.zeros_like(t)
         return self._x2(name) * law.scale(self.dt_s) * law.shape(t, self.dt_s)
 
+    def _shaped_var(self, name, tau_s, statistic) -> np.ndarray:
+        """Variance [(deg/h)^2] of the shaped term S or M at ``tau_s`` (0 when it is not in the model)."""
+        t = np.asarray(tau_s, dtype=np.float64)
+        info = self.shaped.get(name) or {}
+        if name not in self.selected or not info.get("A"):
+            return np.zeros_like(t)
+        if name == "S":
+            return info["A"] * periodic_shape(t, info["lines"], self.dt_s, statistic)
+        return info["A"] * markov_shape(t, info["tc_s"], statistic, self.dt_s)
+
     def model_dev_dph(self, tau_s, statistic=None) -> np.ndarray:
-        """Fitted deviation [deg/h] of ``statistic`` (default: the fitted one) at ``tau_s`` [s]."""
+        """Fitted deviation [deg/h] of ``statistic`` (default: the fitted one) at ``tau_s`` [s]: every selected term,
+        the shaped S and M included (the curve of the printed model)."""
         st = statistic or self.statistic
-        return np.sqrt(sum(self._term_var(n, tau_s, st) for n in TERMS))
+        return np.sqrt(sum(self._term_var(n, tau_s, st) for n in TERMS)
+                       + self._shaped_var("S", tau_s, st) + self._shaped_var("M", tau_s, st))
 
     def term_dev_dph(self, name, tau_s, statistic=None) -> np.ndarray:
         """Deviation [deg/h] of one term alone (its asymptote on the log-log plot)."""
+        if name in ("S", "M"):
+            return np.sqrt(self._shaped_var(name, tau_s, statistic or self.statistic))
         return np.sqrt(self._term_var(name, tau_s, statistic or self.statistic))
 
     def model_adev_dph(self, tau_s) -> np.ndarray:
@@ -202,4 +228,7 @@ class NoiseFit:
             "b_min": self.b_min,
             "readouts": {k: v.to_dict() for k, v in self.readouts.items()},
             "outliers": self.outliers,
+            "shaped": {k: {kk: vv for kk, vv in v.items() if not isinstance(vv, np.ndarray)}
+                       for k, v in self.shaped.items()},
+            "no_fit": self.no_fit,
         }

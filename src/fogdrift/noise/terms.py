@@ -39,6 +39,11 @@ __all__ = [
     "UNESTIMABLE",
     "laws_of",
     "default_terms",
+    "SHAPED_TERMS",
+    "ALL_TERMS",
+    "sinusoid_shape",
+    "periodic_shape",
+    "markov_shape",
 ]
 
 
@@ -262,3 +267,109 @@ def default_terms(statistic="adev") -> tuple:
     """
     laws = laws_of(statistic)
     return tuple(t for t in TERMS if t in laws)
+
+
+# ----------------------------------------------------------------------------------------
+# The two shaped terms of IEEE-952 Annex C: sinusoidal (S) and exponentially correlated (M)
+# ----------------------------------------------------------------------------------------
+#: Facts of the two Annex C terms that are not power laws of tau (long name, reported units, source).
+#: Their variance is ``A * shape(tau)``: S ``A = Omega0^2`` [(deg/h)^2] with :func:`periodic_shape` (its frequencies
+#: come from the spectrum), M ``A = (q_c T_c)^2`` [(deg/h)^2 s] with :func:`markov_shape` (``T_c`` fitted).
+SHAPED_TERMS = MappingProxyType({
+    "S": {"long_name": "sinusoidal (periodic) error", "unit": "deg/h", "freq_unit": "Hz",
+          "source": "IEEE Std 952-1997 Annex C.7 (sinusoidal noise): sigma^2 = Omega0^2 (sin^2(pi f0 tau) / "
+                    "(pi f0 tau))^2; here exact for sampled data: pi f0 tau -> m sin(pi f0 dt)"},
+    "M": {"long_name": "exponentially correlated (first-order Gauss-Markov) noise", "unit": "deg/h/sqrt(s)",
+          "sigma_unit": "deg/h", "tc_unit": "s",
+          "source": "IEEE Std 952-1997 Annex C.6 (exponentially correlated noise): sigma^2 = (q_c T_c)^2 / tau "
+                    "[1 - T_c/(2 tau) (3 - 4 exp(-tau/T_c) + exp(-2 tau/T_c))]; sigma = q_c sqrt(T_c/2)"},
+})
+#: Every term the noise fit can select: the five power-law terms, then S and M.
+ALL_TERMS = TERMS + tuple(SHAPED_TERMS)
+
+
+def sinusoid_shape(tau_s, freq_hz, dt_s, statistic="adev") -> np.ndarray:
+    """Variance of a unit-amplitude sinusoid of ``freq_hz`` [Hz] at ``tau_s`` [s] (``A = Omega0^2`` multiplies it).
+
+    Derived for sampled data: the ``m``-sample mean of ``sin(2 pi f t_k + phi)`` is a sinusoid of amplitude
+    ``D_m = sin(pi f tau) / (m sin(pi f dt))``; a first difference at lag ``tau`` multiplies the amplitude by
+    ``2 sin(pi f tau)``, a second difference by ``4 sin^2(pi f tau)``, and a squared sinusoid averages to 1/2::
+
+        adev: D_m^2 sin^2(pi f tau)          = sin^4(pi f tau) / (m sin(pi f dt))^2
+        hdev: (4/3) D_m^2 sin^4(pi f tau)    = (4/3) sin^6(pi f tau) / (m sin(pi f dt))^2
+        mdev: D_m^4 sin^2(pi f tau)          = sin^6(pi f tau) / (m sin(pi f dt))^4
+
+    As ``dt -> 0`` (``m sin(pi f dt) -> pi f tau``) the Allan law is IEEE-952 Annex C's
+    ``(sin^2(pi f tau) / (pi f tau))^2``.  Zero at every multiple of the period.  Checked against exact
+    discrete computations on noiseless sinusoids in ``tests/test_noise_periodic.py``.
+
+    Examples
+    --------
+    >>> float(sinusoid_shape(0.05, 20.0, 0.01)[()]) < 1e-30     # a whole period: the sinusoid cancels
+    True
+    """
+    t = np.asarray(tau_s, dtype=np.float64)
+    f, dt = float(freq_hz), float(dt_s)
+    m = np.rint(t / dt)
+    s_tau = np.sin(np.pi * f * m * dt)
+    den = m * np.sin(np.pi * f * dt)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if statistic == "adev":
+            out = s_tau**4 / den**2
+        elif statistic == "hdev":
+            out = (4.0 / 3.0) * s_tau**6 / den**2
+        elif statistic == "mdev":
+            out = s_tau**6 / den**4
+        else:
+            laws_of(statistic)
+            raise ConfigError(f"no sinusoid law for statistic {statistic!r}")
+    return np.where(np.isfinite(out), out, 0.0)
+
+
+def periodic_shape(tau_s, lines, dt_s, statistic="adev") -> np.ndarray:
+    """Variance shape of a periodic error made of spectral lines ``[(freq_hz, relative_power), ...]``.
+
+    The lines' powers relative to the first (the fundamental, ``relative_power`` 1) are fixed from the spectrum and
+    one scale ``A = Omega0^2`` (the fundamental's squared amplitude [(deg/h)^2]) is fitted: the lines of one periodic
+    error share its amplitude drift, the spectrum measures their ratios far better than the tau curve could, and one
+    parameter per component keeps the model selection from trading harmonics against Q.
+    """
+    t = np.asarray(tau_s, dtype=np.float64)
+    out = np.zeros(t.shape)
+    for f, r in lines:
+        out = out + float(r) * sinusoid_shape(t, f, dt_s, statistic)
+    return out
+
+
+def markov_shape(tau_s, tc_s, statistic="adev", dt_s=None) -> np.ndarray:
+    """Variance shape of first-order Gauss-Markov rate noise with correlation time ``tc_s`` [s]: ``A = (q_c T_c)^2``
+    [(deg/h)^2 s] multiplies it (IEEE-952 Annex C.6).
+
+    ``adev``: the Annex C law ``1/tau [1 - T_c/(2 tau) (3 - 4 e^(-tau/T_c) + e^(-2 tau/T_c))]`` (-> ``tau / (3 T_c)``
+    for ``tau << T_c``, like a rate random walk, and ``1/tau`` for ``tau >> T_c``, like white noise).  ``hdev`` and
+    ``mdev``: not derived in closed form; the expectation of the estimator under the exact spectrum of the sampled
+    process (an AR(1) with ``phi = exp(-dt/T_c)``, :func:`fogdrift.noise.covariance.expected_variance`), which needs
+    ``dt_s``.
+    """
+    t = np.asarray(tau_s, dtype=np.float64)
+    tc = float(tc_s)
+    if statistic == "adev":
+        x = t / tc
+        with np.errstate(over="ignore", invalid="ignore"):
+            small = x < 1e-3  # series: (1/tau) (x/3 - x^2/12 + ...) avoids the cancellation
+            big = (1.0 - (3.0 - 4.0 * np.exp(-x) + np.exp(-2.0 * x)) / (2.0 * x)) / t
+            ser = (x / 3.0 - x * x / 12.0) / t
+        return np.where(small, ser, big)
+    laws_of(statistic)
+    if dt_s is None:
+        raise ConfigError("the Gauss-Markov law of hdev/mdev needs the sample interval dt_s")
+    from .covariance import expected_variance
+
+    dt = float(dt_s)
+    phi = math.exp(-dt / tc)
+    s2 = 1.0 / (2.0 * tc)  # process variance per unit A: A = (q_c T_c)^2 = 2 sigma^2 T_c
+
+    def spec(f):
+        return s2 * (1.0 - phi * phi) / (1.0 - 2.0 * phi * np.cos(2.0 * np.pi * np.asarray(f)) + phi * phi)
+
+    return expected_variance(np.rint(t / dt), spec, statistic=statistic, per_octave=32)
