@@ -12,15 +12,19 @@ from fogdrift.evaluation.verdicts import independent_origins
 from fogdrift.report.html import _artefact_table, _heading_table, _verdict_li
 
 
-def _row(model, h, rms, ratio, n=30):
+def _row(model, h, rms, ratio, n=30, step_s=300.0):
+    """The model is better (worse) than constant bias at every non-overlapping origin when its ratio is < 1 (> 1)."""
+    k = independent_origins(n, step_s, h)
     return NS(model=model, horizon_s=h, n_origins=n, rms_deg=rms, ratio_to_bias=ratio, median_abs_deg=rms,
-              p90_abs_deg=2 * rms, wins_vs_bias=0.5, predicted_sigma_deg=None, inside_sigma=None)
+              p90_abs_deg=2 * rms, wins_vs_bias=0.5, predicted_sigma_deg=None, inside_sigma=None, n_independent=k,
+              better_independent=k if ratio < 1 else 0, worse_independent=k if ratio > 1 else 0)
 
 
 def _heading(kalman_60, kalman_600, n=30, step_s=300.0):
     """Constant bias and Kalman at 60 s and 600 s; 30 origins every 300 s: all independent at both horizons."""
-    rows = [_row("constant bias", 60.0, 1.0, 1.0, n), _row("Kalman", 60.0, kalman_60, kalman_60, n),
-            _row("constant bias", 600.0, 8.0, 1.0, n), _row("Kalman", 600.0, 8.0 * kalman_600, kalman_600, n)]
+    rows = [_row("constant bias", 60.0, 1.0, 1.0, n, step_s), _row("Kalman", 60.0, kalman_60, kalman_60, n, step_s),
+            _row("constant bias", 600.0, 8.0, 1.0, n, step_s),
+            _row("Kalman", 600.0, 8.0 * kalman_600, kalman_600, n, step_s)]
     return NS(axis="gx", calib_s=300.0, step_s=step_s, horizons_s=(60.0, 600.0), rows=rows, notes=[])
 
 

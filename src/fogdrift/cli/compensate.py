@@ -45,7 +45,9 @@ def compensate(
     heading: Annotated[bool, typer.Option("--heading/--no-heading", help="Heading-error evaluation of every model "
                                                                          "of the bundle on FILE.")] = True,
     artefacts: Annotated[bool, typer.Option("--artefacts/--no-artefacts", help="Filtering-artefact check (injected "
-                                                                               "step, ramp, sinusoids).")] = False,
+                                                                               "step, ramp, sinusoids); on by default, "
+                                                                               "its caveat goes on the before/after "
+                                                                               "figure.")] = True,
     calibration: Annotated[float, typer.Option("--calibration", help="Calibration window [s] before each origin.")]
     = 300.0,
     origin_step: Annotated[float, typer.Option("--origin-step", help="Spacing of the rolling origins [s].")] = 300.0,
@@ -68,7 +70,8 @@ def compensate(
             bundle, file, out, model=model, bias=bias, apply_unit=apply_unit, axis_map=axis_map,
             accept_rate=accept_rate, columns=columns, time_column=None if time_column.lower() == "none" else time_column,
             rate_hz=rate, time_unit=time_unit, chunk_samples=chunk, formats=tuple(csv_list(formats) or ()),
-            heading=heading, artefacts=artefacts, calib_s=calibration, step_s=origin_step, horizons_s=hs)
+            heading=heading, artefacts=artefacts, calib_s=calibration, step_s=origin_step, horizons_s=hs,
+            flags=FLAGS)
         s = result.summary
         console.print(Text(f"compensated {s['n_samples']} samples of {file.name} with {s['model_label']} "
                            f"(unit {s['unit']}, {1 / s['native_dt_s']:g} Hz, models at {1 / s['model_dt_s']:g} Hz)"))

@@ -18,7 +18,7 @@ from ..models import MODEL_NAMES, describe_models
 ALL_MODELS = ",".join(MODEL_NAMES)
 DEFAULT_OUT = Path("out/model")
 ModelsOpt = Annotated[str, typer.Option(
-    "--models", help="Comma-separated drift models (any case): " + "; ".join(describe_models()) + ".")]
+    "--models", help="Comma-separated drift models (any case): " + "; ".join(describe_models().splitlines()) + ".")]
 HiddenOpt = Annotated[int, typer.Option("--hidden", help="Elman hidden units.")]
 LagsOpt = Annotated[int, typer.Option("--lags", help="Input lags p of Elman/grey-Elman, order of AR.")]
 EpochsOpt = Annotated[int, typer.Option("--epochs", help="Maximum training epochs (early stopping on validation).")]
@@ -58,8 +58,9 @@ def model(
     json_out: JsonOpt = False,
 ):
     """Fit drift models on the training block and compare them on the test block."""
+    from ..evaluation import causal_verdict, paper_measure_verdict
     from ..pipeline import AnalysisConfig, run_models
-    from ..report import causal_metrics_rows, metrics_rows, verdict, write_model_outputs
+    from ..report import causal_metrics_rows, metrics_rows, write_model_outputs
 
     with run("model", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
              expect=("metrics.json",)) as r:
@@ -75,11 +76,13 @@ def model(
             results = run_models(record, cfg, progress=epoch_cb)
         say(model_axes_text(results, record))
         for ma in results:
-            console.print(metrics_table(f"axis {ma.name}: one-step metrics on the test block "
-                                        f"(target: wavelet drift), dt {ma.dt_s:g} s", metrics_rows(ma)))
+            console.print(metrics_table(f"axis {ma.name}: one-step metrics on the test block, paper's measure "
+                                        f"(target: non-causal wavelet drift), dt {ma.dt_s:g} s", metrics_rows(ma)))
             console.print(metrics_table(f"axis {ma.name}: target = causal drift", causal_metrics_rows(ma)))
-            for line in verdict(ma):
-                say("  " + line)
+            # the same sentences, labelled the same way, as analyze prints (evaluation.verdicts is their home)
+            for v in (causal_verdict(ma), paper_measure_verdict(ma)):
+                for line in v.lines:
+                    say("  " + line)
         write_model_outputs(results, r.out.path)
         # the self-describing bundle 'fogdrift compensate' applies to other logs
         from ..bundle import write_bundle

@@ -121,10 +121,12 @@ class AllanAccumulator:
         return tuple(np.concatenate(o)[k0:] for o in self._out)
 
 
-def plot_before_after(curves, path, title) -> Path:
+def plot_before_after(curves, path, title, caveat: str = "") -> Path:
     """ADEV of the log before and after compensation, one panel per axis.
 
-    ``curves``: list of ``(axis, AllanResult before, AllanResult after, label)``.
+    ``curves``: list of ``(axis, AllanResult before, AllanResult after, label)``.  ``caveat``: the artefact
+    check's sentence(s) (:func:`~fogdrift.evaluation.verdicts.adev_caveat`), printed under the panels: a causal
+    drift subtraction lowers the long-τ ADEV of any static log, so the curves alone are not evidence.
     """
     import matplotlib
 
@@ -144,6 +146,11 @@ def plot_before_after(curves, path, title) -> Path:
         ax.set_title(f"{title}: {name}")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
+    if caveat:
+        import textwrap
+
+        fig.text(0.01, -0.02, textwrap.fill(caveat, width=int(95 * n)), ha="left", va="top", fontsize=8,
+                 color="C3" if "not evidence" in caveat or "not checked" in caveat else "k")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110, bbox_inches="tight")

@@ -7,7 +7,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import ConfigError
+from ..errors import ConfigError, render_options
 from .engine import BIAS_ONLY, AxisPlan, StreamCompensator
 from .outputs import AllanAccumulator, CsvWriter, NpzWriter, plot_before_after
 from .sources import DEFAULT_CHUNK, match_log, open_log
@@ -89,9 +89,9 @@ def _allan_rows(before, after, dt):
 
 def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_unit=None, axis_map=None,
                     accept_rate=False, columns=None, time_column="auto", rate_hz=None, time_unit=None,
-                    chunk_samples=DEFAULT_CHUNK, formats=FORMATS, figures=True, heading=True, artefacts=False,
+                    chunk_samples=DEFAULT_CHUNK, formats=FORMATS, figures=True, heading=True, artefacts=True,
                     calib_s=300.0, step_s=300.0, horizons_s=(60.0, 600.0, 3600.0), max_model_rate_samples=1 << 23,
-                    segment=None, progress=None) -> CompensationResult:
+                    segment=None, progress=None, flags=None) -> CompensationResult:
     """Compensate the log ``path`` with ``bundle`` and write the results to ``out_dir``.
 
     Parameters
@@ -120,8 +120,9 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
         Write the before/after Allan figure.
     heading, artefacts : bool
         Run the heading-error evaluation (every model of the bundle plus constant bias, on the whole log) /
-        the filtering-artefact check; skipped with a note when the log has more than
-        ``max_model_rate_samples`` samples at the modelling rate.
+        the filtering-artefact check (both by default; the before/after figure and the messages carry the
+        check's caveat, :func:`~fogdrift.evaluation.verdicts.adev_caveat`); skipped with a note when the log has
+        more than ``max_model_rate_samples`` samples at the modelling rate.
     calib_s, step_s, horizons_s
         Heading-error protocol (:func:`fogdrift.evaluation.heading.heading_errors`).
     segment : int, optional
@@ -129,6 +130,9 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
         :class:`~fogdrift.compensate.engine.StreamCompensator`).  Tests use short segments.
     progress : callable, optional
         ``progress(done_samples, total_samples)``.
+    flags : dict, optional
+        Setting name -> how the caller names it (the CLI's ``--apply-unit``); ``{opt:NAME}`` markers in the
+        messages are rendered with it before they are stored (default: ``NAME=``, the keyword of this function).
 
     Returns
     -------
@@ -211,20 +215,31 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
             doc["allan_before_after"] = rows
             curves.append((p.log_name, a_res, b_res, name))
         axes_doc.append(doc)
-    if figures and curves:
-        files["figure"] = plot_before_after(curves, out / "compensation_allan.png", "ADEV before / after")
+    training_sha = b.training.get("sha256")
+    held_out = not (training_sha and source.sha256 and training_sha == source.sha256)
+    if not held_out:
+        messages.insert(0, "WARNING: this log is the bundle's own training log (same SHA-256): the heading-error "
+                           "verdict is NOT held-out evidence")
 
     result = CompensationResult(summary={}, files=files, messages=messages)
     z_all = engine.model_rate_series() if engine.keep_model_rate else None
+    why_not = "" if artefacts else "--no-artefacts"
     if (heading or artefacts) and z_all is None:
-        messages.append(f"evaluation skipped: more than {max_model_rate_samples} samples at the modelling rate")
+        why_not = f"more than {max_model_rate_samples} samples at the modelling rate"
+        messages.append(f"evaluation skipped: {why_not}")
     if z_all is not None and z_all.shape[0]:
         _evaluate(result, b, plans, biases, z_all, heading=heading, artefacts=artefacts, calib_s=calib_s,
                   step_s=step_s, horizons_s=horizons_s)
+    caveats = _caveats(result, name, plans, curves, why_not)
+    messages.extend(caveats)
+    if figures and curves:
+        files["figure"] = plot_before_after(curves, out / "compensation_allan.png", "ADEV before / after",
+                                            caveat=" ".join(caveats))
+    messages[:] = [render_options(m, flags) for m in messages]
     result.summary = {
         "fogdrift_result": "compensation",
         "bundle": str(b.path) if b.path else None, "bundle_training_sha256": b.training.get("sha256"),
-        "log": str(source.path), "log_sha256": source.sha256, "model": name,
+        "log": str(source.path), "log_sha256": source.sha256, "held_out": held_out, "model": name,
         "model_label": "constant bias" if name == BIAS_ONLY else plans[0].model.label,
         "bias_mode": "keep" if bias_mode == "keep" else {"re_estimate_s": bias_mode},
         "unit": match.unit, "scale_to_dph": scale, "native_dt_s": source.dt_s, "model_dt_s": b.model_dt_s,
@@ -239,6 +254,20 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
     files["json"] = _write_json(result.summary, out / "compensation.json")
     result.summary["files"]["json"] = str(files["json"])
     return result
+
+
+def _caveats(result, name, plans, curves, why_not) -> list:
+    """The artefact check's caveat on the before/after ADEV, one sentence per plotted axis (none for 'bias')."""
+    from ..evaluation.verdicts import adev_caveat
+
+    if name == BIAS_ONLY or not curves:
+        return []
+    label = plans[0].model.label
+    arte = {a.axis: a for a in result.artefacts}
+    head = {h.axis: h for h in result.heading}
+    why = why_not or "skipped; see above"
+    return [adev_caveat(label, arte.get(axis), axis=axis, heading=head.get(axis), why_not=why)
+            for axis, *_ in curves]
 
 
 def _write_json(obj, path) -> Path:
@@ -263,10 +292,11 @@ def _write_json(obj, path) -> Path:
 def _evaluate(result, b, plans, biases, z_all, *, heading, artefacts, calib_s, step_s, horizons_s):
     from ..evaluation.artefacts import artefact_check
     from ..evaluation.heading import heading_errors
-    from ..evaluation.verdicts import artefact_verdict, heading_verdict
+    from ..evaluation.verdicts import artefact_verdict, heading_verdict, headline_verdict
     from ..errors import FogdriftError
 
     for k, (p, (_, bias_total)) in enumerate(zip(plans, biases)):
+        h = a = None
         ax = p.bundle_axis
         z = z_all[:, k] - bias_total
         models = {m.label: m for m in ax.models.values()}
@@ -288,3 +318,5 @@ def _evaluate(result, b, plans, biases, z_all, *, heading, artefacts, calib_s, s
             else:
                 result.artefacts.append(a)
                 result.verdicts.append(artefact_verdict(a))
+        if h is not None:  # the one-sentence verdict of the axis, by the same rule (evaluation.verdicts.judge)
+            result.verdicts.append(headline_verdict(h, a, axis=p.log_name))

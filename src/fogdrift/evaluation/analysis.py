@@ -27,7 +27,8 @@ class AxisEvaluation:
         None when not run or when the test block is too short (``notes`` says which).
     artefacts : fogdrift.evaluation.ArtefactResult or None
     verdicts : list of Verdict
-        In reading order: heading, artefacts, causal target, paper's measure.
+        In reading order: heading, artefacts, causal target, paper's measure, and the Table 2 practical rows
+        the artefact check flags (kind ``table2``, only when there are any).
     headline : Verdict
         One sentence (:func:`~fogdrift.evaluation.headline_verdict`); ``headline.data["outcome"]`` is
         ``reduces``, ``mixed``, ``none`` or ``undetermined``.
@@ -89,7 +90,7 @@ def evaluate_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, h
     """
     from ..interrupt import checkpoint
     from . import evaluate_axis
-    from .verdicts import headline_verdict
+    from .verdicts import headline_verdict, table2_verdict
 
     out = []
     for res in (result, getattr(result, "apply_to", None)):
@@ -102,6 +103,9 @@ def evaluate_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, h
                                horizons_s=tuple(horizons_s))
             reason = "; ".join(n for n in ev["notes"] if "heading" in n) or ""
             headline = headline_verdict(ev["heading"], ev["artefacts"], axis=ax.name, reason=reason)
+            flag = table2_verdict(getattr(ax, "table2", None) or [], ev["artefacts"], axis=ax.name)
+            if flag is not None:  # Table 2's practical rows that the artefact check flags (the HTML marks them too)
+                ev["verdicts"].append(flag)
             ax.evaluation = AxisEvaluation(
                 axis=ax.name, heading=ev["heading"], artefacts=ev["artefacts"], verdicts=ev["verdicts"],
                 headline=headline, notes=list(ev["notes"]),

@@ -18,7 +18,10 @@ percentile of |E|, the fraction of origins where the model's |E| is below consta
 model its predicted 1-sigma angle envelope (median over origins) and the fraction of origins with |E| inside it
 (a calibrated noise model gives about 68 %).  Origins are ``step_s`` apart while horizons reach 3600 s, so
 their errors overlap and are correlated: the number of origins overstates the independent evidence for long
-horizons.
+horizons.  Each row therefore also counts, over the origins whose horizon windows do not overlap (every
+``ceil(H / step)``-th origin from the first, :func:`~fogdrift.evaluation.verdicts.independent_subset`), how many
+there are and at how many the model's |E| is below / above constant bias's; the verdicts use only these
+(:func:`~fogdrift.evaluation.verdicts.judge`).
 """
 
 from __future__ import annotations
@@ -31,7 +34,8 @@ import numpy as np
 
 from ..errors import ConfigError, FogdriftError, InsufficientDataError
 
-__all__ = ["HORIZONS_S", "CONSTANT_BIAS", "HeadingRow", "HeadingResult", "heading_errors", "angle_error_deg"]
+__all__ = ["HORIZONS_S", "CONSTANT_BIAS", "HeadingRow", "HeadingResult", "heading_errors", "heading_row",
+           "angle_error_deg"]
 
 #: Default forecast horizons [s].
 HORIZONS_S = (60.0, 600.0, 3600.0)
@@ -68,9 +72,16 @@ class HeadingRow:
     wins_vs_bias: float
     predicted_sigma_deg: float | None = None
     inside_sigma: float | None = None
+    n_independent: int | None = None
+    better_independent: int | None = None
+    worse_independent: int | None = None
 
     def to_dict(self) -> dict:
-        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in self.__dict__.items()}
+        from .verdicts import diverges
+
+        out = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in self.__dict__.items()}
+        out["diverges"] = diverges(self.rms_deg, self.ratio_to_bias)
+        return out
 
 
 @dataclass
@@ -106,6 +117,51 @@ class HeadingResult:
                 "protocol": "bias = mean of the calibration window before each origin; each model forecasts the "
                             "drift free-running from that window only; angle error = integral of (rate - bias - "
                             "forecast) over the horizon"}
+
+
+def heading_row(model, errors_deg, bias_errors_deg, *, horizon_s, step_s, horizon_eff_s=None,
+                sigma_deg=None) -> HeadingRow:
+    """One model's row at one horizon from its angle errors and constant bias's at the same origins [deg].
+
+    ``step_s`` is the origins' spacing; the counts ``better_independent`` / ``worse_independent`` are taken over
+    the origins whose horizon windows do not overlap (:func:`~fogdrift.evaluation.verdicts.independent_subset`,
+    with ``horizon_eff_s``, the horizon as sampled, default ``horizon_s``); a non-finite error counts as worse.
+
+    Examples
+    --------
+    Six origins 300 s apart, 600-s horizon: origins 0, 2 and 4 do not overlap; the model wins at 1, 3, 4 and 5 (4 of
+    6 = most of all origins) but at only 1 of the 3 non-overlapping ones.
+
+    >>> e = np.array([2.0, 0.5, 2.0, 0.5, 0.5, 0.5]); eb = np.ones(6)
+    >>> r = heading_row("m", e, eb, horizon_s=600.0, step_s=300.0)
+    >>> r.wins_vs_bias, r.n_independent, r.better_independent, r.worse_independent
+    (0.6666666666666666, 3, 1, 2)
+    """
+    from .verdicts import independent_subset
+
+    e = np.asarray(errors_deg, dtype=np.float64)
+    eb = np.asarray(bias_errors_deg, dtype=np.float64)
+    with np.errstate(over="ignore", invalid="ignore"):
+        rms = float(np.sqrt(np.mean(np.square(e)))) if e.size else math.nan
+        rms_b = float(np.sqrt(np.mean(np.square(eb)))) if eb.size else math.nan
+        ratio = rms / rms_b if rms_b > 0 else math.nan
+    sub = independent_subset(e.size, step_s, horizon_s if horizon_eff_s is None else horizon_eff_s)
+    ei, ebi = np.abs(e[sub]), np.abs(eb[sub])
+    with np.errstate(invalid="ignore"):
+        n_better, n_worse = int(np.sum(ei < ebi)), int(np.sum(~(ei <= ebi)))  # NaN/inf: worse
+    pred = inside = None
+    if sigma_deg is not None:
+        s = np.asarray(sigma_deg, dtype=np.float64)
+        pred = float(np.median(s))
+        inside = float(np.mean(np.abs(e) <= s))
+    with np.errstate(invalid="ignore"):
+        return HeadingRow(
+            model=model, horizon_s=float(horizon_s), n_origins=int(e.size), rms_deg=rms, ratio_to_bias=ratio,
+            median_abs_deg=float(np.median(np.abs(e))) if e.size else math.nan,
+            p90_abs_deg=float(np.percentile(np.abs(e), 90)) if e.size else math.nan,
+            wins_vs_bias=float(np.mean(np.abs(e) < np.abs(eb))) if e.size else math.nan,
+            predicted_sigma_deg=pred, inside_sigma=inside, n_independent=int(sub.size),
+            better_independent=n_better, worse_independent=n_worse)
 
 
 def _fir(x, g):
@@ -227,24 +283,10 @@ def heading_errors(rate_dph, dt_s, models, *, causal_window: int, wavelet="db2",
     rows = []
     base = errors[CONSTANT_BIAS]
     for label, err in errors.items():
-        for j, (h, _) in enumerate(horizons):
+        for j, (h, H) in enumerate(horizons):
             ok = ~np.isnan(base[:, j])
-            e, eb = err[ok, j], base[ok, j]
-            with np.errstate(over="ignore", invalid="ignore"):
-                rms = float(np.sqrt(np.mean(np.square(e)))) if e.size else math.nan
-                rms_b = float(np.sqrt(np.mean(np.square(eb)))) if eb.size else math.nan
-                ratio = rms / rms_b if rms_b > 0 else math.nan
-            pred = inside = None
-            if label in sigma:
-                s = sigma[label][ok, j]
-                pred = float(np.median(s))
-                inside = float(np.mean(np.abs(e) <= s))
-            rows.append(HeadingRow(
-                model=label, horizon_s=h, n_origins=int(ok.sum()), rms_deg=rms, ratio_to_bias=ratio,
-                median_abs_deg=float(np.median(np.abs(e))) if e.size else math.nan,
-                p90_abs_deg=float(np.percentile(np.abs(e), 90)) if e.size else math.nan,
-                wins_vs_bias=float(np.mean(np.abs(e) < np.abs(eb))) if e.size else math.nan,
-                predicted_sigma_deg=pred, inside_sigma=inside))
+            rows.append(heading_row(label, err[ok, j], base[ok, j], horizon_s=h, step_s=step * dt,
+                                    horizon_eff_s=H * dt, sigma_deg=sigma[label][ok, j] if label in sigma else None))
     return HeadingResult(axis=axis, dt_s=dt, calib_s=float(calib_s), step_s=float(step_s),
                          horizons_s=tuple(h for h, _ in horizons), origins_s=origins * dt, errors=errors,
                          sigma=sigma, rows=rows, notes=notes)

@@ -185,7 +185,7 @@ def _settings_section(result, generated) -> str:
 
 
 def _heading_table(h) -> str:
-    from ..evaluation.verdicts import MATERIAL, MIN_ORIGINS, independent_origins
+    from ..evaluation.verdicts import judge
 
     headers = ["horizon", "compensator", "origins (independent)", "RMS angle error [deg]", "ratio to constant bias",
                "median |E| [deg]", "90th pct |E| [deg]", "better than constant bias at", "Kalman 1σ [deg] / inside"]
@@ -194,21 +194,21 @@ def _heading_table(h) -> str:
         by = {r.model: r for r in h.rows if r.horizon_s == hz}
         for label in _order(by):
             r = by[label]
-            k = independent_origins(r.n_origins, h.step_s, hz)
-            judged = k >= MIN_ORIGINS
+            j = judge(r, step_s=h.step_s)  # the one rule: colour = what the verdict says
+            k = j.n
             cls = ""
-            if judged and label != "constant bias":
-                ratio = r.ratio_to_bias
-                if ratio != ratio or ratio >= 1 + MATERIAL:
-                    cls = "bad"
-                elif ratio <= 1 - MATERIAL:
-                    cls = "good"
-            env = "–" if r.predicted_sigma_deg is None else \
+            if label != "constant bias":
+                cls = "good" if j.reduces else ("bad" if j.worsens else "")
+            div = j.outcome == "diverges"
+            env = "–" if r.predicted_sigma_deg is None or div else \
                 f"{_fmt(r.predicted_sigma_deg, 3)} / {100 * r.inside_sigma:.0f} %"
-            rows.append([f"{hz:g} s", label, f"{r.n_origins} ({k})", _fmt(r.rms_deg, 3),
-                         ("1" if label == "constant bias" else _fmt(r.ratio_to_bias, 3), cls),
-                         _fmt(r.median_abs_deg, 3), _fmt(r.p90_abs_deg, 3),
-                         "–" if label == "constant bias" else f"{100 * r.wins_vs_bias:.0f} % of origins", env])
+            wins = "–" if label == "constant bias" else (
+                f"{'?' if j.better is None else j.better} of {k} non-overlapping ({100 * r.wins_vs_bias:.0f} % of all "
+                f"{r.n_origins})")
+            rows.append([f"{hz:g} s", label, f"{r.n_origins} ({k})", "diverges" if div else _fmt(r.rms_deg, 3),
+                         ("1" if label == "constant bias" else ("diverges" if div else _fmt(r.ratio_to_bias, 3)), cls),
+                         "diverges" if div else _fmt(r.median_abs_deg, 3), "diverges" if div else _fmt(r.p90_abs_deg, 3),
+                         wins, env])
     return _table(headers, rows, "heading")
 
 
@@ -298,8 +298,10 @@ def _compensation_section(ax, fig_dir, pre, fig_offset, evaluated) -> str:
 
 def _table_note_heading() -> str:
     return ('<p class="note">Angle error of each compensator after each horizon (RMS over rolling origins); ratio '
-            "to constant bias below 0.95 (green) reduces the error, above 1.05 (red) worsens it; only horizons with "
-            '10 independent origins are judged (uncoloured otherwise). See <a href="#g-heading">heading error</a>.'
+            "to constant bias at or below 0.95 AND better at more than half of the origins whose horizons do not "
+            "overlap (green) reduces the error; at or above 1.05 AND worse at more than half of them, or a diverged "
+            "forecast (red), worsens it; only horizons with 10 non-overlapping origins are judged (uncoloured "
+            'otherwise). See <a href="#g-heading">heading error</a>.'
             "</p>")
 
 
