@@ -40,7 +40,8 @@ h3{margin-top:1.4em}h4{margin:1.2em 0 0.3em}
 .meta{color:#555;margin:0 0 0.8em}
 .tw{max-width:100%;overflow-x:auto}
 table{border-collapse:collapse;margin:0.5em 0 0.8em;font-size:0.86em}
-th,td{border:1px solid #c4c4c4;padding:3px 7px;text-align:right;vertical-align:top;overflow-wrap:anywhere}
+th,td{border:1px solid #c4c4c4;padding:3px 7px;text-align:right;vertical-align:top;overflow-wrap:normal;
+ word-break:normal;hyphens:manual}
 th{background:#eee}td:first-child,th:first-child{text-align:left}
 table.kv td{text-align:left}table.limits td{text-align:left}table.heading td:nth-child(-n+2),table.heading th:nth-child(-n+2){white-space:nowrap;
  overflow-wrap:normal}table.heading td:nth-child(2){text-align:left}table.limits td:first-child{white-space:nowrap}table.kv td:first-child{white-space:nowrap;color:#444}
