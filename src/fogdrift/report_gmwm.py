@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .gmwm.analysis import J_CAVEAT, GmwmAxis, ieee_rows
+from .gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
 from .output import atomic_path
 from .report import write_json
 
@@ -23,7 +23,9 @@ __all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
 
 
 def fmt(x, digits=4) -> str:
-    """A number with ``digits`` significant digits ('–' for None/NaN)."""
+    """A number with ``digits`` significant digits ('–' for None/NaN; a text cell such as a bound as it is)."""
+    if isinstance(x, str):
+        return x
     if x is None or not math.isfinite(float(x)):
         return "–"
     return f"{float(x):.{digits}g}"
@@ -97,8 +99,12 @@ def gmwm_noise_html(axis: GmwmAxis) -> str:
     sel = axis.selection
     e = html.escape
     head = "".join(f"<th>{h}</th>" for h in ("quantity", "value", "95 % interval", "unit", "from"))
-    body = "".join(f"<tr><td>{e(str(r[0]))}</td><td>{fmt(r[1])}</td><td>[{fmt(r[2])}, {fmt(r[3])}]</td>"
+    body = "".join(f"<tr><td>{e(str(r[0]))}</td><td>{e(fmt(r[1]))}</td>"
+                   f"<td>{'–' if r[2] is None or r[3] is None else f'[{fmt(r[2])}, {fmt(r[3])}]'}</td>"
                    f"<td>{e(str(r[4]))}</td><td>{e(str(r[5]))}</td></tr>" for r in ieee_rows(axis))
+    details = "".join(f"<li>{e(line)}</li>" for line in b_detail_lines(axis))
+    check = "" if axis.allan_check is None else "".join(f"<li>GMWM vs Allan fit: {e(line)}</li>"
+                                                        for line in axis.allan_check["lines"])
     cands = "".join(f"<tr><td>{e(c.model)}</td><td>{fmt(c.wic)}</td><td>{'yes' if c.passed else 'no'}</td>"
                     f"<td>{e('; '.join(c.reasons))}</td></tr>" for c in sel.candidates)
     excl = "".join(f"<li>scale {fmt(x.scale_s)} s: {e(x.reason)}</li>" for x in sel.excluded)
@@ -106,7 +112,8 @@ def gmwm_noise_html(axis: GmwmAxis) -> str:
     return (f"<h4>Noise model by GMWM (wavelet variance): {e(sel.selected)}"
             f"{'' if sel.passed_checks else ' (no candidate passed every check)'}</h4>"
             f"<table class='gmwm'><tr>{head}</tr>{body}</table>"
-            f"<p class='note'>J = {fmt(fit.q)} with {fit.df} degrees of freedom, p = {fmt(fit.j_pvalue, 2)}: "
+            + (f"<ul class='note'>{details}{check}</ul>" if details or check else "")
+            + f"<p class='note'>J = {fmt(fit.q)} with {fit.df} degrees of freedom, p = {fmt(fit.j_pvalue, 2)}: "
             f"{e(J_CAVEAT)}.</p>"
             + (f"<ul class='note'>{excl}</ul>" if excl else "")
             + "<table class='gmwm-candidates'><tr><th>candidate</th><th>WIC</th><th>passed</th><th>why rejected</th>"

@@ -1,9 +1,11 @@
 """``fogdrift noise``: noise model of every axis by GMWM (wavelet variance) or by the Allan fit.
 
 ``--method gmwm`` (default): Haar wavelet variance, WIC model selection over candidate latent models (or one
-``--model``), short scales no candidate explains excluded with the reason, the IEEE-952 table (N, K, R, Q, B,
-GM T_c / sigma) with 95 % intervals, and the J statistic with its caveat.  ``--curve TABLE`` fits a published WV
-curve (the SMAC table format) instead of a log.  ``--method allan`` runs the Allan noise fit of ``fogdrift allan``.
+``--model``), short scales no candidate explains excluded with the reason, the IEEE-952 table (N, K, R, Q, GM T_c
+and sigma, one B named by its rule) with 95 % intervals, the J statistic with its caveat, and, for a log, one line
+per quantity saying whether N and B agree with the Allan fit of the same record (or why not).  ``--curve TABLE``
+fits a published wavelet- or Allan-variance table (the SMAC formats) instead of a log; its unit is the table's
+``unit`` column or ``--unit`` (never its ``unit_inferred`` column) and is printed first.  ``--method allan`` runs the Allan noise fit of ``fogdrift allan``.
 """
 
 from __future__ import annotations
@@ -28,9 +30,11 @@ ModelOpt = Annotated[str, typer.Option("--model", help="GMWM model: 'auto' (sele
 ScalesOpt = Annotated[Optional[int], typer.Option("--scales", help="Number of wavelet scales J (2, 4, ..., 2^J "
                                                                    "samples; default floor(log2 N) - 1).")]
 RobustOpt = Annotated[bool, typer.Option("--robust", help="Huber-robust wavelet variance (logs with outliers).")]
-CurveOpt = Annotated[Optional[Path], typer.Option("--curve", help="Fit a published Haar WV table (SMAC format: "
-                                                                  "scale_s, wvar, n_samples, sample_rate_hz, ...) "
-                                                                  "instead of a log; FILE is then not given.")]
+CurveOpt = Annotated[Optional[Path], typer.Option("--curve", help="Fit a published table instead of a log (FILE is "
+                                                                  "then not given): Haar WV (scale_s, wvar, n_samples, "
+                                                                  "sample_rate_hz) or Allan variance (tau_s, avar or "
+                                                                  "adev, n_samples, sample_rate_hz); the unit comes "
+                                                                  "from its 'unit' column or --unit.")]
 SensorOpt = Annotated[Optional[str], typer.Option("--sensor", help="With --curve: the table's sensor_key to fit.")]
 
 
@@ -50,9 +54,14 @@ def _fmt(x, digits=4):
     return fmt(x, digits)
 
 
+def _interval(lo, hi) -> str:
+    return "–" if lo is None or hi is None else f"[{_fmt(lo)}, {_fmt(hi)}]"
+
+
 def print_gmwm(title, axes):
-    """Per axis: IEEE table, candidates (WIC, why rejected), excluded scales, J with its caveat."""
-    from ..gmwm.analysis import J_CAVEAT, ieee_rows
+    """Per axis: IEEE table (one B, by its rule), the other B readings as details, the comparison with the Allan
+    fit when one was made, candidates (WIC, why rejected), excluded scales, J with its caveat."""
+    from ..gmwm.analysis import J_CAVEAT, b_detail_lines, ieee_rows
 
     for a in axes:
         sel = a.selection
@@ -60,8 +69,14 @@ def print_gmwm(title, axes):
                                    f"{'' if sel.passed_checks else ' (no candidate passed every check)'}, "
                                    "95 % intervals",
                                    ["quantity", "value", "95 % interval", "unit", "from"],
-                                   [[r[0], _fmt(r[1]), f"[{_fmt(r[2])}, {_fmt(r[3])}]", r[4], r[5]]
+                                   [[r[0], _fmt(r[1]), _interval(r[2], r[3]), r[4], r[5]]
                                     for r in ieee_rows(a)]))
+        for line in b_detail_lines(a):
+            say(f"  {a.name}: {line}")
+        if a.allan_check is not None:
+            for line in a.allan_check["lines"]:
+                say(f"  {a.name}: GMWM vs Allan fit: {line}",
+                    style=None if a.allan_check["agree"] is not False else "yellow")
         console.print(fitted_table(f"{title} axis {a.name}: candidates (smallest WIC among those passing wins)",
                                    ["candidate", "WIC", "passed", "why rejected"],
                                    [[c.model + (" *" if c.model == sel.selected else ""), _fmt(c.wic),
@@ -72,6 +87,18 @@ def print_gmwm(title, axes):
             say(f"  {a.name}: scale {_fmt(x.scale_s)} s excluded: {x.reason}", style="yellow")
         if sel.scan_note:
             say(f"  {a.name}: {sel.scan_note}", style="yellow")
+
+
+def _with_allan_check(record, axes):
+    """Attach to each GMWM axis its comparison with the Allan fit of the same record (the 'fogdrift allan' fit)."""
+    from ..gmwm.compare import compare_with_allan
+    from ..pipeline import AnalysisConfig, run_allan
+
+    fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate())}
+    for a in axes:
+        if a.name in fits:
+            a.allan_check = compare_with_allan(a, fits[a.name])
+    return axes
 
 
 @app.command()
@@ -94,7 +121,7 @@ def noise(
     expect = ("noise.json", "wvar.csv", "noise.png") if method == "gmwm" else ("noise.json", "noise.png")
     with run("noise", out, default_out=DEFAULT_OUT, inputs=[load.file, curve], json_out=json_out,
              expect=expect) as r:
-        from ..gmwm.analysis import analyse_gmwm, analyse_wvar, candidates_for, read_curve
+        from ..gmwm.analysis import analyse_gmwm, analyse_wvar, candidates_for, read_curve_table
         from ..report_gmwm import write_gmwm_outputs
 
         if method not in ("gmwm", "allan"):
@@ -110,12 +137,17 @@ def noise(
         if scales is not None and scales < 1:
             raise ConfigError(f"{{opt:scales}} must be >= 1; got {scales}")
         if curve is not None:
-            wvs = read_curve(curve, sensor=sensor, unit=load.unit,
-                             axes=None if load.columns is None else [c.strip() for c in load.columns.split(",")])
+            table = read_curve_table(curve, sensor=sensor, unit=load.unit, axes=None if load.columns is None
+                                     else [c.strip() for c in load.columns.split(",")])
+            wvs = table.wvars
             if scales is not None:
                 wvs = [wv.select(wv.level <= scales) for wv in wvs]
-            say(f"{curve.name}: published WV curve{'' if sensor is None else ' of ' + sensor}, axes "
-                f"{', '.join(w.axis_names[0] for w in wvs)}, {wvs[0].n_samples} samples at dt {wvs[0].dt_s:g} s")
+            say(f"{curve.name}: unit: {table.unit}, {table.unit_source}"
+                f"{'' if table.unit == 'deg/h' else '; converted to deg/h'}; published {table.kind} curve"
+                f"{'' if sensor is None else ' of ' + sensor}"
+                f"{' (as wavelet variance, WV(2τ) = AVAR(τ)/2)' if table.kind != 'wavelet variance' else ''}, "
+                f"axes {', '.join(w.axis_names[0] for w in wvs)}, {wvs[0].n_samples} samples at dt "
+                f"{wvs[0].dt_s:g} s")
             with progress("noise"):
                 axes = [analyse_wvar(w.axis_names[0], w, model=model) for w in wvs]
             source, meta = str(curve), None
@@ -128,6 +160,7 @@ def noise(
             with progress("noise", record.axis_names):
                 axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=model, levels=scales, robust=robust)
                         for name in record.axis_names]
+                _with_allan_check(record, axes)
             source, meta = str(record.source), record.metadata()
         print_gmwm((curve or load.file).name, axes)
         files = write_gmwm_outputs(axes, r.out.path, source=source, record=meta)

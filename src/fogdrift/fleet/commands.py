@@ -181,8 +181,9 @@ def gmwm_columns(axis) -> dict:
     row.update(noise_model=str(sel.selected), fit_quality="good" if sel.passed_checks else "poor",
                fit_dof=int(fit.df), fit_p_value=_f(fit.j_pvalue),
                fit_n_points=int(len(axis.wvar.scale_s) - len(sel.excluded)),
-               b_min_dph=_f(getattr(b, "value_dph", None)), b_min_tau_s=_f(getattr(b, "tau_s", None)),
-               b_min_bound_only=None if b is None else bool(b.flagged))
+               # the model's ADEV minimum, or its 95 % bound where it lies beyond the scales used (gmwm.ieee)
+               b_min_dph=_f(b.value_dph if b.value_dph is not None else b.bound_dph), b_min_tau_s=_f(b.tau_s),
+               b_min_bound_only=None if b.value_dph is None and b.bound_dph is None else b.value_dph is None)
     return row
 
 

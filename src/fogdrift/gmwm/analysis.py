@@ -30,7 +30,8 @@ from .processes import parse_model
 from .selection import SelectionResult, select_model
 from .wvar import WvarResult, from_curve, haar_wvar
 
-__all__ = ["J_CAVEAT", "GmwmAxis", "GmwmTerm", "analyse_gmwm", "analyse_wvar", "candidates_for", "read_curve", "ieee_rows"]
+__all__ = ["J_CAVEAT", "CurveTable", "GmwmAxis", "GmwmTerm", "analyse_gmwm", "analyse_wvar", "b_detail_lines",
+           "candidates_for", "read_curve", "read_curve_table", "ieee_rows"]
 
 #: What the J statistic may and may not be read as (shown next to it in every output).
 J_CAVEAT = ("the J test over-rejects (V is evaluated at the step-1 estimate and the asymptotics are "
@@ -39,7 +40,7 @@ J_CAVEAT = ("the J test over-rejects (V is evaluated at the step-1 estimate and 
 
 #: IEEE quantities in table order: (key in IEEEResult.terms, symbol shown).
 _IEEE_ORDER = (("N_dprh", "N"), ("K_dphrh", "K"), ("R_dph2", "R"), ("Q_urad", "Q"), ("Q_arcsec", "Q"),
-               ("B_dph", "B (flicker)"))
+               ("B_dph", "B"))
 
 
 @dataclass(frozen=True)
@@ -59,14 +60,18 @@ class GmwmAxis:
     name: str
     wvar: WvarResult
     selection: SelectionResult
+    #: The comparison with the Allan fit of the same record (:func:`fogdrift.gmwm.compare.compare_with_allan`),
+    #: when one was made: ``{"agree": bool, "lines": [str, ...], ...}``.
+    allan_check: dict | None = None
 
     def ieee_terms(self) -> dict:
         """The five IEEE-952 terms the selected model implies, as :class:`GmwmTerm` keyed Q, N, B, K, R.
 
         Units as :data:`fogdrift.noise.TERM_UNITS` (Q urad, N deg/sqrt(h), B deg/h, K deg/h^1.5, R deg/h^2).
-        B is the flicker term when the model has one, else the Gauss-Markov reading (rule a of
-        :mod:`fogdrift.gmwm.ieee`) when it has a GM; ``status`` is ``resolved`` when the 95 % interval
-        excludes zero, ``unresolved`` when it does not, ``absent`` when the model has no such term.
+        B is the flicker term when the model has one and ``absent`` otherwise: the bias-instability readings of
+        a model without one (the minimum of its ADEV, a GM hump) are readings, not terms, and live in
+        :attr:`fogdrift.gmwm.ieee.IEEEResult.b_headline` / ``b_details``.  ``status`` is ``resolved`` when the
+        95 % interval excludes zero, ``unresolved`` when it does not, ``absent`` when the model has no such term.
         """
         from ..noise.terms import TERM_TABLE
 
@@ -74,9 +79,7 @@ class GmwmAxis:
         out = {}
         for name, spec in TERM_TABLE.items():
             term = ie.terms.get(name + spec.suffix)
-            if term is None and name == "B" and ie.b_gm is not None:
-                value, lo, hi = ie.b_gm.value_dph, ie.b_gm.lo95_dph, ie.b_gm.hi95_dph
-            elif term is None:
+            if term is None:
                 value = lo = hi = None
             else:
                 value, lo, hi = term.value, term.lo95, term.hi95
@@ -88,6 +91,8 @@ class GmwmAxis:
         sel = self.selection
         return {"name": self.name, "method": "gmwm", "selected": sel.selected,
                 "passed_checks": bool(sel.passed_checks),
+                "b_headline_text": sel.ieee.b_headline.text(),
+                **({} if self.allan_check is None else {"allan_check": self.allan_check}),
                 "j_statistic": {"q": float(sel.fit.q), "df": int(sel.fit.df), "p_value": float(sel.fit.j_pvalue),
                                 "caveat": J_CAVEAT},
                 "wvar": self.wvar.to_dict(), "selection": sel.to_dict()}
@@ -139,29 +144,88 @@ def _open_text(path: Path):
     return gzip.open(path, "rt", newline="") if gz else open(path, newline="")
 
 
-def read_curve(path, *, sensor=None, unit=None, axes=None) -> list[WvarResult]:
-    """Read a published Haar WV table (the SMAC format, optionally gzipped): one :class:`WvarResult` per axis.
+@dataclass(frozen=True)
+class CurveTable:
+    """A published curve table read by :func:`read_curve_table`.
 
-    Columns: ``scale_s``, ``wvar``, ``n_samples``, ``sample_rate_hz``; optional ``wvar_ci_low``/``wvar_ci_high``
-    (published 95 % interval), ``axis``, ``sensor_key`` and ``unit_inferred`` or ``unit`` (the rate unit of the
-    curve; ``unit`` overrides it).  A table with several sensors needs ``sensor``.
+    Attributes
+    ----------
+    wvars : list of WvarResult
+        One per axis, in (deg/h)^2.
+    unit : str
+        Rate unit of the table's numbers.
+    unit_source : str
+        Where the unit came from, in words (``"from the table's unit column"``, ``"from --unit"``).
+    kind : str
+        ``"wavelet variance"`` or ``"Allan variance"`` (converted: WV(2 tau) = AVAR(tau) / 2).
+    """
+
+    wvars: list
+    unit: str
+    unit_source: str
+    kind: str
+
+
+#: Columns of the two table kinds :func:`read_curve_table` reads (besides the optional ones).
+WV_COLUMNS = ("scale_s", "wvar", "n_samples", "sample_rate_hz")
+AVAR_COLUMNS = ("tau_s", "avar", "n_samples", "sample_rate_hz")
+
+
+def _table_unit(name, first_row, unit) -> tuple[str, str]:
+    """(unit, where it came from) of a curve table: ``--unit`` or the ``unit`` column, never ``unit_inferred``."""
+    from ..units import rate_scale_to_dph
+
+    declared = (first_row.get("unit") or "").strip()
+    inferred = (first_row.get("unit_inferred") or "").strip()
+    if unit:
+        if declared and declared != unit:
+            raise ConfigError(f"{name} declares the rate unit {declared!r} in its 'unit' column but {{opt:unit}} "
+                              f"says {unit!r}; drop {{opt:unit}} or correct the table")
+        rate_scale_to_dph(unit)
+        how = "from --unit" + (f" (the table's unit_inferred column, not a declaration, says {inferred})"
+                               if inferred and inferred != unit else "")
+        return unit, how
+    if declared:
+        rate_scale_to_dph(declared)
+        return declared, "from the table's unit column"
+    if inferred:
+        raise ConfigError(f"{name} does not declare its rate unit: its 'unit_inferred' column ({inferred!r}) is an "
+                          "inference, not a declaration; pass {opt:unit}")
+    raise ConfigError(f"{name} declares no rate unit (no 'unit' column); pass {{opt:unit}}")
+
+
+def read_curve_table(path, *, sensor=None, unit=None, axes=None) -> CurveTable:
+    """Read a published wavelet-variance or Allan-variance table (the SMAC formats, optionally gzipped).
+
+    Wavelet variance: columns ``scale_s`` (Haar scale 2^j dt, s), ``wvar`` (unit^2), ``n_samples``,
+    ``sample_rate_hz``; optional ``wvar_ci_low``/``wvar_ci_high`` (published 95 % interval).  Allan variance:
+    ``tau_s`` (s, 2^k dt), ``avar`` (unit^2; or ``adev``, unit), ``n_samples``, ``sample_rate_hz``; optional
+    ``adev_ci_low``/``adev_ci_high``; it is converted with the exact identity of the maximal-overlap estimators,
+    WV(scale 2 tau) = AVAR(tau) / 2.  Both: optional ``axis``, ``sensor_key`` and ``unit`` (the declared rate
+    unit).  ``unit_inferred`` is never used as the unit: a table without ``unit`` needs ``unit`` (``--unit``),
+    and ``unit`` conflicting with a declared one is an error naming both.  A table with several sensors needs
+    ``sensor``.
 
     Raises
     ------
     DataFormatError
-        Missing columns, unparsable numbers (with the line).
+        Missing columns, unparsable numbers (with the axis).
     ConfigError
-        Several sensors and no ``{opt:sensor}``, unknown sensor or axis, no unit.
+        Several sensors and no ``{opt:sensor}``, unknown sensor or axis, no declared unit and no ``{opt:unit}``,
+        or the two in conflict.
     """
     path = Path(path)
     if not path.is_file():
         raise DataFormatError("no such curve file; pass {opt:curve} a CSV table", path=str(path))
     with _open_text(path) as fh:
         rows = list(csv.DictReader(fh))
-    need = {"scale_s", "wvar", "n_samples", "sample_rate_hz"}
-    if not rows or need - set(rows[0]):
-        raise DataFormatError(f"a curve table needs the columns {sorted(need)}; "
-                              f"found {sorted(rows[0]) if rows else 'no rows'}", path=str(path))
+    cols = set(rows[0]) if rows else set()
+    is_wv = not set(WV_COLUMNS) - cols
+    is_av = not set(AVAR_COLUMNS) - cols or (not {"tau_s", "adev", "n_samples", "sample_rate_hz"} - cols)
+    if not rows or not (is_wv or is_av):
+        raise DataFormatError(f"a curve table needs the columns {list(WV_COLUMNS)} (wavelet variance) or "
+                              f"{list(AVAR_COLUMNS)} (Allan variance; or adev for avar); "
+                              f"found {sorted(cols) if rows else 'no rows'}", path=str(path))
     sensors = list(dict.fromkeys(r.get("sensor_key", "") for r in rows))
     if sensor is None and len(sensors) > 1:
         raise ConfigError(f"{path.name} holds {len(sensors)} sensors {sensors}; choose one with {{opt:sensor}}")
@@ -169,6 +233,7 @@ def read_curve(path, *, sensor=None, unit=None, axes=None) -> list[WvarResult]:
         if sensor not in sensors:
             raise ConfigError(f"sensor {sensor!r} is not in {path.name}; it holds {sensors} ({{opt:sensor}})")
         rows = [r for r in rows if r.get("sensor_key", "") == sensor]
+    u, how = _table_unit(path.name, rows[0], unit)
     names = list(dict.fromkeys(r.get("axis", "x") for r in rows))
     if axes:
         bad = [a for a in axes if a not in names]
@@ -177,41 +242,74 @@ def read_curve(path, *, sensor=None, unit=None, axes=None) -> list[WvarResult]:
         names = [a for a in names if a in axes]
     out = []
     for name in names:
-        rs = [(i + 2, r) for i, r in enumerate(rows) if r.get("axis", "x") == name]
+        rs = [r for r in rows if r.get("axis", "x") == name]
         try:
-            col = {k: [float(r[k]) for _, r in rs] for k in ("scale_s", "wvar", "n_samples", "sample_rate_hz")}
+            n_samples, fs = float(rs[0]["n_samples"]), float(rs[0]["sample_rate_hz"])
             ci = None
-            if all(r.get("wvar_ci_low") and r.get("wvar_ci_high") for _, r in rs):
-                ci = ([float(r["wvar_ci_low"]) for _, r in rs], [float(r["wvar_ci_high"]) for _, r in rs])
-        except ValueError as exc:
+            if is_wv:
+                scale = [float(r["scale_s"]) for r in rs]
+                wv = [float(r["wvar"]) for r in rs]
+                if all(r.get("wvar_ci_low") and r.get("wvar_ci_high") for r in rs):
+                    ci = ([float(r["wvar_ci_low"]) for r in rs], [float(r["wvar_ci_high"]) for r in rs])
+            else:
+                scale = [2.0 * float(r["tau_s"]) for r in rs]
+                wv = [(float(r["avar"]) if r.get("avar") else float(r["adev"]) ** 2) / 2.0 for r in rs]
+                if all(r.get("adev_ci_low") and r.get("adev_ci_high") for r in rs):
+                    ci = ([float(r["adev_ci_low"]) ** 2 / 2.0 for r in rs],
+                          [float(r["adev_ci_high"]) ** 2 / 2.0 for r in rs])
+        except (ValueError, KeyError) as exc:
             raise DataFormatError(f"axis {name!r}: {exc}", path=str(path)) from None
-        u = unit or rs[0][1].get("unit") or rs[0][1].get("unit_inferred")
-        if not u:
-            raise ConfigError(f"{path.name} declares no rate unit (column 'unit' or 'unit_inferred'); pass {{opt:unit}}")
-        out.append(from_curve(col["scale_s"], col["wvar"], n_samples=int(col["n_samples"][0]),
-                              dt_s=1.0 / col["sample_rate_hz"][0], ci_low=None if ci is None else ci[0],
-                              ci_high=None if ci is None else ci[1], unit=u, axis_name=name))
-    return out
+        out.append(from_curve(scale, wv, n_samples=int(n_samples), dt_s=1.0 / fs,
+                              ci_low=None if ci is None else ci[0], ci_high=None if ci is None else ci[1],
+                              unit=u, axis_name=name))
+    return CurveTable(out, u, how, "wavelet variance" if is_wv else "Allan variance")
 
 
-def _b_row(label, b):
-    flag = " (extrapolated)" if b.flagged else ""
-    return [label, b.value_dph, b.lo95_dph, b.hi95_dph, "deg/h", f"{b.rule} at tau {b.tau_s:.4g} s{flag}"]
+def read_curve(path, *, sensor=None, unit=None, axes=None) -> list[WvarResult]:
+    """The :class:`WvarResult` of every axis of a curve table (:func:`read_curve_table`, which also says the
+    unit and where it came from)."""
+    return read_curve_table(path, sensor=sensor, unit=unit, axes=axes).wvars
+
+
+def _b_cells(b) -> tuple:
+    """(value, lo95, hi95, from) of a B reading: a bound or nothing is a text value with no interval."""
+    if b.value_dph is not None:
+        where = b.label + ("" if b.tau_s is None else f", at τ = {b.tau_s:.3g} s")
+        return b.value_dph, b.lo95_dph, b.hi95_dph, where
+    if b.bound_dph is not None:
+        return f"< {b.bound_dph:.3g}", None, None, f"{b.label} (a bound, below)"
+    return "not reached", None, None, f"{b.label} (below)"
 
 
 def ieee_rows(axis: GmwmAxis) -> list[list]:
-    """The IEEE-952 reading as rows ``[quantity, value, lo95, hi95, unit, where from]`` (numbers as floats)."""
+    """The IEEE-952 reading as rows ``[quantity, value, lo95, hi95, unit, where from]``.
+
+    Values are floats, except a B reading that lies beyond the scales the fit used: its value is the text of
+    its bound (``"< 7.06"``) or ``"not reached"``, with no interval.  Exactly one B row (the headline reading,
+    :attr:`fogdrift.gmwm.ieee.IEEEResult.b_headline`); the other readings are in :func:`b_detail_lines`.
+    """
     ie = axis.selection.ieee
     rows = []
     for key, sym in _IEEE_ORDER:
-        if key in ie.terms:
+        if key in ie.terms and key != "B_dph":
             v = ie.terms[key]
             rows.append([sym, v.value, v.lo95, v.hi95, v.unit, v.component])
     for g in ie.gm:
-        for key, sym in (("tc_s", "T_c"), ("sigma_gm_dph", "sigma_GM")):
+        for key, sym in (("tc_s", "T_c, correlation time"), ("sigma_gm_dph", "σ, standard deviation")):
             v = g[key]
-            rows.append([f"{sym} ({g['component']})", v.value, v.lo95, v.hi95, v.unit, g["component"]])
-    if ie.b_gm is not None:
-        rows.append(_b_row("B", ie.b_gm))
-    rows.append(_b_row("B (min AVAR)", ie.b_min))
+            rows.append([f"{g['component']} {sym}", v.value, v.lo95, v.hi95, v.unit, f"Gauss-Markov {g['component']}"])
+    value, lo, hi, where = _b_cells(ie.b_headline)
+    rows.append(["B", value, lo, hi, "deg/h", where])
     return rows
+
+
+def b_detail_lines(axis: GmwmAxis) -> list[str]:
+    """Lines under the IEEE table: why the headline B is a bound or nothing (when it is), then the B readings that
+    are not the headline B (the GM hump's, the min-AVAR reading beside a flicker term), each labelled by its rule."""
+    ie = axis.selection.ieee
+    head = ie.b_headline
+    out = [] if head.value_dph is not None else [f"B ({head.label}): {head.text()}"]
+    for b in ie.b_details:
+        label = b.label if b.rule == "gm-peak" else f"B_min, {b.label}"
+        out.append(f"detail, not the headline B: {label}: {b.text()}")
+    return out

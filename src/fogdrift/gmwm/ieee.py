@@ -14,14 +14,23 @@ sigma_GM   ``sqrt(sigma2 / (1 - phi^2))``         deg/h
 B          ``sqrt(b2)`` (FLICKER)                 deg/h (flat ADEV 0.6643 B)
 =========  =====================================  =====================================
 
-Bias instability from GMs, both rules of [GMWM]_ §4, each with the averaging time where it
-occurs: (a) ``B = sqrt(max_T AVAR_GMsum(T)) / 0.6643`` (the GM bump read as a flicker
-plateau; only GMs that are the largest component at one or more fitted scales and whose WV
-peak, at scale ``3.785 T_c``, is at least twice the first scale used: a faster or buried GM
-is short-scale structure such as an output filter, not a flat region), and (b) the classical reading ``B = sqrt(min_T AVAR_total(T)) / 0.6643`` (biased
-up where WN/RW overlap).  A value is *flagged* when its T exceeds ``N dt / 4`` (the curve
-is extrapolated there).  Rule (b) is searched over ``T <= N dt / 2``; rule (a) wherever the
-GM peak is.
+Bias instability, each reading with the averaging time ``T`` where it occurs ([GMWM]_ §4):
+
+* ``"flicker"``: ``B = sqrt(b2)`` of a FLICKER component (a model parameter, no ``T``).
+* ``"min-avar"``: the classical IEEE reading ``B = sqrt(min_T AVAR_model(T)) / 0.6643`` (biased up where
+  WN/RW overlap), searched over the Allan times the fit used, ``T`` in ``[s_1 / 2, s_J / 2]`` (``s_j``
+  the first and last wavelet scales used; AVAR(T) = 2 WV(2T)).
+* ``"gm-peak"``: the GM hump read as a flicker plateau, ``B = sqrt(max_T AVAR_GMsum(T)) / 0.6643``; only
+  GMs that are the largest component at one or more fitted scales and whose WV peak (scale
+  ``3.785 T_c``) is at least twice the first scale used (a faster or buried GM is short-scale
+  structure such as an output filter, not a flat region).  A detail, never the headline B.
+
+**No value is read beyond the data** (:func:`_reading`): a reading whose ``T`` lies outside the fitted
+range is never a number with an interval.  At the longest ``T`` used with the model's ADEV still
+falling (or at the shortest, still rising) it is the 95 % upper bound of the model's ADEV there / 0.6643
+(``value = None``, ``bound_dph`` and ``reason`` set); a GM hump peaking outside the range gives nothing
+(``"not reached within the record"``).  The headline B of an axis (:attr:`IEEEResult.b_headline`) is the
+flicker term when the model has one, else the min-AVAR reading.
 
 Intervals: delta method in the free parameters ``z = log theta`` (the fit's ``cov_z``):
 ``se(log g) = sqrt(grad^T Cov grad)`` with ``grad = d log g / d z`` by central differences,
@@ -88,23 +97,47 @@ class BiasInstability:
     Attributes
     ----------
     rule : str
-        ``"gm-max"`` (rule a) or ``"min-avar"`` (rule b).
-    value_dph, lo95_dph, hi95_dph : float
-        B in deg/h with its 95 % interval.
-    tau_s : float
-        Averaging time where the max/min occurs.
-    flagged : bool
-        True when ``tau_s > N dt / 4`` (extrapolated beyond the reliable part of the record).
-    note : str
+        ``"flicker"``, ``"min-avar"`` or ``"gm-peak"`` (module docstring).
+    value_dph, lo95_dph, hi95_dph : float or None
+        B in deg/h with its 95 % interval; None when the reading lies outside the scales the fit used.
+    tau_s : float or None
+        Averaging time [s] of the reading (for a bound: the end of the fitted range it is read at; None
+        for the flicker term and when nothing is read).
+    bound_dph : float or None
+        95 % upper bound in deg/h when ``value_dph`` is None and the data support one.
+    reason : str
+        Why there is no value (empty when there is one).
+    label : str
+        The rule in words, as shown to the user.
     """
 
     rule: str
-    value_dph: float
-    lo95_dph: float
-    hi95_dph: float
-    tau_s: float
-    flagged: bool
-    note: str
+    value_dph: float | None
+    lo95_dph: float | None
+    hi95_dph: float | None
+    tau_s: float | None
+    bound_dph: float | None
+    reason: str
+    label: str
+
+    @property
+    def flagged(self) -> bool:
+        """True when this reading is not a value (a bound or nothing)."""
+        return self.value_dph is None
+
+    def text(self, digits: int = 4) -> str:
+        """The reading as one cell: ``"39.2 [35.1, 43.8] deg/h at τ = 117 s"``, ``"< 7.06 deg/h (why)"`` or
+        ``"not reached within the record (why)"``."""
+        def f(x, d=digits):
+            return f"{x:.{d}g}"
+
+        if self.value_dph is not None:
+            iv = "" if self.lo95_dph is None else f" [{f(self.lo95_dph, 3)}, {f(self.hi95_dph, 3)}]"
+            at = "" if self.tau_s is None else f" at τ = {f(self.tau_s, 3)} s"
+            return f"{f(self.value_dph)}{iv} deg/h{at}"
+        if self.bound_dph is not None:
+            return f"< {f(self.bound_dph, 3)} deg/h ({self.reason})"
+        return f"not reached within the record ({self.reason})"
 
     def to_dict(self) -> dict:
         return {k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in self.__dict__.items()}
@@ -122,9 +155,13 @@ class IEEEResult:
     gm : list of dict
         Per GM (by increasing T_c): ``{"component", "tc_s": IEEEValue, "sigma_gm_dph": IEEEValue}``.
     b_gm : BiasInstability or None
-        Rule (a), only with GMs.
+        The GM-hump reading (``"gm-peak"``), only with GMs that make a hump.
     b_min : BiasInstability
-        Rule (b).
+        The classical reading (``"min-avar"``).
+    b_flicker : BiasInstability or None
+        The FLICKER term as a reading (``"flicker"``), only with a FLICKER component.
+    tau_range_s : tuple of float
+        Allan times [s] the fit covers, ``(s_1 / 2, s_J / 2)``.
     dt_s : float
     n_samples : int
     """
@@ -136,6 +173,19 @@ class IEEEResult:
     b_min: BiasInstability
     dt_s: float
     n_samples: int
+    b_flicker: BiasInstability | None = None
+    tau_range_s: tuple = (float("nan"), float("nan"))
+
+    @property
+    def b_headline(self) -> BiasInstability:
+        """The one B of the axis: the flicker term when the model has one, else the min-AVAR reading."""
+        return self.b_flicker if self.b_flicker is not None else self.b_min
+
+    @property
+    def b_details(self) -> list:
+        """The other B readings (never a second headline B): the min-AVAR reading beside a flicker term, the
+        GM-hump reading."""
+        return [b for b in (self.b_min if self.b_flicker is not None else None, self.b_gm) if b is not None]
 
     def to_dict(self) -> dict:
         return {
@@ -144,6 +194,9 @@ class IEEEResult:
             "gm": [{k: (v.to_dict() if isinstance(v, IEEEValue) else v) for k, v in g.items()} for g in self.gm],
             "b_gm": None if self.b_gm is None else self.b_gm.to_dict(),
             "b_min": self.b_min.to_dict(),
+            "b_flicker": None if self.b_flicker is None else self.b_flicker.to_dict(),
+            "b_headline": self.b_headline.to_dict(),
+            "tau_range_s": [float(v) for v in self.tau_range_s],
             "dt_s": float(self.dt_s),
             "n_samples": int(self.n_samples),
         }
@@ -221,11 +274,14 @@ def to_ieee(fit) -> IEEEResult:
         else:
             terms.update(entries)
 
-    # rule (a) uses the GMs resolved by the scales: WV peak (scale 3.785 T_c) at least twice the
-    # first scale; a faster GM is short-scale structure (e.g. an output filter), not bias instability
-    # and that are the largest component at one or more of the fitted scales (a GM buried under
-    # the WN everywhere does not make a flat region)
     scales = np.asarray(fit.tau_samples, dtype=np.float64)
+    m_lo, m_hi = float(scales[0]) / 2.0, float(scales[-1]) / 2.0  # Allan factors the fit covers
+    tau_range = (m_lo * dt, m_hi * dt)
+    m_used = _m_range(m_lo, m_hi)
+
+    # the GM hump: GMs resolved by the scales (WV peak, scale 3.785 T_c, at least twice the first scale; a
+    # faster GM is short-scale structure such as an output filter) and the largest component at one or more
+    # fitted scales (a GM buried under the WN everywhere does not make a flat region)
     dominant = set(np.argmax(mdl.wv_components(np.exp(z), scales), axis=0).tolist())
     first_scale = float(fit.scale_s[0])
     gm_idx = [i for i, k in enumerate(mdl.components)
@@ -233,44 +289,71 @@ def to_ieee(fit) -> IEEEResult:
     b_gm = None
     if gm_idx:
         tcs = [dt / math.exp(z[mdl.slices[i].start]) for i in gm_idx]
-        m_a = _m_grid(20.0 * max(tcs) / dt)
         sub = parse_model("+".join(["GM"] * len(gm_idx)))
 
-        def gm_avar(zz):
+        def gm_avar(zz, m):
             th = np.concatenate([np.exp(zz[mdl.slices[i]]) for i in gm_idx])
-            return sub.avar(th, m_a)
+            return sub.avar(th, m)
 
-        def b_a(zz):
-            return math.sqrt(float(np.max(gm_avar(zz)))) / B_ADEV_FACTOR
+        names = ", ".join(f"{mdl.labels[i]} T_c {tc:.3g} s" for i, tc in zip(gm_idx, tcs))
+        m_a = _m_grid(20.0 * max(tcs) / dt)
+        b_gm = _reading("gm-peak", f"B read from the GM hump's ADEV peak / 0.664 ({names})", gm_avar, z, cov, dt,
+                        m_a, m_lo, m_hi, peak=True)
+    b_min = _reading("min-avar", "min of the model's ADEV / 0.664", lambda zz, m: mdl.avar(np.exp(zz), m), z, cov, dt,
+                     m_used, m_lo, m_hi, peak=False)
+    b_flicker = None
+    if "B_dph" in terms:
+        t = terms["B_dph"]
+        b_flicker = BiasInstability("flicker", t.value, t.lo95, t.hi95, None, None, "",
+                                    f"flicker term ({t.component})")
+    return IEEEResult(model=mdl.name, terms=terms, gm=gms, b_gm=b_gm, b_min=b_min, dt_s=dt, n_samples=n,
+                      b_flicker=b_flicker, tau_range_s=tau_range)
 
-        val, se = _delta(b_a, z, cov)
-        tau_a = float(m_a[int(np.argmax(gm_avar(z)))] * dt)
-        flagged = tau_a > n * dt / 4.0
-        b_gm = BiasInstability(
-            "gm-max", float(val), float(val * math.exp(-_Z95 * se)) if math.isfinite(se) else 0.0,
-            float(val * math.exp(_Z95 * se)) if math.isfinite(se) else float("inf"), tau_a, bool(flagged),
-            "sqrt(max AVAR of the GM sum)/0.6643" + (" at T > N dt/4: extrapolated" if flagged else ""),
-        )
-    m_b = _m_grid(max(n // 2, 2))
 
-    def total_avar(zz):
-        return mdl.avar(np.exp(zz), m_b)
+def _m_range(m_lo: float, m_hi: float) -> np.ndarray:
+    """Integer Allan factors from ``m_lo`` to ``m_hi`` (both included), about 40 per decade."""
+    m_lo, m_hi = max(1.0, m_lo), max(1.0, m_hi)
+    k = max(2, int(40 * math.log10(m_hi / m_lo)) + 2)
+    return np.unique(np.concatenate([[m_lo], np.round(np.logspace(math.log10(m_lo), math.log10(m_hi), k)), [m_hi]]))
 
-    def b_b(zz):
-        return math.sqrt(float(np.min(total_avar(zz)))) / B_ADEV_FACTOR
 
-    val, se = _delta(b_b, z, cov)
-    tau_b = float(m_b[int(np.argmin(total_avar(z)))] * dt)
-    flagged = tau_b > n * dt / 4.0
-    edge = tau_b >= m_b[-1] * dt * 0.999
-    note = "sqrt(min implied total AVAR)/0.6643 (classical reading, biased up by WN/RW overlap)"
-    if edge:
-        note += ("; the minimum is at the longest T searched (N dt/2), beyond the reliable N dt/4: the "
-                 "implied AVAR still falls there, so this is an extrapolated upper bound at best")
-    elif flagged:
-        note += "; at T > N dt/4: extrapolated"
-    b_min = BiasInstability(
-        "min-avar", float(val), float(val * math.exp(-_Z95 * se)) if math.isfinite(se) else 0.0,
-        float(val * math.exp(_Z95 * se)) if math.isfinite(se) else float("inf"), tau_b, bool(flagged), note,
-    )
-    return IEEEResult(model=mdl.name, terms=terms, gm=gms, b_gm=b_gm, b_min=b_min, dt_s=dt, n_samples=n)
+def _reading(rule, label, avar, z, cov, dt, m, m_lo, m_hi, *, peak) -> BiasInstability:
+    """One B reading ``sqrt(extremum of avar(z, m)) / 0.6643`` under the rule that no value is read beyond the data.
+
+    ``avar(z, m)`` is the AVAR [(deg/h)^2] at Allan factors ``m``; the extremum (max for ``peak``, else min) is
+    searched on ``m``.  Inside ``[m_lo, m_hi]`` (and not at its end): a value with its delta-method interval.
+    A minimum at an end of the fitted range: the model's ADEV there is still falling (rising), so the 95 %
+    upper limit of ``ADEV(end) / 0.6643`` bounds B.  A peak outside the range: nothing.
+    """
+    tau_lo, tau_hi = m_lo * dt, m_hi * dt
+
+    def at(mm):
+        return lambda zz: math.sqrt(float(avar(zz, np.asarray([mm], dtype=np.float64))[0])) / B_ADEV_FACTOR
+
+    a = np.asarray(avar(z, m), dtype=np.float64)
+    k = int(np.argmax(a) if peak else np.argmin(a))
+    mk = float(m[k])
+    inside = m_lo * (1 - 1e-9) <= mk <= m_hi * (1 + 1e-9) and (peak or 0 < k < m.size - 1)
+    if inside:
+        def ext(zz):
+            aa = np.asarray(avar(zz, m), dtype=np.float64)
+            return math.sqrt(float(np.max(aa) if peak else np.min(aa))) / B_ADEV_FACTOR
+
+        val, se = _delta(ext, z, cov)
+        lo = val * math.exp(-_Z95 * se) if math.isfinite(se) else 0.0
+        hi = val * math.exp(_Z95 * se) if math.isfinite(se) else float("inf")
+        return BiasInstability(rule, float(val), float(lo), float(hi), mk * dt, None, "", label)
+    if peak:
+        where = "after the longest" if mk > m_hi else "before the shortest"
+        return BiasInstability(rule, None, None, None, None, None,
+                               f"the hump's ADEV peak, at τ = {mk * dt:.3g} s, lies {where} τ the fit used "
+                               f"({tau_hi if mk > m_hi else tau_lo:.3g} s)", label)
+    end = m_hi if k == m.size - 1 else m_lo
+    val, se = _delta(at(end), z, cov)
+    bound = val * math.exp(_Z95 * se) if math.isfinite(se) else None
+    how = "still falls at the longest" if end == m_hi else "still rises from the shortest"
+    reason = f"the model's ADEV {how} τ the fit used, {end * dt:.3g} s"
+    if bound is None:
+        return BiasInstability(rule, None, None, None, end * dt, None, reason, label)
+    reason = f"95 % upper bound: {reason}"
+    return BiasInstability(rule, None, None, None, end * dt, float(bound), reason, label)

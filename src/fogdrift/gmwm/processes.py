@@ -330,6 +330,24 @@ PROCESSES: dict[str, Process] = {
     ),
 }
 
+#: A natural parameter in words, as shown to the user (``"RW.gamma2"`` -> ``"RW variance"``).
+_PARAM_WORDS = {"q2": "variance", "sigma2": "variance", "gamma2": "variance", "omega": "slope",
+                "b2": "variance", "beta": "inverse correlation time 1/T_c"}
+
+
+def param_label(name: str) -> str:
+    """A parameter name of :attr:`LatentModel.param_names` in words (``"GM1.beta"`` -> ``"GM1 inverse
+    correlation time 1/T_c"``), for messages; JSON keys keep the names.
+
+    Examples
+    --------
+    >>> param_label("QN.q2"), param_label("DR.omega")
+    ('QN variance', 'DR slope')
+    """
+    comp, _, par = str(name).partition(".")
+    return f"{comp} {_PARAM_WORDS.get(par, par)}" if par else comp
+
+
 #: Accepted spellings in model strings (upper-cased) -> registry key.
 ALIASES = {"GM": "GM", "AR1": "GM", "AR(1)": "GM", "GAUSSMARKOV": "GM", "WN": "WN", "ARW": "WN",
            "QN": "QN", "RW": "RW", "RRW": "RW", "DR": "DR", "RAMP": "DR", "FLICKER": "FLICKER",

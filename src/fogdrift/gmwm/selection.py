@@ -56,7 +56,7 @@ from ..errors import ConfigError, FogdriftWarning, InsufficientDataError
 from .covariance import wvar_covariance
 from .estimator import GMWMFit, _bounds, _check_wv, _finish, _model_V, _step1
 from .ieee import IEEEResult, to_ieee
-from .processes import LatentModel, parse_model
+from .processes import LatentModel, param_label, parse_model
 
 __all__ = ["DEFAULT_CANDIDATES", "CandidateScore", "ExcludedScale", "SelectionResult", "select_model",
            "longest_run_pvalue"]
@@ -258,7 +258,7 @@ def _checks(fit: GMWMFit, mdl: LatentModel, *, z_max, se_log_max, run_alpha, sha
             whiten) -> list[str]:
     reasons = []
     if fit.at_bound:
-        reasons.append(f"hard: at a bound: {', '.join(fit.at_bound)}")
+        reasons.append(f"hard: at a bound: {', '.join(param_label(n) for n in fit.at_bound)}")
     comp = fit.component_wv()
     share = np.max(comp / fit.nu2_hat[None, :], axis=1)
     snr = np.max(comp / fit.sd_nu2[None, :], axis=1)
@@ -269,7 +269,7 @@ def _checks(fit: GMWMFit, mdl: LatentModel, *, z_max, se_log_max, run_alpha, sha
             reasons.append(f"soft: {lab} changes the WV by at most {sn:.2g} SD at any scale (not detectable)")
     if not np.all(np.isfinite(fit.se_z)):
         bad = [n for n, s in zip(fit.param_names, fit.se_z) if not np.isfinite(s)]
-        reasons.append(f"hard: not identified (singular information): {', '.join(bad)}")
+        reasons.append(f"hard: not identified (singular information): {', '.join(param_label(n) for n in bad)}")
     if not fit.converged:
         reasons.append("soft: the optimiser did not report convergence")
     s_min, s_max = float(fit.scale_s[0]), float(fit.scale_s[-1])
@@ -293,8 +293,8 @@ def _checks(fit: GMWMFit, mdl: LatentModel, *, z_max, se_log_max, run_alpha, sha
         reasons.append(f"soft: {run} same-sign innovation residuals in a row (p = {p_run:.2g} < {run_alpha:g})")
     big = [(n, s) for n, s in zip(fit.param_names, fit.se_z) if np.isfinite(s) and s > se_log_max]
     if big:
-        reasons.append("soft: se(log) > {:g} (not identified): ".format(se_log_max)
-                       + ", ".join(f"{n} {s:.2f}" for n, s in big))
+        reasons.append(f"soft: not identified, standard error of the log above {se_log_max:g}: "
+                       + ", ".join(f"{param_label(n)} {s:.2f}" for n, s in big))
     return reasons
 
 
@@ -398,16 +398,16 @@ def select_model(wvar, candidates=None, *, exclude_short=True, max_excluded=None
         j0 += 1
     note = ""
     if exclude_short and max_ex > 0 and j0 >= max_ex:
-        note = f"the exclusion scan stopped at max_excluded = {max_ex}"
+        note = f"the exclusion scan stopped at its limit of {max_ex} excluded short scales"
         if zfirst > z_max:
-            note += (f"; the first kept scales are still not explained (max |z| = {zfirst:.3g}): raise "
-                     "max_excluded or read the result with care")
+            note += (f"; the first kept scales are still not explained (max |z| = {zfirst:.3g}): read the result "
+                     "with care")
         else:
             note += f"; the first kept scales are explained (max |z| = {zfirst:.3g})"
     if not ok:
         warnings.warn(
             f"no candidate passed every sanity check; {chosen.model} (smallest WIC among the candidates "
-            f"without hard failures) is returned with passed_checks=False: {'; '.join(chosen.reasons)}"
+            f"without hard failures) is returned although it failed: {'; '.join(chosen.reasons)}"
             + (f" ({note})" if note else ""),
             FogdriftWarning, stacklevel=2,
         )

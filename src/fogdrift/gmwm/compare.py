@@ -1,0 +1,163 @@
+"""GMWM against the Allan fit of the same record: do their N and B readings agree, and if not, why.
+
+:func:`compare_with_allan` takes a :class:`~fogdrift.gmwm.analysis.GmwmAxis` and the
+:class:`~fogdrift.noise.NoiseFit` of the same axis (``fogdrift.noise.fit_noise`` on its Allan result) and
+returns one line per quantity, in words, with the numbers of both sides.  Only the NoiseFit's public fields
+are read (``terms["N"]``, ``b_min``, ``tau_max_s``, ``selected``), each with a fallback, so a
+fit with more terms or fields compares the same.
+
+Rules (95 % intervals; a bound ``B < x`` is the interval ``[0, x]``):
+
+* **N**: GMWM's white-noise N and the Allan fit's N agree when their intervals overlap.
+* **B**: GMWM's headline B (:attr:`fogdrift.gmwm.ieee.IEEEResult.b_headline`: the flicker term, else the
+  minimum of the model's ADEV) against the Allan fit's IEEE reading ``b_min`` (the minimum of its ADEV,
+  or a bound where the curve still falls).  Two bounds agree (neither finds a minimum within the record).
+  A GM hump's reading, when GMWM makes one, gets its own line: it is a reading of the hump, not of a floor.
+
+Units: N in deg/sqrt(h), B in deg/h, tau in s.
+"""
+
+from __future__ import annotations
+
+__all__ = ["compare_with_allan"]
+
+
+def _g(x, d=3):
+    return f"{x:.{d}g}"
+
+
+def _iv(lo, hi):
+    return "" if lo is None or hi is None else f" [{_g(lo)}, {_g(hi)}]"
+
+
+def _n_line(axis, fit) -> tuple:
+    sel = axis.selection
+    g = sel.ieee.terms.get("N_dprh")
+    a = (getattr(fit, "terms", None) or {}).get("N")
+    a_val = getattr(a, "value", None)
+    if g is None and a_val is None:
+        return None, "N cannot be compared: neither GMWM nor the Allan fit has a white-noise term"
+    if g is None:
+        return False, (f"N differs: the GMWM model {sel.selected} has no white-noise term; the Allan fit finds N "
+                       f"{_g(a_val, 4)}{_iv(a.lo95, a.hi95)} deg/√h")
+    if a_val is None:
+        why = getattr(a, "reason", "") or "not in its model"
+        return False, (f"N differs: GMWM {_g(g.value, 4)}{_iv(g.lo95, g.hi95)} deg/√h; the Allan fit gives no N "
+                       f"({why})")
+    a_lo = a.lo95 if a.lo95 is not None else a_val
+    a_hi = a.hi95 if a.hi95 is not None else a_val
+    both = (f"GMWM {_g(g.value, 4)}{_iv(g.lo95, g.hi95)} deg/√h, the Allan fit {_g(a_val, 4)}"
+            f"{_iv(a.lo95, a.hi95)} deg/√h")
+    if g.lo95 <= a_hi and a_lo <= g.hi95:
+        return True, f"N agrees: {both} (the 95 % intervals overlap)"
+    scales = sel.fit.scale_s
+    why = (f"GMWM {sel.selected} is fitted to wavelet scales {_g(scales[0])}-{_g(scales[-1])} s "
+           f"({len(sel.excluded)} short excluded), the Allan fit {'+'.join(getattr(fit, 'selected', ())) or '?'} "
+           f"to τ {_g(getattr(fit, 'tau_min_s', float('nan')))}-{_g(getattr(fit, 'tau_max_s', float('nan')))} s: "
+           "the two models give the short-τ slope to different terms")
+    return False, f"N differs by {_g(g.value / a_val)}x: {both}; {why}"
+
+
+def _b_interval(value, lo, hi, bound):
+    """``(lo, hi)`` of a reading (a bound is ``[0, bound]``); None when nothing is read."""
+    if value is not None:
+        return (lo if lo is not None else value, hi if hi is not None else value)
+    if bound is not None:
+        return (0.0, bound)
+    return None
+
+
+def _b_line(axis, fit) -> tuple:
+    ie = axis.selection.ieee
+    gb = ie.b_headline
+    ab = getattr(fit, "b_min", None) or {}
+    tau_max = getattr(fit, "tau_max_s", None)
+    g_iv = _b_interval(gb.value_dph, gb.lo95_dph, gb.hi95_dph, gb.bound_dph)
+    a_bound = bool(ab.get("bound_only"))
+    a_val = ab.get("value")
+    a_iv = None if a_val is None else (
+        (0.0, a_val) if a_bound else (ab.get("lo95") if ab.get("lo95") is not None else a_val,
+                                      ab.get("hi95") if ab.get("hi95") is not None else a_val))
+    if gb.value_dph is not None:
+        g_text = (f"GMWM B {_g(gb.value_dph)}{_iv(gb.lo95_dph, gb.hi95_dph)} deg/h"
+                  + ("" if gb.tau_s is None else f" at τ = {_g(gb.tau_s)} s") + f" ({gb.label})")
+    elif gb.bound_dph is not None:
+        lo, hi = ie.tau_range_s
+        g_text = f"GMWM B < {_g(gb.bound_dph)} deg/h (its model's ADEV has no minimum within τ {_g(lo)}-{_g(hi)} s)"
+    else:
+        g_text = f"GMWM reads no B ({gb.reason})"
+    if a_val is None:
+        a_text = "the Allan fit has no ADEV-minimum reading"
+    elif a_bound:
+        a_text = (f"the Allan fit finds no ADEV minimum within τ ≤ {_g(tau_max)} s (B_min < {_g(a_val)} deg/h)"
+                  if tau_max is not None else f"the Allan fit gives only B_min < {_g(a_val)} deg/h")
+    else:
+        a_text = (f"the Allan fit's B_min {_g(a_val)}{_iv(ab.get('lo95'), ab.get('hi95'))} deg/h at τ = "
+                  f"{_g(ab.get('tau_s'))} s")
+    if g_iv is None or a_iv is None:
+        return None, f"B cannot be compared: {g_text}; {a_text}"
+    agree = g_iv[0] <= a_iv[1] and a_iv[0] <= g_iv[1]
+    if agree and gb.value_dph is None and a_bound:
+        return True, f"B agrees, both only as upper bounds: {g_text}; {a_text}"
+    if agree:
+        return True, f"B agrees: {g_text}; {a_text} (the 95 % ranges overlap)"
+    if gb.value_dph is None or a_bound:
+        why = ("one of them reaches an ADEV minimum inside the record and the other does not: the models bend "
+               "the longest τ differently")
+    else:
+        why = "the two models put the ADEV minimum at different heights (compare the curves in noise.png)"
+    return False, f"B differs: {g_text}; {a_text}; {why}"
+
+
+def _hump_line(axis, fit):
+    b = axis.selection.ieee.b_gm
+    if b is None or b.value_dph is None:
+        return None
+    ab = getattr(fit, "b_min", None) or {}
+    a_val, tau_max = ab.get("value"), getattr(fit, "tau_max_s", None)
+    if a_val is None:
+        tail = "the Allan fit has no ADEV-minimum reading"
+    elif ab.get("bound_only"):
+        tail = (f"the Allan fit finds no ADEV minimum within τ ≤ {_g(tau_max)} s (B < {_g(a_val)})"
+                if tau_max is not None else f"the Allan fit gives only B < {_g(a_val)}")
+    else:
+        tail = f"the Allan fit's B_min is {_g(a_val)} deg/h at τ = {_g(ab.get('tau_s'))} s"
+    return (f"GMWM B {_g(b.value_dph, 4)} deg/h at τ = {_g(b.tau_s)} s is read from a GM hump ({b.label.split('(')[-1]}:"
+            f" a detail, not a bias-instability floor; {tail}")
+
+
+def compare_with_allan(axis, noise_fit) -> dict:
+    """N and B of a GMWM axis against the Allan fit of the same record.
+
+    Parameters
+    ----------
+    axis : GmwmAxis
+    noise_fit : fogdrift.noise.NoiseFit
+        The Allan fit of the same axis (``fogdrift.noise.fit_noise(allan_variance(...))``).
+
+    Returns
+    -------
+    dict
+        ``{"agree": bool or None, "n_agree", "b_agree": bool or None, "lines": [str, ...]}``; ``agree`` is
+        True when every comparable quantity agrees, None when nothing could be compared.  Each line is one
+        sentence with the numbers and units of both sides and, when they differ, why.
+
+    Examples
+    --------
+    >>> from fogdrift.gmwm import simulate_latent
+    >>> from fogdrift.gmwm.analysis import analyse_gmwm
+    >>> from fogdrift.allan import allan_variance
+    >>> from fogdrift.noise import fit_noise
+    >>> x = simulate_latent("WN", [1.0], 2**15, seed=1)               # deg/h at dt = 0.01 s
+    >>> c = compare_with_allan(analyse_gmwm("x", x, 0.01, model="WN"), fit_noise(allan_variance(x, 0.01)))
+    >>> c["n_agree"], c["lines"][0].startswith("N agrees")
+    (True, True)
+    """
+    n_ok, n_line = _n_line(axis, noise_fit)
+    b_ok, b_line = _b_line(axis, noise_fit)
+    lines = [n_line, b_line]
+    hump = _hump_line(axis, noise_fit)
+    if hump:
+        lines.append(hump)
+    known = [v for v in (n_ok, b_ok) if v is not None]
+    return {"agree": (all(known) if known else None), "n_agree": n_ok, "b_agree": b_ok, "lines": lines}
