@@ -283,7 +283,7 @@ def welch_edf(nperseg: int, n_segments: int) -> float:
     ``rho_1 = 1/6`` is non-zero, giving ``36 K^2 / (19 K - 1)`` (their eq. 292c).
 
     >>> round(welch_edf(1024, 31), 2), round(36 * 31**2 / (19 * 31 - 1), 2)
-    (58.69, 58.69)
+    (58.84, 58.84)
     """
     h = _window(nperseg)
     step = nperseg // 2
@@ -654,7 +654,7 @@ def sinusoid_avar(tau_s, amplitude_dph, freq_hz, *, dt_s=None) -> np.ndarray:
     Examples
     --------
     >>> sinusoid_avar([0.05, 0.1, 0.125], 1.0, 10.0).round(4).tolist()   # zero at 1/f0, envelope ~ tau^-2
-    [0.4053, 0.0, 0.0633]
+    [0.4053, 0.0, 0.0162]
     """
     t = np.asarray(tau_s, dtype=np.float64)
     a = float(amplitude_dph)
