@@ -13,7 +13,7 @@ import sys
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 BUGS = [
     ("symmetric boundary: half-sample instead of whole-sample reflection (numba kernel)",
-     "src/fogdrift/lifting/_kernels.py", "            j = p - j\n", "            j = p - j - 1 if p - j - 1 >= 0 else 0\n",
+     "src/fogdrift/lifting/_numba.py", "        j = p - j\n", "        j = p - j - 1 if p - j - 1 >= 0 else 0\n",
      ["tests/test_lifting_symmetric.py"]),
     ("symmetric boundary: half-sample reflection (NumPy backend)",
      "src/fogdrift/lifting/_kernels.py", "    return p - j if j > m - 1 else j\n", "    return p - j - 1 if j > m - 1 else j\n",
