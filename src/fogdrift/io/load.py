@@ -375,9 +375,9 @@ def _load_records(path, opts: _Options) -> list[GyroRecord]:
         t_col = t_idx if t_idx is not None or table_time else table.tick_column
         dt, seg_bounds, gap_info = _check_time(table, t, t_col, opts.dt_s, opts.split)
         if opts.dt_s is None:
-            notes.insert(1, f"dt_s {dt:.10g} from the median step of {tname}")
+            notes.insert(1, f"sample interval {dt:.10g} s from the median step of {tname}")
         else:
-            notes.insert(1, f"dt_s {dt:.10g} from dt_s/rate_hz ({tname} agrees within 1 %)")
+            notes.insert(1, f"sample interval {dt:.10g} s as given ({tname} agrees within 1 %)")
     else:
         dt, seg_bounds, gap_info = opts.dt_s, [(0, n)], []
         notes.insert(1, f"dt_s {dt:.10g} from dt_s/rate_hz (no time column)")

@@ -2,11 +2,15 @@
 
 Each entry is ``(term, anchor, text)``; the HTML report renders them as a definition list at the end and
 links to them by anchor.
+
+The words for the Python names that reach user text (model parameters, noise-component keys, their unit
+suffixes of :mod:`fogdrift.units`) live here too: :func:`plain_setting` writes ``arw_dprh 0.0662`` as
+``N 0.0662 deg/√h``.  JSON files keep the Python names.
 """
 
 from __future__ import annotations
 
-__all__ = ["GLOSSARY", "glossary_entries"]
+__all__ = ["GLOSSARY", "NAME_WORDS", "glossary_entries", "plain_name", "plain_setting"]
 
 GLOSSARY = (
     # noise identification
@@ -111,3 +115,66 @@ def glossary_entries() -> list:
     ['adev', 'terms', 'interval']
     """
     return list(GLOSSARY)
+
+
+#: Words and unit of the Python names that reach user text: ``name: (words, unit)``.  Names not listed are
+#: read by their unit suffix (:data:`SUFFIX_UNITS`) with underscores as spaces.
+NAME_WORDS = {
+    # noise components of the Kalman model (fogdrift.models.statespace) and the IEEE-952 terms
+    "arw_dprh": ("N", "deg/√h"),
+    "q_urad": ("Q", "µrad"),
+    "bias_instability_dph": ("B", "deg/h"),
+    "rrw_dphrh": ("K", "deg/h^1.5"),
+    "ramp_dph2": ("R", "deg/h²"),
+    "sigma_dph": ("σ", "deg/h"),
+    "tc_s": ("correlation time", "s"),
+    "white": ("white noise", ""),
+    "quantization": ("quantization noise", ""),
+    "random_walk": ("rate random walk", ""),
+    "gauss_markov": ("Gauss–Markov", ""),
+    "ramp": ("rate ramp", ""),
+    "allan": ("Allan", ""),
+    "gmwm": ("GMWM", ""),
+    # model hyper-parameters whose words are not their name's
+    "bias_prior_dph": ("bias prior 1σ", "deg/h"),
+    "dt_s": ("time step", "s"),
+    "max_order": ("largest order", ""),
+    "val_fraction": ("validation fraction", ""),
+    "clip_norm": ("gradient clip norm", ""),
+    "ago_frame": ("AGO frame", ""),
+}
+
+#: Unit suffixes of fogdrift's names (:mod:`fogdrift.units`), longest first.
+SUFFIX_UNITS = (("_dphrh", "deg/h^1.5"), ("_dprh", "deg/√h"), ("_dph2", "deg/h²"), ("_dph", "deg/h"),
+                ("_dps", "deg/s"), ("_urad", "µrad"), ("_arcsec", "arcsec"), ("_deg", "deg"), ("_hz", "Hz"),
+                ("_s", "s"))
+
+
+def plain_name(name: str) -> tuple[str, str]:
+    """``(words, unit)`` for a Python name (unit ``""`` when it has none).
+
+    Examples
+    --------
+    >>> plain_name("arw_dprh"), plain_name("learning_rate"), plain_name("window_s")
+    (('N', 'deg/√h'), ('learning rate', ''), ('window', 's'))
+    """
+    if name in NAME_WORDS:
+        return NAME_WORDS[name]
+    for suffix, unit in SUFFIX_UNITS:
+        if name.endswith(suffix) and len(name) > len(suffix):
+            return name[: -len(suffix)].replace("_", " "), unit
+    return name.replace("_", " "), ""
+
+
+def plain_setting(name: str, value, fmt=str) -> str:
+    """``name value`` in words with the unit after the value; ``None`` reads "default".
+
+    Examples
+    --------
+    >>> plain_setting("arw_dprh", 0.0662), plain_setting("learning_rate", None), plain_setting("batch_size", 2048)
+    ('N 0.0662 deg/√h', 'learning rate default', 'batch size 2048')
+    """
+    words, unit = plain_name(name)
+    if value is None:
+        return f"{words} default"
+    return f"{words} {fmt(value)}" + (f" {unit}" if unit else "")

@@ -7,6 +7,7 @@ model's hyper-parameters and where its training stopped, and the evaluation sett
 
 from __future__ import annotations
 
+from .glossary import plain_name, plain_setting
 from .tables import _fmt
 
 __all__ = ["settings_rows"]
@@ -16,7 +17,7 @@ _HIDDEN_PARAMS = {"progress"}
 
 
 def _params_text(params: dict) -> str:
-    return ", ".join(f"{k} {v}" for k, v in params.items() if k not in _HIDDEN_PARAMS) or "no parameters"
+    return ", ".join(plain_setting(k, v) for k, v in params.items() if k not in _HIDDEN_PARAMS) or "no parameters"
 
 
 def _fitted_text(model) -> str:
@@ -31,10 +32,11 @@ def _fitted_text(model) -> str:
     if getattr(model, "components_", None) is not None:
         comps = []
         for c in model.components_:
-            vals = ", ".join(f"{k} {_fmt(v, 3)}" for k, v in c.items() if k != "kind")
-            comps.append(f"{c.get('kind')} ({vals})" if vals else str(c.get("kind")))
+            vals = ", ".join(plain_setting(k, v, lambda x: _fmt(x, 3)) for k, v in c.items() if k != "kind")
+            kind = plain_name(str(c.get("kind")))[0]
+            comps.append(f"{kind} ({vals})" if vals else kind)
         ident = getattr(model, "identification_", {}) or {}
-        how = f" from the {ident.get('method')} fit of the training block" if ident.get("method") else ""
+        how = f" from the {plain_name(ident['method'])[0]} fit of the training block" if ident.get("method") else ""
         return "states: " + "; ".join(comps) + how
     if getattr(model, "grade_", None) is not None:
         return f"accuracy grade {model.grade_}, shift {_fmt(getattr(model, 'shift_', None), 4)} deg/h"
