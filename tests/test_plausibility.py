@@ -185,7 +185,7 @@ def test_tactical_fog_in_rad_s_read_as_deg_h_names_the_unit_and_its_class():
     numbers = simulate(60_000, 0.01, arw_dprh=0.06, seed=7) / DPH_PER_RAD_S  # 2.9e-7 deg/sqrt(h) as deg/h
     found = check_record(from_array(numbers, dt_s=0.01, unit="deg/h"))
     assert rules(found) == ["white-noise"] and "rad/s" in found[0].likely_units
-    named = re.search(r"rad/s \(N <= ([0-9.]+) deg/√h, tactical grade\)", found[0].message)
+    named = re.search(r"rad/s \(N <= ([0-9.]+) deg/√h, tactical grade or better\)", found[0].message)
     assert named and float(named.group(1)) == pytest.approx(0.06, rel=0.1)
 
 

@@ -311,7 +311,7 @@ def _hint(likely, floors, record) -> str:
         return "check {opt:unit}"
     worst = max((f.estimate for f in floors if math.isfinite(f.estimate)), default=math.nan)
     named = " or ".join(f"{u} (N <= {_fmt(worst * _factor(u, record))} deg/√h, "
-                        f"{gyro_class(worst * _factor(u, record))})" for u in likely)
+                        f"{gyro_class(worst * _factor(u, record))} or better)" for u in likely)
     return f"the numbers fit {named}: check {{opt:unit}}"
 
 
