@@ -61,8 +61,9 @@ COLUMNS: tuple = (
     ("b_min_bound_only", "bool", "true when the fitted ADEV still falls at the longest tau (b_min is a bound)"),
     ("outliers", "int", "samples beyond the outlier threshold"),
     ("verdict", "str", "analyze: which drift model beat persistence on the test block"),
-    ("compensation_outcome", "str", "analyze: headline of the heading-error evaluation: reduces, mixed, none or "
-                                    "undetermined"),
+    ("compensation_outcome", "str", "analyze: headline of the heading-error evaluation (evaluation.verdicts.judge: "
+                                    ">= 5 % lower RMS AND better at most non-overlapping origins): reduces, mixed, "
+                                    "none or undetermined"),
     ("compensation_headline", "str", "analyze: the headline verdict sentence"),
     ("wall_s", "float", "s, processing time of the file (0 when cached)"),
     ("settings_sha256", "str", "SHA-256 of the command and its settings (re-runs skip unchanged files)"),
