@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -300,6 +301,10 @@ def _interrupt(args, *, after_line: str | None, delay: float, cwd=None, wait_for
             proc.communicate()
 
 
+#: A progress line off a terminal (fogdrift.cli._app._Lines): the command, then " · " and the stage, or ": N %".
+PROGRESS_LINE = re.compile(r"^(allan|noise|separate|model|analyze|compensate|batch \w+)( · |: \d+ % \()")
+
+
 def _assert_clean_interrupt(rc, seconds, err, out_dir: Path):
     assert rc == 130, err
     # How fast it stops is proven by rules, not by this wall-clock figure (measured 0.02-0.75 s when idle; a loaded
@@ -308,8 +313,9 @@ def _assert_clean_interrupt(rc, seconds, err, out_dir: Path):
     # ``seconds`` is bounded only by _interrupt's hang guard.
     del seconds
     assert "after the run had finished" not in err
-    err_lines = lines(err)
+    err_lines = [ln for ln in lines(err) if not PROGRESS_LINE.match(ln)]  # stderr is a pipe: progress is lines
     assert len(err_lines) == 1 and err_lines[0].startswith("interrupted: "), err
+    assert lines(err)[-1] == err_lines[0]  # the last line
     assert "Traceback" not in err and "Exception ignored" not in err
     if out_dir.exists():
         leftovers = [p for p in out_dir.rglob("*") if p.name.startswith(TMP_PREFIX)]

@@ -27,6 +27,7 @@ import inspect
 import os
 import sys
 import threading
+import time
 import typing
 import warnings
 from dataclasses import dataclass
@@ -488,41 +489,150 @@ def progress_label(description: str, axes, stage: str = "", axis=None, model=Non
     return " · ".join(parts)
 
 
+#: Off a terminal (a pipe, a log file, CI) progress is plain lines on stderr instead of a bar: each stage as it
+#: starts, the count of a stage with a known total (taus, epochs, samples, files) each time it passes another
+#: PROGRESS_STEP_PCT % (so at most 100 / PROGRESS_STEP_PCT + 1 lines per stage), and a "still running" line
+#: after HEARTBEAT_S seconds without a line.  Nothing is printed before the first stage or count.
+PROGRESS_STEP_PCT = 10
+HEARTBEAT_S = 30.0
+
+
+def _bar_on_terminal() -> bool:
+    """True when stderr is a terminal (rich draws a live bar there; elsewhere it would draw nothing)."""
+    return err_console.is_terminal
+
+
+class _Bar:
+    """One transient rich progress bar on stderr (a terminal)."""
+
+    def __init__(self, description: str):
+        self._progress = Progress(TextColumn("{task.description}"), BarColumn(), _Counter(), TimeElapsedColumn(),
+                                  console=err_console, transient=True)
+        self._task = None
+        self._description = description
+
+    def __enter__(self):
+        self._progress.__enter__()
+        self._task = self._progress.add_task(self._description, total=None, unit="")
+        return self
+
+    def __exit__(self, *exc):
+        return self._progress.__exit__(*exc)
+
+    def stage(self, label: str) -> None:
+        self._progress.update(self._task, description=label, total=None, completed=0, unit="")
+
+    def count(self, label: str, done, total, unit: str, note: str = "", bar_extra: str = "") -> None:
+        text = " · ".join(t for t in (label, note, bar_extra) if t)
+        self._progress.update(self._task, description=text, completed=done, total=total, unit=unit)
+
+
+class _Lines:
+    """Progress as plain lines on stderr, for a pipe or a log file (see PROGRESS_STEP_PCT, HEARTBEAT_S)."""
+
+    def __init__(self, description: str):
+        self._label = description
+        self._last_stage = None
+        self._count_key, self._step = None, -1
+        self._lock = threading.Lock()
+        self._t0 = self._t_last = time.monotonic()
+        self._stop = threading.Event()
+        self._thread = None
+
+    def __enter__(self):
+        if HEARTBEAT_S > 0:
+            self._thread = threading.Thread(target=self._heartbeat, name="fogdrift-progress-heartbeat", daemon=True)
+            self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=1.0)
+        return False
+
+    def _emit(self, text: str) -> None:
+        with self._lock:
+            self._t_last = time.monotonic()
+            err_console.print(Text(text), soft_wrap=True, highlight=False)
+
+    def _heartbeat(self) -> None:
+        while not self._stop.wait(HEARTBEAT_S / 4):
+            now = time.monotonic()
+            if now - self._t_last >= HEARTBEAT_S:
+                self._emit(f"{self._label}: still running ({now - self._t0:.0f} s since the start)")
+
+    def stage(self, label: str) -> None:
+        self._label = label
+        if label != self._last_stage:
+            self._last_stage, self._count_key = label, None
+            self._emit(label)
+
+    def count(self, label: str, done, total, unit: str, note: str = "", bar_extra: str = "") -> None:
+        self._label = label
+        if not total or total <= 0:
+            return
+        pct = int(100 * min(max(done, 0), total) // total)
+        step = pct // PROGRESS_STEP_PCT
+        if label != self._count_key:
+            self._count_key, self._step = label, -1
+        if step > self._step:
+            self._step = step
+            self._emit(f"{label}: {pct} % ({int(done)} of {int(total)} {unit})" + (f"; {note}" if note else ""))
+
+
+def _display(description: str):
+    return _Bar(description) if _bar_on_terminal() else _Lines(description)
+
+
 @contextlib.contextmanager
 def progress(description: str, axes=()):
-    """Yield (allan_cb, epoch_cb) callbacks that drive one rich progress bar on stderr.
+    """Yield (allan_cb, epoch_cb) callbacks that show the progress of a run on stderr.
 
-    The bar names the stage, the axis (k/n of ``axes``) and the model that :func:`fogdrift.interrupt.checkpoint`
-    announces (:func:`progress_label`); it shows a count only when the total is known (taus, epochs).  Every
+    On a terminal one rich bar names the stage, the axis (k/n of ``axes``) and the model that
+    :func:`fogdrift.interrupt.checkpoint` announces (:func:`progress_label`); it shows a count only when the total
+    is known (taus, epochs).  Off a terminal the same is printed as plain lines (:data:`PROGRESS_STEP_PCT`).  Every
     callback and checkpoint is a point where Ctrl-C stops the run.
     """
     axes = list(axes)
     where = {"stage": "", "axis": None, "model": None}
 
-    with Progress(TextColumn("{task.description}"), BarColumn(), _Counter(), TimeElapsedColumn(),
-                  console=err_console, transient=True) as bar:
-        task = bar.add_task(description, total=None, unit="")
-
+    with _display(description) as display:
         def on_stage(stage, axis, model):
             where.update(stage=stage, axis=axis, model=model)
-            bar.update(task, description=progress_label(description, axes, **where), total=None, completed=0,
-                       unit="")
+            display.stage(progress_label(description, axes, **where))
 
         def allan_cb(done, total):
             interrupt.check()
             if not where["stage"]:
                 where["stage"] = "Allan variance"
-            bar.update(task, description=progress_label(description, axes, **where), completed=done, total=total,
-                       unit="taus")
+            display.count(progress_label(description, axes, **where), done, total, "taus")
 
         def epoch_cb(epoch, n_epochs, train_loss, val_loss):
             interrupt.check()
-            bar.update(task, description=progress_label(description, axes, **where,
-                                                        extra=f"loss {train_loss:.3g} / val {val_loss:.3g}"),
-                       completed=epoch, total=n_epochs, unit="epochs")
+            display.count(progress_label(description, axes, **where), epoch, n_epochs, "epochs",
+                          bar_extra=f"loss {train_loss:.3g} / val {val_loss:.3g}")
 
         with interrupt.stage_listener(on_stage):
             yield allan_cb, epoch_cb
+
+
+@contextlib.contextmanager
+def progress_count(description: str, unit: str):
+    """Yield ``update(done, total, note="")``: the progress of one counted job (samples, files) on stderr, as
+    :func:`progress` shows it.  The stages a checkpoint announces without an axis are shown too (those with an
+    axis belong to one file of a batch)."""
+    with _display(description) as display:
+        def on_stage(stage, axis, model):
+            if axis is None:
+                display.stage(f"{description} · {stage}")
+
+        def update(done, total, note: str = ""):
+            interrupt.check()
+            display.count(description, done, total, unit, note=note)
+
+        with interrupt.stage_listener(on_stage):
+            yield update
 
 
 # -- tables -----------------------------------------------------------------------------------------------------

@@ -13,11 +13,10 @@ from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from ..errors import ConfigError
 from ._app import (FLAGS, LOAD_PARAMS, EstOpt, FitTausOpt, LoadOptions, OutliersOpt, StatisticOpt, TausOpt, TermsOpt,
-                   app, csv_list, err_console, parse_fit_taus, parse_taus, parse_terms, precheck, run, say)
+                   app, csv_list, parse_fit_taus, parse_taus, parse_terms, precheck, progress_count, run, say)
 from .noise import ModelOpt, RobustOpt, ScalesOpt
 
 FLAGS.update({"glob": "--glob", "command": "--command", "scheduler": "--scheduler", "workers": "--workers"})
@@ -127,12 +126,9 @@ def batch(
         settings = {"load": kwargs, "gaps": load.gaps, "analysis": analysis}
         if command == "noise":  # only what was given: a default run keeps the settings hash of earlier runs
             settings["gmwm"] = {k: v for k, v in gmwm.items() if v not in (None, False, "auto")}
-        with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                      console=err_console, transient=True) as bar:
-            task = bar.add_task(f"batch {command}", total=None)
-
+        with progress_count(f"batch {command}", "files") as update:
             def progress(done, total, name):
-                bar.update(task, completed=done, total=total, description=f"batch {command}: {name}")
+                update(done, total, note=f"last finished: {name}")
 
             result = run_batch(inputs, out, command=command, settings=settings, pattern=glob, scheduler=scheduler,
                                workers=workers, progress=progress, flags=FLAGS)

@@ -9,7 +9,7 @@ import typer
 from rich.text import Text
 
 from ..errors import render_options
-from ._app import FLAGS, OutOpt, app, console, csv_list, errors, fitted_table
+from ._app import FLAGS, OutOpt, app, console, csv_list, errors, fitted_table, progress_count
 
 
 @app.command()
@@ -66,12 +66,14 @@ def compensate(
             hs = tuple(float(h) for h in csv_list(horizons))
         except ValueError:
             raise ConfigError(f"--horizons must be numbers of seconds separated by commas; got {horizons!r}") from None
-        result = compensate_file(
-            bundle, file, out, model=model, bias=bias, apply_unit=apply_unit, axis_map=axis_map,
-            accept_rate=accept_rate, columns=columns, time_column=None if time_column.lower() == "none" else time_column,
-            rate_hz=rate, time_unit=time_unit, chunk_samples=chunk, formats=tuple(csv_list(formats) or ()),
-            heading=heading, artefacts=artefacts, calib_s=calibration, step_s=origin_step, horizons_s=hs,
-            flags=FLAGS)
+        with progress_count("compensate", "samples") as update:
+            result = compensate_file(
+                bundle, file, out, model=model, bias=bias, apply_unit=apply_unit, axis_map=axis_map,
+                accept_rate=accept_rate, columns=columns,
+                time_column=None if time_column.lower() == "none" else time_column,
+                rate_hz=rate, time_unit=time_unit, chunk_samples=chunk, formats=tuple(csv_list(formats) or ()),
+                heading=heading, artefacts=artefacts, calib_s=calibration, step_s=origin_step, horizons_s=hs,
+                flags=FLAGS, progress=update)
         s = result.summary
         console.print(Text(f"compensated {s['n_samples']} samples of {file.name} with {s['model_label']} "
                            f"(unit {s['unit']}, {1 / s['native_dt_s']:g} Hz, models at {1 / s['model_dt_s']:g} Hz)"))

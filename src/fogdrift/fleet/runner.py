@@ -10,7 +10,9 @@ Scheduling (``scheduler``):
 * ``"serial"``: no Dask, a loop in this process (debugging; the benchmark's reference).
 
 Each file is one task (:func:`fogdrift.fleet.tasks.run_file`); a task that fails, or a worker that dies,
-becomes an error row, never a crashed batch.  Results are collected as they finish (``progress``).
+becomes an error row, never a crashed batch.  Results are collected as they finish (``progress``); the stages
+(the cluster starting, the files running, the summary being written) are announced at
+:func:`fogdrift.interrupt.checkpoint` (the CLI shows them).
 
 Outputs: the batch folder is a :class:`BatchOutputDir` (a :class:`fogdrift.output.OutputDir` that also
 counts the files whose folders are finished); each file's folder is its own ``OutputDir`` (written by the
@@ -280,10 +282,12 @@ def _run(od, paths, spec, settings, scheduler, workers, page, progress, flags, t
     interrupt.check()
     if scheduler == "serial":
         used = "serial (in-process loop)"
+        interrupt.checkpoint(f"{len(tasks)} files, serial")
         for i, task in enumerate(tasks):
             done(i, run_file(task))
     else:
         used = _run_dask(tasks, scheduler, workers, done)
+    interrupt.checkpoint("writing " + " and ".join((SUMMARY,) + ((PAGE,) if page else ())))
     rows = [{name: row.get(name) for name, _, _ in COLUMNS} for i in range(len(tasks)) for row in results[i]]
     summary = write_summary(rows, out / SUMMARY)
     page_path = None
@@ -376,6 +380,7 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
     muted = {}
     try:
         if scheduler:
+            interrupt.checkpoint(f"connecting to the Dask scheduler {scheduler}")
             try:
                 client = distributed.Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S:g}s")
             except (OSError, TimeoutError, ValueError) as exc:
@@ -386,6 +391,7 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
             n = int(workers or os.cpu_count() or 1)
             if n < 1:
                 raise ConfigError(f"workers must be >= 1; got {workers!r} in {{opt:workers}}")
+            interrupt.checkpoint(f"starting a local Dask cluster of {n} worker processes")
             with _sigint_blocked_for_children():
                 _quiet_resource_tracker()
                 cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
@@ -394,7 +400,7 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
                 client = distributed.Client(cluster)
                 client.run(_ignore_sigint)               # each worker process's main thread
             used = f"local Dask cluster, {n} worker processes"
-        interrupt.check()                                # a Ctrl-C while the cluster started
+        interrupt.checkpoint(f"{len(tasks)} files on the {used}")  # stops after a Ctrl-C while the cluster started
         futures = {client.submit(run_file, t, pure=False, key=f"fogdrift-{i}-{t.settings_sha256[:8]}"): i
                    for i, t in enumerate(tasks)}
         for fut in distributed.as_completed(futures):
