@@ -20,8 +20,9 @@ Small cluster sizes (``2m <= chunk_samples``) are served from one window per chu
 reads two more windows (at ``k + m`` and ``k + 2m``; on an octave grid the window at ``k + 2m`` is the next
 tau's window at ``k + m`` and is reused), so the file is read about ``4 + n_large`` times (``n_large`` taus
 above ``chunk_samples / 2``), sequentially.  Non-overlapping sums with strides above
-1.5 blocks read only the points they need.  EDF and chi-squared bounds are computed by the same
-functions as in :func:`fogdrift.allan.allan_variance` (simple EDF, SP 1065 Table 5).
+1.5 blocks read only the points they need.  The sums become the result (EDF, alpha, chi-squared bounds,
+every field) in :func:`fogdrift.allan.core.result_from_sums`, the function the in-memory
+:func:`fogdrift.allan.allan_variance` ends in.
 
 The Haar wavelet variance of the MODWT at scale ``tau_j = 2^(j-1) dt`` is half the overlapping Allan
 variance at ``m = 2^(j-1)`` (the same second differences over the same ``N - 2m + 1`` positions;
@@ -266,44 +267,6 @@ def _second_difference_sums(phase: _Phase, m: np.ndarray, strides: np.ndarray, c
     return sums
 
 
-# ----------------------------------------------------------------------------------------
-# result
-# ----------------------------------------------------------------------------------------
-def _result(sums, n, m, strides, estimator, noise_alpha, dt):
-    """The AllanResult of the Allan statistic from the per-tau sums of squared second differences.
-
-    The EDF rule, alpha choice and chi-squared bounds are those of :func:`fogdrift.allan.allan_variance`
-    (its ``_edf_rule``, :func:`~fogdrift.allan.ci.resolve_alpha`, :func:`~fogdrift.allan.chi2_bounds`),
-    called with the same arguments, so the result equals the in-memory one field by field.
-    """
-    from .allan import IEEE952_ALPHAS, P68, AllanResult, chi2_bounds, get_statistic
-    from .allan.ci import resolve_alpha
-    from .allan.core import _edf_rule
-
-    stat = get_statistic("adev")
-    n_terms = stat.n_terms(n, m, strides)
-    var = stat.variance(sums, m, n_terms)
-    tau_s = m * dt
-    edf_of, _, base = _edf_rule(stat, estimator, n, m, strides)
-    alphas, rule = resolve_alpha(noise_alpha, tau_s, var, slopes=stat.dev_slopes, candidates=IEEE952_ALPHAS)
-    if isinstance(alphas, str):  # conservative
-        cands = np.array([[edf_of(i, a) for a in IEEE952_ALPHAS] for i in range(m.size)]).reshape(m.size, -1)
-        pick = np.argmin(cands, axis=1)
-        alphas = np.asarray(IEEE952_ALPHAS, dtype=np.int64)[pick]
-        edf = cands[np.arange(m.size), pick]
-    else:
-        edf = np.array([edf_of(i, a) for i, a in enumerate(alphas)], dtype=np.float64)
-    edf = np.clip(np.nan_to_num(edf, nan=1.0, posinf=float(n_terms.max())), 1.0, np.maximum(n_terms, 1))
-    lo68, hi68 = chi2_bounds(var, edf, P68)
-    lo95, hi95 = chi2_bounds(var, edf, 0.95)
-    return AllanResult(
-        tau_s=tau_s.astype(np.float64), m=m.astype(np.int64), var_dph2=var, dev_dph=np.sqrt(var),
-        n_terms=n_terms.astype(np.int64), edf=edf, dev_lo68_dph=np.sqrt(lo68), dev_hi68_dph=np.sqrt(hi68),
-        dev_lo95_dph=np.sqrt(lo95), dev_hi95_dph=np.sqrt(hi95), noise_alpha=np.asarray(alphas, dtype=np.int64),
-        estimator=estimator, edf_rule=base + "; " + rule, dt_s=float(dt), n_samples=int(n), statistic=stat.name,
-    )
-
-
 _ESTIMATORS = ("overlapping", "non-overlapping")
 
 
@@ -377,7 +340,10 @@ def allan_variance_chunked(source, *, taus="octave", estimator="overlapping", no
     n, chunk, m, strides = _prepare(source, taus, estimator, max_fraction, chunk_samples, noise_alpha)
     mu, offsets = _mean_and_offsets(source, chunk, progress)
     sums = _second_difference_sums(_Phase(source, mu, offsets), m, strides, chunk, progress)
-    return _result(sums, n, m, strides, estimator, noise_alpha, source.dt_s)
+    from .allan.core import result_from_sums
+
+    return result_from_sums(sums, n, m, strides, source.dt_s, statistic="adev", estimator=estimator,
+                            noise_alpha=noise_alpha)
 
 
 @dataclass(frozen=True)

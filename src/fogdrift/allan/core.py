@@ -44,7 +44,7 @@ from .grid import tau_grid
 from .result import AllanResult
 from .statistics import get_statistic
 
-__all__ = ["allan_variance", "IEEE952_ALPHAS", "FAST_M0"]
+__all__ = ["allan_variance", "result_from_sums", "IEEE952_ALPHAS", "FAST_M0"]
 
 #: ``noise_alpha="auto"`` trusts a phase-noise slope (alpha > 0, white PM: EDF ~ N/2 even at long tau) only
 #: where at least this many averaging intervals m fit in the record; below it the smallest EDF among the
@@ -200,6 +200,43 @@ def allan_variance(
             progress(done, m.size)
     del p
 
+    return result_from_sums(sums, n, m, strides, dt, statistic=stat.name, estimator=estimator,
+                            noise_alpha=noise_alpha)
+
+
+def result_from_sums(sums, n, m, strides, dt_s, *, statistic, estimator, noise_alpha) -> AllanResult:
+    """The :class:`AllanResult` (variance, EDF, alpha, bounds, every field) from the operator sums.
+
+    The one place where sums of squared differences become a result: :func:`allan_variance` and the
+    out-of-core :func:`fogdrift.allan_chunked.allan_variance_chunked` both end here, so equal sums give
+    equal results field by field.
+
+    Parameters
+    ----------
+    sums : ndarray, shape (n_tau,)
+        Per-tau sums of the squared difference operator over the sampled start indices, with the
+        angle in (deg/h) x samples (:func:`fogdrift.allan._kernels.phase_dph_samples`; phase
+        points, not window means, for a windowed statistic): (deg/h)^2 x samples^2, as
+        :meth:`~fogdrift.allan.statistics.Statistic.variance` takes them.
+    n : int
+        Number of rate samples N.
+    m, strides : ndarray of int, shape (n_tau,)
+        Averaging factors and start-index strides (1 overlapping, m non-overlapping, b fast).
+    dt_s : float
+        Sample interval in s.
+    statistic : {"adev", "hdev", "mdev"}, keyword-only
+    estimator : {"overlapping", "non-overlapping", "fast"}, keyword-only
+    noise_alpha : "auto", "conservative", int or array_like, keyword-only
+        As for :func:`allan_variance`.
+
+    Returns
+    -------
+    AllanResult
+    """
+    stat = get_statistic(statistic)
+    m = np.asarray(m, dtype=np.int64)
+    strides = np.asarray(strides, dtype=np.int64)
+    dt = float(dt_s)
     n_terms = stat.n_terms(n, m, strides)
     var = stat.variance(sums, m, n_terms)
     tau_s = m * dt
