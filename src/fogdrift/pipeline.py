@@ -415,11 +415,12 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     if content is not None:  # the taus at whole multiples of each period, beside the octave grid
         extra = null_taus(content.periods_s, dt_s, float(fit_curve.tau_s[0]), float(fit_curve.tau_s[-1]))
         taus = np.union1d(fit_curve.tau_s, extra)
-        if taus.size != fit_curve.tau_s.size or not np.all(fit_curve.noise_alpha <= 0):
-            fc = allan_variance(rate_dph, dt_s, taus=taus, estimator=cfg.estimator, statistic=cfg.statistic)
-            alphas, _ = periodic_alpha(fc.noise_alpha, True)
+        if taus.size != fit_curve.tau_s.size or np.any(fit_curve.noise_alpha > 0):
+            # each added tau takes the alpha of the nearest octave tau (one pass over the data, not two)
+            near = np.abs(np.log(taus)[:, None] - np.log(fit_curve.tau_s)[None, :]).argmin(axis=1)
+            alphas, _ = periodic_alpha(np.asarray(fit_curve.noise_alpha)[near], True)
             fit_curve = allan_variance(rate_dph, dt_s, taus=taus, estimator=cfg.estimator, statistic=cfg.statistic,
-                                       noise_alpha=alphas) if np.any(alphas != fc.noise_alpha) else fc
+                                       noise_alpha=alphas)
     lo, hi = cfg.fit_tau_s
     tau_range = None if lo is None and hi is None else (lo, hi)
     noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range,

@@ -28,7 +28,7 @@ def allan(
     """Allan variance and IEEE-952 noise coefficients Q, N, B, K, R of every axis: the terms are selected from
     the data, with 95 % intervals, the fit's chi-squared and p-value, and what was left out and why."""
     from ..pipeline import AnalysisConfig, run_allan
-    from ..report import b_min_cell, fit_cell, noise_row, write_allan_outputs
+    from ..report import fit_cell, noise_row, shaped_cell, write_allan_outputs
 
     with run("allan", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
              expect=("allan.json", "allan.csv", "allan.png")) as r:
@@ -44,9 +44,10 @@ def allan(
         name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}[statistic]
         console.print(noise_table(f"{load.file.name}: {estimator} {name}, 95 % intervals in brackets "
                                   "(– (< x): not in the selected model, x its upper bound; [0, x]: in the "
-                                  "model but not resolved from zero)",
-                                  [[a.name] + noise_row(a.noise) + [b_min_cell(a.noise), fit_cell(a.noise)]
-                                   for a in results], fit=True, extra=("B_min IEEE [deg/h]",)))
+                                  "model but not resolved from zero; B: the flicker floor when fitted, else the "
+                                  "IEEE reading min ADEV/0.664; every cell a bound when no model fits)",
+                                  [[a.name] + noise_row(a.noise) + [shaped_cell(a.noise), fit_cell(a.noise)]
+                                   for a in results], fit=True, extra=("periodic / Markov",)))
         for a in results:
             print_noise_notes(a.name, a.noise, a.outliers, record.dt_s)
         temp = record.metadata()["temperature"]

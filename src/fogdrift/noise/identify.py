@@ -151,12 +151,6 @@ class _Context:
         """
         x2 = self.x2(A)
         a_allan = [TERM_TABLE[t].avar_coefficient * x2.get(t, 0.0) for t in TERMS]
-        # a periodic error enters the estimates' covariance as white rate noise at the level of its Allan envelope
-        # at each line's own period (a stand-in: a line's amplitude wanders, and a deterministic sinusoid would
-        # otherwise lend the points it dominates a white-PM-like EDF of thousands)
-        i_s = _NAMES.index("S")
-        if A[i_s] > 0 and self.lines:
-            a_allan[1] += A[i_s] * sum(r / (math.pi**2 * f) for f, r in self.lines)
         mu = self.X @ A
         if not exact_ramp and a_allan[4] > 0:
             extra = 1.5 * a_allan[4] * float(self.tau[-1])
@@ -183,6 +177,16 @@ class _Context:
             V = V + np.diag(self.strides * ramp_cross_variance(self.m, self.n, spec, a_allan[4] * self.dt**2))
         s = np.sqrt(self.inflation)
         C = V * np.outer(s, s) / np.outer(mu, mu)
+        i_s = _NAMES.index("S")
+        if A[i_s] > 0 and self.lines:
+            # a periodic error's share of each estimate gets the white-FM EDF of that tau (independent between
+            # taus): a line's amplitude wanders, and as a deterministic sinusoid it would lend the points it
+            # dominates a white-PM-like EDF of thousands.  At whole periods its share is 0 and nothing is added.
+            from ..allan.ci import edf_simple_safe
+
+            share = self.X[:, i_s] * A[i_s] / mu
+            nu_w = np.array([edf_simple_safe(self.n + 1, float(mm), 0) for mm in self.m])
+            C = C + np.diag(share**2 * 2.0 / np.maximum(nu_w, 1.0))
         # floor: relative s.d. 1e-6 (a noise-free curve, or a term with no spectrum, still has rounding)
         return C + np.diag(np.full(mu.size, 1e-12))
 
@@ -360,9 +364,9 @@ def _describe_excluded(ctx: _Context, start: int, sel, periodic=None, spectrum_g
         if rolloff_hz is not None:
             why = f"an output low-pass / anti-alias filter (the spectrum rolls off above {rolloff_hz:.3g} Hz)"
         elif spectrum_given:
-            why = "correlated samples (the spectrum shows no output-filter roll-off)"
+            why = "correlated samples (the spectrum shows no roll-off)"
         else:
-            why = "correlated samples (no spectrum to tell an output filter)"
+            why = "correlated samples (no spectrum of the series was given to say more)"
         kind = (f"ADEV below the model with a slope of {slope:+.2f} (flatter than white noise's -0.5): {why}, "
                 "not a noise term")
     elif slope < -1.0:
@@ -605,6 +609,9 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
                                         "not in the model: the curve is described as well without it")
     if terms is not None and "B" in laws and out_terms.get("B") is not None and out_terms["B"].value is not None:
         _check_floor(out_terms, c, A)  # a fixed model keeps its terms; a floor above the curve is still refused
+    iQ, iS = _NAMES.index("Q"), _NAMES.index("S")
+    if iQ in best and iS in best and out_terms["Q"].status == "resolved":
+        _q_at_whole_periods(c, prob, best, A, d2, periodic, out_terms)
     if "S" in allowed:
         shaped["S"] = {"A": float(A[_NAMES.index("S")]), "lines": [list(x) for x in lines],
                        "freq_hz": float(periodic.ref_freq_hz), "spectrum_amplitude_dph": periodic.ref_amplitude_dph,
@@ -661,11 +668,49 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     )
 
 
+def _q_at_whole_periods(c: _Context, prob, best, A, d2, periodic, out_terms) -> None:
+    """Quantization and a periodic error both fall like tau^-2 below the period, and lines the spectrum did not
+    detect (the weak harmonics of a sawtooth) add exactly such a tail; only the taus from the shortest period on
+    (where every line of a component vanishes at its whole periods) tell them apart.  A Q the fit resolves is kept
+    resolved only if it is still resolved from zero on those taus alone; otherwise it is reported unresolved with
+    that reason (lower bound 0)."""
+    iQ = _NAMES.index("Q")
+    p_min = min(periodic.periods_s) if periodic is not None and periodic.periods_s else None
+    if p_min is None:
+        return
+    k0 = int(np.searchsorted(c.tau, p_min * (1 - 1e-9)))
+    if c.tau.size - k0 < len(best) + 1:
+        lo = 0.0
+    else:
+        sub = ScoreProblem(prob.X[k0:], prob.y[k0:], _sub_cov(prob, k0), prob.upper)
+        a, q_sub = sub.fit(best)
+        full = np.zeros(len(_NAMES))
+        full[list(best)] = a
+        lo = profile_interval(sub, best, full, iQ, q_sub, d2)[0] if full[iQ] > 0 else 0.0
+    if lo > 0:
+        return
+    t = out_terms["Q"]
+    out_terms["Q"] = NoiseTerm("Q", t.value, t.unit, 0.0, t.hi95, "unresolved",
+                               f"not resolved from zero at whole periods of the periodic error (tau >= {p_min:.3g} s), "
+                               "where a line adds nothing: below the period quantization and the periodic error "
+                               "(with its undetected weak lines) are not told apart")
+
+
+def _sub_cov(prob, k0):
+    """The relative covariance of the points from ``k0`` on, rebuilt from the problem's EDF and whitening."""
+    L = np.linalg.inv(prob.W)
+    R = L @ L.T
+    sd = np.sqrt(2.0 / prob.nu)
+    C = R * np.outer(sd, sd)
+    return C[k0:, k0:]
+
+
 def _points_outside(y, mu, nu) -> np.ndarray:
     """Indices of the points whose own 95 % chi-squared interval (EDF ``nu``) does not hold the model value."""
     nu = np.maximum(np.asarray(nu, dtype=np.float64), 1e-6)
-    lo = y * nu / chi2.ppf(0.975, nu)
-    hi = y * nu / chi2.ppf(0.025, nu)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        lo = y * nu / chi2.ppf(0.975, nu)
+        hi = y * nu / chi2.ppf(0.025, nu)  # inf where nu << 1: such a point bounds nothing above
     return np.flatnonzero((mu < lo) | (mu > hi))
 
 
@@ -742,6 +787,10 @@ def _markov_fits(c: _Context, C, base_cols, tc, penalty):
     return prob, out
 
 
+#: IC gain (beyond the penalty of q_c and T_c) the best Gauss-Markov model needs over the best model without M.
+MARKOV_IC_GAIN = 2.0
+
+
 def _markov_stage(c: _Context, C, res, best, penalty):
     """Try the exponentially correlated term M: profile ``T_c`` on a log grid over the fitted tau range (refined by
     a bounded search), with ``(q_c T_c)^2`` linear given ``T_c``; M enters the model only if its best model's IC
@@ -756,8 +805,12 @@ def _markov_stage(c: _Context, C, res, best, penalty):
         return None
     iM = _NAMES.index("M")
     base_cols = tuple(i for i in c.cols if i != iM)
-    lo_t, hi_t = math.log(c.tau[0] / 2.0), math.log(c.tau[-1] * 2.0)
-    grid = np.linspace(lo_t, hi_t, 14)
+    # T_c inside the fitted range: the Gauss-Markov hump (ADEV maximum at ~1.9 T_c) must lie within it, or the
+    # term only imitates a filter edge (short T_c) or a random walk (long T_c)
+    lo_t, hi_t = math.log(c.tau[0]), math.log(c.tau[-1] / 2.0)
+    if hi_t <= lo_t:
+        return None
+    grid = np.linspace(lo_t, hi_t, 12)
     ic0 = res[best]["ic"]
     scan = []
     for lt in grid:
@@ -765,7 +818,8 @@ def _markov_stage(c: _Context, C, res, best, penalty):
         k = min(fits, key=lambda s: fits[s]["ic"])
         scan.append((fits[k]["ic"], lt, k))
     ic_m, lt_m, sub = min(scan)
-    if not ic_m < ic0:
+    # the correlation time is searched, not given: ask for more than its one-parameter penalty (look-elsewhere)
+    if not ic_m < ic0 - MARKOV_IC_GAIN:
         c.set_tc(math.exp(lt_m))
         c.X[:, iM] = 0.0
         c.tc_s = None
@@ -794,6 +848,9 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     prob = ScoreProblem(c.X, c.y, C2, c._upper(C2))
     res2 = {**non_m, **with_m}
     best2 = min(res2, key=lambda s: res2[s]["ic"])
+    best_non = min(non_m, key=lambda s: non_m[s]["ic"])
+    if iM in best2 and not res2[best2]["ic"] < non_m[best_non]["ic"] - MARKOV_IC_GAIN:
+        best2 = best_non
     if iM not in best2:  # under its own covariance M is no longer needed
         c.X[:, iM] = 0.0
         c.tc_s = None
@@ -803,7 +860,7 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     q_min = res2[best2]["q"]
     dof = max(1, c.tau.size - len(best2) - 1)
     d2 = float(student_t.ppf(0.975, dof) ** 2) * max(1.0, q_min / dof)
-    lt_lo, lt_hi = lo_t - math.log(4.0), hi_t + math.log(4.0)  # the searched range: tau/8 .. 8 tau_max
+    lt_lo, lt_hi = lo_t - math.log(8.0), hi_t + math.log(16.0)  # the interval's range: tau_min/8 .. 8 tau_max
     cache = {}
 
     def q_prof(lt):

@@ -15,7 +15,7 @@ from .figures import (_plt, _safe, _save, plot_allan, plot_models, plot_residual
                       plot_separation_allan, plot_signal, plot_spectrum)
 from .files import write_allan_outputs, write_json, write_model_outputs, write_separation_outputs
 from .html import write_report
-from .tables import (METRICS_HEADERS, NOISE_HEADERS, b_min_cell, causal_metrics_rows, fit_cell, fit_summary, metrics_rows, noise_notes,
+from .tables import (METRICS_HEADERS, NOISE_HEADERS, b_headline, b_min_cell, shaped_cell, causal_metrics_rows, fit_cell, fit_summary, metrics_rows, noise_notes,
                      noise_row, not_estimable_notes, readout_text, term_text, verdict)
 
 __all__ = [
@@ -26,6 +26,8 @@ __all__ = [
     "fit_summary",
     "fit_cell",
     "b_min_cell",
+    "b_headline",
+    "shaped_cell",
     "readout_text",
     "noise_notes",
     "not_estimable_notes",

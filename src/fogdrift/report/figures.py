@@ -124,10 +124,16 @@ def plot_allan(axes_list, path, title=None) -> Path:
         for i, e in enumerate(fit.excluded):
             ax.axvspan(e["tau_min_s"] / 1.2, e["tau_max_s"] * 1.2, color="0.85", zorder=0,
                        label="left out" if i == 0 else None)
-        tau = np.logspace(np.log10(fit.tau_min_s), np.log10(fit.tau_max_s), 200)
-        ax.loglog(tau, fit.model_dev_dph(tau), "r-", lw=2.0, label=f"fit {'+'.join(fit.selected)}")
-        for name, style in zip(("Q", "N", "B", "K", "R"), ("--", "-.", ":", "--", "-.")):
-            if name in fit.selected and fit.terms[name].value:
+        # the printed model, exactly (every selected term, S and M included), over the fitted range only
+        tau = np.unique(np.round(np.logspace(np.log10(fit.tau_min_s), np.log10(fit.tau_max_s), 400) / fit.dt_s)
+                        ) * fit.dt_s
+        no_fit = getattr(fit, "no_fit", None)
+        ax.loglog(tau, fit.model_dev_dph(tau), "r--" if no_fit else "r-", lw=2.0,
+                  label=(f"best candidate {'+'.join(fit.selected)} (no model fits)" if no_fit else
+                         f"fit {'+'.join(fit.selected)}"))
+        for name, style in zip(("Q", "N", "B", "K", "R", "S", "M"), ("--", "-.", ":", "--", "-.", ":", "--")):
+            t = fit.terms.get(name)
+            if name in fit.selected and t is not None and t.value:
                 ax.loglog(tau, fit.term_dev_dph(name, tau), style, lw=1.2, label=name)
         pos = r.dev_lo68_dph > 0
         lo = np.nanmin(r.dev_lo68_dph[pos]) if np.any(pos) else np.nanmin(r.dev_dph)
@@ -137,7 +143,7 @@ def plot_allan(axes_list, path, title=None) -> Path:
         ax.set_xlabel("τ [s]")
         ax.set_ylabel(f"{label} σ(τ) [deg/h]")
         ax.set_title(f"{title or label}: {aa.name}   χ²_red {fit.chi2_red:.3g}, p = {fit.p_value:.2g} "
-                     f"({fit.quality})")
+                     f"({'no model fits' if no_fit else fit.quality})")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(ncols=2 if n == 1 else 1)
     return _save(fig, path)

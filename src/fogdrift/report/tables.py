@@ -50,8 +50,55 @@ def term_text(term) -> str:
 
 def noise_row(noise) -> list[str]:
     """Five cells Q, N, B, K, R of a NoiseFit (95 % intervals in brackets; – = not in the model, with its upper
-    bound; n/e = not estimable)."""
-    return [term_text(noise.terms[name]) for name in ("Q", "N", "B", "K", "R")]
+    bound; n/e = not estimable).
+
+    One B per row: the flicker coefficient when the model holds it, otherwise the IEEE reading named by its rule
+    (:func:`b_headline`).  When no model fits (``noise.no_fit``) every cell is an upper bound or "–": the
+    coefficients of a model that misses the curve are no result."""
+    cells = []
+    for name in ("Q", "N", "B", "K", "R"):
+        t = noise.terms[name]
+        if getattr(noise, "no_fit", None):
+            cells.append("–" if t.hi95 is None else f"– (< {_fmt(t.hi95, 3)})")
+        elif name == "B":
+            cells.append(b_headline(noise))
+        else:
+            cells.append(term_text(t))
+    return cells
+
+
+def b_headline(noise) -> str:
+    """The one bias-instability cell of a row, named by its rule: the fitted flicker floor (``0.51 [0.4, 0.6]
+    flicker``) when the selected model holds B, else the IEEE reading min ADEV / 0.664 (``< 1.14 ADEV min/0.664``
+    or ``0.8 ADEV min/0.664 at τ 117 s``), else the B term's own cell."""
+    t = noise.terms.get("B")
+    if t is not None and t.value is not None:
+        return term_text(t) + " flicker"
+    b = noise.b_min or {}
+    if b.get("value") is not None:
+        if b.get("bound_only"):
+            return f"< {_fmt(b['value'], 3)} ADEV min/0.664"
+        return f"{_fmt(b['value'], 3)} ADEV min/0.664 at τ {_fmt(b.get('tau_s'), 3)} s"
+    return term_text(t) if t is not None else "–"
+
+
+def shaped_cell(noise) -> str:
+    """The IEEE-952 Annex C terms that are no power law, when the selected model holds them:
+    ``S 8.0 deg/h @ 20.02 Hz`` and ``M σ 3.1 deg/h, T_c 48 [35, 70] s`` (``–`` when neither)."""
+    parts = []
+    sh = getattr(noise, "shaped", None) or {}
+    ts = noise.terms.get("S")
+    if ts is not None and ts.value is not None and "S" in noise.selected:
+        parts.append(f"S {_fmt(ts.value, 3)} deg/h @ {sh['S']['freq_hz']:.4g} Hz")
+    tm = noise.terms.get("M")
+    if tm is not None and tm.value is not None and "M" in noise.selected and sh.get("M", {}).get("tc_s"):
+        m = sh["M"]
+        lo, hi = m.get("tc_lo95_s"), m.get("tc_hi95_s")
+        ci = f" [{_fmt(lo, 2) if lo else '?'}, {_fmt(hi, 2) if hi else '?'}]"
+        parts.append(f"M σ {_fmt(m['sigma_dph'], 3)} deg/h, T_c {_fmt(m['tc_s'], 3)}{ci} s")
+    if getattr(noise, "no_fit", None) and parts:
+        return "(no model fits) " + "; ".join(parts)
+    return "; ".join(parts) if parts else "–"
 
 
 def b_min_cell(noise) -> str:
@@ -72,13 +119,19 @@ def fit_cell(noise) -> str:
     (the Table 2 rows are fitted on short blocks and smoothed signals: how well each fits is part of the row)."""
     if noise.chi2_red is None:
         return "–"
+    if getattr(noise, "no_fit", None):
+        return (f"no model fits (χ²ᵣ {_fmt(noise.chi2_red, 2)}, τ {_fmt(noise.tau_min_s, 2)}–"
+                f"{_fmt(noise.tau_max_s, 2)} s)")
     return (f"{noise.quality} (χ²ᵣ {_fmt(noise.chi2_red, 2)}, τ {_fmt(noise.tau_min_s, 2)}–"
             f"{_fmt(noise.tau_max_s, 2)} s)")
 
 
 def fit_summary(noise) -> str:
     """One line: the selected model, the fit statistic and p-value, the fitted tau range."""
-    return (f"model {'+'.join(noise.selected) or '(none)'} selected from {len(noise.candidates)} candidates; "
+    head = (f"no model fits; best candidate {'+'.join(noise.selected) or '(none)'} of {len(noise.candidates)}"
+            if getattr(noise, "no_fit", None) else
+            f"model {'+'.join(noise.selected) or '(none)'} selected from {len(noise.candidates)} candidates")
+    return (f"{head}; "
             f"chi2_red {_fmt(noise.chi2_red, 3)} on {noise.dof} dof (p = {noise.p_value:.2g}, fit {noise.quality}); "
             f"fitted tau {_fmt(noise.tau_min_s, 3)} .. {_fmt(noise.tau_max_s, 3)} s")
 
@@ -96,6 +149,21 @@ def noise_notes(noise) -> list[str]:
     for e in noise.excluded:
         out.append(f"left out tau {_fmt(e['tau_min_s'], 3)} .. {_fmt(e['tau_max_s'], 3)} s: {e['reason']}")
     out += list(noise.notes)
+    sh = getattr(noise, "shaped", None) or {}
+    m = sh.get("M") or {}
+    tm = noise.terms.get("M")
+    if m.get("tc_s") and tm is not None and tm.value is not None:
+        lo, hi = m.get("tc_lo95_s"), m.get("tc_hi95_s")
+        out.append(f"M (exponentially correlated, IEEE-952 C.6): q_c = {_fmt(tm.value, 3)} [{_fmt(tm.lo95, 3)}, "
+                   f"{_fmt(tm.hi95, 3)}] deg/h/√s, T_c = {_fmt(m['tc_s'], 3)} s (95 %: "
+                   f"{_fmt(lo, 3) + ' s' if lo else 'below the searched range'} .. "
+                   f"{_fmt(hi, 3) + ' s' if hi else 'beyond the searched range'}), "
+                   f"sigma = q_c sqrt(T_c/2) = {_fmt(m.get('sigma_dph'), 3)} deg/h")
+    ts = noise.terms.get("S")
+    if sh.get("S") and ts is not None and ts.value is not None:
+        out.append(f"S (sinusoidal, IEEE-952 C.7): Omega0 = {_fmt(ts.value, 3)} [{_fmt(ts.lo95, 3)}, "
+                   f"{_fmt(ts.hi95, 3)}] deg/h at {sh['S']['freq_hz']:.4g} Hz (the strongest line; the other lines "
+                   "keep their spectral ratios)")
     b = noise.b_min or {}
     if b.get("value") is not None:
         if b.get("bound_only"):
