@@ -89,18 +89,6 @@ def print_gmwm(title, axes):
             say(f"  {a.name}: {sel.scan_note}", style="yellow")
 
 
-def _with_allan_check(record, axes):
-    """Attach to each GMWM axis its comparison with the Allan fit of the same record (the 'fogdrift allan' fit)."""
-    from ..gmwm.compare import compare_with_allan
-    from ..pipeline import AnalysisConfig, run_allan
-
-    fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate())}
-    for a in axes:
-        if a.name in fits:
-            a.allan_check = compare_with_allan(a, fits[a.name])
-    return axes
-
-
 @app.command()
 @_optional_file
 @with_load_options
@@ -122,6 +110,7 @@ def noise(
     with run("noise", out, default_out=DEFAULT_OUT, inputs=[load.file, curve], json_out=json_out,
              expect=expect) as r:
         from ..gmwm.analysis import analyse_gmwm, analyse_wvar, candidates_for, read_curve_table
+        from ..gmwm.compare import attach_allan_checks
         from ..report_gmwm import write_gmwm_outputs
 
         if method not in ("gmwm", "allan"):
@@ -160,7 +149,7 @@ def noise(
             with progress("noise", record.axis_names):
                 axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=model, levels=scales, robust=robust)
                         for name in record.axis_names]
-                _with_allan_check(record, axes)
+                attach_allan_checks(record, axes)
             source, meta = str(record.source), record.metadata()
         print_gmwm((curve or load.file).name, axes)
         files = write_gmwm_outputs(axes, r.out.path, source=source, record=meta)

@@ -154,12 +154,14 @@ def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
     passed, else ``poor``) and the bias instability at the AVAR minimum implied by the model.
     """
     from ..gmwm.analysis import analyse_gmwm
+    from ..gmwm.compare import attach_allan_checks
     from ..report_gmwm import write_gmwm_outputs
 
     opts = settings.get("gmwm", {})
     axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=opts.get("model", "auto"),
                          levels=opts.get("levels"), robust=bool(opts.get("robust", False)))
             for name in record.axis_names]
+    attach_allan_checks(record, axes)  # as 'fogdrift noise': N and B against the Allan fit, in noise.json
     write_gmwm_outputs(axes, out_dir, source=str(record.source), record=record.metadata())
     return [{"axis": a.name, **record_columns(record), **gmwm_columns(a)} for a in axes]
 

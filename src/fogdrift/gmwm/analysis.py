@@ -274,7 +274,7 @@ def read_curve(path, *, sensor=None, unit=None, axes=None) -> list[WvarResult]:
 def _b_cells(b) -> tuple:
     """(value, lo95, hi95, from) of a B reading: a bound or nothing is a text value with no interval."""
     if b.value_dph is not None:
-        where = b.label + ("" if b.tau_s is None else f", at τ = {b.tau_s:.3g} s")
+        where = b.label + ("" if b.tau_s is None else f", at τ = {b.tau_s:.4g} s")
         return b.value_dph, b.lo95_dph, b.hi95_dph, where
     if b.bound_dph is not None:
         return f"< {b.bound_dph:.3g}", None, None, f"{b.label} (a bound, below)"

@@ -19,11 +19,16 @@ Units: N in deg/sqrt(h), B in deg/h, tau in s.
 
 from __future__ import annotations
 
-__all__ = ["compare_with_allan"]
+__all__ = ["compare_with_allan", "attach_allan_checks"]
 
 
 def _g(x, d=3):
     return f"{x:.{d}g}"
+
+
+def _t(tau):
+    """A time in s: four significant digits, no exponent below 10^4 s."""
+    return "?" if tau is None else f"{tau:.4g}"
 
 
 def _iv(lo, hi):
@@ -51,9 +56,9 @@ def _n_line(axis, fit) -> tuple:
     if g.lo95 <= a_hi and a_lo <= g.hi95:
         return True, f"N agrees: {both} (the 95 % intervals overlap)"
     scales = sel.fit.scale_s
-    why = (f"GMWM {sel.selected} is fitted to wavelet scales {_g(scales[0])}-{_g(scales[-1])} s "
+    why = (f"GMWM {sel.selected} is fitted to wavelet scales {_t(scales[0])}-{_t(scales[-1])} s "
            f"({len(sel.excluded)} short excluded), the Allan fit {'+'.join(getattr(fit, 'selected', ())) or '?'} "
-           f"to τ {_g(getattr(fit, 'tau_min_s', float('nan')))}-{_g(getattr(fit, 'tau_max_s', float('nan')))} s: "
+           f"to τ {_t(getattr(fit, 'tau_min_s', None))}-{_t(getattr(fit, 'tau_max_s', None))} s: "
            "the two models give the short-τ slope to different terms")
     return False, f"N differs by {_g(g.value / a_val)}x: {both}; {why}"
 
@@ -80,20 +85,20 @@ def _b_line(axis, fit) -> tuple:
                                       ab.get("hi95") if ab.get("hi95") is not None else a_val))
     if gb.value_dph is not None:
         g_text = (f"GMWM B {_g(gb.value_dph)}{_iv(gb.lo95_dph, gb.hi95_dph)} deg/h"
-                  + ("" if gb.tau_s is None else f" at τ = {_g(gb.tau_s)} s") + f" ({gb.label})")
+                  + ("" if gb.tau_s is None else f" at τ = {_t(gb.tau_s)} s") + f" ({gb.label})")
     elif gb.bound_dph is not None:
         lo, hi = ie.tau_range_s
-        g_text = f"GMWM B < {_g(gb.bound_dph)} deg/h (its model's ADEV has no minimum within τ {_g(lo)}-{_g(hi)} s)"
+        g_text = f"GMWM B < {_g(gb.bound_dph)} deg/h (its model's ADEV has no minimum within τ {_t(lo)}-{_t(hi)} s)"
     else:
         g_text = f"GMWM reads no B ({gb.reason})"
     if a_val is None:
         a_text = "the Allan fit has no ADEV-minimum reading"
     elif a_bound:
-        a_text = (f"the Allan fit finds no ADEV minimum within τ ≤ {_g(tau_max)} s (B_min < {_g(a_val)} deg/h)"
+        a_text = (f"the Allan fit finds no ADEV minimum within τ ≤ {_t(tau_max)} s (B_min < {_g(a_val)} deg/h)"
                   if tau_max is not None else f"the Allan fit gives only B_min < {_g(a_val)} deg/h")
     else:
         a_text = (f"the Allan fit's B_min {_g(a_val)}{_iv(ab.get('lo95'), ab.get('hi95'))} deg/h at τ = "
-                  f"{_g(ab.get('tau_s'))} s")
+                  f"{_t(ab.get('tau_s'))} s")
     if g_iv is None or a_iv is None:
         return None, f"B cannot be compared: {g_text}; {a_text}"
     agree = g_iv[0] <= a_iv[1] and a_iv[0] <= g_iv[1]
@@ -118,11 +123,11 @@ def _hump_line(axis, fit):
     if a_val is None:
         tail = "the Allan fit has no ADEV-minimum reading"
     elif ab.get("bound_only"):
-        tail = (f"the Allan fit finds no ADEV minimum within τ ≤ {_g(tau_max)} s (B < {_g(a_val)})"
-                if tau_max is not None else f"the Allan fit gives only B < {_g(a_val)}")
+        tail = (f"the Allan fit finds no ADEV minimum within τ ≤ {_t(tau_max)} s (B_min < {_g(a_val)} deg/h)"
+                if tau_max is not None else f"the Allan fit gives only B_min < {_g(a_val)} deg/h")
     else:
-        tail = f"the Allan fit's B_min is {_g(a_val)} deg/h at τ = {_g(ab.get('tau_s'))} s"
-    return (f"GMWM B {_g(b.value_dph, 4)} deg/h at τ = {_g(b.tau_s)} s is read from a GM hump ({b.label.split('(')[-1]}:"
+        tail = f"the Allan fit's B_min is {_g(a_val)} deg/h at τ = {_t(ab.get('tau_s'))} s"
+    return (f"GMWM B {_g(b.value_dph, 4)} deg/h at τ = {_t(b.tau_s)} s is read from a GM hump ({b.label.split('(')[-1]}:"
             f" a detail, not a bias-instability floor; {tail}")
 
 
@@ -161,3 +166,23 @@ def compare_with_allan(axis, noise_fit) -> dict:
         lines.append(hump)
     known = [v for v in (n_ok, b_ok) if v is not None]
     return {"agree": (all(known) if known else None), "n_agree": n_ok, "b_agree": b_ok, "lines": lines}
+
+
+def attach_allan_checks(record, axes) -> list:
+    """Set ``allan_check`` on each GMWM axis of a record: its comparison with the Allan fit of the same axis (the
+    default fit of ``fogdrift allan``, :func:`fogdrift.pipeline.run_allan`).  Used by ``fogdrift noise`` and
+    ``fogdrift batch --command noise`` alike; returns ``axes``."""
+    from ..errors import InsufficientDataError
+    from ..pipeline import AnalysisConfig, run_allan
+
+    try:
+        fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate())}
+    except InsufficientDataError as exc:  # too short for the Allan fit: the GMWM result stands, and says so
+        for a in axes:
+            a.allan_check = {"agree": None, "n_agree": None, "b_agree": None,
+                             "lines": [f"no comparison: the Allan fit needs more data ({exc})"]}
+        return axes
+    for a in axes:
+        if a.name in fits:
+            a.allan_check = compare_with_allan(a, fits[a.name])
+    return axes

@@ -133,7 +133,7 @@ class BiasInstability:
 
         if self.value_dph is not None:
             iv = "" if self.lo95_dph is None else f" [{f(self.lo95_dph, 3)}, {f(self.hi95_dph, 3)}]"
-            at = "" if self.tau_s is None else f" at τ = {f(self.tau_s, 3)} s"
+            at = "" if self.tau_s is None else f" at τ = {f(self.tau_s, 4)} s"
             return f"{f(self.value_dph)}{iv} deg/h{at}"
         if self.bound_dph is not None:
             return f"< {f(self.bound_dph, 3)} deg/h ({self.reason})"
@@ -346,13 +346,13 @@ def _reading(rule, label, avar, z, cov, dt, m, m_lo, m_hi, *, peak) -> BiasInsta
     if peak:
         where = "after the longest" if mk > m_hi else "before the shortest"
         return BiasInstability(rule, None, None, None, None, None,
-                               f"the hump's ADEV peak, at τ = {mk * dt:.3g} s, lies {where} τ the fit used "
-                               f"({tau_hi if mk > m_hi else tau_lo:.3g} s)", label)
+                               f"the hump's ADEV peak, at τ = {mk * dt:.4g} s, lies {where} τ the fit used "
+                               f"({tau_hi if mk > m_hi else tau_lo:.4g} s)", label)
     end = m_hi if k == m.size - 1 else m_lo
     val, se = _delta(at(end), z, cov)
     bound = val * math.exp(_Z95 * se) if math.isfinite(se) else None
     how = "still falls at the longest" if end == m_hi else "still rises from the shortest"
-    reason = f"the model's ADEV {how} τ the fit used, {end * dt:.3g} s"
+    reason = f"the model's ADEV {how} τ the fit used, {end * dt:.4g} s"
     if bound is None:
         return BiasInstability(rule, None, None, None, end * dt, None, reason, label)
     reason = f"95 % upper bound: {reason}"
