@@ -32,7 +32,8 @@ from .readers.base import Table, split_unit_label
 from .record import GyroRecord
 from .registry import reader_by_name, select_reader
 
-__all__ = ["load", "load_segments", "time_unit_of_name", "TIME_COLUMN_NAMES", "GAP_FACTOR", "DT_TOLERANCE"]
+__all__ = ["load", "load_segments", "time_unit_of_name", "TIME_COLUMN_NAMES", "GAP_FACTOR", "DT_TOLERANCE",
+           "SHORT_STEP_FACTOR", "JITTER_TOLERANCE"]
 
 #: Column names (compared case-insensitively) that ``time_column="auto"`` takes as time; so does one of the
 #: first, third or last with a time-unit suffix (``t_ms``, ``time_us``, ``timestamp_ns``).
@@ -41,6 +42,10 @@ TIME_COLUMN_NAMES = ("t", "t_s", "time", "time_s", "timestamp")
 GAP_FACTOR = 1.5
 #: Largest relative disagreement allowed between the time column and ``dt_s``/``rate_hz``.
 DT_TOLERANCE = 0.01
+#: A time step shorter than ``SHORT_STEP_FACTOR`` sample intervals means the rate changed (or the steps alternate).
+SHORT_STEP_FACTOR = 0.7
+#: Largest spread of the time steps (median absolute deviation / sample interval) of a uniform grid.
+JITTER_TOLERANCE = 0.05
 
 
 def load(
@@ -653,6 +658,49 @@ def _time_vector(table: Table, data, t_idx, table_time: bool, t_scale: float, dt
     return t
 
 
+_UNIFORM_HINT = ("the analysis needs one sample interval; split the log where the rate changes, or, if the samples "
+                 "are uniform and only the time stamps are not, pass {opt:time_column} none with {opt:rate_hz}")
+
+
+def _check_uniform(table: Table, t: np.ndarray, steps: np.ndarray, dt: float, t_idx, gap_rows) -> None:
+    """The time base is checked, not assumed: between gaps the steps must be one sample interval.
+
+    Refused, naming the line: a step shorter than :data:`SHORT_STEP_FACTOR` intervals (the rate changed, or the
+    steps alternate short/long, which the median hides); steps that scatter by more than
+    :data:`JITTER_TOLERANCE` (median absolute deviation relative to ``dt``); a gap-free stretch whose time span
+    differs from ``(n - 1) dt`` by more than :data:`DT_TOLERANCE`.
+    """
+    short = np.flatnonzero(steps < SHORT_STEP_FACTOR * dt)
+    if short.size:
+        i = int(short[0]) + 1
+        s = float(steps[i - 1])
+        raise table.error(
+            f"time step of {s:.6g} s{table.at(i)} (after t={float(t[i - 1])!r} s on {table.row_ref(i - 1)}) is "
+            f"{s / dt:.3g} sample intervals; expected {dt:.10g} s (the median step, {1 / dt:.10g} Hz): the sample "
+            f"rate changes or the steps alternate ({short.size} step(s) shorter than {SHORT_STEP_FACTOR} intervals); "
+            + _UNIFORM_HINT, row=i, col=t_idx)
+    inner = np.ones(steps.size, dtype=bool)
+    inner[gap_rows - 1] = False
+    if inner.sum() >= 8:
+        spread = float(np.median(np.abs(steps[inner] - dt))) / dt
+        if spread > JITTER_TOLERANCE:
+            worst = int(np.argmax(np.where(inner, np.abs(steps - dt), -1.0))) + 1
+            raise table.error(
+                f"time steps scatter by {100 * spread:.3g} % of the sample interval {dt:.10g} s (median absolute "
+                f"deviation; largest {float(steps[worst - 1]):.6g} s{table.at(worst)}); expected a uniform grid "
+                f"within {100 * JITTER_TOLERANCE:g} %; " + _UNIFORM_HINT, row=worst, col=t_idx)
+    bounds = [0, *np.asarray(gap_rows).tolist(), t.shape[0]]
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        if b - a < 3:
+            continue
+        span, grid = float(t[b - 1] - t[a]), (b - 1 - a) * dt
+        if abs(span - grid) > DT_TOLERANCE * grid:
+            raise table.error(
+                f"time column spans {span:.6g} s from {table.row_ref(a)} to {table.row_ref(b - 1)}, but its "
+                f"{b - a} samples at {dt:.10g} s span {grid:.6g} s ({100 * (span / grid - 1):+.3g} %); expected "
+                f"agreement within {100 * DT_TOLERANCE:g} %; " + _UNIFORM_HINT, row=b - 1, col=t_idx)
+
+
 def _check_time(table: Table, t: np.ndarray, t_idx, dt_user, split: bool):
     """Validate the time vector; return (dt_s, [(start, stop) segments], [gap sizes in s])."""
     n = t.shape[0]
@@ -687,6 +735,7 @@ def _check_time(table: Table, t: np.ndarray, t_idx, dt_user, split: bool):
             )
         dt = dt_user
     gap_rows = np.flatnonzero(steps > GAP_FACTOR * dt) + 1
+    _check_uniform(table, t, steps, dt, t_idx, gap_rows)
     if gap_rows.size == 0:
         return dt, [(0, n)], []
     if not split:
