@@ -121,13 +121,16 @@ class AllanAccumulator:
         return tuple(np.concatenate(o)[k0:] for o in self._out)
 
 
-def plot_before_after(curves, path, title, caveat: str = "") -> Path:
+def plot_before_after(curves, path, title, caveats: dict | None = None) -> Path:
     """ADEV of the log before and after compensation, one panel per axis.
 
-    ``curves``: list of ``(axis, AllanResult before, AllanResult after, label)``.  ``caveat``: the artefact
-    check's sentence(s) (:func:`~fogdrift.evaluation.verdicts.adev_caveat`), printed under the panels: a causal
-    drift subtraction lowers the long-τ ADEV of any static log, so the curves alone are not evidence.
+    ``curves``: list of ``(axis, AllanResult before, AllanResult after, label)``.  ``caveats``: axis -> the
+    artefact check's sentence (:func:`~fogdrift.evaluation.verdicts.adev_caveat`), printed under that axis's
+    panel (red when the lower ADEV is not evidence): a causal drift subtraction lowers the long-τ ADEV of any
+    static log, so the curves alone are not evidence.
     """
+    import textwrap
+
     import matplotlib
 
     matplotlib.use("Agg")
@@ -146,11 +149,10 @@ def plot_before_after(curves, path, title, caveat: str = "") -> Path:
         ax.set_title(f"{title}: {name}")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    if caveat:
-        import textwrap
-
-        fig.text(0.01, -0.02, textwrap.fill(caveat, width=int(95 * n)), ha="left", va="top", fontsize=8,
-                 color="C3" if "not evidence" in caveat or "not checked" in caveat else "k")
+        text = (caveats or {}).get(name)
+        if text:
+            ax.text(0.0, -0.17, textwrap.fill(text, width=80), transform=ax.transAxes, ha="left", va="top",
+                    fontsize=7, color="C3" if "not evidence" in text or "not checked" in text else "k")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110, bbox_inches="tight")

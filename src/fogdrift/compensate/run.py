@@ -231,10 +231,10 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
         _evaluate(result, b, plans, biases, z_all, heading=heading, artefacts=artefacts, calib_s=calib_s,
                   step_s=step_s, horizons_s=horizons_s)
     caveats = _caveats(result, name, plans, curves, why_not)
-    messages.extend(caveats)
+    messages.extend(caveats.values())
     if figures and curves:
         files["figure"] = plot_before_after(curves, out / "compensation_allan.png", "ADEV before / after",
-                                            caveat=" ".join(caveats))
+                                            caveats=caveats)
     messages[:] = [render_options(m, flags) for m in messages]
     result.summary = {
         "fogdrift_result": "compensation",
@@ -257,17 +257,17 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
 
 
 def _caveats(result, name, plans, curves, why_not) -> list:
-    """The artefact check's caveat on the before/after ADEV, one sentence per plotted axis (none for 'bias')."""
+    """Axis -> the artefact check's caveat on the before/after ADEV, per plotted axis (none for 'bias')."""
     from ..evaluation.verdicts import adev_caveat
 
     if name == BIAS_ONLY or not curves:
-        return []
+        return {}
     label = plans[0].model.label
     arte = {a.axis: a for a in result.artefacts}
     head = {h.axis: h for h in result.heading}
     why = why_not or "skipped; see above"
-    return [adev_caveat(label, arte.get(axis), axis=axis, heading=head.get(axis), why_not=why)
-            for axis, *_ in curves]
+    return {axis: adev_caveat(label, arte.get(axis), axis=axis, heading=head.get(axis), why_not=why)
+            for axis, *_ in curves}
 
 
 def _write_json(obj, path) -> Path:

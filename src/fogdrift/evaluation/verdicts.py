@@ -260,7 +260,7 @@ def heading_verdict(result, *, material: float = MATERIAL, min_origins: int = MI
     >>> rows = [row("constant bias", 0.5, 1.0, 0, 0), row("AR(p)", 0.6, 1.2, 6, 14), row("Kalman", 0.44, 0.88, 9, 11)]
     >>> v = heading_verdict(NS(axis="gz", calib_s=300.0, horizons_s=(600.0,), rows=rows))
     >>> print(v.lines[-1])
-    gz, 600 s: no model reduces the heading error (5 % or more lower RMS and better at most non-overlapping origins); Kalman -12 % but better at only 9 of 20 non-overlapping origins; worse: AR(p) +20 %, worse at 14 of 20 non-overlapping origins.
+    gz, 600 s: no model reduces the heading error (5 % or more lower RMS and better at most non-overlapping origins); Kalman -12 % but better at only 9 of 20 non-overlapping origins; worse: AR(p) (+20 %, worse at 14 of 20 non-overlapping origins).
     """
     lines, data = [], {}
     step = getattr(result, "step_s", None)
@@ -315,7 +315,7 @@ def heading_verdict(result, *, material: float = MATERIAL, min_origins: int = MI
             text += "; " + "; ".join(f"{label} {_pct(j.ratio)} but {j.counts('better' if j.ratio < 1 else 'worse', True)}"
                                      for label, j in unsure)
         if worse or diverged:
-            text += "; worse: " + ", ".join([f"{label} {_pct(j.ratio)}, {j.counts('worse')}" for label, j in worse]
+            text += "; worse: " + ", ".join([f"{label} ({_pct(j.ratio)}, {j.counts('worse')})" for label, j in worse]
                                             + [f"{label} diverges" for label in diverged])
         lines.append(text + ".")
         data[str(h)] = {"reduces": [label for _, label, _ in sorted(better, key=lambda x: x[0])],
