@@ -167,6 +167,6 @@ def test_ieee_bias_instability_of_one_gm():
     sigma_gm, tc = g["sigma_gm_dph"].value, g["tc_s"].value
     assert_allclose(r.b_gm.value_dph, 0.9293 * sigma_gm, rtol=2e-3)
     assert_allclose(r.b_gm.tau_s, 1.893 * tc, rtol=0.03)
-    assert not r.b_gm.flagged and r.b_gm.rule == "gm-peak"  # 1.9 s: inside the scales used (to 655 s)
+    assert not r.b_gm.flagged and r.b_gm.rule == "gm-max"  # 1.9 s: inside the scales used (to 655 s)
     assert abs(math.log(sigma_gm / math.sqrt(sp2))) < 3 * g["sigma_gm_dph"].se_log
     assert abs(math.log(tc / (dt / beta))) < 3 * g["tc_s"].se_log

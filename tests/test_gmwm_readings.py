@@ -138,7 +138,7 @@ def test_gm_hump_b_is_a_labelled_detail_and_the_headline_b_is_one():
         assert names[key][2] < names[key][1] < names[key][3]
     assert ie.b_headline.rule == "min-avar" and "min of the model's ADEV" in names["B"][5]
     # the hump: max GM AVAR at 1.893 T_c, B = 0.9293 sigma_GM (exact for one GM), labelled with T_c, a detail
-    assert ie.b_gm.rule == "gm-peak" and f"T_c {tc:.3g} s" in ie.b_gm.label
+    assert ie.b_gm.rule == "gm-max" and f"T_c {tc:.3g} s" in ie.b_gm.label
     assert ie.b_gm.value_dph == pytest.approx(0.9293 * ie.gm[0]["sigma_gm_dph"].value, rel=3e-3)
     (line,) = [ln for ln in b_detail_lines(ax) if "GM hump" in ln]
     assert line.startswith("detail, not the headline B: B read from the GM hump's ADEV peak")
@@ -250,3 +250,23 @@ def test_allan_table_from_fogdrift_allan_equals_the_log(tmp_path):
     n_log, n_tab = (json.loads((tmp_path / d / "noise.json").read_text())["axes"][0]["selection"]["ieee"]["terms"]
                     ["N_dprh"] for d in ("log", "tab"))
     assert n_tab["value"] == pytest.approx(n_log["value"], rel=1e-6)
+
+
+def test_one_rule_in_the_report_table_and_the_fleet_row():
+    """The 30-s record's bound reaches the HTML table (no interval) and the fleet row (b_min_bound_only) alike."""
+    from fogdrift.fleet.commands import gmwm_columns
+    from fogdrift.report_gmwm import gmwm_noise_html
+
+    x = simulate_latent("WN+RW", [1.0, 1e-9], 3000, seed=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the RW is not detectable in 30 s: the fit says so; not the point here
+        ax = analyse_gmwm("gz", x, 0.01, model="WN+RW")
+    b = ax.selection.ieee.b_headline
+    assert b.value_dph is None and b.bound_dph is not None
+    html = gmwm_noise_html(ax)
+    assert f"<td>B</td><td>&lt; {b.bound_dph:.3g}</td><td>–</td>" in html
+    assert "still falls at the longest τ the fit used" in html
+    row = gmwm_columns(ax)
+    assert row["b_min_dph"] == pytest.approx(b.bound_dph) and row["b_min_bound_only"] is True
+    assert row["b_min_tau_s"] == pytest.approx(ax.selection.fit.scale_s[-1] / 2)
+    assert row["B_dph"] is None and row["B_status"] == "absent"  # no flicker term: B is a reading, not a term

@@ -310,6 +310,6 @@ def b_detail_lines(axis: GmwmAxis) -> list[str]:
     head = ie.b_headline
     out = [] if head.value_dph is not None else [f"B ({head.label}): {head.text()}"]
     for b in ie.b_details:
-        label = b.label if b.rule == "gm-peak" else f"B_min, {b.label}"
+        label = b.label if b.rule == "gm-max" else f"B_min, {b.label}"
         out.append(f"detail, not the headline B: {label}: {b.text()}")
     return out

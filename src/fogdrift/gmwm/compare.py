@@ -60,6 +60,9 @@ def _n_line(axis, fit) -> tuple:
            f"({len(sel.excluded)} short excluded), the Allan fit {'+'.join(getattr(fit, 'selected', ())) or '?'} "
            f"to τ {_t(getattr(fit, 'tau_min_s', None))}-{_t(getattr(fit, 'tau_max_s', None))} s: "
            "the two models give the short-τ slope to different terms")
+    if getattr(axis.wvar, "robust", False):
+        why = ("GMWM used the robust (Huber) wavelet variance, which discounts the outlying samples the Allan "
+               "variance keeps; " + why)
     return False, f"N differs by {_g(g.value / a_val)}x: {both}; {why}"
 
 

@@ -20,7 +20,7 @@ Bias instability, each reading with the averaging time ``T`` where it occurs ([G
 * ``"min-avar"``: the classical IEEE reading ``B = sqrt(min_T AVAR_model(T)) / 0.6643`` (biased up where
   WN/RW overlap), searched over the Allan times the fit used, ``T`` in ``[s_1 / 2, s_J / 2]`` (``s_j``
   the first and last wavelet scales used; AVAR(T) = 2 WV(2T)).
-* ``"gm-peak"``: the GM hump read as a flicker plateau, ``B = sqrt(max_T AVAR_GMsum(T)) / 0.6643``; only
+* ``"gm-max"``: the GM hump read as a flicker plateau, ``B = sqrt(max_T AVAR_GMsum(T)) / 0.6643``; only
   GMs that are the largest component at one or more fitted scales and whose WV peak (scale
   ``3.785 T_c``) is at least twice the first scale used (a faster or buried GM is short-scale
   structure such as an output filter, not a flat region).  A detail, never the headline B.
@@ -97,7 +97,7 @@ class BiasInstability:
     Attributes
     ----------
     rule : str
-        ``"flicker"``, ``"min-avar"`` or ``"gm-peak"`` (module docstring).
+        ``"flicker"``, ``"min-avar"`` or ``"gm-max"`` (module docstring).
     value_dph, lo95_dph, hi95_dph : float or None
         B in deg/h with its 95 % interval; None when the reading lies outside the scales the fit used.
     tau_s : float or None
@@ -155,7 +155,7 @@ class IEEEResult:
     gm : list of dict
         Per GM (by increasing T_c): ``{"component", "tc_s": IEEEValue, "sigma_gm_dph": IEEEValue}``.
     b_gm : BiasInstability or None
-        The GM-hump reading (``"gm-peak"``), only with GMs that make a hump.
+        The GM-hump reading (``"gm-max"``), only with GMs that make a hump.
     b_min : BiasInstability
         The classical reading (``"min-avar"``).
     b_flicker : BiasInstability or None
@@ -297,7 +297,7 @@ def to_ieee(fit) -> IEEEResult:
 
         names = ", ".join(f"{mdl.labels[i]} T_c {tc:.3g} s" for i, tc in zip(gm_idx, tcs))
         m_a = _m_grid(20.0 * max(tcs) / dt)
-        b_gm = _reading("gm-peak", f"B read from the GM hump's ADEV peak / 0.664 ({names})", gm_avar, z, cov, dt,
+        b_gm = _reading("gm-max", f"B read from the GM hump's ADEV peak / 0.664 ({names})", gm_avar, z, cov, dt,
                         m_a, m_lo, m_hi, peak=True)
     b_min = _reading("min-avar", "min of the model's ADEV / 0.664", lambda zz, m: mdl.avar(np.exp(zz), m), z, cov, dt,
                      m_used, m_lo, m_hi, peak=False)
