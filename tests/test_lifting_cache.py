@@ -12,18 +12,20 @@ import os
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from fogdrift.lifting import _kernels, _numba
 
-KERNELS = ("step", "split", "merge", "fwd_blocks", "inv_blocks", "apply_steps_local", "step_local", "bmap")
+KERNELS = ("step", "split", "merge", "fwd_blocks", "inv_blocks", "fwd_blocks_serial", "inv_blocks_serial", "fwd_block",
+           "inv_block", "apply_steps_local", "step_local", "bmap")
 
 _RUN_ALL = """
 import numpy as np
 from fogdrift import lifting as L
-x = np.random.default_rng(0).standard_normal(5000)
+x = np.random.default_rng(0).standard_normal(70000)
 for mode in L.MODES:
-    L.separate(x, "db2", 4, mode)          # fused block kernels (n >= 2048)
+    L.separate(x, "db2", 4, mode)          # fused block kernels, parallel at level 1, serial further down
     L.separate(x[:500], "db4", 3, mode)    # step / split / merge kernels
 """
 
@@ -37,7 +39,7 @@ def test_kernel_is_module_level_and_disk_cached(name):
 
 def test_factory_returns_the_module_level_kernels():
     assert _kernels._numba_kernels() == (_numba.step, _numba.split, _numba.merge, _numba.fwd_blocks,
-                                         _numba.inv_blocks)
+                                         _numba.inv_blocks, _numba.fwd_blocks_serial, _numba.inv_blocks_serial)
 
 
 def test_second_process_loads_every_kernel_and_compiles_none():
@@ -48,5 +50,27 @@ def test_second_process_loads_every_kernel_and_compiles_none():
     ]
     mine = [line for line in logs[1].splitlines() if "lifting" in line and "_numba." in line]
     loaded = {line.split("_numba.")[1].split("-")[0] for line in mine if line.startswith("[cache] data loaded")}
-    assert {"step", "split", "merge", "fwd_blocks", "inv_blocks"} <= loaded, logs[1]
+    assert {"step", "split", "merge", "fwd_blocks", "inv_blocks", "fwd_blocks_serial", "inv_blocks_serial"} <= loaded, \
+        logs[1]
     assert not [line for line in mine if "saved" in line], logs[1]
+
+
+@pytest.mark.parametrize("mode", ["periodization", "symmetric"])
+@pytest.mark.parametrize("n", [2048, 40_001, 70_000])
+def test_serial_and_parallel_block_drivers_are_bit_identical(monkeypatch, n, mode):
+    # the same blocks and arithmetic in both drivers: which one runs must not change a single bit
+    from fogdrift import lifting as L
+    from fogdrift.lifting import _drift
+
+    x = np.random.default_rng(n).standard_normal(n)
+    scheme = L.get_wavelet("db4")
+    out = {}
+    for name, min_blocks in (("parallel", 0), ("serial", 10**9)):
+        monkeypatch.setattr(_drift, "_PARALLEL_MIN_BLOCKS", min_blocks)
+        drift, noise = np.empty(n), np.empty(n)
+        _drift._fused_drift(x, scheme, 5, mode == "periodization", drift, noise)
+        out[name] = drift, noise
+    np.testing.assert_array_equal(out["parallel"][0], out["serial"][0])
+    np.testing.assert_array_equal(out["parallel"][1], out["serial"][1])
+    ref = _drift._drift_ref(x, scheme, 5, mode == "periodization")
+    np.testing.assert_allclose(out["serial"][0], ref, rtol=0, atol=1e-13 * max(1.0, np.abs(ref).max()))

@@ -28,6 +28,7 @@ from .transform import _band_lengths, _forward, _inverse, _raw_forward
 
 _FUSED_MIN = 2048  # records shorter than this use the step-by-step kernels
 _BLOCK = 2048  # channel samples per block of the fused kernels (buffers stay in L1/L2)
+_PARALLEL_MIN_BLOCKS = 8  # fewer blocks run serially: starting the threads costs more than the work
 
 
 def _drift_1d(x, scheme, level, periodic, out=None, noise=None):
@@ -95,6 +96,17 @@ def _sym_edges_inverse(s, n, scheme, M, out):
             out[2 * g1 + 1 :: 2] = o[keep_from:]
 
 
+def _run_blocks(parallel, serial, *args):
+    """Run a fused block kernel whose last arguments are ``g_lo, g_hi, B`` (channel samples [g_lo, g_hi)).
+
+    The parallel kernel for at least ``_PARALLEL_MIN_BLOCKS`` blocks, otherwise its serial twin (the same
+    blocks and arithmetic, bit-identical output): on a few blocks, starting the threads costs more than
+    the work (``causal_drift`` separates ``window`` unit vectors one after the other).
+    """
+    g_lo, g_hi = args[-3], args[-2]
+    return (parallel if g_hi - g_lo >= _PARALLEL_MIN_BLOCKS * _BLOCK else serial)(*args)
+
+
 def _fused_drift(x, scheme, level, periodic, out=None, noise=None):
     """Drift (and optionally noise) with the fused numba block kernels.
 
@@ -105,7 +117,13 @@ def _fused_drift(x, scheme, level, periodic, out=None, noise=None):
     most M samples inwards, so they are exact.
     """
     kern = _numba_kernels()
-    fwd_blocks, inv_blocks = kern[3], kern[4]
+
+    def fwd_blocks(*args):
+        return _run_blocks(kern[3], kern[5], *args)
+
+    def inv_blocks(*args):
+        return _run_blocks(kern[4], kern[6], *args)
+
     kf, pf, of, cf, rf, mf = _fused_tables(scheme, reverse=False)
     ki, pi, oi, ci, ri, mi = _fused_tables(scheme, reverse=True)
     M = max(mf, mi, _fused_tables_full_reach(scheme))

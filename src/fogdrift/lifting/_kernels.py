@@ -104,7 +104,7 @@ def _np_merge(e, o, shift, out):
 
 
 def _numba_kernels():
-    """The compiled kernels ``(step, split, merge, fwd_blocks, inv_blocks)``.
+    """The compiled kernels ``(step, split, merge, fwd_blocks, inv_blocks, fwd_blocks_serial, inv_blocks_serial)``.
 
     They live at module level in :mod:`fogdrift.lifting._numba` (imported here on first use, so that
     importing :mod:`fogdrift.lifting` does not import numba), where numba's on-disk cache serves
@@ -114,7 +114,8 @@ def _numba_kernels():
     if _NUMBA is None:
         from . import _numba
 
-        _NUMBA = (_numba.step, _numba.split, _numba.merge, _numba.fwd_blocks, _numba.inv_blocks)
+        _NUMBA = (_numba.step, _numba.split, _numba.merge, _numba.fwd_blocks, _numba.inv_blocks,
+                  _numba.fwd_blocks_serial, _numba.inv_blocks_serial)
     return _NUMBA
 
 

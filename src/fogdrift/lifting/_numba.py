@@ -12,8 +12,9 @@ the kernels as arrays (``_kernels._step_arrays``, ``_kernels._fused_tables``), n
     even/odd split and merge with padding and input shift;
 ``fwd_blocks``, ``inv_blocks``
     fused split + all steps + scaling of the approximation path (and its inverse with a zero
-    detail band) on cache-sized blocks with a halo, blocks in parallel (used by
-    :mod:`fogdrift.lifting._drift` for long records).
+    detail band) on cache-sized blocks with a halo (``fwd_block``, ``inv_block``), blocks in
+    parallel (used by :mod:`fogdrift.lifting._drift` for long records); ``*_serial``: the same
+    blocks one after the other, for records of a few blocks.
 
 The NumPy reference of the same arithmetic is in :mod:`fogdrift.lifting._kernels`.
 """
@@ -22,7 +23,7 @@ import numba
 import numpy as np
 from numba import prange
 
-__all__ = ["step", "split", "merge", "fwd_blocks", "inv_blocks"]
+__all__ = ["step", "split", "merge", "fwd_blocks", "inv_blocks", "fwd_blocks_serial", "inv_blocks_serial"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -151,83 +152,110 @@ def apply_steps_local(E, O, w, kinds, ptr, offs, coefs, reach, sign):  # pragma:
             step_local(E, O, r, w - r, ptr[k], ptr[k + 1], offs, coefs, sign)
 
 
+@numba.njit(cache=True)
+def fwd_block(x, n_pad, shift, kinds, ptr, offs, coefs, reach, M, scale_a, s_out, g_lo, g_hi, B, ib):  # pragma: no cover
+    # block ib of the fused split + lifting + scaling of the approximation (halo M), with its own buffers
+    n = x.shape[0]
+    a = g_lo + ib * B
+    E = np.empty(B + 2 * M)
+    O = np.empty(B + 2 * M)
+    b = min(a + B, g_hi)
+    w = b - a + 2 * M
+    base = a - M
+    j0 = 2 * base - shift
+    if j0 >= 0 and j0 + 2 * w - 1 < n:
+        for i in range(w):
+            E[i] = x[j0 + 2 * i]
+            O[i] = x[j0 + 2 * i + 1]
+    else:
+        for i in range(w):
+            j = (j0 + 2 * i) % n_pad
+            if j < 0:
+                j += n_pad
+            E[i] = x[min(j, n - 1)]
+            j = (j0 + 2 * i + 1) % n_pad
+            if j < 0:
+                j += n_pad
+            O[i] = x[min(j, n - 1)]
+    apply_steps_local(E, O, w, kinds, ptr, offs, coefs, reach, 1.0)
+    for i in range(b - a):
+        s_out[a + i] = E[M + i] * scale_a
+
+
+@numba.njit(cache=True)
+def inv_block(s, n_out, shift, kinds, ptr, offs, coefs, reach, M, scale_a, out, x, noise,
+              g_lo, g_hi, B, ib):  # pragma: no cover - compiled
+    # block ib of the fused unscaling + inverse lifting (zero detail band) + merge; kinds/ptr/offs/
+    # coefs/reach describe the reversed step list; writes noise = x - out when noise has the length of out
+    h = s.shape[0]
+    n_pad = 2 * h
+    do_noise = noise.shape[0] == out.shape[0]
+    inv_a = 1.0 / scale_a
+    a = g_lo + ib * B
+    E = np.empty(B + 2 * M)
+    O = np.empty(B + 2 * M)
+    b = min(a + B, g_hi)
+    w = b - a + 2 * M
+    base = a - M
+    if base >= 0 and base + w <= h:
+        for i in range(w):
+            E[i] = s[base + i] * inv_a
+            O[i] = 0.0
+    else:
+        for i in range(w):
+            g = (base + i) % h
+            if g < 0:
+                g += h
+            E[i] = s[g] * inv_a
+            O[i] = 0.0
+    apply_steps_local(E, O, w, kinds, ptr, offs, coefs, reach, -1.0)
+    j0 = 2 * a - shift
+    if j0 >= 0 and j0 + 2 * (b - a) <= n_out:
+        for i in range(b - a):
+            out[j0 + 2 * i] = E[M + i]
+            out[j0 + 2 * i + 1] = O[M + i]
+            if do_noise:
+                noise[j0 + 2 * i] = x[j0 + 2 * i] - E[M + i]
+                noise[j0 + 2 * i + 1] = x[j0 + 2 * i + 1] - O[M + i]
+    else:
+        for i in range(b - a):
+            for q in range(2):
+                j = (j0 + 2 * i + q) % n_pad
+                if j < 0:
+                    j += n_pad
+                if j < n_out:
+                    v = E[M + i] if q == 0 else O[M + i]
+                    out[j] = v
+                    if do_noise:
+                        noise[j] = x[j] - v
+
+
+# The drivers: blocks are independent, so they run in parallel; the serial twins (same blocks, same
+# arithmetic, bit-identical output) serve records of a few blocks, where starting the threads costs more
+# than the work (causal_drift separates `window` unit vectors one by one).
+
 @numba.njit(cache=True, parallel=True)
 def fwd_blocks(x, n_pad, shift, kinds, ptr, offs, coefs, reach, M, scale_a, s_out, g_lo, g_hi, B):  # pragma: no cover
-    # fused split + lifting + scaling of the approximation, block by block (halo M);
-    # blocks are independent, so they run in parallel, each with its own buffers
-    n = x.shape[0]
     for ib in prange((g_hi - g_lo + B - 1) // B):
-        a = g_lo + ib * B
-        E = np.empty(B + 2 * M)
-        O = np.empty(B + 2 * M)
-        b = min(a + B, g_hi)
-        w = b - a + 2 * M
-        base = a - M
-        j0 = 2 * base - shift
-        if j0 >= 0 and j0 + 2 * w - 1 < n:
-            for i in range(w):
-                E[i] = x[j0 + 2 * i]
-                O[i] = x[j0 + 2 * i + 1]
-        else:
-            for i in range(w):
-                j = (j0 + 2 * i) % n_pad
-                if j < 0:
-                    j += n_pad
-                E[i] = x[min(j, n - 1)]
-                j = (j0 + 2 * i + 1) % n_pad
-                if j < 0:
-                    j += n_pad
-                O[i] = x[min(j, n - 1)]
-        apply_steps_local(E, O, w, kinds, ptr, offs, coefs, reach, 1.0)
-        for i in range(b - a):
-            s_out[a + i] = E[M + i] * scale_a
+        fwd_block(x, n_pad, shift, kinds, ptr, offs, coefs, reach, M, scale_a, s_out, g_lo, g_hi, B, ib)
+
+
+@numba.njit(cache=True)
+def fwd_blocks_serial(x, n_pad, shift, kinds, ptr, offs, coefs, reach, M, scale_a, s_out, g_lo, g_hi,
+                      B):  # pragma: no cover - compiled
+    for ib in range((g_hi - g_lo + B - 1) // B):
+        fwd_block(x, n_pad, shift, kinds, ptr, offs, coefs, reach, M, scale_a, s_out, g_lo, g_hi, B, ib)
 
 
 @numba.njit(cache=True, parallel=True)
 def inv_blocks(s, n_out, shift, kinds, ptr, offs, coefs, reach, M, scale_a, out, x, noise,
                g_lo, g_hi, B):  # pragma: no cover - compiled
-    # fused unscaling + inverse lifting (zero detail band) + merge, block by block;
-    # kinds/ptr/offs/coefs/reach describe the reversed step list; writes noise = x - out
-    # when noise has the length of out.
-    h = s.shape[0]
-    n_pad = 2 * h
-    do_noise = noise.shape[0] == out.shape[0]
-    inv_a = 1.0 / scale_a
     for ib in prange((g_hi - g_lo + B - 1) // B):
-        a = g_lo + ib * B
-        E = np.empty(B + 2 * M)
-        O = np.empty(B + 2 * M)
-        b = min(a + B, g_hi)
-        w = b - a + 2 * M
-        base = a - M
-        if base >= 0 and base + w <= h:
-            for i in range(w):
-                E[i] = s[base + i] * inv_a
-                O[i] = 0.0
-        else:
-            for i in range(w):
-                g = (base + i) % h
-                if g < 0:
-                    g += h
-                E[i] = s[g] * inv_a
-                O[i] = 0.0
-        apply_steps_local(E, O, w, kinds, ptr, offs, coefs, reach, -1.0)
-        j0 = 2 * a - shift
-        if j0 >= 0 and j0 + 2 * (b - a) <= n_out:
-            for i in range(b - a):
-                out[j0 + 2 * i] = E[M + i]
-                out[j0 + 2 * i + 1] = O[M + i]
-                if do_noise:
-                    noise[j0 + 2 * i] = x[j0 + 2 * i] - E[M + i]
-                    noise[j0 + 2 * i + 1] = x[j0 + 2 * i + 1] - O[M + i]
-        else:
-            for i in range(b - a):
-                for q in range(2):
-                    j = (j0 + 2 * i + q) % n_pad
-                    if j < 0:
-                        j += n_pad
-                    if j < n_out:
-                        v = E[M + i] if q == 0 else O[M + i]
-                        out[j] = v
-                        if do_noise:
-                            noise[j] = x[j] - v
+        inv_block(s, n_out, shift, kinds, ptr, offs, coefs, reach, M, scale_a, out, x, noise, g_lo, g_hi, B, ib)
+
+
+@numba.njit(cache=True)
+def inv_blocks_serial(s, n_out, shift, kinds, ptr, offs, coefs, reach, M, scale_a, out, x, noise,
+                      g_lo, g_hi, B):  # pragma: no cover - compiled
+    for ib in range((g_hi - g_lo + B - 1) // B):
+        inv_block(s, n_out, shift, kinds, ptr, offs, coefs, reach, M, scale_a, out, x, noise, g_lo, g_hi, B, ib)
