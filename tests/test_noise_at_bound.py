@@ -60,11 +60,14 @@ def test_no_bound_note_when_white_noise_is_fitted_freely():
 
 
 def test_rlg_largest_gap_is_named_with_the_ratio_the_fit_stores(rlg_fits):
-    # the RLG's gx model keeps a flat floor the curve contradicts: at long tau the model lies far above the data
+    # the RLG's gx: the flat floor the curve contradicts is no longer in the model (it was 5.6x above the last
+    # point); the model still lies ~2x above the data at the longest tau, inside that point's wide interval
     f = rlg_fits["gx"]
+    assert "B" not in f.selected
     (note,) = [n for n in f.notes if n.startswith("largest gap")]
     m = re.match(r"largest gap: at tau = ([0-9.eE+]+) s the model's deviation is ([0-9.]+)x the measured one "
-                 r"\(above it; ~([0-9.eE+-]+) degrees of freedom\), outside that point's own 95 % interval", note)
+                 r"\(above it; ~([0-9.eE+-]+) degrees of freedom\), (inside|outside) that point's own 95 % "
+                 r"interval", note)
     assert m, note
     k = int(np.argmin(np.abs(np.asarray(f.fit_tau_s) - float(m.group(1)))))
     ratio = np.sqrt(np.asarray(f.model_var) / np.asarray(f.fit_var))

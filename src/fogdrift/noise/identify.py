@@ -674,9 +674,21 @@ def _q_at_whole_periods(c: _Context, prob, best, A, d2, periodic, out_terms) -> 
     (where every line of a component vanishes at its whole periods) tell them apart.  A Q the fit resolves is kept
     resolved only if it is still resolved from zero on those taus alone; otherwise it is reported unresolved with
     that reason (lower bound 0)."""
-    iQ = _NAMES.index("Q")
+    iQ, iS = _NAMES.index("Q"), _NAMES.index("S")
     p_min = min(periodic.periods_s) if periodic is not None and periodic.periods_s else None
     if p_min is None:
+        return
+    # a real line is no perfect sinusoid (its amplitude and frequency wander, which fills its nulls): a Q whose
+    # tau^-2 coefficient is no larger than the lines' own tau^-2 envelope (sum Omega_i^2 / (pi f_i)^2) is not told
+    # apart from them at any tau
+    env = A[iS] * sum(r / (math.pi * f) ** 2 for f, r in c.lines)
+    if A[iQ] <= env:
+        t = out_terms["Q"]
+        out_terms["Q"] = NoiseTerm(
+            "Q", t.value, t.unit, 0.0, t.hi95, "unresolved",
+            f"not told apart from the periodic error: its tau^-2 level is below the lines' own envelope "
+            f"(Omega0^2 / (pi f0)^2 over the lines, {math.sqrt(env / max(A[iQ], 1e-300)):.3g}x Q in deviation), and a "
+            "real line's wandering amplitude and frequency fill its nulls; notch the line to read Q")
         return
     k0 = int(np.searchsorted(c.tau, p_min * (1 - 1e-9)))
     if c.tau.size - k0 < len(best) + 1:

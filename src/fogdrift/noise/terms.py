@@ -345,8 +345,8 @@ def markov_shape(tau_s, tc_s, statistic="adev", dt_s=None) -> np.ndarray:
     """Variance shape of first-order Gauss-Markov rate noise with correlation time ``tc_s`` [s]: ``A = (q_c T_c)^2``
     [(deg/h)^2 s] multiplies it (IEEE-952 Annex C.6).
 
-    ``adev``: the Annex C law ``1/tau [1 - T_c/(2 tau) (3 - 4 e^(-tau/T_c) + e^(-2 tau/T_c))]`` (-> ``tau / (3 T_c)``
-    for ``tau << T_c``, like a rate random walk, and ``1/tau`` for ``tau >> T_c``, like white noise).  ``hdev`` and
+    ``adev``: the Annex C law ``1/tau [1 - T_c/(2 tau) (3 - 4 e^(-tau/T_c) + e^(-2 tau/T_c))]`` (-> ``tau / (3 T_c^2)``,
+    i.e. ``q_c^2 tau / 3``, for ``tau << T_c``, like a rate random walk of ``K = q_c``, and ``1/tau`` for ``tau >> T_c``, like white noise).  ``hdev`` and
     ``mdev``: not derived in closed form; the expectation of the estimator under the exact spectrum of the sampled
     process (an AR(1) with ``phi = exp(-dt/T_c)``, :func:`fogdrift.noise.covariance.expected_variance`), which needs
     ``dt_s``.
@@ -356,9 +356,9 @@ def markov_shape(tau_s, tc_s, statistic="adev", dt_s=None) -> np.ndarray:
     if statistic == "adev":
         x = t / tc
         with np.errstate(over="ignore", invalid="ignore"):
-            small = x < 1e-3  # series: (1/tau) (x/3 - x^2/12 + ...) avoids the cancellation
+            small = x < 1e-3  # series: (1/tau) (x^2/3 - x^3/4 + ...) avoids the cancellation
             big = (1.0 - (3.0 - 4.0 * np.exp(-x) + np.exp(-2.0 * x)) / (2.0 * x)) / t
-            ser = (x / 3.0 - x * x / 12.0) / t
+            ser = (x * x / 3.0 - x**3 / 4.0) / t
         return np.where(small, ser, big)
     laws_of(statistic)
     if dt_s is None:
