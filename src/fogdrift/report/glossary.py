@@ -53,9 +53,10 @@ GLOSSARY = (
      "The reference: subtract the calibration window's mean and nothing else (what a navigation system does "
      "after static alignment). A drift model is worth running only if it beats this."),
     ("ratio to constant bias", "ratio",
-     "RMS heading error of a model divided by constant bias's at the same horizon and origins: below 0.95 the "
-     "model reduces the error, above 1.05 it makes it worse. Very large values (x1e+30) are diverging "
-     "forecasts."),
+     "RMS heading error of a model divided by constant bias's at the same horizon and origins. The model reduces "
+     "the error only at 0.95 or below AND when it is better at more than half of the non-overlapping origins; it "
+     "makes it worse at 1.05 or above AND when worse at more than half. A forecast whose error is not finite or "
+     "above 1000 x constant bias's reads “diverges”."),
     ("origins, independent origins", "origins",
      "Calibration origins of the rolling evaluation. Origins closer than the horizon share most of their "
      "integration window; only origins with non-overlapping horizons count as independent, and a verdict needs "
