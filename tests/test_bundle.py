@@ -86,8 +86,11 @@ def _copy(out, tmp_path):
     return dst, json.loads((dst / "manifest.json").read_text())
 
 
-def _write(dst, doc):
-    (dst / "manifest.json").write_text(json.dumps(doc))
+def _write(dst, doc, *, reseal=True):
+    """Write an edited manifest; resealed by default, so that the structural checks behind the seal are tested."""
+    from fogdrift.bundle import seal_manifest
+
+    (dst / "manifest.json").write_text(json.dumps(seal_manifest(doc) if reseal else doc))
 
 
 def test_newer_format_is_refused_with_a_clear_message(fitted, tmp_path):
@@ -95,7 +98,8 @@ def test_newer_format_is_refused_with_a_clear_message(fitted, tmp_path):
     doc["format_version"] = BUNDLE_FORMAT_VERSION + 1
     doc["fogdrift_version"] = "9.9"
     _write(dst, doc)
-    with pytest.raises(ModelFileError, match=r"format version 2 was written by fogdrift 9.9.*upgrade fogdrift"):
+    with pytest.raises(ModelFileError, match=rf"format version {BUNDLE_FORMAT_VERSION + 1} was written by "
+                                             r"fogdrift 9.9.*upgrade fogdrift"):
         load_bundle(dst)
 
 
@@ -148,3 +152,59 @@ def test_model_command_writes_a_loadable_bundle(bundled_path, tmp_path):
     b = load_bundle(tmp_path / "bundle")
     assert b.axis_names == ("gz",) and b.model_names == ("ar", "persistence")
     assert b.training["sha256"] == hashlib.sha256(bundled_path.read_bytes()).hexdigest()
+
+
+# ------------------------------------------------------------------------------------------
+# The bundle is verified whole (one seal over the manifest, which holds every file's SHA-256)
+# ------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("edit, what", [
+    (lambda d: d["axes"][0].update(bias_dph=d["axes"][0]["bias_dph"] + 5000.0), "bias +5000 deg/h"),
+    (lambda d: d.update(input_unit="rad/s" if d["input_unit"] != "rad/s" else "deg/s"), "unit"),
+    (lambda d: d["axes"][0].update(earth_rate_dph=d["axes"][0]["earth_rate_dph"] + 1.0), "Earth rate"),
+    (lambda d: d["training"].update(sha256="0" * 64), "training SHA-256"),
+    (lambda d: d["axes"][0]["models"]["ar"]["sha256"].update(json="0" * 64), "a file's hash"),
+])
+def test_any_edit_of_the_manifest_is_refused(fitted, tmp_path, edit, what):
+    dst, doc = _copy(fitted[4], tmp_path)
+    assert load_bundle(dst).axes  # the copy as written loads
+    edit(doc)
+    _write(dst, doc, reseal=False)
+    with pytest.raises(ModelFileError, match="does not match its integrity seal") as info:
+        load_bundle(dst)
+    assert "manifest.json" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_an_unsealed_version_1_bundle_is_refused_with_advice(fitted, tmp_path):
+    dst, doc = _copy(fitted[4], tmp_path)
+    doc.pop("seal_sha256")
+    doc["format_version"] = 1
+    _write(dst, doc, reseal=False)
+    with pytest.raises(ModelFileError, match="no integrity seal; re-create the bundle"):
+        load_bundle(dst)
+
+
+@pytest.mark.parametrize("rel", ["/etc/passwd", "../outside/ar", "gx/../../outside/ar", "gx\\..\\..\\ar", ""])
+def test_model_files_outside_the_bundle_are_refused(fitted, tmp_path, rel):
+    out = tmp_path / "outside"
+    dst, doc = _copy(fitted[4], tmp_path)
+    shutil.copytree(dst / "gx", out)  # a valid model file outside the bundle, with matching hashes
+    doc["axes"][0]["models"]["ar"]["file"] = rel
+    _write(dst, doc)
+    with pytest.raises(ModelFileError, match="is not a relative path inside the bundle|models.ar.file"):
+        load_bundle(dst)
+
+
+def test_non_finite_parameters_are_refused_at_load(fitted, tmp_path):
+    dst, doc = _copy(fitted[4], tmp_path)
+    npz = dst / "gx" / "ar.npz"
+    with np.load(npz, allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    arrays["coef_"] = np.full_like(arrays["coef_"], np.nan)
+    np.savez(npz, **arrays)
+    # hashes made consistent, as a careful editor would: the seal passes, the parameters do not
+    from fogdrift.bundle import _sha256
+
+    doc["axes"][0]["models"]["ar"]["sha256"]["npz"] = _sha256(npz)
+    _write(dst, doc)
+    with pytest.raises(ModelFileError, match="parameter 'coef_' of gx/ar holds NaN or inf"):
+        load_bundle(dst)

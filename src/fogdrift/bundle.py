@@ -61,12 +61,67 @@ __all__ = [
     "save_bundle",
     "write_bundle",
     "load_bundle",
+    "seal_manifest",
 ]
 
 BUNDLE_FORMAT = "fogdrift-bundle"
-#: Version of the bundle layout (manifest keys, file names). Readers refuse a newer one.
-BUNDLE_FORMAT_VERSION = 1
+#: Version of the bundle layout (manifest keys, file names). Readers refuse a newer one.  Version 2 added the
+#: integrity seal; a version-1 bundle (no seal) is refused with the advice to re-create it.
+BUNDLE_FORMAT_VERSION = 2
 MANIFEST = "manifest.json"
+#: Manifest key of the seal: SHA-256 of the canonical manifest without this key.
+SEAL_KEY = "seal_sha256"
+
+
+def _canonical_sha256(doc: dict) -> str:
+    """SHA-256 of the manifest without its seal, serialised canonically (sorted keys, no spaces)."""
+    body = {k: v for k, v in doc.items() if k != SEAL_KEY}
+    text = json.dumps(body, sort_keys=True, separators=(",", ":"), ensure_ascii=True, allow_nan=False)
+    return hashlib.sha256(text.encode("ascii")).hexdigest()
+
+
+def seal_manifest(doc: dict) -> dict:
+    """``doc`` with its integrity seal (:data:`SEAL_KEY`) set.
+
+    The manifest holds the SHA-256 of every model file, so one hash over the manifest covers the whole bundle:
+    a change to any field (a bias, the unit, a file entry) or to any file is refused at load.  It detects an
+    edited or damaged bundle; it is not a signature (whoever can write the folder can re-seal it).
+
+    Examples
+    --------
+    >>> d = seal_manifest({"format": "fogdrift-bundle", "axes": []})
+    >>> len(d["seal_sha256"]), seal_manifest(d) == d
+    (64, True)
+    """
+    return {**{k: v for k, v in doc.items() if k != SEAL_KEY}, SEAL_KEY: _canonical_sha256(doc)}
+
+
+def _inside(root: Path, rel: str) -> bool:
+    """Whether the relative path ``rel`` names a place inside ``root`` (no absolute path, no ``..``)."""
+    if not rel or Path(rel).is_absolute() or "\\" in rel or ".." in Path(rel).parts:
+        return False
+    try:
+        (root / rel).resolve().relative_to(root.resolve())
+    except ValueError:
+        return False
+    return True
+
+
+def _check_finite_parameters(npz_path: Path, where: str) -> None:
+    """Refuse a model whose parameter arrays hold NaN or inf (training curves, diagnostics only, may)."""
+    try:
+        with np.load(npz_path, allow_pickle=False) as z:
+            for key in z.files:
+                a = z[key]
+                if key.endswith("_curve_") or a.dtype.kind not in "fc":
+                    continue
+                if not np.all(np.isfinite(a)):
+                    raise ModelFileError(f"{npz_path}: parameter {key!r} of {where} holds NaN or inf; a model with "
+                                         "non-finite parameters cannot be applied (re-create the bundle)")
+    except ModelFileError:
+        raise
+    except Exception as exc:  # a damaged archive: load_model reports it with its own words
+        raise ModelFileError(f"{npz_path}: not a readable model archive of {where} ({type(exc).__name__})") from None
 
 
 @dataclass(frozen=True)
@@ -308,7 +363,8 @@ def save_bundle(bundle: Bundle, out_dir) -> Path:
         "latitude_deg": bundle.latitude_deg, "training": bundle.training, "settings": bundle.settings,
         "axes": axes_doc,
     }
-    text = json.dumps(_finite(json.loads(json.dumps(doc, default=json_default))), indent=2, allow_nan=False)
+    text = json.dumps(seal_manifest(_finite(json.loads(json.dumps(doc, default=json_default)))), indent=2,
+                      allow_nan=False)
     # the manifest last and whole (temporary name, renamed): a bundle without one is incomplete, never half-read
     with atomic_path(out / MANIFEST) as tmp:
         tmp.write_text(text)
@@ -414,6 +470,17 @@ def load_bundle(path) -> Bundle:
             f"this fogdrift {__version__} reads format version {BUNDLE_FORMAT_VERSION} and older: upgrade fogdrift")
     if version < 1:
         d.fail("format_version", f"expected an integer >= 1, got {version}")
+    if version < 2:
+        raise ModelFileError(f"{mpath}: bundle format version {version} has no integrity seal; re-create the bundle "
+                             f"with this fogdrift {__version__} ('fogdrift model' or 'fogdrift analyze')")
+    seal = raw.get(SEAL_KEY)
+    try:
+        expected = _canonical_sha256(raw)
+    except (TypeError, ValueError):
+        expected = None
+    if not isinstance(seal, str) or seal != expected:
+        raise ModelFileError(f"{mpath}: the manifest does not match its integrity seal ({SEAL_KEY}): it was edited "
+                             "or damaged after the bundle was written; re-create the bundle")
     unit = d.get(raw, "input_unit", str, "")
     if unit not in RATE_UNITS and not (unit.startswith("inc:") and unit[4:] in INCREMENT_UNITS):
         d.fail("input_unit", f"unknown unit {unit!r}")
@@ -458,6 +525,8 @@ def load_bundle(path) -> Bundle:
             except ConfigError:
                 d.fail(f"{w}models", f"unknown model {key!r}")
             rel = d.get(entry, "file", str, wm)
+            if not _inside(root, rel):
+                d.fail(f"{wm}file", f"{rel!r} is not a relative path inside the bundle")
             cls = d.get(entry, "class", str, wm)
             if cls != spec.cls:
                 d.fail(f"{wm}class", f"{key!r} is a {spec.cls}, got {cls!r}")
@@ -469,6 +538,7 @@ def load_bundle(path) -> Bundle:
                 if sums.get(ext) != _sha256(f):
                     raise ModelFileError(f"{f}: SHA-256 differs from the manifest; the model file was modified "
                                          "after the bundle was written")
+            _check_finite_parameters(model_file_paths(base)[1], f"{name}/{key}")
             model = load_model(base)
             if type(model).__name__ != spec.cls:
                 raise ModelFileError(f"{base}.json: holds a {type(model).__name__}, the manifest says {spec.cls}")
