@@ -270,3 +270,32 @@ def test_one_rule_in_the_report_table_and_the_fleet_row():
     assert row["b_min_dph"] == pytest.approx(b.bound_dph) and row["b_min_bound_only"] is True
     assert row["b_min_tau_s"] == pytest.approx(ax.selection.fit.scale_s[-1] / 2)
     assert row["B_dph"] is None and row["B_status"] == "absent"  # no flicker term: B is a reading, not a term
+
+
+def test_b_comparison_rules_with_a_bound():
+    """GMWM B < x against an Allan B_min value: agrees when the Allan interval reaches below x, differs (with the
+    reason) when it lies wholly above; an Allan bound against a GMWM bound always agrees.  Only NoiseFit's public
+    fields are read, so a stand-in object with them is enough."""
+    from types import SimpleNamespace
+
+    x = simulate_latent("WN+RW", [1.0, 1e-9], 3000, seed=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ax = analyse_gmwm("gz", x, 0.01, model="WN+RW")
+    bound = ax.selection.ieee.b_headline.bound_dph
+    n = ax.selection.ieee.terms["N_dprh"]
+    term = SimpleNamespace(value=n.value, lo95=n.lo95, hi95=n.hi95, reason="")
+
+    def fit(b_min):
+        return SimpleNamespace(terms={"N": term}, b_min=b_min, tau_max_s=7.5, tau_min_s=0.01, selected=("N",))
+
+    inside = compare_with_allan(ax, fit({"value": 0.9 * bound, "lo95": 0.5 * bound, "hi95": 1.5 * bound,
+                                         "tau_s": 5.0, "bound_only": False}))
+    assert inside["b_agree"] is True and inside["lines"][1].startswith("B agrees")
+    above = compare_with_allan(ax, fit({"value": 3 * bound, "lo95": 2 * bound, "hi95": 4 * bound, "tau_s": 5.0,
+                                        "bound_only": False}))
+    assert above["b_agree"] is False and above["agree"] is False
+    assert above["lines"][1].startswith("B differs") and "the other does not" in above["lines"][1]
+    both = compare_with_allan(ax, fit({"value": 10 * bound, "tau_s": 7.5, "bound_only": True, "rule": ""}))
+    assert both["b_agree"] is True and "both only as upper bounds" in both["lines"][1]
+    assert both["n_agree"] is True  # the same N on both sides

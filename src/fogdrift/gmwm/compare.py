@@ -75,6 +75,20 @@ def _b_interval(value, lo, hi, bound):
     return None
 
 
+def _allan_b_text(ab, tau_max, *, interval) -> str:
+    """The Allan fit's B_min reading in words (a value, a bound and why, or none)."""
+    a_val = ab.get("value")
+    if a_val is None:
+        return "the Allan fit has no ADEV-minimum reading"
+    if ab.get("bound_only"):
+        if "measured curve" in str(ab.get("rule", "")):
+            return f"the Allan fit gives B_min < {_g(a_val)} deg/h (its fitted floor lies above the measured curve)"
+        return (f"the Allan fit finds no ADEV minimum within τ ≤ {_t(tau_max)} s (B_min < {_g(a_val)} deg/h)"
+                if tau_max is not None else f"the Allan fit gives only B_min < {_g(a_val)} deg/h")
+    iv = _iv(ab.get("lo95"), ab.get("hi95")) if interval else ""
+    return f"the Allan fit's B_min is {_g(a_val)}{iv} deg/h at τ = {_t(ab.get('tau_s'))} s"
+
+
 def _b_line(axis, fit) -> tuple:
     ie = axis.selection.ieee
     gb = ie.b_headline
@@ -94,14 +108,7 @@ def _b_line(axis, fit) -> tuple:
         g_text = f"GMWM B < {_g(gb.bound_dph)} deg/h (its model's ADEV has no minimum within τ {_t(lo)}-{_t(hi)} s)"
     else:
         g_text = f"GMWM reads no B ({gb.reason})"
-    if a_val is None:
-        a_text = "the Allan fit has no ADEV-minimum reading"
-    elif a_bound:
-        a_text = (f"the Allan fit finds no ADEV minimum within τ ≤ {_t(tau_max)} s (B_min < {_g(a_val)} deg/h)"
-                  if tau_max is not None else f"the Allan fit gives only B_min < {_g(a_val)} deg/h")
-    else:
-        a_text = (f"the Allan fit's B_min {_g(a_val)}{_iv(ab.get('lo95'), ab.get('hi95'))} deg/h at τ = "
-                  f"{_t(ab.get('tau_s'))} s")
+    a_text = _allan_b_text(ab, tau_max, interval=True)
     if g_iv is None or a_iv is None:
         return None, f"B cannot be compared: {g_text}; {a_text}"
     agree = g_iv[0] <= a_iv[1] and a_iv[0] <= g_iv[1]
@@ -113,7 +120,7 @@ def _b_line(axis, fit) -> tuple:
         why = ("one of them reaches an ADEV minimum inside the record and the other does not: the models bend "
                "the longest τ differently")
     else:
-        why = "the two models put the ADEV minimum at different heights (compare the curves in noise.png)"
+        why = "the GMWM model and the Allan fit put the ADEV minimum at different heights"
     return False, f"B differs: {g_text}; {a_text}; {why}"
 
 
@@ -122,14 +129,7 @@ def _hump_line(axis, fit):
     if b is None or b.value_dph is None:
         return None
     ab = getattr(fit, "b_min", None) or {}
-    a_val, tau_max = ab.get("value"), getattr(fit, "tau_max_s", None)
-    if a_val is None:
-        tail = "the Allan fit has no ADEV-minimum reading"
-    elif ab.get("bound_only"):
-        tail = (f"the Allan fit finds no ADEV minimum within τ ≤ {_t(tau_max)} s (B_min < {_g(a_val)} deg/h)"
-                if tau_max is not None else f"the Allan fit gives only B_min < {_g(a_val)} deg/h")
-    else:
-        tail = f"the Allan fit's B_min is {_g(a_val)} deg/h at τ = {_t(ab.get('tau_s'))} s"
+    tail = _allan_b_text(ab, getattr(fit, "tau_max_s", None), interval=False)
     return (f"GMWM B {_g(b.value_dph, 4)} deg/h at τ = {_t(b.tau_s)} s is read from a GM hump ({b.label.split('(')[-1]}:"
             f" a detail, not a bias-instability floor; {tail}")
 
