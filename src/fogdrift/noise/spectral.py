@@ -24,9 +24,10 @@ Method (:func:`analyse_spectrum`)
    interpolation of the peak, power = sum over the cluster and its main lobe of ``(P - floor) df`` (the density
    scaling already accounts for the window's ENBW), amplitude ``sqrt(2 power)``.
 4. Lines whose frequencies are whole multiples of a lower line (within 1.5 bins, harmonics taken in order with at
-   most two missing) form a :class:`PeriodicComponent`; its fundamental is the least-squares ``f0`` of the lines.
-5. Roll-off: on the line-free spectrum (running median) in 1/6-octave bands, a flat white-noise plateau (slope
-   within 1.5 dB/octave over an octave) followed by a monotone fall to at least 6 dB below it at Nyquist; the corner
+   most two missing; once three lines make a series, any higher multiple within 1 bin) form a
+   :class:`PeriodicComponent`; its fundamental is the least-squares ``f0`` of the lines.
+5. Roll-off: on the line-free spectrum (lines replaced by their floor) in 1/6-octave bands, a flat white-noise
+   plateau (slope within 1.5 dB/octave over two octaves) followed by a monotone fall to at least 6 dB below it at Nyquist; the corner
    is where the level first falls 3 dB below the plateau.
 
 References
@@ -59,8 +60,17 @@ _NPERSEG_MIN, _NPERSEG_MAX = 64, 65536
 _GUARD = 2  # bins either side of the tested bin left out of its floor (the Hann main lobe)
 _W_MAX, _W_MIN = 15, 7  # floor half-window [bins], odd
 _MERGE_GAP = 2  # significant bins at most this far apart are one line
+_LEVELS = (1, 4, 16, 64, 256)  # resolutions searched: the Welch bins averaged in groups of L (broad lines)
+_MIN_COARSE_BINS = 64
+_BROAD_POWER_RATIO = 1.5  # a coarse cluster replaces a finer line when it holds this much more power
+#: The chi^2_nu law with the Welch EDF matches the variance of a (bin-averaged) Welch estimate but its tail is a
+#: little light: on 600 white records of 2^16 samples the bins beyond its 1e-4 point were 1.13x (Welch bins),
+#: 1.38x (4 bins averaged) and 1.32x (16) the nominal rate; the test uses 0.9 nu, which is conservative at all three.
+_EDF_SAFETY = 0.9
+_BROAD_WIDTH_BINS = 4.0  # a line wider than this many Welch bins is "broad"  # a coarser resolution is searched only when it keeps at least this many bins
 _ROLLOFF_DB = 6.0  # a roll-off is reported when Nyquist is at least this far below the white plateau
 _PLATEAU_DB_PER_OCT = 1.5  # |slope| of a white plateau
+_PLATEAU_OCTAVES = 2.0  # span of the plateau fit
 _MONOTONE_TOL_DB = 1.0  # a band may rise this much above the running minimum and still count as falling
 
 
@@ -90,6 +100,11 @@ class SpectralLine:
         searched bins.
     harmonic_of : float or None
         Fundamental frequency [Hz] when this line is a harmonic of another line found; None otherwise.
+    width_hz : float
+        Twice the RMS spread [Hz] of the line's excess power about ``freq_hz`` (about one bin for a tone).
+    broad : bool
+        True when ``width_hz`` exceeds 4 Welch bins (a tone is about 1.2 bins wide): a vibration hump or a wandering
+        line rather than a tone; its Allan variance has no clean nulls at whole periods.
     """
 
     freq_hz: float
@@ -98,9 +113,11 @@ class SpectralLine:
     snr_db: float
     p_value: float
     harmonic_of: float | None = None
+    width_hz: float = 0.0
+    broad: bool = False
 
     def to_dict(self) -> dict:
-        return {k: _finite_or_none(v) for k, v in self.__dict__.items()}
+        return {k: (v if isinstance(v, bool) else _finite_or_none(v)) for k, v in self.__dict__.items()}
 
 
 @dataclass(frozen=True)
@@ -139,6 +156,11 @@ def _freq_text(f_hz: float, df_hz: float) -> str:
     """A frequency [Hz] with the decimals its resolution supports (one tenth of a bin)."""
     dec = int(min(6, max(0, math.ceil(-math.log10(df_hz / 10.0))))) if df_hz > 0 else 3
     return f"{f_hz:.{dec}f} Hz"
+
+
+def _sig2(x: float) -> str:
+    """Two significant digits, no trailing point: 24 -> '24', 5 -> '5.0', 0.0123 -> '0.012'."""
+    return f"{x:#.2g}".rstrip(".") if abs(x) < 100 else f"{x:.0f}"
 
 
 def _p_text(p: float) -> str:
@@ -204,13 +226,15 @@ class SpectrumSummary:
         for c in self.components:
             if len(c.lines) == 1:
                 ln = c.lines[0]
-                out.append(f"spectral line at {_freq_text(ln.freq_hz, df)}, amplitude {ln.amplitude_dph:#.2g} deg/h "
+                kind = f"broad spectral peak ({ln.width_hz:.2g} Hz wide)" if ln.broad else "spectral line"
+                out.append(f"{kind} at {_freq_text(ln.freq_hz, df)}, amplitude {_sig2(ln.amplitude_dph)} deg/h, "
+                           f"{_sig2(100.0 * ln.power_dph2 / self.variance_dph2)} % of the variance "
                            f"({_p_text(ln.p_value)}, {rate})")
             else:
                 share = 100.0 * c.power_dph2 / self.variance_dph2 if self.variance_dph2 > 0 else float("nan")
                 n_h = c.n_harmonics
-                out.append(f"periodic error with period {c.period_s:.3g} s ({_freq_text(c.fundamental_hz, df)} and "
-                           f"{n_h} harmonic{'s' if n_h != 1 else ''}), {share:#.2g} % of the variance")
+                out.append(f"periodic error with period {c.period_s:#.3g} s ({_freq_text(c.fundamental_hz, df)} and "
+                           f"{n_h} harmonic{'s' if n_h != 1 else ''}), {_sig2(share)} % of the variance")
         if not self.lines and self.band_hz is not None:
             out.append(f"no spectral line from {_freq_text(self.band_hz[0], df)} to {_freq_text(self.band_hz[1], df)} "
                        f"({rate}, resolution {_freq_text(df, df)})")
@@ -299,22 +323,6 @@ def welch_edf(nperseg: int, n_segments: int) -> float:
     return 2.0 * k / (1.0 + 2.0 * corr)
 
 
-def _bin_correlation(nperseg: int, max_lag: int = 4) -> float:
-    """``1 + 2 sum_d |rho_d|^2``: how many neighbouring bins one independent bin is worth (white noise, window h).
-
-    ``rho_d = sum_t h_t^2 exp(-2 pi i d t / N) / sum_t h_t^2`` is the correlation of two DFT values ``d`` bins apart;
-    for Hann ``|rho_1|^2 = 4/9``, ``|rho_2|^2 = 1/36``.
-    """
-    h2 = _window(nperseg) ** 2
-    t = np.arange(nperseg)
-    s = float(h2.sum())
-    out = 1.0
-    for d in range(1, max_lag + 1):
-        r = abs(np.sum(h2 * np.exp(-2j * np.pi * d * t / nperseg))) / s
-        out += 2.0 * r * r
-    return out
-
-
 class _MedianNull:
     """Null distribution of ``r = P_k / max(med_left, med_right)`` for one half-window ``w`` (odd).
 
@@ -385,6 +393,103 @@ def _local_medians(p: np.ndarray):
     return left, right, w
 
 
+def _fine_bin_r(nperseg: int) -> np.ndarray:
+    """``|rho_d|^2``, d = 0..4: correlation of Welch PSD values ``d`` bins apart (white noise, Hann window ``h``).
+
+    ``rho_d = sum_t h_t^2 exp(-2 pi i d t / N) / sum_t h_t^2`` (Percival & Walden 1993, Sec. 6.17); for Hann
+    ``|rho_1|^2 = 4/9``, ``|rho_2|^2 = 1/36`` and 0 beyond.
+    """
+    h2 = _window(nperseg) ** 2
+    t = np.arange(nperseg)
+    s = float(h2.sum())
+    return np.array([abs(np.sum(h2 * np.exp(-2j * np.pi * d * t / nperseg))) / s for d in range(5)]) ** 2
+
+
+def _coarse_stats(nu: float, r: np.ndarray, L: int):
+    """EDF of the mean of ``L`` adjacent Welch bins, and ``1 + 2 sum_k corr_k`` of neighbouring coarse bins."""
+    rr = np.zeros(3 * L + 8)
+    rr[: r.size] = r
+
+    def pair_sum(k):  # sum over a in coarse bin 0, b in coarse bin k of r_|b - a|
+        d = np.arange(k * L - (L - 1), k * L + L)
+        return float(np.sum((L - np.abs(d - k * L)) * rr[np.abs(d)]))
+
+    var = pair_sum(0)
+    nu_l = nu * L * L / var
+    corr = 1.0 + 2.0 * sum(pair_sum(k) / var for k in (1, 2))
+    return nu_l, corr
+
+
+def _search_level(p: np.ndarray, L: int, nu: float, r: np.ndarray, alpha: float, df: float):
+    """Line search on the Welch PSD averaged over ``L`` adjacent bins, family-wise level ``alpha``.
+
+    Returns (clusters, number of bins searched, (lowest, highest) searched frequency [Hz]) or None.  A cluster is a
+    dict with fine-bin ``lo``/``hi`` (its extent, main lobe included), ``peak`` (fine bin of the maximum), ``p``
+    (Sidak-corrected), ``power`` [(deg/h)^2], ``floor`` [(deg/h)^2/Hz] and ``L``.
+    """
+    from scipy.stats import chi2
+
+    if L == 1:
+        pl = p
+    else:
+        nbl = (p.size - 1) // L
+        pl = p[: nbl * L].reshape(nbl, L).mean(axis=1)
+    nu_l, corr = (nu, 1.0 + 2.0 * float(np.sum(r[1:]))) if L == 1 else _coarse_stats(nu, r, L)
+    nu_l *= _EDF_SAFETY
+    left, right, w = _local_medians(pl)
+    ok = (w > 0) & (np.fmax(left, right) > 0)
+    m = int(ok.sum())
+    if m == 0:
+        return None
+    ratio = np.zeros(pl.size)
+    ratio[ok] = pl[ok] / np.maximum(left[ok], right[ok])
+    p_target = -math.expm1(math.log1p(-alpha) / m)  # per-bin level of the Sidak correction
+    p_fw = np.ones(pl.size)
+    for ww in np.unique(w[ok]):
+        null = _MedianNull(nu_l, int(ww), corr)
+        cand = np.nonzero(ok & (w == ww) & (ratio >= null.critical(p_target)))[0]
+        if cand.size:
+            pb = null.sf(ratio[cand])
+            p_fw[cand] = np.where(pb < 1e-12, m * pb, -np.expm1(m * np.log1p(-np.minimum(pb, 1.0 - 1e-16))))
+    q = chi2.median(nu_l) / nu_l
+    idx = np.nonzero(ok)[0]
+    band = ((idx[0] * L + 0.5 * (L - 1)) * df, (idx[-1] * L + 0.5 * (L - 1)) * df)  # centres of the coarse bins
+    sig = np.nonzero(ok & (p_fw <= alpha))[0]
+    out = []
+    if sig.size:
+        g = _GUARD if L == 1 else 1
+        for run in np.split(sig, np.nonzero(np.diff(sig) > _MERGE_GAP + 1)[0] + 1):
+            a, b = int(run[0]), int(run[-1])
+            k = a + int(np.argmax(pl[a: b + 1]))
+            floor = float(math.sqrt(left[k] * right[k]) / q)  # median-unbiased on a locally straight log-spectrum
+            lo, hi = max(1, a - g), min(pl.size - 2, b + g)
+            power = float(np.sum(pl[lo: hi + 1] - floor) * df * L)
+            if not power > 0:
+                power = float((pl[k] - floor) * df * L)
+            lo_f, hi_f = lo * L, (hi + 1) * L - 1
+            peak = lo_f + int(np.argmax(p[lo_f: hi_f + 1]))
+            out.append({"lo": lo_f, "hi": min(hi_f, p.size - 2), "peak": peak, "p": float(np.min(p_fw[a: b + 1])),
+                        "power": power, "floor": floor, "L": L})
+    return out, m, band
+
+
+def _merge_levels(found: list) -> list:
+    """One line per feature from the clusters of every resolution (finest first).
+
+    A coarser cluster overlapping no accepted line is added; overlapping exactly one, it replaces it when it holds
+    more than ``_BROAD_POWER_RATIO`` times its power (the finer resolution saw only the top of a broad line);
+    overlapping two or more, it is dropped (the finer resolution separates them).
+    """
+    acc = []
+    for c in sorted(found, key=lambda c: c["L"]):
+        hit = [i for i, a in enumerate(acc) if c["lo"] <= a["hi"] and a["lo"] <= c["hi"]]
+        if not hit:
+            acc.append(c)
+        elif len(hit) == 1 and c["power"] > _BROAD_POWER_RATIO * acc[hit[0]]["power"]:
+            acc[hit[0]] = c
+    return acc
+
+
 def _refine_freq(p: np.ndarray, k: int, df: float) -> float:
     """Gaussian (log-parabolic) interpolation of the peak at bin ``k`` [Hz]."""
     if k <= 0 or k >= p.size - 1:
@@ -424,20 +529,30 @@ def _group_harmonics(raw: list, df: float) -> list:
             else:
                 missing += 1
             h += 1
+        if len(members) >= 3:  # an established series: its isolated higher harmonics too (tighter tolerance)
+            for i in sorted(free, key=lambda i: raw[i]["f"]):
+                hh = int(round(raw[i]["f"] / f0))
+                if hh > max(m[0] for m in members) and abs(raw[i]["f"] - hh * f0) <= df:
+                    members.append((hh, i))
+                    free.discard(i)
         comps.append((f0, members))
     return comps
 
 
-def _rolloff(f: np.ndarray, p: np.ndarray, df: float):
-    """(corner_hz, fall_db, plateau_top_hz) when the line-free spectrum shows a low-pass roll-off, else None."""
-    from scipy.ndimage import median_filter
+def _rolloff(f: np.ndarray, p_free: np.ndarray, df: float):
+    """(corner_hz, fall_db) when the line-free spectrum ``p_free`` shows a low-pass roll-off, else None.
 
-    nb = p.size
-    nyq = f[-1]
-    smooth = median_filter(p, size=2 * _W_MAX + 1, mode="nearest")
-    f_a = max(2 * _W_MAX * df, nyq / 32.0)
+    Levels are band means in 1/6-octave bands from ``max(4 df, Nyquist / 64)`` to two bins below Nyquist.  A white
+    plateau is two octaves of bands whose fitted slope is within ``_PLATEAU_DB_PER_OCT``; the highest plateau counts
+    when every band above it stays within ``_MONOTONE_TOL_DB`` of the running minimum (a monotone fall) and the top
+    band is at least ``_ROLLOFF_DB`` below both the plateau's mean level and its fitted trend carried to Nyquist
+    (so a 1/f spectrum, which falls everywhere, shows no roll-off).  The corner is where the band levels first fall
+    3 dB below that level (interpolated in log frequency).
+    """
+    nyq = float(f[-1])
+    f_a = max(4.0 * df, nyq / 64.0)
     top = nyq - 2.0 * df
-    if top <= 4.0 * f_a:
+    if top <= 8.0 * f_a:
         return None
     n_band = int(math.floor(6.0 * math.log2(top / f_a)))
     edges = f_a * 2.0 ** (np.arange(n_band + 1) / 6.0)
@@ -447,48 +562,37 @@ def _rolloff(f: np.ndarray, p: np.ndarray, df: float):
         sel = (f >= lo) & (f < hi)
         if not sel.any():
             continue
-        v = float(np.mean(smooth[sel]))
-        if v <= 0:
+        v = float(np.mean(p_free[sel]))
+        if not v > 0:
             return None
         lev.append(10.0 * math.log10(v))
         cen.append(math.sqrt(lo * hi))
     lev, cen = np.asarray(lev), np.asarray(cen)
-    if lev.size < 10:
+    if lev.size < 12:
         return None
     oct_ = np.log2(cen)
     l_top = lev[-1]
-    best = None
-    for i in range(lev.size - 2, 5, -1):  # highest plateau first
-        sel = (oct_ >= oct_[i] - 1.0) & (oct_ <= oct_[i])
-        if sel.sum() < 5:
+    for i in range(lev.size - 2, 4, -1):  # the highest plateau first
+        sel = (oct_ >= oct_[i] - _PLATEAU_OCTAVES) & (oct_ <= oct_[i])
+        if oct_[i] - oct_[0] < _PLATEAU_OCTAVES - 1e-9:
             break
         slope, icpt = np.polyfit(oct_[sel], lev[sel], 1)
         if abs(slope) > _PLATEAU_DB_PER_OCT:
             continue
         white = float(np.mean(lev[sel]))
+        trend_top = float(icpt + slope * oct_[-1])  # the plateau's own trend carried to Nyquist
+        if min(white, trend_top) - l_top < _ROLLOFF_DB:
+            return None  # the highest plateau reaches Nyquist, or the fall is only its own trend: no roll-off
         after = lev[i + 1:]
-        if white - l_top < _ROLLOFF_DB:
+        run_min = np.minimum.accumulate(np.concatenate([[white], after]))[:-1]
+        if np.any(after > run_min + _MONOTONE_TOL_DB):
             continue
-        if np.any(after > np.minimum.accumulate(np.concatenate([[white], after]))[:-1] + _MONOTONE_TOL_DB):
-            continue
-        best = (i, white)
-        break
-    if best is None:
-        return None
-    i, white = best
-    # corner: first frequency above the plateau where the smoothed PSD falls 3 dB below it
-    k0 = int(np.searchsorted(f, cen[i]))
-    sl = 10.0 * np.log10(np.maximum(smooth, 1e-300))
-    below = np.nonzero(sl[k0:nb - 1] <= white - 3.0)[0]
-    if below.size == 0:
-        return None
-    k = k0 + int(below[0])
-    if k > k0:
-        y0, y1 = sl[k - 1] - (white - 3.0), sl[k] - (white - 3.0)
-        corner = f[k - 1] + (f[k] - f[k - 1]) * (y0 / (y0 - y1) if y0 != y1 else 0.0)
-    else:
-        corner = f[k]
-    return float(corner), float(white - l_top), float(cen[i])
+        below = np.nonzero(after <= white - 3.0)[0]
+        j = i + 1 + int(below[0])
+        y0, y1 = lev[j - 1] - (white - 3.0), lev[j] - (white - 3.0)
+        x = oct_[j - 1] + (oct_[j] - oct_[j - 1]) * (y0 / (y0 - y1) if y0 > 0 and y0 != y1 else 0.0)
+        return float(2.0**x), float(white - l_top)
+    return None
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -559,50 +663,38 @@ def analyse_spectrum(rate_dph, dt_s, *, false_alarm=0.01, max_lines=16) -> Spect
     nperseg = _nperseg(n)
     f, p, n_seg = _welch(x - x.mean(), fs, nperseg)
     df = fs / nperseg
-    nb = p.size
     nu = welch_edf(nperseg, n_seg)
-    left, right, w = _local_medians(p)
-    searched = w > 0
-    m = int(searched.sum())
-    if m == 0:
+    r_fine = _fine_bin_r(nperseg)
+    levels = [L for L in _LEVELS if L == 1 or (p.size - 1) // L >= _MIN_COARSE_BINS]
+    found, m_total, band = [], 0, None
+    for L in levels:
+        res = _search_level(p, L, nu, r_fine, fa / len(levels), df)
+        if res is None:
+            continue
+        clusters, m_l, band_l = res
+        m_total += m_l
+        if L == 1:
+            band = band_l
+        for c in clusters:
+            c["p"] = min(1.0, c["p"] * len(levels))  # Bonferroni over the resolutions
+            found.append(c)
+    if m_total == 0 or band is None:
         return SpectrumSummary(dt, n, fa, df, variance_dph2=var, note="no spectrum: too few frequency bins")
-    from scipy.stats import chi2
-
-    q = chi2.median(nu) / nu
-    ref = np.where(searched, np.maximum(left, right), np.nan)
-    ratio = np.zeros(nb)
-    ok = searched & (ref > 0)
-    ratio[ok] = p[ok] / ref[ok]
-    p_target = -math.expm1(math.log1p(-fa) / m)  # per-bin level of the Sidak correction
-    bin_corr = _bin_correlation(nperseg)
-    p_fw = np.ones(nb)
-    for ww in np.unique(w[ok]):
-        null = _MedianNull(nu, int(ww), bin_corr)
-        cand = np.nonzero(ok & (w == ww) & (ratio >= null.critical(p_target)))[0]
-        if cand.size:
-            pb = null.sf(ratio[cand])
-            p_fw[cand] = np.where(pb < 1e-12, m * pb, -np.expm1(m * np.log1p(-np.minimum(pb, 1.0 - 1e-16))))
-    # the floor under a line: median-unbiased on a locally straight log-spectrum
-    floor_c = np.zeros(nb)
-    floor_c[ok] = np.sqrt(left[ok] * right[ok]) / q
-    sig = np.nonzero(ok & (p_fw <= fa))[0]
-    band = (float(f[searched][0]), float(f[searched][-1]))
+    raw = _merge_levels(found)
+    p_free = p.copy()  # the spectrum with every significant line replaced by its floor (for the roll-off)
+    for c in raw:
+        p_free[c["lo"]: c["hi"] + 1] = c["floor"]
     enbw = nperseg * float(np.sum(_window(nperseg) ** 2)) / float(np.sum(_window(nperseg))) ** 2
-
-    raw = []
-    if sig.size:
-        splits = np.nonzero(np.diff(sig) > _MERGE_GAP + 1)[0] + 1
-        for run in np.split(sig, splits):
-            a, b = int(run[0]), int(run[-1])
-            k = a + int(np.argmax(p[a: b + 1]))
-            fl_k = floor_c[k]
-            lo, hi = max(1, a - _GUARD), min(nb - 2, b + _GUARD)
-            power = float(np.sum(p[lo: hi + 1] - fl_k) * df)
-            if not power > 0:
-                power = float((p[k] - fl_k) * df * enbw)
-            raw.append({"f": _refine_freq(p, k, df), "power": power,
-                        "snr": 10.0 * math.log10(power / (fl_k * enbw * df)) if fl_k > 0 else float("inf"),
-                        "p": float(np.min(p_fw[a: b + 1]))})
+    for c in raw:
+        if c["L"] == 1:
+            c["f"] = _refine_freq(p, c["peak"], df)
+        else:  # a broad line: the centroid of its excess power
+            ex = np.maximum(p[c["lo"]: c["hi"] + 1] - c["floor"], 0.0)
+            c["f"] = float(np.sum(ex * f[c["lo"]: c["hi"] + 1]) / np.sum(ex)) if ex.sum() > 0 else float(f[c["peak"]])
+        ex = np.maximum(p[c["lo"]: c["hi"] + 1] - c["floor"], 0.0)
+        fr = f[c["lo"]: c["hi"] + 1]
+        c["width"] = 2.0 * math.sqrt(float(np.sum(ex * (fr - c["f"]) ** 2) / np.sum(ex))) if ex.sum() > 0 else df
+        c["snr"] = 10.0 * math.log10(c["power"] / (c["floor"] * enbw * df)) if c["floor"] > 0 else float("inf")
     raw.sort(key=lambda r: -r["power"])
     raw = raw[:n_max]
 
@@ -613,17 +705,18 @@ def analyse_spectrum(rate_dph, dt_s, *, false_alarm=0.01, max_lines=16) -> Spect
             r = raw[i]
             lines.append(SpectralLine(freq_hz=r["f"], amplitude_dph=math.sqrt(2.0 * r["power"]),
                                       power_dph2=r["power"], snr_db=r["snr"], p_value=min(1.0, r["p"]),
-                                      harmonic_of=None if h == 1 else f0))
+                                      harmonic_of=None if h == 1 else f0, width_hz=r["width"],
+                                      broad=r["width"] > _BROAD_WIDTH_BINS * df))
             r["line"] = lines[-1]
         comps.append(PeriodicComponent(fundamental_hz=f0, period_s=1.0 / f0, lines=tuple(lines),
                                        power_dph2=float(sum(ln.power_dph2 for ln in lines))))
     comps.sort(key=lambda c: -c.power_dph2)
     lines = tuple(sorted((r["line"] for r in raw), key=lambda ln: -ln.power_dph2))
 
-    ro = _rolloff(f, p, df)
+    ro = _rolloff(f, p_free, df)
     return SpectrumSummary(dt, n, fa, df, lines=lines, components=tuple(comps),
                            rolloff_hz=None if ro is None else ro[0], rolloff_db=None if ro is None else ro[1],
-                           variance_dph2=var, searched_bins=m, band_hz=band)
+                           variance_dph2=var, searched_bins=m_total, band_hz=band)
 
 
 def sinusoid_avar(tau_s, amplitude_dph, freq_hz, *, dt_s=None) -> np.ndarray:
