@@ -60,7 +60,8 @@ COLUMNS: tuple = (
     ("b_min_tau_s", "float", "s, tau of that minimum"),
     ("b_min_bound_only", "bool", "true when the fitted ADEV still falls at the longest tau (b_min is a bound)"),
     ("outliers", "int", "samples beyond the outlier threshold"),
-    ("verdict", "str", "analyze: which drift model beat persistence on the test block"),
+    ("verdict", "str", "analyze: paper's measure (one step ahead, target = non-causal wavelet drift; not a "
+                       "compensation result): which drift model beat persistence on the test block"),
     ("compensation_outcome", "str", "analyze: headline of the heading-error evaluation (evaluation.verdicts.judge: "
                                     ">= 5 % lower RMS AND better at most non-overlapping origins): reduces, mixed, "
                                     "none or undetermined"),
