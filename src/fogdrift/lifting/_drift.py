@@ -8,7 +8,8 @@ runs either
   approximation, then ``J`` inverse levels with zero detail bands, through the generic step
   applier of the selected backend; or
 * the fused path (:func:`_fused_drift`, numba backend and ``n >= _FUSED_MIN``): the same
-  arithmetic, block by block with a halo, in parallel.  Tests check it against
+  arithmetic, block by block with a halo, in parallel (serially below ``_PARALLEL_MIN_BLOCKS``
+  blocks, where starting the threads costs more than the work).  Tests check it against
   :func:`_drift_ref` for every registered wavelet, both modes, odd and even lengths.
 """
 
