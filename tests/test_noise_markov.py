@@ -70,7 +70,7 @@ def test_markov_law_on_a_long_simulated_series():
 
 def _fit(seed, n=2**15, dt=0.2, tc=50.0, sigma=2.0, arw=0.05):
     y = simulate(n, dt, arw_dprh=arw, seed=seed) + _gm(n, dt, tc, sigma, seed)
-    return fit_noise(allan_variance(y, dt))
+    return fit_noise(allan_variance(y, dt), markov=True)
 
 
 def _covers(f, tc=50.0):
@@ -103,6 +103,14 @@ def test_gauss_markov_tc_interval_covers_the_truth_20_seeds():
     assert covered >= 18, covered
 
 
+def test_markov_is_opt_in_for_fit_noise():
+    # the Kalman filter and model bundles build from the power-law A: without markov=True M is never tried
+    f = _fit(0)
+    y = simulate(2**15, 0.2, arw_dprh=0.05, seed=0) + _gm(2**15, 0.2, 50.0, 2.0, 0)
+    assert "M" in f.selected and "M" not in fit_noise(allan_variance(y, 0.2)).selected
+
+
 def test_white_noise_gets_no_markov_term():
-    fits = [fit_noise(allan_variance(simulate(2**15, 0.1, arw_dprh=0.05, seed=s), 0.1)) for s in range(10)]
+    fits = [fit_noise(allan_variance(simulate(2**15, 0.1, arw_dprh=0.05, seed=s), 0.1), markov=True)
+            for s in range(10)]
     assert sum("M" in f.selected for f in fits) <= 1

@@ -230,5 +230,5 @@ def test_no_model_fits_is_said_and_cells_are_bounds():
     assert f.no_fit is not None and f.notes[0].startswith("no model fits tau")
     assert all(c.startswith("–") for c in noise_row(f))
     assert fit_cell(f).startswith("no model fits")
-    g = fit_noise(allan_variance(y, dt))  # with M the hump is modelled
+    g = fit_noise(allan_variance(y, dt), markov=True)  # with M the hump is modelled
     assert g.no_fit is None and "M" in g.selected

@@ -424,7 +424,7 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     lo, hi = cfg.fit_tau_s
     tau_range = None if lo is None and hi is None else (lo, hi)
     noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range,
-                      spectrum=spectrum)
+                      spectrum=spectrum, markov=True)
     if outliers is not None:
         noise.outliers = outliers.to_dict()
     return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers)

@@ -111,7 +111,7 @@ def _inflation(allan):
 
 
 def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penalty=2.0,
-              plausible_delta=6.0, spectrum=None, markov=True) -> NoiseFit:
+              plausible_delta=6.0, spectrum=None, markov=False) -> NoiseFit:
     """Identify the IEEE-952 noise terms of an Allan-family curve.
 
     Parameters
@@ -135,7 +135,9 @@ def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penal
         frequencies, and a short-tau shape is called an output filter only where it shows a roll-off.  None (a
         published curve): no S term, and no shape is called a filter.
     markov : bool, keyword-only
-        Try the exponentially correlated (Gauss-Markov) term M (default True; only without fixed ``terms``).
+        Try the exponentially correlated (Gauss-Markov) term M (only without fixed ``terms``).  Default False, so
+        the callers that build models from ``A`` (the Kalman filter, model bundles: power-law terms only) see the
+        same fit as before; :func:`fogdrift.pipeline.analyse_allan` (``fogdrift allan``, the reports) turns it on.
 
     Returns
     -------

@@ -817,9 +817,9 @@ def _markov_stage(c: _Context, C, res, best, penalty):
         return None
     iM = _NAMES.index("M")
     base_cols = tuple(i for i in c.cols if i != iM)
-    # T_c inside the fitted range: the Gauss-Markov hump (ADEV maximum at ~1.9 T_c) must lie within it, or the
-    # term only imitates a filter edge (short T_c) or a random walk (long T_c)
-    lo_t, hi_t = math.log(c.tau[0]), math.log(c.tau[-1] / 2.0)
+    # T_c inside the fitted range (2 tau_min .. tau_max / 2): the Gauss-Markov hump (ADEV maximum at ~1.9 T_c)
+    # must lie within it, or the term only imitates a filter edge (short T_c) or a random walk (long T_c)
+    lo_t, hi_t = math.log(2.0 * c.tau[0]), math.log(c.tau[-1] / 2.0)
     if hi_t <= lo_t:
         return None
     grid = np.linspace(lo_t, hi_t, 12)

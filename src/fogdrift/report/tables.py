@@ -84,7 +84,8 @@ def b_headline(noise) -> str:
 
 def shaped_cell(noise) -> str:
     """The IEEE-952 Annex C terms that are no power law, when the selected model holds them:
-    ``S 8.0 deg/h @ 20.02 Hz`` and ``M σ 3.1 deg/h, T_c 48 [35, 70] s`` (``–`` when neither)."""
+    ``S 8.0 deg/h @ 20.02 Hz`` and ``M σ 3.1 deg/h, T_c 48 [35, 70] s`` (``–`` when neither, or when no model
+    fits)."""
     parts = []
     sh = getattr(noise, "shaped", None) or {}
     ts = noise.terms.get("S")
@@ -96,8 +97,8 @@ def shaped_cell(noise) -> str:
         lo, hi = m.get("tc_lo95_s"), m.get("tc_hi95_s")
         ci = f" [{_fmt(lo, 2) if lo else '?'}, {_fmt(hi, 2) if hi else '?'}]"
         parts.append(f"M σ {_fmt(m['sigma_dph'], 3)} deg/h, T_c {_fmt(m['tc_s'], 3)}{ci} s")
-    if getattr(noise, "no_fit", None) and parts:
-        return "(no model fits) " + "; ".join(parts)
+    if getattr(noise, "no_fit", None):  # no headline value from a model that misses the curve (notes have them)
+        return "–"
     return "; ".join(parts) if parts else "–"
 
 
