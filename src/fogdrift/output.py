@@ -15,6 +15,12 @@
 
 An interrupted run (see :mod:`fogdrift.interrupt`) leaves only complete files; :meth:`OutputDir.summary` says
 which were written and which were not.
+
+One run per folder at a time: :class:`OutputDir` holds an exclusive ``flock`` on :data:`LOCK` in the folder from
+its start (or from its first write, when the folder does not exist yet) to its end; a second run is refused with
+one line naming the first (its command, process id and start).  The kernel drops the lock when a process ends,
+so a crashed run never leaves the folder locked.  An output that would replace one of the run's inputs is
+refused.
 """
 
 from __future__ import annotations
@@ -31,10 +37,17 @@ from pathlib import Path
 from .errors import ConfigError
 from .interrupt import check, critical
 
-__all__ = ["MANIFEST", "TMP_PREFIX", "OutputDir", "atomic_path", "check_out_dir", "active"]
+try:  # POSIX; elsewhere runs are not serialised (said in the docstring of _FolderLock)
+    import fcntl
+except ImportError:  # pragma: no cover - not on the supported platforms
+    fcntl = None
+
+__all__ = ["MANIFEST", "LOCK", "TMP_PREFIX", "OutputDir", "atomic_path", "check_out_dir", "active"]
 
 #: Name of the manifest a run keeps in its output folder.
 MANIFEST = ".fogdrift-manifest.json"
+#: Lock file of the run writing a folder (removed when the run ends; its lock dies with the process).
+LOCK = ".fogdrift-lock"
 #: Prefix of the temporary files (followed by the process id, a dash and the final name).
 TMP_PREFIX = ".fogdrift-tmp-"
 _TMP = re.compile(re.escape(TMP_PREFIX) + r"(\d+)-")
@@ -155,6 +168,56 @@ def atomic_path(path):
         raise
 
 
+class _FolderLock:
+    """Exclusive, non-blocking ``flock`` on ``folder/LOCK``; the holder's description is written into the file.
+
+    The file is unlinked while still locked when released; a process that opened the old file before the unlink
+    sees another inode at the path after locking and tries again, so two runs never both hold the folder.
+    Without ``fcntl`` (not POSIX) nothing is locked.
+    """
+
+    def __init__(self, folder: Path, who: str):
+        self.path = folder / LOCK
+        self.who = who
+        self.fd = None
+
+    def acquire(self) -> None:
+        if fcntl is None or self.fd is not None:
+            return
+        for _ in range(8):
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                try:
+                    holder = os.read(fd, 512).decode("utf-8", "replace").strip() or "another fogdrift run"
+                finally:
+                    os.close(fd)
+                raise ConfigError(f"{{opt:out}} {self.path.parent}: {holder} is writing there now; wait for it to "
+                                  "finish or choose another folder") from None
+            try:
+                same = os.fstat(fd).st_ino == os.stat(self.path).st_ino
+            except FileNotFoundError:
+                same = False
+            if not same:  # released and unlinked between our open and our lock: take the new file
+                os.close(fd)
+                continue
+            os.ftruncate(fd, 0)
+            os.write(fd, self.who.encode("utf-8"))
+            self.fd = fd
+            return
+        raise ConfigError(f"{{opt:out}} {self.path.parent}: could not take the folder's lock {LOCK}")
+
+    def release(self) -> None:
+        if self.fd is None:
+            return
+        with contextlib.suppress(OSError):
+            os.unlink(self.path)
+        with contextlib.suppress(OSError):
+            os.close(self.fd)
+        self.fd = None
+
+
 class OutputDir:
     """One run's output folder (see the module docstring).
 
@@ -192,9 +255,13 @@ class OutputDir:
         self._lock = threading.RLock()
         self._aborted = False
         self._started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+        self._folder_lock = _FolderLock(self.path, f"'fogdrift {command}' (process {os.getpid()}, started "
+                                                   f"{self._started})")
 
     # -- context ------------------------------------------------------------------------------------
     def __enter__(self):
+        if self.path.is_dir():  # an existing folder is taken before any work; a new one at its creation
+            self._folder_lock.acquire()
         _active.append(self)
         return self
 
@@ -207,6 +274,7 @@ class OutputDir:
         finally:
             self._discard_pending()
             _active.remove(self)
+            self._folder_lock.release()
         return False
 
     def expect(self, *names) -> None:
@@ -223,6 +291,10 @@ class OutputDir:
         check()
         final = Path(path) if Path(path).is_absolute() else self.path / path
         rel = self._rel(final)
+        if final.absolute() in self.protect or any(final.exists() and p.exists() and final.samefile(p)
+                                                   for p in self.protect):
+            raise ConfigError(f"{{opt:out}} {self.path}: the output {rel} would replace the input file {final}; "
+                              "choose another output folder")
         with self._lock:
             if self._aborted:
                 raise RuntimeError("output folder closed after an interruption")
@@ -272,7 +344,8 @@ class OutputDir:
             if self.create_parents:
                 self.path.mkdir(parents=True, exist_ok=True)
             else:
-                self.path.mkdir()
+                self.path.mkdir(exist_ok=True)  # another run may create it at the same moment: the lock decides
+        self._folder_lock.acquire()
         previous = self._read_manifest()
         for rel in previous.get("files", []):
             target = self._inside(rel)
