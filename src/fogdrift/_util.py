@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from .errors import ConfigError, DataFormatError, InsufficientDataError
@@ -101,3 +103,38 @@ def json_default(obj):
     if hasattr(obj, "to_dict"):
         return obj.to_dict()
     raise TypeError(f"not JSON-serialisable: {type(obj).__name__}")
+
+
+def safe_name(name) -> str:
+    """An axis, model or file name as a file-name part: runs of characters other than ASCII letters, digits,
+    ``.``, ``_`` and ``-`` become one ``_`` (deterministic; no path separator), ``"_"`` if nothing is left.
+
+    The one sanitiser of output names (figures, bundle, compensated files, fleet folders); two names that map to
+    the same part are refused where they are made (:func:`check_distinct_names`), never silently overwritten.
+
+    Examples
+    --------
+    >>> safe_name("g x"), safe_name("gyro/z"), safe_name("../x"), safe_name("")
+    ('g_x', 'gyro_z', 'x', '_')
+    """
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._") or "_"
+
+
+def check_distinct_names(names, what: str = "axis names", hint: str = "") -> None:
+    """Refuse names that :func:`safe_name` maps to one output name (``g x`` and ``g_x``; ``a b.csv``, ``a_b.csv``).
+
+    Examples
+    --------
+    >>> check_distinct_names(["gx", "gy"])
+    >>> check_distinct_names(["g x", "g_x"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.ConfigError: axis names 'g x' and 'g_x' would share the output name 'g_x'...
+    """
+    seen: dict[str, str] = {}
+    for n in names:
+        key = safe_name(n).lower()  # also distinct on a case-insensitive file system
+        if key in seen and seen[key] != str(n):
+            raise ConfigError(f"{what} {seen[key]!r} and {str(n)!r} would share the output name "
+                              f"{safe_name(n)!r}; their files would overwrite each other" + (f"; {hint}" if hint else ""))
+        seen.setdefault(key, str(n))

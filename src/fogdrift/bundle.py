@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from ._util import json_default
+from ._util import json_default, safe_name
 from .errors import ConfigError, FogdriftError, ModelFileError
 from .output import atomic_path
 
@@ -331,10 +331,6 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _safe(name: str) -> str:
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "_"
-
-
 def save_bundle(bundle: Bundle, out_dir) -> Path:
     """Write ``bundle`` to the directory ``out_dir`` (created; an existing manifest is replaced); returns it."""
     out = Path(out_dir)
@@ -343,7 +339,7 @@ def save_bundle(bundle: Bundle, out_dir) -> Path:
     for ax in bundle.axes:
         files = {}
         for name, model in ax.models.items():
-            rel = f"{_safe(ax.name)}/{_safe(name)}"
+            rel = f"{safe_name(ax.name)}/{safe_name(name)}"
             json_path, npz_path = model.save(out / rel)
             files[name] = {"file": rel, "class": type(model).__name__, "label": model.label,
                            "input": model.input_kind,

@@ -40,13 +40,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .._util import safe_name
 from ..output import atomic_path
 
 __all__ = ["write_compensated_test_block", "compensated_test_block"]
-
-
-def _safe(name: str) -> str:
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "_"
 
 
 def compensated_test_block(model_axis, t0_s: float = 0.0) -> dict[str, np.ndarray]:
@@ -76,7 +73,7 @@ def write_compensated_test_block(model_axes, out_dir, *, t0_s: float = 0.0) -> l
         names = list(cols)
         header = ",".join(["t_s"] + [f"{n}[deg/h]" for n in names[1:]])
         data = np.column_stack([cols[n] for n in names])
-        path = Path(out_dir) / f"compensated_test_{_safe(ma.name)}.csv"
+        path = Path(out_dir) / f"compensated_test_{safe_name(ma.name)}.csv"
         with atomic_path(path) as tmp:
             with open(tmp, "w") as fh:
                 fh.write(header + "\n")

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._util import check_distinct_names
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
 from ._checks import first_nonfinite, int_arg, parse_unit, positive_float, split_keys, take_columns, to_dph, unit_scale
 
@@ -95,6 +96,8 @@ class GyroRecord:
             raise ConfigError(f"axis_names must name the {r.shape[1]} columns of rate_dph; got {names!r}")
         if len(set(names)) != len(names):
             raise ConfigError(f"axis_names must be unique; got {names!r}")
+        check_distinct_names(names, "axis names", "rename a column (the file's header) or select one with "
+                                                  "{opt:columns}")
         object.__setattr__(self, "axis_names", names)
         declared = tuple(None if u is None else str(u) for u in self.declared_units) or (None,) * len(names)
         if len(declared) != len(names):
