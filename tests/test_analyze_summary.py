@@ -60,8 +60,18 @@ def test_details_prints_every_table(bundled_path, tmp_path):
     res = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models",
                               "persistence", "--no-heading", "--details", "--out", str(tmp_path)])
     assert res.exit_code == 0, res.output
-    assert "Table 2" in res.stdout and "one-step metrics on the test block" in res.stdout
+    assert "Table 2" in res.stdout and "one-step metrics on the test block (paper's measure)" in res.stdout
     assert "heading error not evaluated (--no-heading)" in res.stdout
+    assert "gz: paper's measure (one step ahead" in res.stdout and "beat persistence one step" not in res.stdout
+
+
+def test_details_flag_practical_table2_rows_the_artefact_check_flags(bundled_path, tmp_path):
+    # persistence on the bundled gz: the artefact check flags it at 0.001-0.02 Hz (report and console alike)
+    res = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models",
+                              "persistence", *DEMO, "--details", "--out", str(tmp_path)], env={"COLUMNS": "250"})
+    assert res.exit_code == 0, res.output
+    flagged = [ln for ln in res.stdout.splitlines() if "FLAGGED: improvement partly removes real rate" in ln]
+    assert flagged and all("(practical)" in ln for ln in flagged)
 
 
 @pytest.mark.parametrize("args, message", [

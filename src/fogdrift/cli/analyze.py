@@ -204,24 +204,29 @@ def parse_heading_options(calibration: float, origin_step: float, horizons: str)
 def _print_details(result, title, apply_title, evaluations) -> None:
     """Every table of the run on the console (``--details``): Table 2, one-step metrics, GMWM, heading error,
     artefacts and every verdict line."""
-    from ..report import fit_cell, metrics_rows, noise_row, verdict
+    from ..evaluation.verdicts import paper_measure_verdict, table2_marks
+    from ..report import fit_cell, metrics_rows, noise_row
     from .compensate import print_evaluation
 
     for res, name in ((result, title), (result.apply_to, apply_title)):
         if res is None:
             continue
         for ax in res.axes:
+            ev = getattr(ax, "evaluation", None)
+            marks = table2_marks(ax.table2, ev.artefacts) if ev is not None and ev.artefacts is not None else {}
             console.print(noise_table(f"{name} axis {ax.name}: Table 2 (test block, {ax.models.dt_s:g} s "
                                       "samples; 95 % intervals)",
                                       [["original (whole record, native rate)"] + noise_row(ax.original.noise)
                                        + [fit_cell(ax.original.noise)]]
-                                      + [[row.label] + noise_row(row.analysis.noise)
-                                         + [fit_cell(row.analysis.noise)] for row in ax.table2],
+                                      + [[row.label + (f" FLAGGED: {marks[row.label]}" if row.label in marks else "")]
+                                         + noise_row(row.analysis.noise) + [fit_cell(row.analysis.noise)]
+                                         for row in ax.table2],
                                       fit=True))
-            console.print(metrics_table(f"{name} axis {ax.name}: one-step metrics on the test block",
-                                        metrics_rows(ax.models)))
-            for line in verdict(ax.models):
-                say("  " + line)
+            console.print(metrics_table(f"{name} axis {ax.name}: one-step metrics on the test block (paper's "
+                                        "measure)", metrics_rows(ax.models)))
+            if ev is None:  # with an evaluation, its verdicts (printed below) carry the same labelled sentence
+                for line in paper_measure_verdict(ax.models).lines:
+                    say("  " + line)
             if ax.gmwm is not None:
                 from .noise import print_gmwm
 
