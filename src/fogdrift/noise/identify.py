@@ -863,6 +863,11 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     best_non = min(non_m, key=lambda s: non_m[s]["ic"])
     if iM in best2 and not res2[best2]["ic"] < non_m[best_non]["ic"] - MARKOV_IC_GAIN:
         best2 = best_non
+    if iM in best2 and res2[best2]["q"] / max(1, c.tau.size - len(best2) - 1) > POOR_CHI2_RED:
+        # an M that still leaves a poor fit describes no hump: it only bends the model somewhere; no M
+        c.X[:, iM] = 0.0
+        c.tc_s = None
+        return None
     if iM not in best2:  # under its own covariance M is no longer needed
         c.X[:, iM] = 0.0
         c.tc_s = None
@@ -1049,6 +1054,11 @@ def _classical_b(c: _Context, A, floor_refused: bool = False) -> dict:
                         "floor lies above the measured curve"}
     grid = np.logspace(math.log10(c.tau[0]), math.log10(c.tau[-1]), 400)
     var = sum(A[i] * c.laws[n].shape(grid, c.dt) for i, n in enumerate(_NAMES) if n in c.laws)
+    iS, iM = _NAMES.index("S"), _NAMES.index("M")
+    if A[iM] > 0 and c.tc_s is not None:  # the printed model: its shaped terms too
+        var = var + A[iM] * markov_shape(grid, c.tc_s, c.statistic, c.dt)
+    if A[iS] > 0 and c.lines:
+        var = var + A[iS] * periodic_shape(grid, c.lines, c.dt, c.statistic)
     k = int(np.argmin(var))
     j = int(np.argmin(np.abs(np.log(c.tau / grid[k]))))
     value = math.sqrt(var[k]) / B_FACTOR
