@@ -108,7 +108,9 @@ def test_adis16405_log_read_as_deg_h_is_warned(tmp_path):
     (["analyze", "--models", ""], "no drift model given"),
     (["analyze", "--latitude", "34.2"], "without the axis it applies to; pass --earth-axis"),
     (["analyze", "--latitude", "95", "--earth-axis", "gz=up"], "latitude must be in [-90, 90]"),
-    (["analyze", "--model-rate", "-1"], "model_rate_hz must be > 0"),
+    (["analyze", "--model-rate", "-1"], "the modelling rate (--model-rate) must be > 0 Hz"),
+    (["analyze", "--train-fraction", "0.7", "--val-fraction", "0.3"], "(--train-fraction + --val-fraction) must "
+                                                                       "leave a test block"),
     (["separate", "--wavelet", "db9"], "db9"),
     (["separate", "--mode", "wrap"], "--mode must be one of"),
     (["model", "--training", "sgd"], "--training must be 'bptt' or 'bp'"),

@@ -130,11 +130,13 @@ class AnalysisConfig:
     def validate(self) -> "AnalysisConfig":
         if not 0 < self.train_fraction < 1 or not 0 <= self.val_fraction < 1:
             raise ConfigError(
-                f"train_fraction must be in (0, 1) and val_fraction in [0, 1); got {self.train_fraction}, {self.val_fraction}"
+                f"the training share ({{opt:train_fraction}}) must be in (0, 1) and the validation share "
+                f"({{opt:val_fraction}}) in [0, 1); got {self.train_fraction}, {self.val_fraction}"
             )
         if self.train_fraction + self.val_fraction >= 1:
             raise ConfigError(
-                f"train_fraction + val_fraction must leave a test block; got {self.train_fraction + self.val_fraction:.3g} >= 1"
+                f"the training and validation shares ({{opt:train_fraction}} + {{opt:val_fraction}}) must leave a "
+                f"test block; got {self.train_fraction + self.val_fraction:.3g} >= 1"
             )
         from .models import model_spec
 
@@ -152,11 +154,12 @@ class AnalysisConfig:
         if self.noise_method not in ("allan", "gmwm"):
             raise ConfigError(f"noise_method must be 'allan' or 'gmwm', got {self.noise_method!r} ({{opt:noise_method}})")
         if self.model_rate_hz is not None and not self.model_rate_hz > 0:
-            raise ConfigError(f"model_rate_hz must be > 0 Hz or None; got {self.model_rate_hz!r}")
+            raise ConfigError(f"the modelling rate ({{opt:model_rate_hz}}) must be > 0 Hz; got {self.model_rate_hz!r}")
         if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
-            raise ConfigError(f"lags, hidden and epochs must be >= 1; got {self.lags}, {self.hidden}, {self.epochs}")
+            raise ConfigError(f"{{opt:lags}}, {{opt:hidden}} and {{opt:epochs}} must be >= 1; got {self.lags}, "
+                              f"{self.hidden}, {self.epochs}")
         if not self.causal_window_s > 0:
-            raise ConfigError(f"causal_window_s must be > 0 s; got {self.causal_window_s!r}")
+            raise ConfigError(f"the causal window ({{opt:causal_window_s}}) must be > 0 s; got {self.causal_window_s!r}")
         if self.latitude_deg is not None and not -90.0 <= float(self.latitude_deg) <= 90.0:
             raise ConfigError(f"latitude must be in [-90, 90] deg; got {self.latitude_deg!r} (option {{opt:latitude_deg}})")
         if self.latitude_deg is not None and not self.earth_axes:

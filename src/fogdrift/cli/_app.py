@@ -70,7 +70,8 @@ FLAGS = {
     "apply_unit": "--apply-unit", "axis_map": "--axis-map", "accept_rate": "--accept-rate", "bias": "--bias",
     "model": "--model", "chunk_samples": "--chunk", "out": "--out", "pdf": "--pdf",
     "method": "--method", "noise_method": "--noise-method", "scales": "--scales", "levels": "--scales",
-    "curve": "--curve", "sensor": "--sensor", "robust": "--robust",
+    "curve": "--curve", "sensor": "--sensor", "robust": "--robust", "train_fraction": "--train-fraction",
+    "val_fraction": "--val-fraction", "causal_window_s": "--causal-window",
     # reader options (fogdrift.io.registry.READERS) and the temperature column
     "temperature": "--temperature", "topic": "--topic", "stamp": "--stamp", "dataset": "--dataset",
     "variable": "--variable", "gain": "--gain", "layout": "--layout", "scale": "--scale",
