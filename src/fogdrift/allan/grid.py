@@ -90,7 +90,7 @@ def tau_grid(n_samples, dt_s, taus="octave", *, max_fraction=0.25, statistic="ad
             m = np.arange(1, m_max + 1)
         else:
             raise ConfigError(
-                f"taus must be 'octave', 'decade', 'all', an int or an array of tau_s, got {taus!r}"
+                f"taus must be 'octave', 'decade', 'all', an int or an array of τ values [s], got {taus!r}"
             )
     elif isinstance(taus, (int, np.integer)) and not isinstance(taus, bool):
         if not 1 <= int(taus) <= MAX_TAUS:
@@ -100,15 +100,15 @@ def tau_grid(n_samples, dt_s, taus="octave", *, max_fraction=0.25, statistic="ad
         try:
             t = np.asarray(taus, dtype=np.float64).ravel()
         except (TypeError, ValueError):
-            raise ConfigError(f"taus must be a keyword, an int or an array of tau_s, got {taus!r}") from None
+            raise ConfigError(f"taus must be a keyword, an int or an array of τ values [s], got {taus!r}") from None
         if t.size == 0 or not np.all(np.isfinite(t)):
-            raise ConfigError(f"taus must be a non-empty array of finite tau_s, got {taus!r}")
+            raise ConfigError(f"taus must be a non-empty array of finite τ values [s], got {taus!r}")
         m = np.rint(t / dt)
         if m.min() < 1 or m.max() > m_top:
             bad = t[(m < 1) | (m > m_top)][0]
             raise ConfigError(
                 f"tau {bad!r} s is outside the computable range of the {stat.long_name}; expected "
-                f"{dt} s <= tau <= {m_top * dt} s (1 <= m <= {m_top} with N={n}, dt_s={dt})"
+                f"{dt} s <= tau <= {m_top * dt} s (1 <= m <= {m_top} for {n} samples at {dt} s)"
             )
         if m.size > MAX_TAUS:
             raise ConfigError(f"at most {MAX_TAUS} taus, got {m.size}")

@@ -149,7 +149,7 @@ def _open_npy(path: Path, columns, time_column, rate_hz, time_unit) -> LogSource
             raise ConfigError(f"{path}: cannot tell the sample interval: a .npy file has no time column unless "
                               "one is named with {opt:time_column}; pass the sample rate in Hz as {opt:rate_hz}")
         dt, t0 = 1.0 / float(rate_hz), 0.0
-        notes.append(f"dt_s {dt:.10g} from the given rate (no time column)")
+        notes.append(f"sample interval {dt:.10g} s from the given rate (no time column)")
     else:
         head = read(0, min(rows, 65537))[:, t_idx] * t_scale
         if head.size < 2:
@@ -161,7 +161,7 @@ def _open_npy(path: Path, columns, time_column, rate_hz, time_unit) -> LogSource
                 raise DataFormatError(f"time column disagrees with the given rate; expected steps of "
                                       f"{1 / float(rate_hz):.10g} s, got {dt:.10g} s", path=path, column=f"col{t_idx}")
             dt = 1.0 / float(rate_hz)
-        notes.append(f"dt_s {dt:.10g} from the time column col{t_idx} (median of the first steps)")
+        notes.append(f"sample interval {dt:.10g} s from the time column col{t_idx} (median of the first steps)")
     if not (math.isfinite(dt) and dt > 0):
         raise DataFormatError(f"sample interval {dt!r} s; expected a finite interval > 0", path=path)
 
