@@ -166,7 +166,7 @@ def test_analyze_batch_rows_carry_the_verdict(tmp_path):
     res = run_batch([f], tmp_path / "o", command="analyze", settings=settings, scheduler="serial")
     row = res.rows[0]
     assert row["status"] == "ok", row["error"]
-    assert row["verdict"].startswith("AR(p) ") and "persistence one step ahead" in row["verdict"]
+    assert row["verdict"].startswith(f"{row['axis']}: paper's measure (one step ahead") and "AR(p) RMSE" in row["verdict"]
     doc = json.loads((tmp_path / "o" / "a.csv" / "analysis.json").read_text())
     ev = doc["axes"][0]["evaluation"]                                # as `fogdrift analyze` stores it
     assert row["compensation_outcome"] == ev["headline"]["data"]["outcome"]

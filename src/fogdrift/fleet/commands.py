@@ -122,7 +122,8 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     from ..compensate.test_block import write_compensated_test_block
     from ..evaluation import evaluate_analysis
     from ..pipeline import run_analysis
-    from ..report import verdict, write_report
+    from ..evaluation.verdicts import paper_measure_verdict
+    from ..report import write_report
 
     cfg = _config(settings)
     result = run_analysis(record, cfg)
@@ -134,7 +135,7 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     for ax in result.axes:
         ev = evaluations.get(ax.name)
         rows.append({"axis": ax.name, **record_columns(record), **noise_columns(ax.original.noise),
-                     "verdict": " ".join(verdict(ax.models)),
+                     "verdict": " ".join(paper_measure_verdict(ax.models).lines),
                      "compensation_outcome": None if ev is None else str(ev.outcome),
                      "compensation_headline": None if ev is None else " ".join(ev.headline.lines)})
     return rows
