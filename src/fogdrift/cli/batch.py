@@ -95,7 +95,10 @@ def batch(
     robust: RobustOpt = False,
     set_: Annotated[Optional[list[str]], typer.Option(
         "--set", help="Any other analysis setting NAME=VALUE (fogdrift.pipeline.AnalysisConfig), repeatable.")] = None,
-    fail_on_error: Annotated[bool, typer.Option("--fail-on-error", help="Exit 1 if any file failed.")] = False,
+    fail_on_error: Annotated[bool, typer.Option(
+        "--fail-on-error/--allow-failures", help="Exit 1 if any file failed (the default; the batch still goes "
+                                                 "on and writes every other file's results); --allow-failures "
+                                                 "exits 0 all the same.")] = True,
     out: Annotated[Path, typer.Option("--out", help="Batch folder: one folder per file, summary.parquet, "
                                                     "fleet.html.")] = DEFAULT_OUT,
 ):
@@ -141,4 +144,6 @@ def batch(
         if result.page_path is not None:
             say(f"fleet page: {result.page_path}")
         if fail_on_error and result.n_error:
+            say(f"exit code 1: {result.n_error} of {result.n_files} files failed (--allow-failures exits 0)",
+                style="red")
             raise typer.Exit(code=1)
