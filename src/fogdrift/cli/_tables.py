@@ -31,7 +31,8 @@ def print_noise_notes(label, noise, outliers=None, dt_s=None):
     for i, note in enumerate(noise_notes(noise)):
         if detailed and note.startswith("outliers:"):
             continue
-        say(f"  {label}: {note}", style="bold" if i == 0 else ("yellow" if note.startswith("fit poor") else "dim"))
+        say(f"  {label}: {note}", style="bold" if i == 0 else
+            ("yellow" if note.startswith(("fit poor", "no model fits")) else "dim"))
     if detailed:
         say(f"  {label}: outliers: {outliers.summary(dt_s)}", style="yellow")
     say(f"  {label}: slope read-outs (IEEE-952 cross-check, not the result): {readout_text(noise)}", style="dim")
