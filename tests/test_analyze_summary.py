@@ -58,7 +58,8 @@ def test_the_demo_protocol_gives_a_judged_verdict(demo_run):
 
 def test_details_prints_every_table(bundled_path, tmp_path):
     res = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--models",
-                              "persistence", "--no-heading", "--details", "--out", str(tmp_path)])
+                              "persistence", "--no-heading", "--details", "--out", str(tmp_path)],
+                        env={"COLUMNS": "250"})
     assert res.exit_code == 0, res.output
     assert "Table 2" in res.stdout and "one-step metrics on the test block (paper's measure)" in res.stdout
     assert "heading error not evaluated (--no-heading)" in res.stdout
@@ -96,3 +97,15 @@ def test_stacked_cells_keep_the_whole_text():
     assert _stacked("0.3043 [0.237, 0.304]") == "0.3043\n[0.237, 0.304]"
     assert _short_label("N angle random walk [deg/√h]") == "N [deg/√h]"
     assert _short_label("selected noise model") == "model"
+
+
+def test_the_headline_holds_no_value_where_no_model_fits(demo_run):
+    _, folder = demo_run
+    doc = json.loads((folder / "analysis.json").read_text())
+    fit = doc["axes"][0]["original"]["noise"]
+    rows = {r[0]: r[1] for r in doc["report_summary"]["noise"]["rows"]}
+    terms = [label for label in rows if label[:2] in ("N ", "B ", "K ", "R ", "Q ")]
+    assert len(terms) == 5
+    assert fit["no_fit"]  # the bundled gz at 100 Hz: broad 2.7/5.6 Hz vibration peaks no IEEE term describes
+    assert all(rows[t].startswith(("–", "n/e")) for t in terms), rows
+    assert rows["selected noise model"].startswith("no model fits (best candidate ")

@@ -239,6 +239,7 @@ def _print_details(result, title, apply_title, evaluations) -> None:
 
 #: Short console labels of the report's headline rows (the report keeps the long ones).
 _SHORT_LABELS = {"selected noise model": "model", "selected noise model (WIC)": "model (WIC)",
+                 "periodic / Markov terms (IEEE-952 Annex C)": "periodic / Markov",
                  "χ²_red (fit quality, p)": "fit χ²_red", "fitted τ range [s]": "fitted τ [s]"}
 
 
@@ -270,11 +271,11 @@ def print_summary(result, record, *, evaluated: bool, apply_name: str = "") -> N
     keep = []
     for row in rows:
         sym = row[0].split(" ")[0]
-        optional = sym in ("K", "R", "Q") and all(c.startswith(("–", "n/e")) for c in row[1:])
+        optional = sym in ("K", "R", "Q", "periodic") and all(c.startswith(("–", "n/e")) for c in row[1:])
         if not optional:
             keep.append([_short_label(row[0])] + list(row[1:]))
     keep = [[row[0]] + [_stacked(c) for c in row[1:]] for row in keep]
-    console.print(fitted_table(f"Noise of the original output ({headers[0]}; 95 % intervals)",
+    console.print(fitted_table(f"Noise of the original output: {headers[0]}, 95 % intervals",
                                [""] + [h.replace("axis ", "") for h in headers[1:]], keep))
     say("  – (< x): not in the selected model, x its 95 % upper bound; n/e: not estimable (the report says why)",
         style="dim")

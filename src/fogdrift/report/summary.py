@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .tables import _fmt, b_min_cell, term_text
+from .tables import _fmt, term_text
 
 __all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "recording_rows", "noise_headline", "verdict_items",
            "cannot_support", "summary_dict"]
@@ -66,20 +66,32 @@ def recording_rows(result, sensor: str | None = None) -> list:
 
 
 def noise_headline(result) -> tuple:
-    """``(headers, rows)``: one column per axis; rows N, B, K, R, Q (value [95 % interval]), the IEEE B_min
-    reading, the selected model, chi2_red with the fit quality, and the fitted tau range."""
+    """``(headers, rows)``: one column per axis; rows N, B (one reading per axis, named by its rule), K, R, Q
+    (value [95 % interval]), the periodic / Markov terms, the selected model (or "no model fits" with the best
+    candidate), chi2_red with the fit quality, and the fitted tau range.
+
+    The cells are the allan table's (:func:`~fogdrift.report.tables.noise_row`): when no model fits, every
+    coefficient is an upper bound, never a value."""
+    from .tables import noise_row, shaped_cell
+
     axes = list(result.axes)
     if axes and all(getattr(ax, "gmwm", None) is not None for ax in axes):
         return _gmwm_headline(axes)
     headers = ["whole record, native rate (Allan fit)"] + [f"axis {ax.name}" for ax in axes]
     fits = [ax.original.noise for ax in axes]
+    cells = [dict(zip(("Q", "N", "B", "K", "R"), noise_row(f))) for f in fits]
     rows = []
     for name in HEADLINE_TERMS:
-        rows.append([_term_label(name)] + [term_text(f.terms[name]) for f in fits])
-    rows.append(["B_min, IEEE reading at the ADEV minimum [deg/h]"] + [b_min_cell(f) for f in fits])
-    rows.append(["selected noise model"] + ["+".join(f.selected) or "(none)" for f in fits])
-    rows.append(["χ²_red (fit quality, p)"] + [f"{_fmt(f.chi2_red, 3)} ({f.quality}, p = {f.p_value:.2g})"
-                                               for f in fits])
+        label = ("B bias instability: the flicker floor when fitted, else the IEEE reading min ADEV/0.664 [deg/h]"
+                 if name == "B" else _term_label(name))
+        rows.append([label] + [c[name] for c in cells])
+    rows.append(["periodic / Markov terms (IEEE-952 Annex C)"] + [shaped_cell(f) for f in fits])
+    rows.append(["selected noise model"] + [
+        (f"no model fits (best candidate {'+'.join(f.selected) or 'none'})" if getattr(f, "no_fit", None)
+         else "+".join(f.selected) or "(none)") for f in fits])
+    rows.append(["χ²_red (fit quality, p)"] + [
+        f"{_fmt(f.chi2_red, 3)} ({'no model fits' if getattr(f, 'no_fit', None) else f.quality}, p = {f.p_value:.2g})"
+        for f in fits])
     rows.append(["fitted τ range [s]"] + [f"{_fmt(f.tau_min_s, 3)} – {_fmt(f.tau_max_s, 3)}" for f in fits])
     return headers, rows
 
