@@ -95,8 +95,11 @@ def shaped_cell(noise) -> str:
     if tm is not None and tm.value is not None and "M" in noise.selected and sh.get("M", {}).get("tc_s"):
         m = sh["M"]
         lo, hi = m.get("tc_lo95_s"), m.get("tc_hi95_s")
-        ci = f" [{_fmt(lo, 2) if lo else '?'}, {_fmt(hi, 2) if hi else '?'}]"
-        parts.append(f"M σ {_fmt(m['sigma_dph'], 3)} deg/h, T_c {_fmt(m['tc_s'], 3)}{ci} s")
+        if not (lo and hi) or not tm.lo95:  # a T_c or q_c the data do not bound is no number to print
+            parts.append("M in the model, not resolved (T_c not bounded by the data)")
+        else:
+            parts.append(f"M σ {_fmt(m['sigma_dph'], 3)} deg/h, T_c {_fmt(m['tc_s'], 3)} [{_fmt(lo, 2)}, "
+                         f"{_fmt(hi, 2)}] s")
     if getattr(noise, "no_fit", None):  # no headline value from a model that misses the curve (notes have them)
         return "–"
     return "; ".join(parts) if parts else "–"
