@@ -24,7 +24,7 @@ Procedure (method notes §2.5 and §9; each step is a function below):
 7. **Checks and words.**  A flat bias-instability floor above the measured curve's minimum is refused (the
    classical bound min ADEV / 0.664 is reported instead); the fit quality (chi-squared, p-value, worst tau
    range with the sign and size of the misfit) is always returned, with the reason for every term that is not
-   resolved.
+   resolved.  The checks and the classical reading are in :mod:`.checks`, the words in :mod:`.notes`.
 
 Simulation checks (tests): over 50 seeds each of white + random walk, white + flicker + random walk and
 quantization + white + random walk + ramp, the 95 % intervals cover the true coefficient of every present term in
@@ -40,11 +40,17 @@ from scipy.optimize import brentq
 from scipy.stats import chi2, t as student_t
 
 from ..errors import ConfigError, InsufficientDataError
-from ..units import B_FACTOR
+from .checks import _check_floor, _classical_b, _drop_rejected, _point_limits, _q_at_whole_periods
 from .covariance import estimator_covariance, expected_variance, ieee_spectrum, ramp_cross_variance
 from .engine import ScoreProblem, all_subsets, fit_subsets, profile_interval
+from .notes import (_absent_reason, _at_bound_notes, _describe_excluded, _largest_gap_note, _misfit_note, _no_fit,
+                    _unresolved_reason)
 from .result import NoiseFit, NoiseTerm
-from .terms import ALL_TERMS, DISPLAY_UNITS, TERM_TABLE, TERMS, UNESTIMABLE, laws_of, markov_shape, periodic_shape
+from .terms import ALL_TERMS, TERM_TABLE, TERMS, UNESTIMABLE, laws_of, markov_shape, periodic_shape
+
+# the checks and words that lived here before the split stay importable from this module
+from .checks import _points_outside, _sub_cov  # noqa: F401
+from .notes import GAP_NOTE_RATIO, _shape_hint, _slope, _tau_span, _worst_region  # noqa: F401
 
 __all__ = ["identify", "thin_taus", "POOR_CHI2_RED"]
 
@@ -258,12 +264,6 @@ def _reduced(sel, n_points):
     return r["q"] / max(1, n_points - len(sel["best"]))
 
 
-def _tau_span(lo: float, hi: float) -> str:
-    """``"0.64"`` for one point, ``"0.64-5.12"`` for a range (3 significant digits)."""
-    a, b = f"{lo:.3g}", f"{hi:.3g}"
-    return a if a == b else f"{a}-{b}"
-
-
 def _choose_start(ctx: _Context, penalty: float, max_fraction: float = 0.5, thresh: float = 16.0,
                   thresh_below: float = 6.25):
     """First fitted point: grow the fit range from where the curve is visibly white noise (else from the long-tau
@@ -328,76 +328,6 @@ def _choose_start(ctx: _Context, penalty: float, max_fraction: float = 0.5, thre
             break
         s -= 1
     return s, _select(ctx.sub(s), penalty), "grown"
-
-
-def _slope(tau, var):
-    lt, ls = np.log(tau), 0.5 * np.log(var)
-    if tau.size < 2:
-        return math.nan
-    return float(np.polyfit(lt, ls, 1)[0])
-
-
-def _describe_excluded(ctx: _Context, start: int, sel, periodic=None, spectrum_given=False, rolloff_hz=None) -> str:
-    """Why the short taus [0, start) were left out, in words.
-
-    An oscillation is named by the real frequency of the spectral lines when the spectrum found any (the tau of a
-    bump is no frequency estimate: a line at 72 Hz in a 100-Hz log puts it anywhere); a curve below the model is
-    called an output filter only where the spectrum shows a roll-off (``rolloff_hz``)."""
-    tau, y = ctx.tau[: start + 1], ctx.y[: start + 1]
-    model = (ctx.X[: start + 1] @ sel["res"][sel["best"]]["a"])
-    ratio = np.sqrt(y / model)  # ADEV data / model
-    slope = _slope(tau[:-1], y[:-1]) if start >= 2 else _slope(tau, y)
-    g = np.sqrt(y * tau)  # ADEV * sqrt(tau): flat for white noise
-    sd = np.log(ctx.y_hi[: start + 1] / y) / (2 * 1.96)  # ~ relative sd of the ADEV
-    # a bump: an interior maximum of ADEV*sqrt(tau) clearly (2 sd) above where the fit starts
-    interior = [k for k in range(1, start) if g[k] > g[k - 1] and g[k] >= g[k + 1]
-                and g[k] > g[start] * (1 + 2 * max(sd[k], 0.01))]
-    i_max = max(interior, key=lambda k: g[k]) if interior else -1
-    if periodic is not None:
-        return f"{periodic.text()} (periodic content the fitted terms do not describe there), not a noise term"
-    if i_max > 0:
-        what = ("an oscillation, but the spectrum shows no line: not a noise term" if spectrum_given else
-                "an oscillation or vibration; its frequency needs the spectrum of the series, not the tau of the "
-                "bump")
-        return f"a bump in the curve near tau = {tau[i_max]:.3g} s ({what})"
-    if np.all(ratio[:-1] < 1.0) and slope > -0.5:
-        if rolloff_hz is not None:
-            why = f"an output low-pass / anti-alias filter (the spectrum rolls off above {rolloff_hz:.3g} Hz)"
-        elif spectrum_given:
-            why = "correlated samples (the spectrum shows no roll-off)"
-        else:
-            why = "correlated samples (no spectrum of the series was given to say more)"
-        kind = (f"ADEV below the model with a slope of {slope:+.2f} (flatter than white noise's -0.5): {why}, "
-                "not a noise term")
-    elif slope < -1.0:
-        kind = f"a slope of {slope:+.2f}, steeper than quantization's -1: not an IEEE-952 term"
-    else:
-        dev = ratio[:-1] - 1.0 if start >= 1 else ratio - 1.0
-        k = int(np.argmax(np.abs(dev)))
-        kind = (f"a shape no IEEE-952 term describes: the ADEV is {'above' if dev[k] > 0 else 'below'} the model by up "
-                f"to {100 * abs(dev[k]):.2g} %, many times its statistical error there")
-    return kind
-
-
-def _worst_region(tau, z):
-    """Contiguous run of |z| > 2 with the largest sum of z^2: (i0, i1) inclusive, or None."""
-    best, cur = None, None
-    for i, v in enumerate(z):
-        if abs(v) > 2.0:
-            if cur is None:
-                cur = [i, i, 0.0]
-            cur[1] = i
-            cur[2] += v * v
-        else:
-            if cur is not None and (best is None or cur[2] > best[2]):
-                best = cur
-            cur = None
-    if cur is not None and (best is None or cur[2] > best[2]):
-        best = cur
-    if best is None and z.size:
-        i = int(np.argmax(np.abs(z)))
-        best = [i, i, float(z[i] ** 2)]
-    return None if best is None else (best[0], best[1])
 
 
 def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev", terms=None, tau_range_s=None,
@@ -631,30 +561,15 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             shaped["M"].update(tc_s=None, tc_lo95_s=None, tc_hi95_s=None, sigma_dph=None)
     notes.extend(_at_bound_notes(prob, A, best, c.tau, out_terms))
     if quality != "good":
-        i01 = _worst_region(c.tau, z)
-        if i01 is not None:
-            i0, i1 = i01
-            dev = np.sqrt(c.y[i0:i1 + 1] / mu[i0:i1 + 1]) - 1.0
-            k = int(np.argmax(np.abs(dev)))
-            side = "above" if dev[k] > 0 else "below"
-            notes.append(
-                f"fit {quality}: chi2_red = {chi2_red:.3g} (p = {p:.2g}); the model misses the curve most at "
-                f"tau = {_tau_span(c.tau[i0], c.tau[i1])} s, where the measured deviation is {side} the model by up to "
-                f"{100 * abs(dev[k]):.0f} %" + _shape_hint(c.tau[i0:i1 + 1], c.y[i0:i1 + 1], dev))
+        notes.extend(_misfit_note(c.tau, c.y, mu, z, quality, chi2_red, p))
         if infl > 1:
             notes.append(f"intervals widened by sqrt(chi2_red) = {math.sqrt(infl):.3g} for the misfit")
     notes.extend(_largest_gap_note(c.tau, c.y, mu, prob.nu))
     no_fit = None
     if chi2_red > POOR_CHI2_RED:
-        miss = _points_outside(c.y, mu, prob.nu)
-        if miss.size:
-            no_fit = {"tau_min_s": float(c.tau[0]), "tau_max_s": float(c.tau[-1]),
-                      "miss_tau_s": [float(t) for t in c.tau[miss]],
-                      "best_candidate": "+".join(_NAMES[i] for i in best)}
-            notes.insert(0, f"no model fits tau {c.tau[0]:.3g}-{c.tau[-1]:.3g} s: the best candidate "
-                            f"({no_fit['best_candidate']}, chi2_red {chi2_red:.3g}) misses the measured curve outside "
-                            f"its 95 % intervals at tau = {', '.join(f'{t:.3g}' for t in c.tau[miss])} s; the "
-                            "coefficients are not a result (the table shows their upper bounds only)")
+        no_fit, note = _no_fit(c.tau, c.y, mu, prob.nu, best, chi2_red)
+        if no_fit is not None:
+            notes.insert(0, note)
     b_min = _classical_b(c, A, floor_refused=out_terms.get("B") is not None and out_terms["B"].status ==
                          "not_estimable" and "contradicted" in (out_terms["B"].reason or "")) \
         if statistic == "adev" else {}
@@ -666,125 +581,6 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         quality=quality, inflation=float(infl), excluded=excluded, notes=notes, b_min=b_min,
         n_samples=int(n_samples), shaped=shaped, no_fit=no_fit,
     )
-
-
-def _q_at_whole_periods(c: _Context, prob, best, A, d2, periodic, out_terms) -> None:
-    """Quantization and a periodic error both fall like tau^-2 below the period, and lines the spectrum did not
-    detect (the weak harmonics of a sawtooth) add exactly such a tail; only the taus from the shortest period on
-    (where every line of a component vanishes at its whole periods) tell them apart.  A Q the fit resolves is kept
-    resolved only if it is still resolved from zero on those taus alone; otherwise it is reported unresolved with
-    that reason (lower bound 0)."""
-    iQ, iS = _NAMES.index("Q"), _NAMES.index("S")
-    p_min = min(periodic.periods_s) if periodic is not None and periodic.periods_s else None
-    if p_min is None:
-        return
-    # a real line is no perfect sinusoid (its amplitude and frequency wander, which fills its nulls): a Q whose
-    # tau^-2 coefficient is no larger than the lines' own tau^-2 envelope (sum Omega_i^2 / (pi f_i)^2) is not told
-    # apart from them at any tau
-    env = A[iS] * sum(r / (math.pi * f) ** 2 for f, r in c.lines)
-    if A[iQ] <= env:
-        t = out_terms["Q"]
-        out_terms["Q"] = NoiseTerm(
-            "Q", t.value, t.unit, 0.0, t.hi95, "unresolved",
-            f"not told apart from the periodic error: its tau^-2 level is below the lines' own envelope "
-            f"(Omega0^2 / (pi f0)^2 over the lines, {math.sqrt(env / max(A[iQ], 1e-300)):.3g}x Q in deviation), and a "
-            "real line's wandering amplitude and frequency fill its nulls; notch the line to read Q")
-        return
-    k0 = int(np.searchsorted(c.tau, p_min * (1 - 1e-9)))
-    if c.tau.size - k0 < len(best) + 1:
-        lo = 0.0
-    else:
-        sub = ScoreProblem(prob.X[k0:], prob.y[k0:], _sub_cov(prob, k0), prob.upper)
-        a, q_sub = sub.fit(best)
-        full = np.zeros(len(_NAMES))
-        full[list(best)] = a
-        lo = profile_interval(sub, best, full, iQ, q_sub, d2)[0] if full[iQ] > 0 else 0.0
-    if lo > 0:
-        return
-    t = out_terms["Q"]
-    out_terms["Q"] = NoiseTerm("Q", t.value, t.unit, 0.0, t.hi95, "unresolved",
-                               f"not resolved from zero at whole periods of the periodic error (tau >= {p_min:.3g} s), "
-                               "where a line adds nothing: below the period quantization and the periodic error "
-                               "(with its undetected weak lines) are not told apart")
-
-
-def _sub_cov(prob, k0):
-    """The relative covariance of the points from ``k0`` on, rebuilt from the problem's EDF and whitening."""
-    L = np.linalg.inv(prob.W)
-    R = L @ L.T
-    sd = np.sqrt(2.0 / prob.nu)
-    C = R * np.outer(sd, sd)
-    return C[k0:, k0:]
-
-
-def _points_outside(y, mu, nu) -> np.ndarray:
-    """Indices of the points whose own 95 % chi-squared interval (EDF ``nu``) does not hold the model value."""
-    nu = np.maximum(np.asarray(nu, dtype=np.float64), 1e-6)
-    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        lo = y * nu / chi2.ppf(0.975, nu)
-        hi = y * nu / chi2.ppf(0.025, nu)  # inf where nu << 1: such a point bounds nothing above
-    return np.flatnonzero((mu < lo) | (mu > hi))
-
-
-def _drop_rejected(c: _Context, prob, res, best, plausible_delta=6.0):
-    """Re-select without every selected term its own checks reject.  Returns ``(best, {index: NoiseTerm})`` with
-    the dropped terms' entries (status ``not_estimable``, the bound and the reason).
-
-    * A flat B floor above the measured curve's minimum (:func:`_check_floor`) is always dropped: the data
-      contradict it.
-    * A term at its ~4-sigma data bound (one point sets it) is dropped when a model without it is plausible (IC
-      within ``plausible_delta`` of the current one): then nothing but that one point asks for the value.  When
-      every model without it is far worse the term stays, named in the notes (:func:`_at_bound_notes`): the data
-      need it, and its value is the largest they allow.
-    """
-    dropped = {}
-    ic_now = res[best]["ic"]
-    for _ in range(len(_NAMES)):
-        a = res[best]["a"]
-        bad = None
-        iB = _NAMES.index("B")
-        if iB in best and "B" in c.laws:
-            tmp = {}
-            _check_floor(tmp, c, a)
-            if "B" in tmp:
-                bad = (iB, tmp["B"])
-        if bad is None:
-            for i in best:
-                u = float(prob.upper[i])
-                if u > 0 and a[i] >= (1.0 - 1e-3) * u and len(best) > 1:
-                    name = _NAMES[i]
-                    ub_pt = _point_limits(prob.y, prob.nu)
-                    k = int(np.nanargmin(np.where(prob.X[:, i] > 0, ub_pt / np.where(prob.X[:, i] > 0, prob.X[:, i], 1),
-                                                  np.inf)))
-                    if name in c.laws:
-                        conv = TERM_TABLE[name].to_unit / math.sqrt(c.laws[name].scale(c.dt))
-                        bound, unit = conv * math.sqrt(u), DISPLAY_UNITS[name]
-                    elif name == "S":
-                        bound, unit = math.sqrt(u), "deg/h"
-                    else:
-                        bound, unit = math.sqrt(u) / max(c.tc_s or 1.0, 1e-300), "deg/h/√s"
-                    bad = (i, NoiseTerm(
-                        name, None, TERM_TABLE[name].unit if name in TERM_TABLE else unit, None, bound,
-                        "not_estimable",
-                        f"left out of the model: its fit ran into its data bound ({bound:.4g} {unit}, set by the "
-                        f"point at tau = {c.tau[k]:.3g} s alone), so the data bound it but do not measure it; "
-                        f"the model was re-selected without it"))
-                    break
-        if bad is None:
-            break
-        i, term = bad
-        keep = [k for k in res if not any(j in k for j in dropped) and i not in k]
-        if not keep:
-            break
-        alt = min(keep, key=lambda k: res[k]["ic"])
-        if _NAMES[i] != "B" and res[alt]["ic"] > ic_now + plausible_delta:
-            break  # the data need the term: it stays at its bound (noted)
-        dropped[i] = term
-        best = alt
-        nz = tuple(j for j in best if res[best]["a"][j] > 0)
-        if nz and nz != best and nz in res:
-            best = nz
-    return best, dropped
 
 
 def _markov_fits(c: _Context, C, base_cols, tc, penalty):
@@ -934,150 +730,3 @@ def _markov_qc_interval(c: _Context, prob, best, info, q_min, d2, lo_v, hi_v):
         his.append(math.sqrt(hi) / tc)
     c.set_tc(tc0)
     return min(los), max(his)
-
-
-def _point_limits(y, nu) -> np.ndarray:
-    """Each point's ~4-sigma upper limit ``y nu / chi2_nu(3.17e-5)`` (the 4-sigma lower quantile of chi2_nu / nu);
-    inf where nu << 1 (the quantile is 0: the point bounds nothing)."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        return y * nu / chi2.ppf(3.17e-5, nu)
-
-
-#: A model deviation at least this many times the measured one (or below 1/this) at one point is named in the
-#: notes whatever the fit statistic says.
-GAP_NOTE_RATIO = 2.0
-
-
-def _largest_gap_note(tau, y, mu, nu) -> list:
-    """The point where the model's deviation is farthest, as a ratio, from the measured one, when that ratio is
-    at least :data:`GAP_NOTE_RATIO` either way.  Chi-squared weighs each point by its EDF, so a long-tau point
-    with few averaging intervals can sit 2x off and count little; a reader of the plot sees it at once, and the
-    note says whether the gap is inside that point's own 95 % interval (chance) or not."""
-    ratio = np.sqrt(mu / y)
-    k = int(np.argmax(np.abs(np.log(ratio))))
-    r, v = float(ratio[k]), float(nu[k])
-    if max(r, 1.0 / r) < GAP_NOTE_RATIO or not np.isfinite(v) or v <= 0:
-        return []
-    lo, hi = chi2.ppf(0.025, v) / v, chi2.ppf(0.975, v) / v  # measured/true variance, 95 %
-    inside = lo <= 1.0 / r**2 <= hi
-    side = "above" if r > 1 else "below"
-    verdict = ("inside that point's own 95 % interval: with so few averaging intervals the data cannot tell, so "
-               "terms acting there rest on little" if inside else
-               "outside that point's own 95 % interval: the model's shape is wrong there")
-    return [f"largest gap: at tau = {tau[k]:.3g} s the model's deviation is {r:.2f}x the measured one ({side} it; "
-            f"~{v:.2g} degrees of freedom), {verdict}"]
-
-
-def _at_bound_notes(prob, A, best, tau, out_terms) -> list:
-    """A selected term whose estimate sits at its upper bound (:meth:`_Context._upper`): the value is set by one
-    point of the curve (the term alone would exceed that point's ~4-sigma upper limit), not by the fit."""
-    notes = []
-    ub_pt = _point_limits(prob.y, prob.nu)
-    for i in best:
-        u = float(prob.upper[i])
-        if not (u > 0 and A[i] >= (1.0 - 1e-3) * u):
-            continue
-        name = _NAMES[i]
-        t = out_terms[name]
-        if t.value is None:  # refused afterwards (a floor above the measured curve): its reason says why
-            continue
-        k = int(np.nanargmin(ub_pt / prob.X[:, i]))
-        notes.append(
-            f"{name} = {t.value:.4g} {DISPLAY_UNITS.get(name, t.unit)} sits at its data bound: a larger {name} alone would "
-            f"exceed the measured curve's ~4-sigma upper limit at tau = {tau[k]:.3g} s, so that one point sets the "
-            f"value, not the fit as a whole; read it as the largest {name} the data allow")
-    return notes
-
-
-def _shape_hint(tau, y, dev) -> str:
-    if tau.size >= 2 and np.any(dev < 0) and np.all(dev <= 0.05):
-        return ("; the curve falls faster than the fitted terms allow (a correlated/Gauss-Markov component or "
-                "bounded platform motion; `fogdrift noise` models Gauss-Markov terms)")
-    if tau.size >= 2:
-        return f"; local ADEV slope there {_slope(tau, y):+.2f}"
-    return ""
-
-
-def _unresolved_reason(name, lacking, plaus, res, ic_best) -> str:
-    if lacking:
-        alt = "+".join(_NAMES[i] for i in lacking[0])
-        return (f"not resolved from zero: the model {alt} without {name} describes the curve about as well "
-                f"(IC {res[lacking[0]]['ic'] - ic_best:+.1f})")
-    return "not resolved from zero: its 95 % interval reaches 0"
-
-
-def _absent_reason(c: _Context, name, A, hi_a) -> str:
-    """Why a term is not in the model: where would it show at its upper bound?"""
-    law = c.laws[name]
-    i = _NAMES.index(name)
-    grid = np.logspace(math.log10(c.tau[0]) - 4, math.log10(c.tau[-1]) + 4, 801)
-    rest = sum(A[j] * c.laws[n].shape(grid, c.dt) for j, n in enumerate(_NAMES) if n in c.laws and j != i)
-    dom = grid[hi_a * law.shape(grid, c.dt) >= rest]
-    if law.power >= 0 and (dom.size == 0 or dom.min() > c.tau[-1]):
-        where = "beyond the record" if dom.size == 0 else f"only beyond tau = {dom.min():.3g} s"
-        return f"not in the model: at its upper bound it would dominate {where} (longest fitted tau {c.tau[-1]:.3g} s); a longer record can resolve it"
-    if law.power < 0 and (dom.size == 0 or dom.max() < c.tau[0]):
-        return f"not in the model: at its upper bound it would dominate only below the fitted range (tau < {c.tau[0]:.3g} s)"
-    return "not in the model: the curve shows no sign of it in the fitted range"
-
-
-def _check_floor(terms, c: _Context, A) -> None:
-    """Refuse a flat B floor above the measured curve's minimum (its 95 % upper bound): the data fall below it."""
-    i = _NAMES.index("B")
-    floor_var = A[i]
-    k = int(np.argmin(c.y))
-    if floor_var > c.y_hi[k]:
-        scale = c.laws["B"].scale(c.dt)
-        bound = math.sqrt(c.y[k] / scale) * TERM_TABLE["B"].to_unit
-        name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}.get(c.statistic, c.statistic)
-        terms["B"] = NoiseTerm(
-            "B", None, TERM_TABLE["B"].unit, None, bound, "not_estimable",
-            f"a flat floor of {math.sqrt(floor_var / scale):.3g} deg/h is contradicted by the measured curve, which "
-            f"falls to {math.sqrt(c.y[k]):.3g} deg/h at tau = {c.tau[k]:.3g} s: no bias-instability floor within the "
-            f"record; classical bound B <= min {name} / {math.sqrt(scale):.4g} = {bound:.3g} deg/h")
-
-
-def _classical_b(c: _Context, A, floor_refused: bool = False) -> dict:
-    """IEEE-952 practice: bias instability read at the minimum of the (fitted) Allan deviation, B = min ADEV / 0.664.
-
-    The minimum is searched on the fitted curve inside the fitted tau range.  When it sits at the longest tau the
-    curve is still falling there and the value is only an upper bound, never above the one the measured curve
-    gives (min measured ADEV / 0.664).  When the fitted flat floor was refused (it lies above the measured curve)
-    the measured minimum is the only reading.  The interval is the measured point's 95 % interval at the tau
-    nearest the minimum.
-    """
-    if floor_refused:
-        j = int(np.argmin(c.y))
-        return {"value": math.sqrt(c.y[j]) / B_FACTOR, "unit": "deg/h", "tau_s": float(c.tau[j]), "bound_only": True,
-                "lo95": None, "hi95": math.sqrt(c.y_hi[j]) / B_FACTOR,
-                "rule": "min of the measured ADEV / 0.664 (IEEE Std 952-1997 C.2), an upper bound: the fitted flat "
-                        "floor lies above the measured curve"}
-    grid = np.logspace(math.log10(c.tau[0]), math.log10(c.tau[-1]), 400)
-    var = sum(A[i] * c.laws[n].shape(grid, c.dt) for i, n in enumerate(_NAMES) if n in c.laws)
-    iS, iM = _NAMES.index("S"), _NAMES.index("M")
-    if A[iM] > 0 and c.tc_s is not None:  # the printed model: its shaped terms too
-        var = var + A[iM] * markov_shape(grid, c.tc_s, c.statistic, c.dt)
-    if A[iS] > 0 and c.lines:
-        var = var + A[iS] * periodic_shape(grid, c.lines, c.dt, c.statistic)
-    k = int(np.argmin(var))
-    j = int(np.argmin(np.abs(np.log(c.tau / grid[k]))))
-    value = math.sqrt(var[k]) / B_FACTOR
-    at_edge = k >= grid.size - 2
-    lo = math.sqrt(c.y[j] * (c.y[j] / c.y_hi[j])) / B_FACTOR  # symmetric-in-log guess of the lower bound
-    rule = ("min of the fitted ADEV / 0.664 (IEEE Std 952-1997 C.2); an upper bound when the curve still falls at "
-            "the longest fitted tau")
-    jm = int(np.argmin(c.y))
-    if at_edge:  # two valid upper bounds: the fitted curve's end and the measured minimum; keep the tighter
-        if math.sqrt(c.y[jm]) / B_FACTOR < value:
-            value, j, k = math.sqrt(c.y[jm]) / B_FACTOR, jm, None
-    elif not lo <= value <= math.sqrt(c.y_hi[j]) / B_FACTOR:
-        # the fitted curve misses the measured points at its minimum (a poor fit): read the measured curve
-        value, j, k = math.sqrt(c.y[jm]) / B_FACTOR, jm, None
-        lo = math.sqrt(c.y[j] * (c.y[j] / c.y_hi[j])) / B_FACTOR
-        rule = ("min of the measured ADEV / 0.664 (IEEE Std 952-1997 C.2): the fitted curve misses the measured "
-                "points at its minimum")
-    return {
-        "value": value, "unit": "deg/h", "tau_s": float(grid[k] if k is not None else c.tau[j]),
-        "bound_only": bool(at_edge),
-        "lo95": None if at_edge else lo, "hi95": math.sqrt(c.y_hi[j]) / B_FACTOR, "rule": rule,
-    }
