@@ -35,6 +35,27 @@ def _slope(tau, var):
     return float(np.polyfit(lt, ls, 1)[0])
 
 
+#: A spectral line is named as the reason for left-out taus only where its own Allan variance reaches this
+#: fraction of the measured one at one of them (a 0.56-Hz line does not shape the curve at tau <= 0.08 s).
+LINE_SHARE = 0.1
+
+
+def _lines_that_matter(periodic, tau, y) -> list:
+    """Phrases for the spectral lines of ``periodic`` whose sinusoid Allan variance (IEEE-952 C.5 law, the line's
+    amplitude) is at least :data:`LINE_SHARE` of the measured variance ``y`` at some tau of ``tau``."""
+    if periodic is None or len(tau) == 0:
+        return []
+    from .spectral import sinusoid_avar
+
+    out = []
+    for f, rel in periodic.lines:
+        amp = periodic.ref_amplitude_dph * math.sqrt(rel)
+        share = sinusoid_avar(np.asarray(tau, dtype=float), amp, f) / np.asarray(y, dtype=float)
+        if np.nanmax(share) >= LINE_SHARE:
+            out.append(f"spectral line at {f:.4g} Hz, {amp:.3g} deg/h")
+    return out
+
+
 def _describe_excluded(ctx: _Context, start: int, sel, periodic=None, spectrum_given=False, rolloff_hz=None) -> str:
     """Why the short taus [0, start) were left out, in words.
 
@@ -51,8 +72,9 @@ def _describe_excluded(ctx: _Context, start: int, sel, periodic=None, spectrum_g
     interior = [k for k in range(1, start) if g[k] > g[k - 1] and g[k] >= g[k + 1]
                 and g[k] > g[start] * (1 + 2 * max(sd[k], 0.01))]
     i_max = max(interior, key=lambda k: g[k]) if interior else -1
-    if periodic is not None:
-        return f"{periodic.text()} (periodic content the fitted terms do not describe there), not a noise term"
+    named = _lines_that_matter(periodic, tau[:-1] if start >= 1 else tau, y[:-1] if start >= 1 else y)
+    if named:
+        return f"{'; '.join(named)} (periodic content the fitted terms do not describe there), not a noise term"
     if i_max > 0:
         what = ("an oscillation, but the spectrum shows no line: not a noise term" if spectrum_given else
                 "an oscillation or vibration; its frequency needs the spectrum of the series, not the tau of the "
