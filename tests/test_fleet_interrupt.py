@@ -94,6 +94,31 @@ def test_interruption_between_files_keeps_finished_folders_and_the_earlier_summa
                                                           "unit2.npy": "ok"}
 
 
+def test_a_killed_workers_dead_lock_file_is_removed_a_live_one_kept(tmp_path, monkeypatch):
+    # a worker SIGKILLed between its folder's batch.json and the end of its run leaves OutputDir's lock file (the
+    # kernel drops the lock itself); the batch removes it after killing its workers, never one still held
+    from fogdrift.fleet import runner
+    from fogdrift.fleet.tasks import FileTask
+    from fogdrift.output import LOCK, _FolderLock
+
+    monkeypatch.setattr(runner, "STALE_LOCK_WAIT_S", 0.05)
+    dead, live = tmp_path / "dead.npy", tmp_path / "live.npy"
+    for folder in (dead, live):
+        folder.mkdir()
+        (folder / BATCH_JSON).write_text("{}")
+    (dead / LOCK).write_text("'fogdrift allan' (process 12345, killed)")  # nobody holds it
+    held = _FolderLock(live, "a run still writing")
+    held.acquire()
+    try:
+        tasks = [FileTask(path=str(f), file=f.name, out_dir=str(f), rel_out=f.name, command="allan", settings={},
+                          settings_sha256="0" * 64, flags={}) for f in (dead, live)]
+        runner._remove_temporaries(tasks)
+        assert not (dead / LOCK).exists() and (dead / BATCH_JSON).exists()
+        assert (live / LOCK).exists()  # held by a live run: not removed
+    finally:
+        held.release()
+
+
 BOOT = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); sys.argv[0] = 'fogdrift'; "
         "from fogdrift.cli import main; main()")
 

@@ -4,7 +4,8 @@ Scheduling (``scheduler``):
 
 * ``None`` (default): a local Dask cluster of worker *processes*, one per core (``workers`` to change it),
   one thread each; numeric libraries inside a worker get ``cores // workers`` threads so that workers do
-  not oversubscribe the machine.  The cluster listens on 127.0.0.1 only and has no dashboard.
+  not oversubscribe the machine.  The cluster listens on 127.0.0.1 only (its scheduler's HTTP server on a free
+  port: distributed's default 8787 may be another cluster's, and taking another port prints a warning).
 * ``"tcp://HOST:8786"``: an existing cluster (``dask scheduler`` + ``dask worker`` on other machines); the
   workers need fogdrift installed and must see the input and output paths (a shared file system).
 * ``"serial"``: no Dask, a loop in this process (debugging; the benchmark's reference).
@@ -49,6 +50,10 @@ __all__ = ["BatchResult", "BatchOutputDir", "run_batch", "find_inputs", "setting
 
 #: Seconds to wait for an existing cluster's scheduler (``scheduler="tcp://..."``) before giving up.
 CONNECT_TIMEOUT_S = 20.0
+#: The local scheduler's HTTP server (health/metrics; the dashboard needs bokeh): loopback, a free port.
+HTTP_ADDRESS = "127.0.0.1:0"
+#: Seconds to wait for killed workers' folder locks to die with them (the kernel drops a lock as its process exits).
+STALE_LOCK_WAIT_S = 2.0
 
 #: File names written into the batch folder.
 SUMMARY = "summary.parquet"
@@ -395,7 +400,7 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
             with _sigint_blocked_for_children():
                 _quiet_resource_tracker()
                 cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                                   host="127.0.0.1", dashboard_address=None,
+                                                   host="127.0.0.1", dashboard_address=HTTP_ADDRESS,
                                                    silence_logs=logging.ERROR, env=_worker_env(n))
                 client = distributed.Client(cluster)
                 client.run(_ignore_sigint)               # each worker process's main thread
@@ -457,15 +462,29 @@ def _kill_workers(cluster) -> None:
 
 
 def _remove_temporaries(tasks) -> None:
-    """Remove the temporary files killed workers left in the files' folders (never a complete file)."""
-    from ..output import TMP_PREFIX
+    """Remove the temporary files killed workers left in the files' folders (never a complete file), and their
+    lock files: a worker killed between its folder's last file and the end of its run leaves the (dead) lock
+    file of :class:`fogdrift.output.OutputDir`."""
+    from ..output import LOCK, TMP_PREFIX, _FolderLock
 
+    deadline = time.monotonic() + STALE_LOCK_WAIT_S
     for task in tasks:
         folder = Path(task.out_dir)
         for tmp in (folder.rglob(TMP_PREFIX + "*") if folder.is_dir() else ()):
             if tmp.is_file() and not tmp.name.startswith(f"{TMP_PREFIX}{os.getpid()}-"):
                 with contextlib.suppress(OSError):
                     tmp.unlink()
+        while (folder / LOCK).exists():
+            lock = _FolderLock(folder, f"fogdrift batch (process {os.getpid()}) removing a killed worker's lock")
+            try:
+                lock.acquire()  # free once the worker's process has exited
+            except (ConfigError, OSError):
+                if time.monotonic() > deadline:  # still held: not ours to remove
+                    break
+                time.sleep(0.02)
+                continue
+            lock.release()  # unlinks the file
+            break
 
 
 def _close(client, cluster, *, quick: bool) -> None:
