@@ -200,13 +200,15 @@ def profile_interval(problem: ScoreProblem, cols, a_hat, col, q_min, delta, *, l
         # tolerances relative to the bracket, not to the value: a ramp or a white-noise level can be known to
         # 1e-4 of itself, and a relative tolerance of 1e-3 would then miss the interval entirely
         lo = brentq(g, 0.0, v_hat, xtol=1e-7 * v_hat, rtol=1e-12, maxiter=100) if g(v_hat) < 0 else v_hat
-    x0 = v_hat if v_hat > 0 else 1e-12 * ub
-    x1 = max(2.0 * x0, x0 + 1e-9 * ub)
-    while x1 < ub and g(x1) <= 0:
+    x0 = min(v_hat if v_hat > 0 else 1e-12 * ub, ub)
+    x1 = min(ub, max(2.0 * x0, x0 + 1e-9 * ub))  # never past the upper bound (the fit is not defined there)
+    g1 = g(x1)
+    while x1 < ub and g1 <= 0:
         x0, x1 = x1, min(ub, 4.0 * x1)
-    if x1 >= ub and g(ub) <= 0:
-        hi = ub
-    elif g(x0) <= 0:
+        g1 = g(x1)
+    if g1 <= 0:  # still inside at the upper bound
+        hi = x1
+    elif x1 > x0 and g(x0) <= 0:
         hi = brentq(g, x0, x1, xtol=1e-7 * (x1 - x0), rtol=1e-12, maxiter=100)
     else:
         hi = x0
