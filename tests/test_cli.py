@@ -39,7 +39,7 @@ def test_allan_on_bundled_recording(bundled_path, tmp_path):
     assert "tau_s" in header and "adev_dph" in header
     assert (tmp_path / "allan.png").stat().st_size > 10_000
     # the console table carries the IEEE B_min reading and the fit quality of each axis, as stored in the JSON
-    assert "B_min IEEE [deg/h]" in out and "fit" in out
+    assert "B [deg/h]" in out and "periodic / Markov" in out and "fit" in out
     for a in doc["axes"]:
         b = a["noise"]["b_min"]
         if b.get("value") is not None:

@@ -189,8 +189,14 @@ class _FolderLock:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError:
-                try:
-                    holder = os.read(fd, 512).decode("utf-8", "replace").strip() or "another fogdrift run"
+                try:  # the holder writes who it is right after locking: give it a moment (a few ms) to do so
+                    holder = ""
+                    for _ in range(50):
+                        holder = os.pread(fd, 512, 0).decode("utf-8", "replace").strip()
+                        if holder:
+                            break
+                        time.sleep(0.01)
+                    holder = holder or "another fogdrift run"
                 finally:
                     os.close(fd)
                 raise ConfigError(f"{{opt:out}} {self.path.parent}: {holder} is writing there now; wait for it to "

@@ -9,7 +9,7 @@ import typer
 from rich.text import Text
 
 from ..errors import render_options
-from ._app import FLAGS, OutOpt, app, console, csv_list, errors, fitted_table, progress_count
+from ._app import FLAGS, OutOpt, _configure, app, console, csv_list, errors, fitted_table, progress_count
 
 
 @app.command()
@@ -61,6 +61,7 @@ def compensate(
     from ..compensate import compensate_file
     from ..errors import ConfigError
 
+    _configure()  # this run's console widths (a terminal, else COLUMNS, else whole lines), as run() does
     with errors():
         try:
             hs = tuple(float(h) for h in csv_list(horizons))
@@ -76,11 +77,12 @@ def compensate(
                 flags=FLAGS, progress=update)
         s = result.summary
         console.print(Text(f"compensated {s['n_samples']} samples of {file.name} with {s['model_label']} "
-                           f"(unit {s['unit']}, {1 / s['native_dt_s']:g} Hz, models at {1 / s['model_dt_s']:g} Hz)"))
+                           f"(unit {s['unit']}, {1 / s['native_dt_s']:g} Hz, models at {1 / s['model_dt_s']:g} Hz)"),
+                      soft_wrap=True)
         for line in result.messages:
-            console.print(Text("  " + render_options(line, FLAGS)), highlight=False)
+            console.print(Text("  " + render_options(line, FLAGS)), highlight=False, soft_wrap=True)
         print_evaluation(result.heading, result.artefacts, result.verdicts)
-        console.print(Text(f"wrote {', '.join(str(p) for p in result.files.values())}"))
+        console.print(Text(f"wrote {', '.join(str(p) for p in result.files.values())}"), soft_wrap=True)
 
 
 def print_evaluation(headings, artefacts, verdicts):
@@ -97,4 +99,4 @@ def print_evaluation(headings, artefacts, verdicts):
                             f"(amplitude {a.amplitude_dph:.4g} deg/h)", headers, rows))
     for v in verdicts:
         for line in v.lines:
-            console.print(Text("  " + render_options(line, FLAGS)), highlight=False)
+            console.print(Text("  " + render_options(line, FLAGS)), highlight=False, soft_wrap=True)
