@@ -97,6 +97,18 @@ def test_stacked_cells_keep_the_whole_text():
     assert _stacked("0.3043 [0.237, 0.304]") == "0.3043\n[0.237, 0.304]"
     assert _short_label("N angle random walk [deg/√h]") == "N [deg/√h]"
     assert _short_label("selected noise model") == "model"
+    from fogdrift.cli.analyze import _terse
+
+    assert _terse("40.6 (no model fits, p = 1e-135)") == "40.6 (no model fits)"
+    assert _terse("no model fits (best candidate Q+N+S)") == "no model fits (best Q+N+S)"
+
+
+def test_the_three_axis_summary_fits_80_columns(bundled_path, tmp_path):
+    res = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--models", "persistence",
+                              "--no-heading", "--out", str(tmp_path)], env={"COLUMNS": "80"})
+    assert res.exit_code == 0, res.output
+    table = [ln for ln in res.stdout.splitlines() if ln[:1] in "┏┃┡│└"]
+    assert max(len(ln) for ln in table) <= 80 and "(continued" not in res.stdout  # one table, three axes
 
 
 def test_the_headline_holds_no_value_where_no_model_fits(demo_run):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -252,6 +253,13 @@ def _short_label(label: str) -> str:
     return f"{sym} [{unit}" if unit and head else label
 
 
+def _terse(cell: str) -> str:
+    """The console's short form of a headline cell (the report keeps the long one): no p-value beside χ²_red,
+    "best" for "best candidate"."""
+    cell = re.sub(r", p = [^)]*\)", ")", cell)
+    return cell.replace("(best candidate ", "(best ")
+
+
 def _stacked(cell: str) -> str:
     """A cell's interval or remark on a second line, so that three axes fit an 80-column terminal."""
     for sep in (" [", " (", " at "):
@@ -274,7 +282,7 @@ def print_summary(result, record, *, evaluated: bool, apply_name: str = "") -> N
         optional = sym in ("K", "R", "Q", "periodic") and all(c.startswith(("–", "n/e")) for c in row[1:])
         if not optional:
             keep.append([_short_label(row[0])] + list(row[1:]))
-    keep = [[row[0]] + [_stacked(c) for c in row[1:]] for row in keep]
+    keep = [[row[0]] + [_stacked(_terse(c)) for c in row[1:]] for row in keep]
     console.print(fitted_table(f"Noise of the original output: {headers[0]}, 95 % intervals",
                                [""] + [h.replace("axis ", "") for h in headers[1:]], keep))
     say("  – (< x): not in the selected model, x its 95 % upper bound; n/e: not estimable (the report says why)",
