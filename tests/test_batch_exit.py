@@ -40,3 +40,15 @@ def test_all_files_ok_exit_0(tmp_path):
     res = CliRunner().invoke(app, ["batch", str(d), "--glob", "*.csv", "--command", "allan", "--scheduler", "serial",
                                    "--out", str(tmp_path / "o")])
     assert res.exit_code == 0, res.output
+
+
+def test_inputs_that_would_share_an_output_folder_are_refused(tmp_path):
+    d = _inputs(tmp_path)
+    (d / "broken.csv").unlink()
+    (d / "unit 0.csv").write_text((d / "unit0.csv").read_text())
+    (d / "unit_0.csv").write_text((d / "unit0.csv").read_text())
+    res = CliRunner().invoke(app, ["batch", str(d), "--glob", "*.csv", "--command", "allan", "--scheduler", "serial",
+                                   "--out", str(tmp_path / "o")])
+    assert res.exit_code != 0 and "Traceback" not in res.output
+    assert "'unit 0.csv' and 'unit_0.csv' would share the output folder 'unit_0.csv'" in res.output
+    assert not (tmp_path / "o" / "unit_0.csv").exists()

@@ -269,6 +269,13 @@ def _run(od, paths, spec, settings, scheduler, workers, page, progress, flags, t
     out = od.path
     digest = settings_sha256(spec.name, settings)
     names = _names(paths)
+    seen: dict[str, str] = {}
+    for n in names:  # distinct inputs, distinct folders: never one file's results over another's
+        key = _folder(n).lower()
+        if key in seen:
+            raise ConfigError(f"{seen[key]!r} and {n!r} would share the output folder {_folder(n)!r} in "
+                              f"{out}; rename one of them or run them in two batches")
+        seen[key] = n
     tasks = [FileTask(path=str(p), file=n, out_dir=str(out / _folder(n)), rel_out=_folder(n), command=spec.name,
                       settings=settings, settings_sha256=digest, flags=flags) for p, n in zip(paths, names)]
     results: dict[int, list] = {}
