@@ -29,6 +29,14 @@ COUNT = re.compile(r"^(?P<label>.+): (?P<pct>\d+) % \((?P<done>\d+) of (?P<total
 MAX_PER_STAGE = 100 // cli_app.PROGRESS_STEP_PCT + 1
 
 
+@pytest.fixture(autouse=True)
+def _no_quiet_start(request, monkeypatch):
+    """The rules below are about the lines a run prints; a run here ends within the quiet start (QUIET_S) that
+    keeps short runs silent, so it is switched off, except for the tests of that rule itself."""
+    if "quiet_start" not in request.node.name:
+        monkeypatch.setattr(cli_app, "QUIET_S", 0.0)
+
+
 def lines(text: str) -> list[str]:
     return [ln for ln in text.splitlines() if ln.strip()]
 
@@ -202,3 +210,25 @@ def test_compensate_piped_counts_the_samples(tmp_path):
     pcts = per_stage["compensate"]
     assert pcts[-1] == 100 and 5 <= len(pcts) <= MAX_PER_STAGE  # 13 chunks of <= 1000 samples: several steps
     assert counts(result.stderr)[-1]["total"] == "12345"
+
+
+def test_quiet_start_a_short_run_prints_no_progress(bundled_path, tmp_path):
+    assert cli_app.QUIET_S > 0
+    result = runner.invoke(app, ["allan", str(bundled_path), "--unit", "deg/h", "--columns", "gz",
+                                 "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    assert not [ln for ln in lines(result.stderr) if ln.startswith("allan · ")]  # ~1 s: only the result
+
+
+def test_quiet_start_a_long_run_prints_the_line_it_is_at_then_every_line(monkeypatch, capsys):
+    monkeypatch.setattr(cli_app, "QUIET_S", 0.2)
+    monkeypatch.setattr(cli_app, "HEARTBEAT_S", 60.0)
+    with cli_app._Lines("job") as display:
+        display.stage("job · stage 1")
+        display.stage("job · stage 2")          # held back: within the quiet start
+        deadline = time.monotonic() + 30        # hang guard only: wait for the quiet start to pass and flush
+        while display._pending is not None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        display.stage("job · stage 3")
+    err = lines(capsys.readouterr().err)
+    assert err == ["job · stage 2", "job · stage 3"]  # the latest held-back line once, then each line

@@ -24,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import inspect
+import math
 import os
 import sys
 import threading
@@ -493,9 +494,12 @@ def progress_label(description: str, axes, stage: str = "", axis=None, model=Non
 #: Off a terminal (a pipe, a log file, CI) progress is plain lines on stderr instead of a bar: each stage as it
 #: starts, the count of a stage with a known total (taus, epochs, samples, files) each time it passes another
 #: PROGRESS_STEP_PCT % (so at most 100 / PROGRESS_STEP_PCT + 1 lines per stage), and a "still running" line
-#: after HEARTBEAT_S seconds without a line.  Nothing is printed before the first stage or count.
+#: after HEARTBEAT_S seconds without a line.  Nothing is printed before the first stage or count, nor during the
+#: first QUIET_S seconds of a run: a run that ends sooner prints no progress (its output is the result alone), a
+#: longer one prints the line it is at when QUIET_S has passed, and every line after it.
 PROGRESS_STEP_PCT = 10
 HEARTBEAT_S = 30.0
+QUIET_S = 3.0
 
 
 def _bar_on_terminal() -> bool:
@@ -539,9 +543,10 @@ class _Lines:
         self._t0 = self._t_last = time.monotonic()
         self._stop = threading.Event()
         self._thread = None
+        self._pending = None  # the latest line held back during the first QUIET_S seconds
 
     def __enter__(self):
-        if HEARTBEAT_S > 0:
+        if HEARTBEAT_S > 0 or QUIET_S > 0:
             self._thread = threading.Thread(target=self._heartbeat, name="fogdrift-progress-heartbeat", daemon=True)
             self._thread.start()
         return self
@@ -554,13 +559,23 @@ class _Lines:
 
     def _emit(self, text: str) -> None:
         with self._lock:
-            self._t_last = time.monotonic()
+            now = time.monotonic()
+            if now - self._t0 < QUIET_S:
+                self._pending = text
+                return
+            self._pending = None
+            self._t_last = now
             err_console.print(Text(text), soft_wrap=True, highlight=False)
 
     def _heartbeat(self) -> None:
-        while not self._stop.wait(HEARTBEAT_S / 4):
+        tick = min(x for x in (HEARTBEAT_S / 4, 0.25 if QUIET_S > 0 else math.inf) if x > 0)
+        while not self._stop.wait(tick):
             now = time.monotonic()
-            if now - self._t_last >= HEARTBEAT_S:
+            with self._lock:  # taken under the lock: a line printed meanwhile clears it, never printed twice
+                pending, self._pending = (self._pending, None) if now - self._t0 >= QUIET_S else (None, self._pending)
+            if pending is not None:
+                self._emit(pending)
+            elif HEARTBEAT_S > 0 and now - self._t_last >= HEARTBEAT_S and now - self._t0 >= QUIET_S:
                 self._emit(f"{self._label}: still running ({now - self._t0:.0f} s since the start)")
 
     def stage(self, label: str) -> None:
