@@ -42,7 +42,7 @@ def vm_hwm_mb():
 
 mode, path, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
 from fogdrift.allan import allan_variance
-from fogdrift.allan_chunked import allan_variance_chunked
+from fogdrift.allan.chunked import allan_variance_chunked
 from fogdrift.io.chunked import open_source
 # warm-up (numba compilation or cache load) on a small file, excluded from the timing
 small = np.random.default_rng(0).normal(size=300_000).astype(np.float32)

@@ -15,7 +15,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from fogdrift.allan import allan_variance
-from fogdrift.allan_chunked import allan_variance_chunked, haar_wavelet_variance_chunked
+from fogdrift.allan.chunked import allan_variance_chunked, haar_wavelet_variance_chunked
 from fogdrift.errors import ConfigError, DataFormatError
 from fogdrift.io import load
 from fogdrift.io.chunked import open_source

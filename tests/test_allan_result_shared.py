@@ -1,6 +1,6 @@
 """In-memory and out-of-core Allan results are built by one function and agree field by field.
 
-Both :func:`fogdrift.allan.allan_variance` and :func:`fogdrift.allan_chunked.allan_variance_chunked` end in
+Both :func:`fogdrift.allan.allan_variance` and :func:`fogdrift.allan.chunked.allan_variance_chunked` end in
 :func:`fogdrift.allan.core.result_from_sums`.  The out-of-core path used to carry its own copy of that tail,
 without the later EDF rule for phase-noise slopes at long tau (fewer than ``AUTO_MIN_INTERVALS`` intervals):
 on differenced white noise (2^16 samples, octave taus, default ``noise_alpha``) its EDF at the two longest
@@ -22,7 +22,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from fogdrift.allan import AllanResult, allan_variance
 from fogdrift.allan.core import AUTO_MIN_INTERVALS, result_from_sums
-from fogdrift.allan_chunked import BLOCK, allan_variance_chunked
+from fogdrift.allan.chunked import BLOCK, allan_variance_chunked
 from fogdrift.io.chunked import open_source
 from fogdrift.simulate import simulate
 

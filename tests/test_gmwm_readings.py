@@ -256,7 +256,7 @@ def test_allan_table_from_fogdrift_allan_equals_the_log(tmp_path):
 def test_one_rule_in_the_report_table_and_the_fleet_row():
     """The 30-s record's bound reaches the HTML table (no interval) and the fleet row (b_min_bound_only) alike."""
     from fogdrift.fleet.commands import gmwm_columns
-    from fogdrift.report_gmwm import gmwm_noise_html
+    from fogdrift.report.gmwm import gmwm_noise_html
 
     x = simulate_latent("WN+RW", [1.0, 1e-9], 3000, seed=4)
     with warnings.catch_warnings():

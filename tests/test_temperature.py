@@ -15,7 +15,7 @@ from scipy.stats import linregress
 from fogdrift.errors import ConfigError, DataFormatError
 from fogdrift.io import load, load_segments
 from fogdrift.temperature import summary_line, temperature_summary
-from fogdrift.temperature_plot import plot_rate_and_temperature
+from fogdrift.report.temperature import plot_rate_and_temperature
 
 
 def _csv(tmp_path, temp, t=None, header="t_s,gx[deg/h],gy[deg/h],temp"):

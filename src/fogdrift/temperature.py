@@ -5,7 +5,7 @@ A reader can carry one temperature column (deg C) into the record
 scale factor depend on temperature (IEEE Std 952-1997 §§ 8.2.1 and C.5 ask for the temperature
 during a drift test to be recorded with it), so a characterisation states how much the
 temperature moved while the log was taken.  This module only summarises; the figure is
-:func:`fogdrift.temperature_plot.plot_rate_and_temperature`.  Temperature as a model covariate
+:func:`fogdrift.report.temperature.plot_rate_and_temperature`.  Temperature as a model covariate
 comes later.
 """
 

@@ -37,7 +37,11 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import ConfigError, DataFormatError, InsufficientDataError
+from ..errors import ConfigError, DataFormatError, InsufficientDataError
+from .ci import resolve_alpha
+from .core import IEEE952_ALPHAS, result_from_sums
+from .grid import tau_grid
+from .statistics import get_statistic
 
 __all__ = ["allan_variance_chunked", "haar_wavelet_variance_chunked", "HaarWaveletVariance", "BLOCK",
            "DEFAULT_CHUNK"]
@@ -271,9 +275,6 @@ _ESTIMATORS = ("overlapping", "non-overlapping")
 
 
 def _prepare(source, taus, estimator, max_fraction, chunk_samples, noise_alpha=None):
-    from .allan import IEEE952_ALPHAS, get_statistic, tau_grid
-    from .allan.ci import resolve_alpha
-
     if estimator not in _ESTIMATORS:
         raise ConfigError(f"estimator must be one of {list(_ESTIMATORS)} out of core; got {estimator!r}")
     n = int(source.n_samples)
@@ -340,8 +341,6 @@ def allan_variance_chunked(source, *, taus="octave", estimator="overlapping", no
     n, chunk, m, strides = _prepare(source, taus, estimator, max_fraction, chunk_samples, noise_alpha)
     mu, offsets = _mean_and_offsets(source, chunk, progress)
     sums = _second_difference_sums(_Phase(source, mu, offsets), m, strides, chunk, progress)
-    from .allan.core import result_from_sums
-
     return result_from_sums(sums, n, m, strides, source.dt_s, statistic="adev", estimator=estimator,
                             noise_alpha=noise_alpha)
 

@@ -208,7 +208,7 @@ def result_from_sums(sums, n, m, strides, dt_s, *, statistic, estimator, noise_a
     """The :class:`AllanResult` (variance, EDF, alpha, bounds, every field) from the operator sums.
 
     The one place where sums of squared differences become a result: :func:`allan_variance` and the
-    out-of-core :func:`fogdrift.allan_chunked.allan_variance_chunked` both end here, so equal sums give
+    out-of-core :func:`fogdrift.allan.chunked.allan_variance_chunked` both end here, so equal sums give
     equal results field by field.
 
     Parameters

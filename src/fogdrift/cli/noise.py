@@ -49,7 +49,7 @@ def _optional_file(func):
 
 
 def _fmt(x, digits=4):
-    from ..report_gmwm import fmt
+    from ..report.gmwm import fmt
 
     return fmt(x, digits)
 
@@ -111,7 +111,7 @@ def noise(
              expect=expect) as r:
         from ..gmwm.analysis import analyse_gmwm, analyse_wvar, candidates_for, read_curve_table
         from ..gmwm.compare import attach_allan_checks
-        from ..report_gmwm import write_gmwm_outputs
+        from ..report.gmwm import write_gmwm_outputs
 
         if method not in ("gmwm", "allan"):
             raise ConfigError(f"{{opt:method}} must be 'gmwm' or 'allan'; got {method!r}")

@@ -13,7 +13,7 @@ inputs, one Dask task per file:
 
 Layout: :mod:`.commands` (the command table and the summary row of one axis), :mod:`.tasks` (one file),
 :mod:`.runner` (inputs, Dask), :mod:`.summary` (the Parquet schema), :mod:`.page` (the HTML page).
-The out-of-core Allan variance for single logs larger than memory is :mod:`fogdrift.allan_chunked`.
+The out-of-core Allan variance for single logs larger than memory is :mod:`fogdrift.allan.chunked`.
 """
 
 from .commands import COMMANDS, CommandSpec, command_spec

@@ -149,14 +149,14 @@ def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
     missing keys take that command's defaults.
 
     The same calls as the ``noise`` command (:func:`fogdrift.gmwm.analysis.analyse_gmwm`,
-    :func:`fogdrift.report_gmwm.write_gmwm_outputs`).  Row: each IEEE-952 coefficient the selected model
+    :func:`fogdrift.report.gmwm.write_gmwm_outputs`).  Row: each IEEE-952 coefficient the selected model
     implies with its 95 % interval (``resolved`` when the interval excludes zero, ``absent`` when the model
     has no such term), the selected model, the J test's p-value (``fit_quality`` ``good`` when every check
     passed, else ``poor``) and the bias instability at the AVAR minimum implied by the model.
     """
     from ..gmwm.analysis import analyse_gmwm
     from ..gmwm.compare import attach_allan_checks
-    from ..report_gmwm import write_gmwm_outputs
+    from ..report.gmwm import write_gmwm_outputs
 
     opts = settings.get("gmwm", {})
     axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=opts.get("model", "auto"),

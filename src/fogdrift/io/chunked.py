@@ -1,4 +1,4 @@
-"""Windows of one axis of a large file, in deg/h, for out-of-core analysis (:mod:`fogdrift.allan_chunked`).
+"""Windows of one axis of a large file, in deg/h, for out-of-core analysis (:mod:`fogdrift.allan.chunked`).
 
 :func:`open_source` opens ``.npy``, raw binary or HDF5 without loading it: :meth:`ChunkSource.read` returns
 samples ``[start, stop)`` of one column as float64 deg/h, read with plain file reads (``np.fromfile`` at an

@@ -15,9 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
-from .output import atomic_path
-from .report import write_json
+from ..gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
+from ..output import atomic_path
+from .files import write_json
 
 __all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
 

@@ -325,7 +325,7 @@ def _axis_section(ax, result, fig_dir, pre, fig_offset, evaluated) -> str:
              _img(plot_separation_allan(ax.separation, fig_dir / f"{pre}fig6_allan_{name}.png")),
              _compensation_section(ax, fig_dir, pre, fig_offset, evaluated), "</section>"]
     if getattr(ax, "gmwm", None) is not None:  # analyze --noise-method gmwm: the GMWM table first
-        from ..report_gmwm import gmwm_noise_html
+        from .gmwm import gmwm_noise_html
 
         parts.insert(2, gmwm_noise_html(ax.gmwm))
     return "\n".join(parts)
@@ -350,7 +350,7 @@ def _temperature_block(record, fig_dir) -> str:
     if temp is None:
         return ""
     from ..temperature import summary_line, temperature_summary
-    from ..temperature_plot import plot_rate_and_temperature
+    from .temperature import plot_rate_and_temperature
 
     line = summary_line(temperature_summary(temp, record.dt_s))
     return (f'<h3>Temperature</h3><p class="note">{_e(line)}. The noise fit and the drift models use the '

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ConfigError
-from .output import atomic_path
-from .temperature import summary_line, temperature_summary
+from ..errors import ConfigError
+from ..output import atomic_path
+from ..temperature import summary_line, temperature_summary
 
 __all__ = ["plot_rate_and_temperature", "MAX_POINTS"]
 
