@@ -1,6 +1,10 @@
 """Units and physical constants.
 
-The internal angular-rate unit of fogdrift is deg/h and time is in seconds.
+The internal angular-rate unit of fogdrift is deg/h, the internal specific-force unit m/s^2, and
+time is in seconds.  Every unit string a user gives (``--unit``, a ``gz[deg/s]`` header cell, a
+bundle's ``input_unit``) is read by the one parser :func:`parse_unit`, which returns a
+:class:`UnitSpec` naming the physical quantity; every sample interval is checked by the one
+validator :func:`check_dt_s`.
 Conversions happen only on the way in (:mod:`fogdrift.io`) and on the way out
 (:mod:`fogdrift.report`, the CLI).
 
@@ -12,12 +16,24 @@ Name suffixes used across the package: ``_dph`` deg/h, ``_dps`` deg/s, ``_s`` se
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from .errors import ConfigError
 
 __all__ = [
+    "QUANTITIES",
+    "INTERNAL_UNITS",
+    "STANDARD_GRAVITY_MPS2",
+    "SPECIFIC_FORCE_UNITS",
+    "VELOCITY_INCREMENT_UNITS",
+    "UnitSpec",
+    "parse_unit",
+    "valid_units",
+    "check_rate_hz",
+    "DT_MIN_S",
+    "DT_MAX_S",
     "EARTH_RATE_DPH",
     "RATE_UNITS",
     "INCREMENT_UNITS",
@@ -61,6 +77,179 @@ INCREMENT_UNITS: dict[str, float] = {
     "rad": 180.0 / math.pi * 3600.0,
     "arcsec": 1.0,
 }
+
+
+#: Standard gravity g_n = 9.80665 m/s^2 (exact by definition, CGPM 1901; ISO 80000-3): the value of
+#: one "g" in :data:`SPECIFIC_FORCE_UNITS`.  Not the local gravity of any site.
+STANDARD_GRAVITY_MPS2 = 9.80665
+
+#: Multiply a specific force in the key's unit by the value to get m/s^2 ("ug" is micro-g).
+SPECIFIC_FORCE_UNITS: dict[str, float] = {
+    "m/s^2": 1.0,
+    "g": STANDARD_GRAVITY_MPS2,
+    "mg": STANDARD_GRAVITY_MPS2 * 1e-3,
+    "ug": STANDARD_GRAVITY_MPS2 * 1e-6,
+}
+
+#: Multiply a velocity increment per sample in the key's unit by the value, then divide by the sample
+#: interval in seconds, to get m/s^2.
+VELOCITY_INCREMENT_UNITS: dict[str, float] = {
+    "m/s": 1.0,
+}
+
+#: The physical quantities a channel can carry, and the internal unit each is converted to on the way in.
+INTERNAL_UNITS: dict[str, str] = {
+    "angular_rate": "deg/h",
+    "specific_force": "m/s^2",
+}
+
+#: The quantities :func:`parse_unit` knows (the keys of :data:`INTERNAL_UNITS`).
+QUANTITIES: tuple[str, ...] = tuple(INTERNAL_UNITS)
+
+#: Per quantity: (rate table, increment table, what a rate is called, what an increment is called).
+_UNIT_TABLES: dict[str, tuple[dict[str, float], dict[str, float], str, str]] = {
+    "angular_rate": (RATE_UNITS, INCREMENT_UNITS, "a rate unit", "an angle increment per sample"),
+    "specific_force": (SPECIFIC_FORCE_UNITS, VELOCITY_INCREMENT_UNITS, "a specific-force unit",
+                       "a velocity increment per sample"),
+}
+
+
+@dataclass(frozen=True)
+class UnitSpec:
+    """A parsed unit string: the quantity it measures, rate or increment, and the factor to the internal unit.
+
+    Attributes
+    ----------
+    text : str
+        The unit as written, stripped (``"deg/s"``, ``"inc:arcsec"``, ``"mg"``).
+    quantity : str
+        ``"angular_rate"`` or ``"specific_force"`` (a key of :data:`INTERNAL_UNITS`).
+    kind : str
+        ``"rate"`` (a value per unit time: deg/s, m/s^2) or ``"increment"`` (an angle or velocity
+        increment per sample, ``inc:<base>``).
+    base : str
+        The key in the quantity's rate or increment table (``"deg/s"``, ``"arcsec"``, ``"m/s"``).
+    factor : float
+        For a rate, the value in the internal unit of one ``base``; for an increment, the internal unit
+        times seconds of one ``base`` (divide by the sample interval, see :meth:`scale_to_internal`).
+    """
+
+    text: str
+    quantity: str
+    kind: str
+    base: str
+    factor: float
+
+    @property
+    def internal_unit(self) -> str:
+        """The quantity's internal unit (``"deg/h"`` or ``"m/s^2"``)."""
+        return INTERNAL_UNITS[self.quantity]
+
+    @property
+    def needs_dt(self) -> bool:
+        """True for an increment unit, whose scale depends on the sample interval."""
+        return self.kind == "increment"
+
+    def scale_to_internal(self, dt_s=None) -> float:
+        """Factor that converts a value in this unit to the internal unit.
+
+        Parameters
+        ----------
+        dt_s : float, optional
+            Sample interval in s; needed (and checked by :func:`check_dt_s`) for an increment unit.
+
+        Examples
+        --------
+        >>> parse_unit("deg/s").scale_to_internal()
+        3600.0
+        >>> parse_unit("inc:arcsec").scale_to_internal(0.01)   # 0.1 arcsec per 10 ms = 10 deg/h
+        100.0
+        >>> parse_unit("mg", "specific_force").scale_to_internal()
+        0.00980665
+        """
+        if self.kind == "rate":
+            return self.factor
+        if dt_s is None:
+            raise ConfigError(f"unit {self.text!r} is an increment per sample; its scale needs the sample interval dt_s")
+        return self.factor / check_dt_s(dt_s)
+
+
+def valid_units(quantity: str | None = "angular_rate") -> list[str]:
+    """Every unit string :func:`parse_unit` accepts for ``quantity`` (None: for every quantity).
+
+    Examples
+    --------
+    >>> valid_units()
+    ['deg/h', 'deg/s', 'rad/s', 'rad/h', 'arcsec/s', 'inc:deg', 'inc:rad', 'inc:arcsec']
+    >>> valid_units("specific_force")
+    ['m/s^2', 'g', 'mg', 'ug', 'inc:m/s']
+    """
+    out: list[str] = []
+    for q in _quantities(quantity):
+        rates, incs, _, _ = _UNIT_TABLES[q]
+        out += list(rates) + [f"inc:{k}" for k in incs]
+    return out
+
+
+def _quantities(quantity) -> tuple[str, ...]:
+    if quantity is None:
+        return QUANTITIES
+    if quantity not in _UNIT_TABLES:
+        raise ConfigError(f"unknown quantity {quantity!r}; expected one of {list(QUANTITIES)}")
+    return (quantity,)
+
+
+def parse_unit(unit, quantity: str | None = "angular_rate") -> UnitSpec:
+    """Parse a unit string: the one unit parser of fogdrift.
+
+    Parameters
+    ----------
+    unit : str
+        A rate unit of the quantity (``"deg/s"``, ``"rad/s"``, ``"m/s^2"``, ``"mg"`` ...) or an
+        increment per sample ``"inc:<base>"`` (``"inc:arcsec"``, ``"inc:m/s"``); surrounding blanks
+        are ignored, nothing else is (``"DEG/S"`` is refused: units are never guessed).
+    quantity : str or None
+        ``"angular_rate"`` (default: a gyro channel), ``"specific_force"`` (an accelerometer
+        channel), or None to accept a unit of any quantity.
+
+    Returns
+    -------
+    UnitSpec
+
+    Raises
+    ------
+    ConfigError
+        If ``unit`` is not a unit of ``quantity``; the message lists the valid units.
+
+    Examples
+    --------
+    >>> parse_unit("inc:arcsec")
+    UnitSpec(text='inc:arcsec', quantity='angular_rate', kind='increment', base='arcsec', factor=1.0)
+    >>> parse_unit("g", None).factor
+    9.80665
+    """
+    qs = _quantities(quantity)
+    if isinstance(unit, str):
+        u = unit.strip()
+        for q in qs:
+            rates, incs, _, _ = _UNIT_TABLES[q]
+            if u in rates:
+                return UnitSpec(text=u, quantity=q, kind="rate", base=u, factor=float(rates[u]))
+            if u.startswith("inc:") and u[4:].strip() in incs:
+                base = u[4:].strip()
+                return UnitSpec(text=u, quantity=q, kind="increment", base=base, factor=float(incs[base]))
+    if len(qs) == 1:
+        _, _, rate_word, inc_word = _UNIT_TABLES[qs[0]]
+        what = f"{rate_word} or {inc_word}"
+    else:
+        what = "a unit of " + " or ".join(q.replace("_", " ") for q in qs)
+    raise ConfigError(f"unknown unit {unit!r}; expected {what}, one of {valid_units(quantity)}")
+
+
+#: The sample intervals :func:`check_dt_s` accepts: 1 ns (1 GHz) to 1e9 s (about 32 years).  Outside
+#: them a number is a typo or a unit slip, and downstream arithmetic (tau grids, least squares) breaks.
+DT_MIN_S = 1e-9
+DT_MAX_S = 1e9
 
 
 #: Multiply a time stamp in the key's unit by the value to get seconds (time columns, ``time_unit``).
@@ -127,14 +316,73 @@ def time_scale_to_s(unit: str) -> float:
 
 
 def check_dt_s(dt_s, name: str = "dt_s") -> float:
-    """Return a sample interval [s] as a float, or raise ConfigError naming ``name`` if it is not finite and > 0."""
+    """The one sample-interval validator: ``dt_s`` [s] as a float in [:data:`DT_MIN_S`, :data:`DT_MAX_S`].
+
+    Parameters
+    ----------
+    dt_s : float
+        Sample interval in s.
+    name : str
+        How the message names the setting (``"dt_s"``, ``"{opt:rate_hz}"`` ...).
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``name`` if ``dt_s`` is not a number, not finite, <= 0, or outside
+        1e-9 .. 1e9 s.
+
+    Examples
+    --------
+    >>> check_dt_s(0.01)
+    0.01
+    >>> check_dt_s(1e-300)
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.ConfigError: dt_s must be a sample interval between 1e-09 s and 1e+09 s, got 1e-300
+    """
+    if isinstance(dt_s, bool):
+        raise ConfigError(f"{name} must be a number of seconds > 0, got {dt_s!r}")
     try:
         dt = float(dt_s)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ConfigError(f"{name} must be a number of seconds > 0, got {dt_s!r}") from None
     if not (dt > 0 and math.isfinite(dt)):
         raise ConfigError(f"{name} must be a finite number of seconds > 0, got {dt_s!r}")
+    if not DT_MIN_S <= dt <= DT_MAX_S:
+        raise ConfigError(f"{name} must be a sample interval between {DT_MIN_S:g} s and {DT_MAX_S:g} s, got {dt_s!r}")
     return dt
+
+
+def check_rate_hz(rate_hz, name: str = "rate_hz") -> float:
+    """A sample rate [Hz] as a float whose interval ``1 / rate_hz`` passes :func:`check_dt_s`.
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``name`` if ``rate_hz`` is not a finite number > 0 or lies outside
+        1e-9 .. 1e9 Hz.
+
+    Examples
+    --------
+    >>> check_rate_hz(100.0)
+    100.0
+    >>> check_rate_hz(1e300)
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.ConfigError: rate_hz must be a sample rate between 1e-09 Hz and 1e+09 Hz, got 1e+300
+    """
+    if isinstance(rate_hz, bool):
+        raise ConfigError(f"{name} must be a number of Hz > 0, got {rate_hz!r}")
+    try:
+        fs = float(rate_hz)
+    except (TypeError, ValueError, OverflowError):
+        raise ConfigError(f"{name} must be a number of Hz > 0, got {rate_hz!r}") from None
+    if not (fs > 0 and math.isfinite(fs)):
+        raise ConfigError(f"{name} must be a finite number of Hz > 0, got {rate_hz!r}")
+    if not 1.0 / DT_MAX_S <= fs <= 1.0 / DT_MIN_S:
+        raise ConfigError(f"{name} must be a sample rate between {1.0 / DT_MAX_S:g} Hz and {1.0 / DT_MIN_S:g} Hz, "
+                          f"got {rate_hz!r}")
+    return fs
 
 
 def rate_scale_to_dph(unit: str) -> float:
@@ -145,13 +393,13 @@ def rate_scale_to_dph(unit: str) -> float:
     >>> rate_scale_to_dph("deg/s")
     3600.0
     """
-    try:
-        return RATE_UNITS[unit]
-    except KeyError:
+    spec = parse_unit(unit) if isinstance(unit, str) and unit in RATE_UNITS else None
+    if spec is None:
         raise ConfigError(
             f"unknown rate unit {unit!r}; expected one of {sorted(RATE_UNITS)} "
             f"or an increment unit {sorted('inc:' + u for u in INCREMENT_UNITS)}"
-        ) from None
+        )
+    return spec.factor
 
 
 def increment_scale_to_dph(unit: str, dt_s: float) -> float:
@@ -162,11 +410,9 @@ def increment_scale_to_dph(unit: str, dt_s: float) -> float:
     >>> increment_scale_to_dph("arcsec", 0.01)   # 0.1 arcsec per 10 ms = 10 deg/h
     100.0
     """
-    if unit not in INCREMENT_UNITS:
+    if not isinstance(unit, str) or unit not in INCREMENT_UNITS:
         raise ConfigError(f"unknown increment unit {unit!r}; expected one of {sorted(INCREMENT_UNITS)}")
-    if not dt_s > 0:
-        raise ConfigError(f"sample interval must be > 0 s, got {dt_s!r}")
-    return INCREMENT_UNITS[unit] / dt_s
+    return parse_unit("inc:" + unit).scale_to_internal(dt_s)
 
 
 #: Unit vectors (east, north, up) of named sensitive-axis orientations.

@@ -51,28 +51,23 @@ def int_arg(value, name: str) -> int:
 
 
 def parse_unit(unit):
-    """``("rate", name)`` or ``("inc", angle unit)`` for a unit string; ConfigError listing the valid units."""
-    if isinstance(unit, str):
-        u = unit.strip()
-        if u in units.RATE_UNITS:
-            return "rate", u
-        if u.startswith("inc:") and u[4:].strip() in units.INCREMENT_UNITS:
-            return "inc", u[4:].strip()
-    raise ConfigError(
-        f"unknown unit {unit!r}; expected a rate unit or an angle increment per sample, one of {valid_units()}"
-    )
+    """``("rate", name)`` or ``("inc", angle unit)`` for an angular-rate unit string.
+
+    A thin view of :func:`fogdrift.units.parse_unit` (the one unit parser) kept for the readers;
+    new code calls that and keeps the :class:`~fogdrift.units.UnitSpec`.
+    """
+    spec = units.parse_unit(unit)
+    return ("rate" if spec.kind == "rate" else "inc"), spec.base
 
 
 def valid_units() -> list[str]:
-    """Every unit string :func:`parse_unit` accepts."""
-    return list(units.RATE_UNITS) + [f"inc:{k}" for k in units.INCREMENT_UNITS]
+    """Every angular-rate unit string :func:`fogdrift.units.parse_unit` accepts."""
+    return units.valid_units("angular_rate")
 
 
 def unit_scale(kind: str, base: str, dt_s: float) -> float:
     """Factor to deg/h for a parsed unit (see :func:`parse_unit`) at sample interval ``dt_s`` [s]."""
-    if kind == "rate":
-        return units.rate_scale_to_dph(base)
-    return units.increment_scale_to_dph(base, dt_s)
+    return units.parse_unit(base if kind == "rate" else f"inc:{base}").scale_to_internal(dt_s)
 
 
 def split_keys(keys, name: str) -> list:
