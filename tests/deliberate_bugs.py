@@ -38,6 +38,12 @@ BUGS = [
     ("report figures saved blank (figure cleared before saving)",
      "src/fogdrift/report/figures.py", "            fig.savefig(tmp, dpi=DPI)", "            fig.clf(); fig.savefig(tmp, dpi=DPI)",
      ["tests/test_golden.py", "-k", "figures_have_content"]),
+    # H-structure
+    ("out-of-core Allan: the old copied tail (auto alpha from the slopes, without the long-tau EDF rule)",
+     "src/fogdrift/allan/chunked.py", "                            noise_alpha=noise_alpha)\n",
+     "                            noise_alpha=resolve_alpha(noise_alpha, m * source.dt_s, sums / (2.0 * m**2 * (n - 2 * m + 1)), "
+     "slopes=get_statistic(\"adev\").dev_slopes, candidates=IEEE952_ALPHAS)[0] if noise_alpha == \"auto\" else noise_alpha)\n",
+     ["tests/test_allan_result_shared.py", "-k", "quantization_long_tau"]),
 ]
 
 
