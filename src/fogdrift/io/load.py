@@ -16,15 +16,14 @@ import numpy as np
 
 from .. import units
 from ..errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
+from ..signal import Channel, Sampling, SignalDescription
 from ._checks import (
     check_path,
     first_nonfinite,
-    parse_unit,
     positive_float,
     split_keys,
     take_columns,
     to_dph,
-    unit_scale,
     valid_units,
 )
 from .hashing import file_sha256
@@ -246,7 +245,7 @@ class _Options:
     columns: object
     time_column: object
     dt_s: float | None          # from dt_s or rate_hz
-    unit: str | None
+    unit: units.UnitSpec | None  # parsed once here
     time_unit: str | None
     split: bool
     min_samples: int
@@ -258,8 +257,7 @@ class _Options:
 def _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
              reader_options, temperature=None) -> _Options:
     """Validate every option before the file is touched."""
-    if unit is not None:
-        parse_unit(unit)
+    spec = None if unit is None else units.parse_unit(unit)
     if time_unit is not None and time_unit not in units.TIME_UNITS:
         raise ConfigError(f"unknown time unit {time_unit!r}; expected one of {list(units.TIME_UNITS)}")
     if isinstance(min_samples, bool) or not isinstance(min_samples, (int, np.integer)) or min_samples < 1:
@@ -279,14 +277,14 @@ def _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, ga
     if temperature is not None and not (isinstance(temperature, str) and temperature.strip()) and (
             isinstance(temperature, bool) or not isinstance(temperature, (int, np.integer))):
         raise ConfigError(f"temperature must be a column name or a 0-based index; got {temperature!r}")
-    return _Options(columns=columns, time_column=time_column, dt_s=_interval_option(dt_s, rate_hz), unit=unit,
+    return _Options(columns=columns, time_column=time_column, dt_s=_interval_option(dt_s, rate_hz), unit=spec,
                     time_unit=time_unit, split=gaps == "split", min_samples=int(min_samples), format=format,
                     reader_options=ropts, temperature=temperature)
 
 
 def _interval_option(dt_s, rate_hz):
-    dt = None if dt_s is None else positive_float(dt_s, "dt_s")
-    fs = None if rate_hz is None else positive_float(rate_hz, "rate_hz")
+    dt = None if dt_s is None else units.check_dt_s(positive_float(dt_s, "dt_s"), "dt_s")
+    fs = None if rate_hz is None else units.check_rate_hz(rate_hz, "{opt:rate_hz}")
     if dt is not None and fs is not None and abs(dt * fs - 1.0) > 1e-6:
         raise ConfigError(
             f"dt_s and rate_hz disagree; expected dt_s = 1/rate_hz, got dt_s={dt_s!r}, rate_hz={rate_hz!r}"
@@ -342,8 +340,9 @@ def _load_records(path, opts: _Options) -> list[GyroRecord]:
             "name one with {opt:time_column}) and no sample rate given; pass the sample rate in Hz as {opt:rate_hz}"
         )
     notes = []
-    kind_u, base_u, unit = _rate_unit(table, r_idx, opts.unit, notes)
-    t_scale = _time_scale(table, t_idx, opts.time_unit, notes)
+    spec, unit_source = _rate_unit(table, r_idx, opts.unit, notes)
+    unit = spec.text
+    t_scale, time_unit = _time_scale(table, t_idx, opts.time_unit, notes)
     temp_offset = _temperature_offset(table, tm_idx, notes)
 
     # values: finite in every used column
@@ -386,14 +385,28 @@ def _load_records(path, opts: _Options) -> list[GyroRecord]:
     else:
         dt, seg_bounds, gap_info = opts.dt_s, [(0, n)], []
         notes.insert(1, f"dt_s {dt:.10g} from dt_s/rate_hz (no time column)")
-    scale = unit_scale(kind_u, base_u, dt)
+    if opts.dt_s is not None:
+        dt_source = "rate option"
+    elif t_idx is not None:
+        dt_source = "time column"
+    else:
+        dt_source = "time stamps"
+    sampling = Sampling(dt_s=dt, dt_source=dt_source, time_column=None if t_idx is None else table.names[t_idx],
+                        time_unit=time_unit,
+                        time_unit_source=None if time_unit is None else ("option" if opts.time_unit else "header"))
+    scale = spec.scale_to_internal(dt)
     if scale != 1.0:
         notes.append(f"input unit {unit!r} scaled by {scale:.10g} to deg/h")
+    signal = SignalDescription(sampling, tuple(
+        Channel(name=table.names[j], unit=spec, unit_source=unit_source, declared_unit=table.units[j],
+                scale_to_internal=scale) for j in r_idx))
     temp = None if tm_idx is None else (tm_idx, temp_offset)
-    return _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, opts.min_samples, temp)
+    return _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, opts.min_samples, temp,
+                    signal)
 
 
-def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, min_samples, temp=None):
+def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, min_samples, temp=None,
+             signal=None):
     p = table.path
     n = data.shape[0]
     m = len(seg_bounds)
@@ -436,7 +449,7 @@ def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes
         records.append(GyroRecord(
             rate_dph=rate, dt_s=dt, axis_names=names, source=str(p), input_unit=unit, scale_to_dph=scale,
             t0_s=float(t[a]) if t is not None else 0.0, notes=tuple(seg_notes), sha256=sha256,
-            declared_units=declared, temperature_c=temp_c,
+            declared_units=declared, temperature_c=temp_c, signal=signal,
         ))
     if dropped:
         if not records:
@@ -527,16 +540,19 @@ def _header_error(table: Table, message: str, col: int) -> DataFormatError:
 
 
 def _rate_unit(table: Table, r_idx, unit, notes: list):
-    """(kind, base, unit string) for the rate columns: the given unit, else the declared one; never a guess."""
+    """(UnitSpec, "option" or "header") for the rate columns: the given unit, else the declared one; never a guess.
+
+    ``unit`` is the option already parsed by :func:`fogdrift.units.parse_unit` (or None); a declared
+    unit is parsed here, once.
+    """
     declared = {j: table.units[j] for j in r_idx}
     if unit is None and table.unit_hint and set(declared.values()) == {None}:
         raise ConfigError(f"{table.path}: {table.unit_hint} ({', '.join(valid_units())}; units are never guessed)")
     if unit is not None:
-        kind, base = parse_unit(unit)
-        other = {table.names[j]: u for j, u in declared.items() if u is not None and u.strip() != unit.strip()}
+        other = {table.names[j]: u for j, u in declared.items() if u is not None and u.strip() != unit.text}
         if other:
-            notes.append(f"the file declares {other}; unit {unit!r} given takes precedence")
-        return kind, base, unit
+            notes.append(f"the file declares {other}; unit {unit.text!r} given takes precedence")
+        return unit, "option"
     kinds = set(declared.values())
     if kinds == {None}:
         cols = [table.names[j] for j in r_idx]
@@ -553,14 +569,14 @@ def _rate_unit(table: Table, r_idx, unit, notes: list):
                    f"with {{opt:columns}} or pass {{opt:unit}}), got {listing}", odd,
         )
     try:
-        kind, base = parse_unit(first)
+        spec = units.parse_unit(first)
     except ConfigError:
         raise _header_error(
             table, f"unknown unit {first!r} declared in the header; expected one of {valid_units()} "
                    f"(or pass {{opt:unit}}), got {first!r}", r_idx[0],
         ) from None
     notes.append(f"unit {first!r} declared in the file")
-    return kind, base, first
+    return spec, "header"
 
 
 def _temperature_offset(table: Table, tm_idx, notes: list) -> float:
@@ -602,13 +618,14 @@ def time_unit_of_name(name: str) -> str | None:
     return suffix if sep and stem and suffix in units.TIME_UNITS else None
 
 
-def _time_scale(table: Table, t_idx, time_unit, notes: list) -> float:
-    """Factor from the time column's unit to s: the given time_unit, else the declared one; never a guess.
+def _time_scale(table: Table, t_idx, time_unit, notes: list) -> tuple[float, str | None]:
+    """(factor to s, unit) of the time column: the given time_unit, else the declared one; never a guess.
 
     A column declares its unit in brackets (``t[ms]``) or by a suffix of its name (``t_s``, ``time_ms``).
+    Without a time column: ``(1.0, None)``.
     """
     if t_idx is None:
-        return 1.0
+        return 1.0, None
     declared = table.units[t_idx]
     name = table.names[t_idx]
     if time_unit is not None:
@@ -631,7 +648,7 @@ def _time_scale(table: Table, t_idx, time_unit, notes: list) -> float:
             "with {opt:time_column} none and give the sample rate as {opt:rate_hz} (units are never guessed)"
         )
     notes.append(f"time column {name!r} in {unit}")
-    return units.time_scale_to_s(unit)
+    return units.time_scale_to_s(unit), unit
 
 
 # --------------------------------------------------------------------------------------------

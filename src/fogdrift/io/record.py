@@ -13,9 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import units
 from .._util import check_distinct_names
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
-from ._checks import first_nonfinite, int_arg, parse_unit, positive_float, split_keys, take_columns, to_dph, unit_scale
+from ..signal import Channel, Sampling, SignalDescription
+from ._checks import first_nonfinite, int_arg, positive_float, split_keys, take_columns, to_dph
 
 __all__ = ["GyroRecord", "block_average", "from_array", "decimation_factor"]
 
@@ -60,6 +62,11 @@ class GyroRecord:
         Temperature in deg C carried with the log (``load(..., temperature=NAME)``), one value
         per sample; kept through :meth:`slice`, :meth:`select` and block averaging (averaged
         like the rates).  None when the log has none.  Stored read-only.
+    signal : fogdrift.signal.SignalDescription, optional
+        The sampling and channels as :func:`fogdrift.io.load` described them while reading (where
+        the interval and each unit came from); kept through :meth:`select` and block averaging.
+        Default: made here from ``dt_s``, ``input_unit``, ``scale_to_dph``, ``declared_units`` and
+        ``block_average_factor`` with the sources ``"argument"``.  Must agree with those fields.
 
     Notes
     -----
@@ -79,6 +86,7 @@ class GyroRecord:
     declared_units: tuple[str | None, ...] = ()
     block_average_factor: int = 1
     temperature_c: np.ndarray | None = None
+    signal: SignalDescription | None = None
 
     def __post_init__(self):
         r = self.rate_dph
@@ -124,6 +132,44 @@ class GyroRecord:
                 temp = temp.view()
                 temp.flags.writeable = False
             object.__setattr__(self, "temperature_c", temp)
+        if self.signal is None:
+            object.__setattr__(self, "signal", self._default_signal())
+        else:
+            self._check_signal()
+
+    def _default_signal(self) -> SignalDescription:
+        """The description of a record built from its fields (no file: every source is "argument")."""
+        spec = units.parse_unit(self.input_unit)
+        sampling = Sampling(dt_s=self.dt_s, dt_source="argument", block_average_factor=self.block_average_factor)
+        return SignalDescription(sampling, tuple(
+            Channel(name=n, unit=spec, unit_source="argument", declared_unit=d, scale_to_internal=self.scale_to_dph)
+            for n, d in zip(self.axis_names, self.declared_units)))
+
+    def _check_signal(self) -> None:
+        sig = self.signal
+        if not isinstance(sig, SignalDescription):
+            raise ConfigError(f"signal must be a fogdrift.signal.SignalDescription; got {type(sig).__name__}")
+        smp = sig.sampling
+        bad = []
+        if abs(smp.dt_s - self.dt_s) > 1e-12 * self.dt_s:
+            bad.append(f"dt_s {smp.dt_s!r} vs {self.dt_s!r}")
+        if smp.block_average_factor != self.block_average_factor:
+            bad.append(f"block_average_factor {smp.block_average_factor} vs {self.block_average_factor}")
+        if sig.names != self.axis_names:
+            bad.append(f"channels {list(sig.names)} vs axes {list(self.axis_names)}")
+        for c, d in zip(sig.channels, self.declared_units):
+            if c.quantity != "angular_rate" or c.unit_as_read != self.input_unit.strip() \
+                    or c.scale_to_internal != self.scale_to_dph or c.declared_unit != d:
+                bad.append(f"channel {c.name!r} ({c.quantity}, {c.unit_as_read}, x{c.scale_to_internal:.10g}) vs "
+                           f"the record (angular_rate, {self.input_unit}, x{self.scale_to_dph:.10g})")
+                break
+        if bad:
+            raise ConfigError("signal does not describe this record: " + "; ".join(bad))
+
+    @property
+    def sampling(self) -> Sampling:
+        """The sampling part of :attr:`signal` (interval, its source, native interval, factor)."""
+        return self.signal.sampling
 
     # -- sizes ---------------------------------------------------------------------------------
     @property
@@ -203,7 +249,7 @@ class GyroRecord:
             raise ConfigError(f"keys select an axis twice; expected distinct axes, got {keys!r}")
         return dataclasses.replace(
             self, rate_dph=take_columns(self.rate_dph, idx), axis_names=tuple(self.axis_names[i] for i in idx),
-            declared_units=tuple(self.declared_units[i] for i in idx),
+            declared_units=tuple(self.declared_units[i] for i in idx), signal=self.signal.select(idx),
         )
 
     def slice(self, start: int, stop: int) -> "GyroRecord":
@@ -319,8 +365,10 @@ class GyroRecord:
         dropped = n - avg.shape[0] * m
         note = f"block-averaged x{m} ({self.dt_s:.10g} s -> {m * self.dt_s:.10g} s), dropped {dropped} trailing samples"
         temp = None if self.temperature_c is None else block_average(self.temperature_c, m)
-        return dataclasses.replace(self, rate_dph=avg, dt_s=m * self.dt_s, notes=self.notes + (note,),
-                                   block_average_factor=self.block_average_factor * m, temperature_c=temp)
+        signal = self.signal.averaged(m)
+        return dataclasses.replace(self, rate_dph=avg, dt_s=signal.sampling.dt_s, notes=self.notes + (note,),
+                                   block_average_factor=signal.sampling.block_average_factor, temperature_c=temp,
+                                   signal=signal)
 
     def metadata(self) -> dict:
         """JSON-serialisable description (no arrays): every field but the data, plus sizes.
@@ -330,10 +378,11 @@ class GyroRecord:
         dict
             ``source, sha256, input_unit, declared_units (list), scale_to_dph, rate_unit
             ("deg/h"), dt_s, fs_hz, native_fs_hz, block_average_factor, t0_s, n_samples,
-            n_axes, duration_s, axis_names (list), notes (list), temperature``.  ``fs_hz`` is
+            n_axes, duration_s, axis_names (list), notes (list), temperature, signal``.  ``fs_hz`` is
             the effective rate after block averaging; ``native_fs_hz`` the rate as loaded;
             ``temperature`` is None or the range and drift of the temperature carried with the
-            log (:meth:`fogdrift.temperature.TemperatureSummary.to_dict`, deg C and deg C/h).
+            log (:meth:`fogdrift.temperature.TemperatureSummary.to_dict`, deg C and deg C/h);
+            ``signal`` is :meth:`fogdrift.signal.SignalDescription.to_dict` of :attr:`signal`.
         """
         from ..temperature import temperature_summary
 
@@ -356,6 +405,7 @@ class GyroRecord:
             "axis_names": list(self.axis_names),
             "notes": list(self.notes),
             "temperature": temp,
+            "signal": self.signal.to_dict(),
         }
 
     def __repr__(self) -> str:
@@ -529,7 +579,8 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
     array([10., 10., 20.])
     """
     dt = positive_float(dt_s, "dt_s")
-    kind, base = parse_unit(unit)
+    spec = units.parse_unit(unit)
+    sampling = Sampling(dt_s=dt, dt_source="argument")
     try:
         arr = np.asarray(rate)
         if arr.dtype.kind not in "biuf":
@@ -562,7 +613,7 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
             f"non-finite value at sample {i}; expected a finite number, got {float(arr[i, j])!r}",
             path=source, column=names[j],
         )
-    scale = unit_scale(kind, base, dt)
+    scale = spec.scale_to_internal(dt)
     rate_dph = to_dph(arr, scale)
     if scale != 1.0:
         bad = first_nonfinite(rate_dph)
@@ -572,7 +623,9 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
                 f"value at sample {i} overflows in deg/h; expected |value| * {scale:.6g} below "
                 f"{np.finfo(np.float64).max:.3g}, got {float(arr[i, j])!r} {unit}", path=source, column=names[j],
             )
+    signal = SignalDescription(sampling, tuple(
+        Channel(name=n, unit=spec, unit_source="argument", declared_unit=None, scale_to_internal=scale) for n in names))
     return GyroRecord(
         rate_dph=rate_dph, dt_s=dt, axis_names=tuple(names), source=str(source),
-        input_unit=unit, scale_to_dph=scale,
+        input_unit=unit, scale_to_dph=scale, signal=signal,
     )
