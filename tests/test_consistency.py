@@ -1,0 +1,229 @@
+"""Consistency check (issue 22 item 4): closed forms by hand, against an exact discrete covariance, and coverage
+counted on seeded simulations whose truth is known."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+from fogdrift.errors import ConfigError, InsufficientDataError
+from fogdrift.evaluation.consistency import (BANDS, angle_error_variance_deg2, check_consistency,
+                                             components_from_noise_fit, coverage_rows, inflation_factor,
+                                             observed_angle_errors_deg, random_walk_covering, reduced_model)
+
+DEG_PER_URAD = 1e-6 * 180.0 / math.pi
+
+
+# --------------------------------------------------------------------------------------------------------------
+# closed forms, by hand
+# --------------------------------------------------------------------------------------------------------------
+def test_white_closed_form_by_hand():
+    # N = 0.6 deg/sqrt(h) = 0.01 deg/sqrt(s); T = 100 s, h = 100 s: 1e-4 (100 + 100^2/100) = 0.02 deg^2
+    v = angle_error_variance_deg2([{"kind": "white", "arw_dprh": 0.6}], [100.0, 25.0], 100.0)
+    assert v[0] == pytest.approx(0.02, rel=1e-12)
+    assert v[1] == pytest.approx(1e-4 * (25 + 625 / 100), rel=1e-12)
+
+
+def test_random_walk_closed_form_by_hand():
+    # K = 216000 deg/h^1.5 = 1 deg/s^1.5; h = 3, T = 6: h^3/3 + h^2 T/3 = 9 + 18 = 27 deg^2
+    v = angle_error_variance_deg2([{"kind": "random_walk", "rrw_dphrh": 216000.0}], 3.0, 6.0)
+    assert v[0] == pytest.approx(27.0, rel=1e-12)
+
+
+def test_gauss_markov_closed_form_by_hand():
+    # sigma = 1 deg/s, Tc = h = T = 1 s: 2 (2/e) - 2 (1 - 1/e)^2 = 0.672365
+    v = angle_error_variance_deg2([{"kind": "gauss_markov", "tc_s": 1.0, "sigma_dph": 3600.0}], 1.0, 1.0)
+    e = math.exp(-1.0)
+    assert v[0] == pytest.approx(4 * e - 2 * (1 - e) ** 2, rel=1e-12)
+    assert v[0] == pytest.approx(0.672365, abs=1e-6)
+
+
+def test_quantization_and_ramp_closed_forms_by_hand():
+    # angle white noise of 1 deg: 1 + (1 + h/T)^2 + (h/T)^2 = 6 at h = T
+    q = angle_error_variance_deg2([{"kind": "quantization", "q_urad": 1.0 / DEG_PER_URAD}], 5.0, 5.0)
+    assert q[0] == pytest.approx(6.0, rel=1e-12)
+    # ramp slope 1 deg/s^2: error rate s (t + T/2), angle s (h^2/2 + h T/2) = 4 at h = T = 2
+    r = angle_error_variance_deg2([{"kind": "ramp", "ramp_dph2": 3600.0**2}], 2.0, 2.0)
+    assert r[0] == pytest.approx(16.0, rel=1e-12)
+
+
+def test_variance_is_sum_of_components_and_linear_in_parameter_variance():
+    comps = [{"kind": "white", "arw_dprh": 0.3}, {"kind": "random_walk", "rrw_dphrh": 5.0},
+             {"kind": "gauss_markov", "tc_s": 30.0, "sigma_dph": 2.0}]
+    h = [1.0, 10.0, 100.0]
+    total, parts = angle_error_variance_deg2(comps, h, 20.0, by_component=True)
+    assert np.allclose(total, np.sum(parts, axis=0))
+    scaled = [{"kind": "white", "arw_dprh": 0.6}, {"kind": "random_walk", "rrw_dphrh": 10.0},
+              {"kind": "gauss_markov", "tc_s": 30.0, "sigma_dph": 4.0}]
+    assert np.allclose(angle_error_variance_deg2(scaled, h, 20.0), 4.0 * total, rtol=1e-12)
+
+
+def _exact_discrete_var(cov_fn, n_cal, n_h, dt):
+    """Var of dt * sum_{horizon}(y - mean_cal(y)) from the full covariance matrix of the samples (deg/s, deg)."""
+    n = n_cal + n_h
+    t = np.arange(n) * dt
+    C = cov_fn(t[:, None], t[None, :])
+    w = np.r_[np.full(n_cal, -dt * n_h / n_cal), np.full(n_h, dt)]
+    return float(w @ C @ w)
+
+
+@pytest.mark.parametrize("h_s", [2.0, 10.0, 40.0])
+def test_closed_forms_match_exact_discrete_covariance(h_s):
+    """Independent reference: the covariance matrix of the sampled processes (deg/s) and the linear weights of
+    'sum over the horizon minus h/T times the calibration sum'."""
+    dt, T = 0.02, 10.0
+    n_cal, n_h = int(round(T / dt)), int(round(h_s / dt))
+    ns, ks, s, tc = 0.01, 0.002, 0.05, 7.0  # deg/sqrt(s), deg/s^1.5, deg/s, s
+    white = _exact_discrete_var(lambda a, b: (a == b) * ns**2 / dt, n_cal, n_h, dt)
+    # random walk observed at the sample times, reference zero at t = T (only differences matter)
+    rw = _exact_discrete_var(lambda a, b: ks**2 * np.where((a - T) * (b - T) > 0,
+                                                           np.minimum(np.abs(a - T), np.abs(b - T)), 0.0),
+                             n_cal, n_h, dt)
+    gm = _exact_discrete_var(lambda a, b: s**2 * np.exp(-np.abs(a - b) / tc), n_cal, n_h, dt)
+    got = angle_error_variance_deg2([{"kind": "white", "arw_dprh": 60 * ns}], h_s, T)[0]
+    assert got == pytest.approx(white, rel=1e-9)  # white: exact in discrete time too
+    got = angle_error_variance_deg2([{"kind": "random_walk", "rrw_dphrh": 216000 * ks}], h_s, T)[0]
+    assert got == pytest.approx(rw, rel=0.01)
+    got = angle_error_variance_deg2([{"kind": "gauss_markov", "tc_s": tc, "sigma_dph": 3600 * s}], h_s, T)[0]
+    assert got == pytest.approx(gm, rel=0.01)
+
+
+def test_white_matches_statespace_forecast_with_a_diffuse_bias():
+    """Second independent route: the Kalman filter of models.statespace on the calibration window with a diffuse
+    bias prior estimates the window mean; its free-run angle variance is N^2 h + N^2 h^2 / T."""
+    from fogdrift.models.statespace import forecast_uncertainty, kalman_filter, state_space
+
+    dt, T, h = 0.1, 20.0, 30.0
+    comps = [{"kind": "white", "arw_dprh": 0.5}]
+    ss = state_space(comps, dt_s=dt, bias_prior_dph=1e7)
+    _, _, state = kalman_filter(ss, np.zeros(int(round(T / dt))))
+    _, _, ang = forecast_uncertainty(ss, int(round(h / dt)), state)
+    assert float(ang[-1]) ** 2 == pytest.approx(angle_error_variance_deg2(comps, h, T)[0], rel=1e-6)
+
+
+# --------------------------------------------------------------------------------------------------------------
+# measured errors, inflation factor
+# --------------------------------------------------------------------------------------------------------------
+def test_observed_errors_by_hand_ramp():
+    # rate = t deg/h at dt 1 s, T = 4, h = 2: origin 4: bias = mean(0..3) = 1.5; sum(4, 5) - 2*1.5 = 6 -> 6/3600
+    y = np.arange(12, dtype=float)
+    origins, e = observed_angle_errors_deg(y, 1.0, 4.0, [2.0])
+    assert origins.tolist() == [4.0, 10.0]  # step T + h = 6 s: non-overlapping
+    assert e[0, 0] == pytest.approx(6.0 / 3600.0)
+
+
+def test_observed_errors_refuses_short_log():
+    with pytest.raises(InsufficientDataError, match="calibration window plus the longest horizon"):
+        observed_angle_errors_deg(np.zeros(10), 1.0, 8.0, [5.0])
+    with pytest.raises(ConfigError, match="horizons"):
+        observed_angle_errors_deg(np.zeros(10), 1.0, 2.0, [-1.0])
+
+
+def test_inflation_factor_by_hand():
+    r = np.array([0.5, 1.0, 2.0, 4.0])
+    assert inflation_factor(r, 0.5, 1.0)[0] == 1.0  # 2nd smallest
+    assert inflation_factor(r, 0.75, 1.0)[0] == 4.0  # 3rd smallest, squared
+    assert inflation_factor(r, 0.75, 2.0)[0] == 1.0  # z = 2
+    lam, lo, hi = inflation_factor(np.linspace(0.01, 3, 1000), 0.68, 1.0)
+    assert lo < lam < hi
+
+
+# --------------------------------------------------------------------------------------------------------------
+# coverage on seeded simulations
+# --------------------------------------------------------------------------------------------------------------
+def _simulate(seed, n, dt, n_dprh, sigma_dph=0.0, tc_s=1.0):
+    rng = np.random.default_rng(seed)
+    y = rng.normal(0.0, 60.0 * n_dprh / math.sqrt(dt), n)
+    if sigma_dph > 0:
+        phi = math.exp(-dt / tc_s)
+        w = rng.normal(0.0, sigma_dph * math.sqrt(1 - phi * phi), n)
+        w[0] = rng.normal(0.0, sigma_dph)
+        y += lfilter([1.0], [1.0, -phi], w)
+    return y + 123.0  # a constant bias the calibration removes
+
+
+TRUE = [{"kind": "white", "arw_dprh": 0.2}, {"kind": "gauss_markov", "tc_s": 15.0, "sigma_dph": 4.0}]
+DT, T_CAL, H = 0.1, 20.0, [5.0, 30.0]
+
+
+@pytest.fixture(scope="module")
+def sim_logs():
+    return [({"x": _simulate(seed, 200_000, DT, 0.2, 4.0, 15.0)}, DT) for seed in range(6)]
+
+
+def test_correct_model_covers_nominal(sim_logs):
+    res = check_consistency("truth", {"x": TRUE}, sim_logs, t_cal_s=T_CAL, horizons_s=H)
+    for row in res.axes["x"]["rows"]:
+        n = row.n_origins
+        assert n > 1000
+        for name, p, _ in BANDS:
+            tol = 4.0 * math.sqrt(p * (1 - p) / n)  # binomial, 4 sigma
+            assert abs(row.coverage[name] - p) < tol, (row.horizon_s, name, row.coverage[name])
+            lam, lo, hi = row.inflation[name]
+            assert lo < 1.0 < hi or abs(lam - 1) < 0.15
+
+
+def test_halved_white_noise_needs_inflation_four(sim_logs):
+    white_only = [({"x": _simulate(seed, 100_000, DT, 0.2)}, DT) for seed in range(3)]
+    half = [{"kind": "white", "arw_dprh": 0.1}]
+    res = check_consistency("N halved", {"x": half}, white_only, t_cal_s=T_CAL, horizons_s=H)
+    for row in res.axes["x"]["rows"]:
+        # predicted sigma is half the truth: the 68 % band holds |Z| <= 0.5, i.e. 38.3 %
+        assert abs(row.coverage["68 %"] - 0.3829) < 4 * math.sqrt(0.38 * 0.62 / row.n_origins)
+        for name, _, _ in BANDS:
+            lam, lo, hi = row.inflation[name]
+            assert lam == pytest.approx(4.0, rel=0.15)
+            assert lo < 4.0 < hi
+    lam, _, _ = res.worst_inflation("x")
+    assert lam > 3.0
+
+
+def test_white_plus_rw_target_undercovers_bias_wander_and_the_covering_rw_fixes_it(sim_logs):
+    """A Gauss-Markov wander dropped by a white+RW target: under-coverage at 30 s; the random walk that covers the
+    wander at 30 s brings the 30 s coverage back within tolerance."""
+    reduced = reduced_model(TRUE)
+    assert reduced == [TRUE[0]]
+    res = check_consistency("white+RW", {"x": reduced}, sim_logs, t_cal_s=T_CAL, horizons_s=H)
+    row = res.axes["x"]["rows"][1]
+    assert row.coverage["68 %"] < 0.6 and row.inflation["68 %"][1] > 1.5
+    cover = random_walk_covering(TRUE, 30.0, T_CAL)
+    assert cover["ratio"] is None and "no random walk of its own" in cover["sentence"]
+    model = reduced + [{"kind": "random_walk", "rrw_dphrh": cover["k_eff_dphrh"]}]
+    # same predicted variance at the covered horizon, by construction
+    assert angle_error_variance_deg2(model, 30.0, T_CAL)[0] == pytest.approx(
+        angle_error_variance_deg2(TRUE, 30.0, T_CAL)[0], rel=1e-9)
+    res = check_consistency("covering", {"x": model}, sim_logs, t_cal_s=T_CAL, horizons_s=[30.0])
+    row = res.axes["x"]["rows"][0]
+    assert abs(row.coverage["68 %"] - BANDS[0][1]) < 4 * math.sqrt(0.68 * 0.32 / row.n_origins)
+
+
+def test_random_walk_covering_sentence_and_ratio():
+    comps = [{"kind": "white", "arw_dprh": 0.1}, {"kind": "random_walk", "rrw_dphrh": 2.0},
+             {"kind": "gauss_markov", "tc_s": 50.0, "sigma_dph": 1.0}]
+    d = random_walk_covering(comps, 60.0, 60.0)
+    assert d["ratio"] > 1.0 and d["k_eff_dphrh"] == pytest.approx(2.0 * d["ratio"])
+    assert d["sentence"].startswith("to cover the bias wander over 60 s")
+    assert "gyroscope_random_walk = " in d["sentence"] and "× the random walk alone" in d["sentence"]
+    # SI: K [deg/h^1.5] / 216000 -> deg/s^1.5, * pi/180 -> rad/s^2/sqrt(Hz)
+    assert d["k_eff_si"] == pytest.approx(d["k_eff_dphrh"] / 216000 * math.pi / 180)
+
+
+def test_components_from_noise_fit_keeps_the_markov_term():
+    fit = SimpleNamespace(statistic="adev", A=np.array([0.0, 36.0, 0.0, 0.0, 0.0]), tau_min_s=0.1, tau_max_s=100.0,
+                          shaped={"M": {"tc_s": 20.0, "sigma_dph": 3.0}}, selected=("N", "M", "S"), no_fit=None)
+    comps, notes = components_from_noise_fit(fit)
+    assert comps == [{"kind": "white", "arw_dprh": 0.1}, {"kind": "gauss_markov", "tc_s": 20.0, "sigma_dph": 3.0}]
+    assert any("periodic term S" in n for n in notes)
+    with pytest.raises(ConfigError, match="Allan-variance fit"):
+        components_from_noise_fit(SimpleNamespace(statistic="hdev"))
+
+
+def test_coverage_rows_shapes():
+    rows = coverage_rows([np.array([0.5, -1.5]), np.array([3.0])], [1.0, 2.0], [1.0, 2.0])
+    assert [r.n_origins for r in rows] == [2, 1]
+    assert rows[0].coverage["68 %"] == 0.5 and rows[1].coverage["68 %"] == 0.0
+    assert rows[1].to_dict()["inflation"]["68 %"]["lambda"] == pytest.approx(2.25)
