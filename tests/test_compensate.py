@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 
 from fogdrift.bundle import write_bundle
 from fogdrift.compensate import compensate_file
-from fogdrift.errors import ConfigError, InsufficientDataError
+from fogdrift.errors import ConfigError, FogdriftWarning, InsufficientDataError
 from fogdrift.io import from_array, load
 from fogdrift.pipeline import AnalysisConfig, run_models
 from fogdrift.simulate import simulate
@@ -58,6 +58,7 @@ def _run(bundle_dir, path, out, **kw):
     kw.setdefault("figures", False)
     if str(path).endswith(".npy"):
         kw.setdefault("rate_hz", FS)
+        kw.setdefault("unit", "deg/s")  # a .npy declares no unit
         kw.setdefault("axis_map", "col0=gx,col1=gz")
     return compensate_file(bundle_dir, path, out, **kw)
 
@@ -181,9 +182,9 @@ def test_unit_rate_and_axis_mismatches_are_refused_unless_mapped(bundle_dir, log
                header="t_s,gx[rad/s],gz[rad/s]", comments="", fmt="%.17g")
     with pytest.raises(ConfigError) as info:
         _run(bundle_dir, tmp_path / "rad.csv", tmp_path / "o1")
-    assert "declares unit rad/s" in info.value.render({"apply_unit": "--apply-unit"}) and "--apply-unit" in \
-        info.value.render({"apply_unit": "--apply-unit"})
-    res = _run(bundle_dir, tmp_path / "rad.csv", tmp_path / "o2", apply_unit="rad/s", model="ar")
+    assert "declares unit rad/s" in info.value.render({"unit": "--unit"}) and "--unit rad/s" in \
+        info.value.render({"unit": "--unit"})
+    res = _run(bundle_dir, tmp_path / "rad.csv", tmp_path / "o2", unit="rad/s", model="ar")
     assert res.summary["unit"] == "rad/s"
     assert (tmp_path / "o2" / "compensated.csv").read_text().splitlines()[0].startswith("t_s,gx[rad/s],gz[rad/s]")
     ref = _run(bundle_dir, d / "log.csv", tmp_path / "o3", model="ar")
@@ -199,7 +200,7 @@ def test_unit_rate_and_axis_mismatches_are_refused_unless_mapped(bundle_dir, log
     assert res.summary["block_average_factor"] == 20 and any("x20" in m for m in res.messages)
 
     with pytest.raises(ConfigError, match="log axis 'col0' has no model in the bundle.*axis_map"):
-        compensate_file(bundle_dir, d / "log.npy", tmp_path / "o6", rate_hz=FS, heading=False)
+        compensate_file(bundle_dir, d / "log.npy", tmp_path / "o6", rate_hz=FS, unit="deg/s", heading=False)
     with pytest.raises(ConfigError, match="both map to bundle axis 'gx'"):
         _run(bundle_dir, d / "log.npy", tmp_path / "o7", axis_map="col0=gx,col1=gx")
     res = _run(bundle_dir, d / "log.npy", tmp_path / "o8", columns="1", axis_map="col1=gz", model="ar")
@@ -238,24 +239,27 @@ def test_cli_compensate_prints_the_heading_table_and_refuses_in_one_line(bundle_
                header="t_s,gx[rad/s]", comments="")
     result = runner.invoke(app, ["compensate", str(bundle_dir), str(tmp_path / "rad.csv"), "--out", str(tmp_path)])
     assert result.exit_code == 1
-    assert "--apply-unit rad/s" in result.output and "Traceback" not in result.output
+    assert "--unit rad/s" in result.output and "Traceback" not in result.output
     assert len([ln for ln in result.output.splitlines() if ln.strip()]) <= 3
 
 
-def test_csv_without_a_declared_unit_takes_the_bundles_and_says_so(bundle_dir, logs, tmp_path):
-    # the ADIS16405 and most logger CSVs declare no unit: compensate reads them in the bundle's unit (a note
-    # names --apply-unit), and the result equals the same numbers in a CSV that declares that unit
+def test_csv_without_a_declared_unit_is_refused_suggesting_the_bundles(bundle_dir, logs, tmp_path):
+    # the ADIS16405 and most logger CSVs declare no unit: compensate refuses to guess (not even the bundle's unit)
+    # and suggests it; with --unit the result equals the same numbers in a CSV that declares that unit
     d, x = logs
     t = np.arange(x.shape[0]) / FS
     np.savetxt(tmp_path / "plain.csv", np.column_stack([t, x]), delimiter=",", header="t_s,gx,gz", comments="",
                fmt="%.17g")
-    res = _run(bundle_dir, tmp_path / "plain.csv", tmp_path / "o1", model="ar")
+    with pytest.raises(ConfigError) as info:
+        _run(bundle_dir, tmp_path / "plain.csv", tmp_path / "o1", model="ar")
+    assert "pass --unit deg/s (the bundle was trained on deg/s)" in info.value.render({"unit": "--unit"})
+    assert not (tmp_path / "o1" / "compensated.csv").exists()
+    res = _run(bundle_dir, tmp_path / "plain.csv", tmp_path / "o1", model="ar", unit="deg/s")
     assert res.summary["unit"] == "deg/s"
-    note = next(m for m in res.messages if m.startswith("unit:"))
-    assert "declares none" in note and "pass apply_unit= to override" in note and "{opt:" not in note  # rendered
     ref = _run(bundle_dir, d / "log.csv", tmp_path / "o2", model="ar")
     np.testing.assert_array_equal(_npz(tmp_path / "o1")["compensated"], _npz(tmp_path / "o2")["compensated"])
     assert ref.summary["unit"] == "deg/s"
-    # given explicitly, the unit is the one given (here: the same numbers read as deg/h differ by 3600)
-    res = _run(bundle_dir, tmp_path / "plain.csv", tmp_path / "o3", model="bias", apply_unit="deg/s")
+    # the deprecated spelling still works, with a warning
+    with pytest.warns(FogdriftWarning, match="deprecated"):
+        res = _run(bundle_dir, tmp_path / "plain.csv", tmp_path / "o3", model="bias", apply_unit="deg/s")
     assert res.summary["unit"] == "deg/s"

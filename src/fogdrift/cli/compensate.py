@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import functools
+import inspect
+import typing
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -9,36 +12,58 @@ import typer
 from rich.text import Text
 
 from ..errors import render_options
-from ._app import FLAGS, OutOpt, _configure, app, console, csv_list, errors, fitted_table, progress_count
+from ._app import (FLAGS, LOAD_PARAMS, LoadOptions, OutOpt, app, console, csv_list, fitted_table, progress_count, run,
+                   warn)
+
+DEFAULT_OUT = Path("out/compensate")
+
+#: Output files of a complete run (the figure only when an axis has enough samples).
+EXPECTED = ("compensated.csv", "compensated.npz", "compensation.json")
+
+
+def with_load_options_after(func):
+    """:func:`fogdrift.cli._app.with_load_options` for a command whose own positional arguments come before FILE
+    (``compensate BUNDLE FILE``): the shared reading options, FILE second; the command receives ``load``.
+
+    (A candidate for ``cli/_app.py``: ``with_load_options(func, after=("bundle",))``.)
+    """
+    sig = inspect.signature(func)
+    hints = typing.get_type_hints(func, include_extras=True)
+    own = [p.replace(annotation=hints.get(p.name, p.annotation)) for p in sig.parameters.values() if p.name != "load"]
+    positional = [p for p in own if p.default is inspect.Parameter.empty]
+    options = [p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in own if p.default is not inspect.Parameter.empty]
+    shared = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=ann)
+              for name, ann, default in LOAD_PARAMS]
+    params = [p.replace(kind=inspect.Parameter.POSITIONAL_OR_KEYWORD) for p in positional] + \
+             [shared[0].replace(kind=inspect.Parameter.POSITIONAL_OR_KEYWORD)] + options + shared[1:]
+
+    @functools.wraps(func)
+    def wrapper(**kwargs):
+        opts = LoadOptions(**{name: kwargs.pop(name) for name, _, _ in LOAD_PARAMS})
+        return func(load=opts, **kwargs)
+
+    wrapper.__signature__ = sig.replace(parameters=params)
+    return wrapper
 
 
 @app.command()
+@with_load_options_after
 def compensate(
     bundle: Annotated[Path, typer.Argument(help="Bundle directory written by 'analyze' or 'model' (OUT/bundle).")],
-    file: Annotated[Path, typer.Argument(help="Gyro log to compensate: CSV/TXT (optionally .gz), .npy (streamed) "
-                                              "or .npz.")],
+    load: LoadOptions,
     model: Annotated[Optional[str], typer.Option(
         "--model", help="Model of the bundle to apply (registry name, e.g. kalman, ar, grey-elman) or 'bias' for "
                         "constant-bias compensation only; default: kalman if the bundle has it, else bias.")] = None,
     bias: Annotated[str, typer.Option(
         "--bias", help="'keep' the bundle's bias, or 're-estimate:SECONDS' on the first SECONDS of the log.")] = "keep",
     apply_unit: Annotated[Optional[str], typer.Option(
-        "--apply-unit", help="Unit of FILE's numbers (deg/h, deg/s, rad/s, ..., inc:arcsec); needed when it declares "
-                             "another unit than the bundle's; default: declared, else the bundle's.")] = None,
+        "--apply-unit", hidden=True, help="Deprecated spelling of --unit.")] = None,
     axis_map: Annotated[Optional[str], typer.Option(
         "--axis-map", help="LOG_AXIS=BUNDLE_AXIS pairs, comma-separated, for axes whose names differ "
                            "(e.g. col0=gz).")] = None,
     accept_rate: Annotated[bool, typer.Option(
         "--accept-rate", help="Accept a native rate other than the training log's (block-averaged to the "
                               "bundle's modelling rate).")] = False,
-    rate: Annotated[Optional[float], typer.Option("--rate", help="Sample rate [Hz] (if FILE has no time column).")]
-    = None,
-    time_unit: Annotated[Optional[str], typer.Option("--time-unit", help="Unit of the time column: s, ms, us, ns.")]
-    = None,
-    columns: Annotated[Optional[str], typer.Option("--columns", help="Comma-separated column names or indices.")]
-    = None,
-    time_column: Annotated[str, typer.Option("--time-column", help="Time column name/index, 'auto' or 'none'.")]
-    = "auto",
     chunk: Annotated[int, typer.Option("--chunk", help="Rows read at a time (memory bound; outputs do not depend "
                                                        "on it).")] = 1 << 20,
     formats: Annotated[str, typer.Option("--formats", help="Output files: csv, npz or csv,npz.")] = "csv,npz",
@@ -53,30 +78,39 @@ def compensate(
     origin_step: Annotated[float, typer.Option("--origin-step", help="Spacing of the rolling origins [s].")] = 300.0,
     horizons: Annotated[str, typer.Option("--horizons", help="Forecast horizons [s], comma-separated.")]
     = "60,600,3600",
-    out: OutOpt = Path("out/compensate"),
+    out: OutOpt = DEFAULT_OUT,
 ):
     """Apply a bundle causally to FILE (each output sample uses only past input) at FILE's native rate, write the
     compensated rate and the subtracted drift (CSV/NPZ), a JSON summary and before/after Allan figures, and print
-    the heading-error table."""
+    the heading-error table.  FILE is read with the same options as every command (a .npy is streamed in chunks);
+    a FILE that declares no unit needs --unit."""
     from ..compensate import compensate_file
     from ..errors import ConfigError
 
-    _configure()  # this run's console widths (a terminal, else COLUMNS, else whole lines), as run() does
-    with errors():
+    fmts = tuple(csv_list(formats) or ())
+    with run("compensate", out, default_out=DEFAULT_OUT, inputs=[load.file],
+             expect=tuple(n for n in EXPECTED if n.rsplit(".", 1)[-1] in fmts or n.endswith(".json"))):
         try:
             hs = tuple(float(h) for h in csv_list(horizons))
         except ValueError:
             raise ConfigError(f"--horizons must be numbers of seconds separated by commas; got {horizons!r}") from None
+        unit = load.unit
+        if apply_unit is not None:
+            warn("--apply-unit is deprecated; use --unit (the same meaning)")
+            if unit is not None and unit.strip() != apply_unit.strip():
+                raise ConfigError(f"--unit {unit} and --apply-unit {apply_unit} disagree; pass --unit only")
+            unit = apply_unit
+        if load.gaps not in ("error", "longest"):
+            raise ConfigError(f"--gaps must be 'error' or 'longest', got {load.gaps!r}")
+        kwargs = load.load_kwargs()
+        kwargs.update(unit=unit, gaps="split" if load.gaps == "longest" else "error")
         with progress_count("compensate", "samples") as update:
             result = compensate_file(
-                bundle, file, out, model=model, bias=bias, apply_unit=apply_unit, axis_map=axis_map,
-                accept_rate=accept_rate, columns=columns,
-                time_column=None if time_column.lower() == "none" else time_column,
-                rate_hz=rate, time_unit=time_unit, chunk_samples=chunk, formats=tuple(csv_list(formats) or ()),
-                heading=heading, artefacts=artefacts, calib_s=calibration, step_s=origin_step, horizons_s=hs,
-                flags=FLAGS, progress=update)
+                bundle, load.file, out, model=model, bias=bias, axis_map=axis_map, accept_rate=accept_rate,
+                chunk_samples=chunk, formats=fmts, heading=heading, artefacts=artefacts, calib_s=calibration,
+                step_s=origin_step, horizons_s=hs, flags=FLAGS, progress=update, **kwargs)
         s = result.summary
-        console.print(Text(f"compensated {s['n_samples']} samples of {file.name} with {s['model_label']} "
+        console.print(Text(f"compensated {s['n_samples']} samples of {load.file.name} with {s['model_label']} "
                            f"(unit {s['unit']}, {1 / s['native_dt_s']:g} Hz, models at {1 / s['model_dt_s']:g} Hz)"),
                       soft_wrap=True)
         for line in result.messages:

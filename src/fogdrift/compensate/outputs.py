@@ -6,13 +6,16 @@ header (``gz[deg/s]``, readable by :func:`fogdrift.io.load`) and in the NPZ (``u
 time ``t_s``, the compensated rate per axis, the subtracted drift estimate per axis (``<axis>_drift``), and for
 a Kalman model its 1-sigma (``<axis>_drift_sigma``).  The NPZ is written without holding the arrays: each array
 goes to a temporary ``.npy`` (header first, rows appended) and the archive is assembled at the end.
+
+Every file is written through the shared atomic output edge (:func:`fogdrift.output.atomic_path`, recorded in the
+output folder's manifest): an error or a Ctrl-C leaves no partial file under a final name.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
-import tempfile
 import zipfile
 from pathlib import Path
 
@@ -22,11 +25,14 @@ __all__ = ["CsvWriter", "NpzWriter", "AllanAccumulator", "plot_before_after"]
 
 
 class CsvWriter:
-    """Append rows to ``path``: header ``t_s,<axes>[unit],<axes>_drift[unit](,<axes>_drift_sigma[unit])``."""
+    """Append rows to ``path``: header ``t_s,<axes>[unit],<axes>_drift[unit](,<axes>_drift_sigma[unit])``.
+
+    ``path`` is the temporary name :func:`fogdrift.output.atomic_path` gives (the caller renames it when the whole
+    log is written, or the edge removes it): the final name never holds a partial CSV.
+    """
 
     def __init__(self, path, axis_names, unit, with_sigma):
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         self._fh = open(self.path, "w")
         cols = ["t_s"] + [f"{a}[{unit}]" for a in axis_names] + [f"{a}_drift[{unit}]" for a in axis_names]
         if with_sigma:
@@ -44,21 +50,32 @@ class CsvWriter:
 
 
 class NpzWriter:
-    """An ``.npz`` of known shapes written row block by row block (see the module docstring)."""
+    """An ``.npz`` of known shapes written row block by row block (see the module docstring).
+
+    ``path`` is the temporary name of the archive (:func:`fogdrift.output.atomic_path`); each array goes to a
+    temporary ``.npy`` beside it, named ``.fogdrift-tmp-<pid>-...`` (:data:`fogdrift.output.TMP_PREFIX`, so a
+    killed run's leftovers are removed by the next run in the folder), and :meth:`abort` removes them.
+    """
 
     def __init__(self, path, n_samples, axis_names, unit, scale_to_dph, with_sigma):
+        from ..output import TMP_PREFIX
+
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._dir = tempfile.mkdtemp(prefix="fogdrift-npz-", dir=self.path.parent)
         k = len(axis_names)
         shapes = {"t_s": (n_samples,), "compensated": (n_samples, k), "drift_estimate": (n_samples, k)}
         if with_sigma:
             shapes["drift_sigma"] = (n_samples, k)
+        stem = self.path.name if self.path.name.startswith(TMP_PREFIX) else f"{TMP_PREFIX}{os.getpid()}-{self.path.name}"
+        self._paths = {name: self.path.with_name(f"{stem}.{name}.npy") for name in shapes}
         self._files = {}
-        for name, shape in shapes.items():
-            fh = open(os.path.join(self._dir, name + ".npy"), "wb")
-            np.lib.format.write_array_header_2_0(fh, {"descr": "<f8", "fortran_order": False, "shape": shape})
-            self._files[name] = fh
+        try:
+            for name, shape in shapes.items():
+                fh = open(self._paths[name], "wb")
+                self._files[name] = fh
+                np.lib.format.write_array_header_2_0(fh, {"descr": "<f8", "fortran_order": False, "shape": shape})
+        except BaseException:
+            self.abort()
+            raise
         self._small = {"axis_names": np.array(list(axis_names)), "unit": np.array(unit),
                        "scale_to_dph": np.array(float(scale_to_dph))}
         self.n = 0
@@ -73,26 +90,28 @@ class NpzWriter:
         self.n += t.shape[0]
 
     def abort(self):
-        """Close and remove the temporary files (after an error)."""
-        for name, fh in self._files.items():
-            fh.close()
-            os.remove(os.path.join(self._dir, name + ".npy"))
-        os.rmdir(self._dir)
-
-    def close(self):
+        """Close and remove the temporary member files (after an error or an interruption)."""
         for fh in self._files.values():
             fh.close()
-        if self.n != self.n_samples:  # pragma: no cover - the engine emits every sample once
-            raise RuntimeError(f"NPZ writer got {self.n} rows, expected {self.n_samples}")
-        with zipfile.ZipFile(self.path, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
-            for name in self._files:
-                zf.write(os.path.join(self._dir, name + ".npy"), arcname=name + ".npy")
-            for name, a in self._small.items():
-                with zf.open(name + ".npy", "w") as fh:
-                    np.lib.format.write_array(fh, a, allow_pickle=False)
-        for name in self._files:
-            os.remove(os.path.join(self._dir, name + ".npy"))
-        os.rmdir(self._dir)
+        for p in self._paths.values():
+            with contextlib.suppress(OSError):
+                os.remove(p)
+
+    def close(self):
+        """Assemble the archive at ``path`` from the member files (removed afterwards, also on failure)."""
+        try:
+            for fh in self._files.values():
+                fh.close()
+            if self.n != self.n_samples:  # pragma: no cover - the engine emits every sample once
+                raise RuntimeError(f"NPZ writer got {self.n} rows, expected {self.n_samples}")
+            with zipfile.ZipFile(self.path, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
+                for name in self._files:
+                    zf.write(self._paths[name], arcname=name + ".npy")
+                for name, a in self._small.items():
+                    with zf.open(name + ".npy", "w") as fh:
+                        np.lib.format.write_array(fh, a, allow_pickle=False)
+        finally:
+            self.abort()
 
 
 class AllanAccumulator:
@@ -153,8 +172,12 @@ def plot_before_after(curves, path, title, caveats: dict | None = None) -> Path:
         if text:
             ax.text(0.0, -0.17, textwrap.fill(text, width=80), transform=ax.transAxes, ha="left", va="top",
                     fontsize=7, color="C3" if "not evidence" in text or "not checked" in text else "k")
+    from ..output import atomic_path
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110, bbox_inches="tight")
+    finally:
+        plt.close(fig)
     return path

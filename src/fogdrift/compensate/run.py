@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import ConfigError, render_options
+from ..errors import ConfigError, FogdriftWarning, render_options
 from .engine import BIAS_ONLY, AxisPlan, StreamCompensator
 from .outputs import AllanAccumulator, CsvWriter, NpzWriter, plot_before_after
 from .sources import DEFAULT_CHUNK, match_log, open_log
@@ -87,9 +89,9 @@ def _allan_rows(before, after, dt):
                   for t, x, y in zip(a.tau_s, a.adev_dph, b.adev_dph)]
 
 
-def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_unit=None, axis_map=None,
-                    accept_rate=False, columns=None, time_column="auto", rate_hz=None, time_unit=None,
-                    chunk_samples=DEFAULT_CHUNK, formats=FORMATS, figures=True, heading=True, artefacts=True,
+def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", unit=None, axis_map=None,
+                    accept_rate=False, columns=None, time_column="auto", rate_hz=None, time_unit=None, format=None,
+                    reader_options=None, temperature=None, gaps="error", apply_unit=None, chunk_samples=DEFAULT_CHUNK, formats=FORMATS, figures=True, heading=True, artefacts=True,
                     calib_s=300.0, step_s=300.0, horizons_s=(60.0, 600.0, 3600.0), max_model_rate_samples=1 << 23,
                     segment=None, progress=None, flags=None) -> CompensationResult:
     """Compensate the log ``path`` with ``bundle`` and write the results to ``out_dir``.
@@ -102,17 +104,24 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
         The log to compensate (any format :func:`fogdrift.io.load` reads; ``.npy`` is streamed).
     out_dir : str or Path
         Output directory: ``compensated.csv``, ``compensated.npz``, ``compensation.json``,
-        ``compensation_allan.png``.
+        ``compensation_allan.png``, each written atomically (:func:`fogdrift.output.atomic_path`) and listed in
+        the folder's manifest; without an active :class:`fogdrift.output.OutputDir` for it (the CLI's), one is
+        opened here.
     model : str, optional
         Registry name of a model of the bundle, or ``"bias"`` (constant bias only); default
         :func:`default_model`.
     bias : "keep" or "re-estimate:SECONDS" or float
         Keep the bundle's bias, or re-estimate it on the first SECONDS of the log (see
         :mod:`fogdrift.compensate.engine`).
-    apply_unit, axis_map, accept_rate
+    unit : str, optional
+        Unit of the log's numbers (as :func:`fogdrift.io.load`: it takes precedence over a declared unit).  A
+        log that declares none needs it (refused otherwise, suggesting the bundle's unit).
+    axis_map, accept_rate
         How to map a log that does not match the bundle (:func:`~fogdrift.compensate.sources.match_log`).
-    columns, time_column, rate_hz, time_unit
+    columns, time_column, rate_hz, time_unit, format, reader_options, temperature, gaps
         How to read the log (as :func:`fogdrift.io.load`).
+    apply_unit : str, optional
+        Deprecated spelling of ``unit`` (a :class:`~fogdrift.errors.FogdriftWarning` says so).
     chunk_samples : int
         Rows read at a time; the outputs do not depend on it.
     formats : sequence of {"csv", "npz"}
@@ -131,7 +140,7 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
     progress : callable, optional
         ``progress(done_samples, total_samples)``.
     flags : dict, optional
-        Setting name -> how the caller names it (the CLI's ``--apply-unit``); ``{opt:NAME}`` markers in the
+        Setting name -> how the caller names it (the CLI's ``--unit``); ``{opt:NAME}`` markers in the
         messages are rendered with it before they are stored (default: ``NAME=``, the keyword of this function).
 
     Returns
@@ -139,6 +148,34 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
     CompensationResult
     """
     from ..bundle import Bundle, load_bundle
+    from ..output import OutputDir, active
+
+    if apply_unit is not None:
+        if unit is not None and unit.strip() != apply_unit.strip():
+            raise ConfigError(f"unit {unit!r} and its deprecated spelling apply_unit {apply_unit!r} disagree; pass "
+                              "{opt:unit} only")
+        warnings.warn("{opt:apply_unit} is deprecated; pass {opt:unit} (the same meaning)", FogdriftWarning,
+                      stacklevel=2)
+        unit = apply_unit
+    edge = contextlib.nullcontext() if active(Path(out_dir) / "compensation.json") is not None else \
+        OutputDir(out_dir, command="compensate", protect=[path])
+    with edge:
+        return _compensate(bundle, path, out_dir, Bundle=Bundle, load_bundle=load_bundle, model=model, bias=bias,
+                           unit=unit, axis_map=axis_map, accept_rate=accept_rate,
+                           load_kwargs=dict(columns=columns, time_column=time_column, rate_hz=rate_hz,
+                                            time_unit=time_unit, format=format, reader_options=reader_options,
+                                            temperature=temperature, gaps=gaps),
+                           chunk_samples=chunk_samples, formats=formats, figures=figures, heading=heading,
+                           artefacts=artefacts, calib_s=calib_s, step_s=step_s, horizons_s=horizons_s,
+                           max_model_rate_samples=max_model_rate_samples, segment=segment, progress=progress,
+                           flags=flags)
+
+
+def _compensate(bundle, path, out_dir, *, Bundle, load_bundle, model, bias, unit, axis_map, accept_rate, load_kwargs,
+                chunk_samples, formats, figures, heading, artefacts, calib_s, step_s, horizons_s,
+                max_model_rate_samples, segment, progress, flags) -> CompensationResult:
+    from ..interrupt import checkpoint
+    from ..output import atomic_path
 
     t_start = time.perf_counter()
     b = bundle if isinstance(bundle, Bundle) else load_bundle(bundle)
@@ -147,25 +184,17 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
         raise ConfigError(f"formats must be a non-empty subset of {list(FORMATS)}; got {list(formats)!r}")
     bias_mode = parse_bias(bias)
     name = _model_name(b, model)
-    source = open_log(path, columns=columns, time_column=time_column, rate_hz=rate_hz, time_unit=time_unit)
-    match = match_log(source, b, apply_unit=apply_unit, axis_map=axis_map, accept_rate=accept_rate)
+    source = open_log(path, unit=unit, bundle_unit=b.input_unit, **load_kwargs)
+    match = match_log(source, b, axis_map=axis_map, accept_rate=accept_rate)
     plans = [AxisPlan(log_ax, b.axis(b_ax), name) for log_ax, b_ax in match.axes]
     engine = StreamCompensator(plans, factor=match.factor, model_dt_s=b.model_dt_s, wavelet=b.wavelet, mode=b.mode,
                                bias=bias_mode, segment=segment,
                                keep_model_rate=(heading or artefacts)
                                and source.n_samples // match.factor <= max_model_rate_samples)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     names = [a for a, _ in match.axes]
-    scale = match.scale_to_dph
+    scale = match.scale_to_dph  # the reader's own factor (file unit -> deg/h), carried: outputs divide by it once
     writers, files = [], {}
-    if "csv" in formats:
-        writers.append(CsvWriter(out / "compensated.csv", names, match.unit, engine.has_sigma))
-        files["csv"] = out / "compensated.csv"
-    if "npz" in formats:
-        writers.append(NpzWriter(out / "compensated.npz", source.n_samples, names, match.unit, scale,
-                                 engine.has_sigma))
-        files["npz"] = out / "compensated.npz"
     acc = AllanAccumulator(source.n_samples, len(names))
 
     def emit(blocks):
@@ -175,18 +204,28 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", apply_uni
                         None if blk.sigma_dph is None else blk.sigma_dph / scale)
             acc.add(blk.rate_dph, blk.compensated_dph)
 
-    try:
-        for t, x in source.chunks(scale, chunk_samples):
-            emit(engine.push(t, x))
-            if progress is not None:
-                progress(engine.n_in, source.n_samples)
-        emit(engine.finish())
-    except BaseException:
+    checkpoint("compensating")
+    with contextlib.ExitStack() as stack:  # the final names appear (renamed) only when every row is written
+        if "csv" in formats:
+            files["csv"] = out / "compensated.csv"
+            writers.append(CsvWriter(stack.enter_context(atomic_path(files["csv"])), names, match.unit,
+                                     engine.has_sigma))
+        if "npz" in formats:
+            files["npz"] = out / "compensated.npz"
+            writers.append(NpzWriter(stack.enter_context(atomic_path(files["npz"])), source.n_samples, names,
+                                     match.unit, scale, engine.has_sigma))
+        try:
+            for t, x in source.chunks(chunk_samples):
+                emit(engine.push(t, x))
+                if progress is not None:
+                    progress(engine.n_in, source.n_samples)
+            emit(engine.finish())
+        except BaseException:
+            for w in writers:
+                w.abort()
+            raise
         for w in writers:
-            w.abort()
-        raise
-    for w in writers:
-        w.close()
+            w.close()
 
     messages = list(match.notes)
     biases = engine.biases()
@@ -271,22 +310,10 @@ def _caveats(result, name, plans, curves, why_not) -> list:
 
 
 def _write_json(obj, path) -> Path:
-    import json
+    """The summary as strict JSON (NaN/inf as null), atomically: the one JSON writer of the reports."""
+    from ..report.files import write_json
 
-    from .._util import json_default
-
-    def clean(o):
-        if isinstance(o, float):
-            return o if math.isfinite(o) else None
-        if isinstance(o, dict):
-            return {str(k): clean(v) for k, v in o.items()}
-        if isinstance(o, (list, tuple)):
-            return [clean(v) for v in o]
-        return o
-
-    data = clean(json.loads(json.dumps(obj, default=json_default)))
-    Path(path).write_text(json.dumps(data, indent=2, allow_nan=False))
-    return Path(path)
+    return write_json(obj, path)
 
 
 def _evaluate(result, b, plans, biases, z_all, *, heading, artefacts, calib_s, step_s, horizons_s):

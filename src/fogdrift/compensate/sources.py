@@ -1,16 +1,22 @@
-"""Reading the log to compensate in chunks, and matching it to the bundle (unit, rate, axes).
+"""Reading the log to compensate, through :mod:`fogdrift.io`, and matching it to the bundle (unit, rate, axes).
 
-* ``.npy`` files are read **chunk by chunk from the file** (the header is parsed, rows are read with
-  ``numpy.fromfile``): memory stays bounded by the chunk size whatever the file size (a 10^8-sample log
-  works in well under 2 GB).  Columns are ``col0, col1, ...`` as for :func:`fogdrift.io.load`; a time column
-  is used only when named (``time_column``); otherwise the sample rate must be given.
-* Every other format is read by :func:`fogdrift.io.load` (the whole file; text logs are parsed in memory) and
-  handed on in chunks.
+* ``.npy`` files are streamed **chunk by chunk from the file** by the io chunked source
+  (:func:`fogdrift.io.chunked.open_rows`): memory stays bounded by the chunk size whatever the file size.
+  Columns are ``col0, col1, ...`` as for :func:`fogdrift.io.load`; a time column is used only when named.
+* Every other format (and a ``.npy`` read with options only :func:`fogdrift.io.load` has: a forced format, reader
+  options, a temperature column, gap splitting) is read **once** by :func:`fogdrift.io.load`, with the same
+  options as every other command, and handed on in chunks.
+
+Either way the numbers are converted to deg/h once, by the reader, with the scale it records
+(:attr:`LogSource.scale_to_dph`); the outputs divide by that same scale to write the log's own unit.
+
+The unit (:func:`open_log`): ``unit`` if given (it takes precedence over a unit the file declares, as for every
+command), else the unit the file declares.  A log that declares none, read without ``unit``, is **refused** with
+one line suggesting the bundle's unit: units are never guessed, not even from the bundle.
 
 Matching (:func:`match_log`), each refusal one line naming the option that maps it:
 
-* **unit**: the log's unit is ``apply_unit`` if given, else the unit its header declares, else the bundle's
-  (said in a note).  A declared unit that differs from the bundle's is refused unless ``apply_unit`` is given.
+* **unit**: a declared unit that differs from the bundle's is refused unless ``unit`` is given (then converted).
 * **rate**: a native rate different from the bundle's is refused unless ``accept_rate`` (then the log is
   block-averaged to the bundle's modelling rate by its own integer factor).
 * **axes** are matched **by name**; ``axis_map`` (``{"col0": "gz"}``) maps others.  A log axis with no bundle
@@ -19,42 +25,35 @@ Matching (:func:`match_log`), each refusal one line naming the option that maps 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError, DataFormatError, FogdriftError
-from ..units import INCREMENT_UNITS, RATE_UNITS, TIME_UNITS, increment_scale_to_dph, rate_scale_to_dph
+from ..errors import ConfigError, DataFormatError
 
-__all__ = ["LogSource", "open_log", "match_log", "LogMatch", "unit_scale_to_dph"]
+__all__ = ["LogSource", "open_log", "match_log", "LogMatch", "DEFAULT_CHUNK"]
 
 #: Rows per chunk when a caller gives none.
 DEFAULT_CHUNK = 1 << 20
 
 
-def unit_scale_to_dph(unit: str, dt_s: float) -> float:
-    """Factor from ``unit`` (rate unit or ``inc:<angle>`` per sample of ``dt_s``) to deg/h."""
-    u = unit.strip()
-    if u in RATE_UNITS:
-        return rate_scale_to_dph(u)
-    if u.startswith("inc:") and u[4:].strip() in INCREMENT_UNITS:
-        return increment_scale_to_dph(u[4:].strip(), dt_s)
-    valid = list(RATE_UNITS) + [f"inc:{k}" for k in INCREMENT_UNITS]
-    raise ConfigError(f"unknown unit {unit!r}; expected one of {valid}; pass {{opt:apply_unit}}")
-
-
 @dataclass
 class LogSource:
-    """A log opened for chunked reading (numbers in the file's unit until :meth:`chunks` scales them).
+    """A log opened for chunked reading, its numbers converted to deg/h once by the reader.
 
     Attributes
     ----------
     path : Path
     axis_names : tuple of str
+    unit : str
+        Unit of the file's numbers: the one given, else the one the file declares.
+    unit_given : bool
+        True when ``unit`` was given (not declared by the file).
     declared_unit : str or None
         Unit the file declares for its rate columns (None: none).
+    scale_to_dph : float
+        Factor the reader applied to the file's numbers (``unit`` to deg/h).
     dt_s, t0_s : float
     n_samples : int
     sha256 : str or None
@@ -63,193 +62,103 @@ class LogSource:
 
     path: Path
     axis_names: tuple
+    unit: str
+    unit_given: bool
     declared_unit: str | None
+    scale_to_dph: float
     dt_s: float
     t0_s: float
     n_samples: int
     sha256: str | None
     notes: list = field(default_factory=list)
-    _reader: object = None
+    _chunks: object = None
 
-    def chunks(self, scale_to_dph: float, chunk_samples: int = DEFAULT_CHUNK):
+    def chunks(self, chunk_samples: int = DEFAULT_CHUNK):
         """Yield ``(t_s (n,), rate_dph (n, n_axes))`` in order, ``chunk_samples`` rows at a time."""
         if isinstance(chunk_samples, bool) or not isinstance(chunk_samples, (int, np.integer)) or chunk_samples < 1:
             raise ConfigError(f"chunk_samples must be an integer >= 1; got {chunk_samples!r}")
-        yield from self._reader(float(scale_to_dph), int(chunk_samples))
+        yield from self._chunks(int(chunk_samples))
 
 
-# ----------------------------------------------------------------------------------------------------------
-# .npy, streamed
-# ----------------------------------------------------------------------------------------------------------
-def _npy_header(path: Path):
-    try:
-        with open(path, "rb") as fh:
-            major, _ = np.lib.format.read_magic(fh)
-            if major == 1:
-                shape, fortran, dtype = np.lib.format.read_array_header_1_0(fh)
-            else:
-                shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
-            offset = fh.tell()
-    except (ValueError, OSError, EOFError) as exc:
-        raise DataFormatError(f"unreadable .npy header; expected a NumPy array file, got {exc}", path=path) from None
-    if dtype.kind not in "biuf" or len(shape) not in (1, 2) or dtype.hasobject:
-        raise DataFormatError(f"array of dtype {dtype} and shape {shape}; expected a real numeric 1-D or 2-D array",
-                              path=path)
-    rows = int(shape[0])
-    cols = 1 if len(shape) == 1 else int(shape[1])
-    if path.stat().st_size < offset + rows * cols * dtype.itemsize:
-        raise DataFormatError(f"file is shorter than its header says ({rows} x {cols} {dtype}); expected the whole "
-                              "array, got a truncated file", path=path)
-    return rows, cols, dtype, bool(fortran) and cols > 1, offset
-
-
-def _column_index(key, cols, option, path):
-    if isinstance(key, (int, np.integer)) and not isinstance(key, bool) and -cols <= int(key) < cols:
-        return int(key) % cols
-    if isinstance(key, str):
-        k = key.strip()
-        if k.isdigit() and int(k) < cols:
-            return int(k)
-        if k.startswith("col") and k[3:].isdigit() and int(k[3:]) < cols:
-            return int(k[3:])
-    raise DataFormatError(f"unknown column {key!r}; expected one of col0..col{cols - 1} or an index in "
-                          f"{{opt:{option}}}", path=path, column=key)
-
-
-def _open_npy(path: Path, columns, time_column, rate_hz, time_unit) -> LogSource:
-    from ..io import file_sha256
-
-    rows, cols, dtype, fortran, offset = _npy_header(path)
-    t_idx = None
-    if time_column is not None and not (isinstance(time_column, str) and time_column.strip().lower() == "auto"):
-        t_idx = _column_index(time_column, cols, "time_column", path)
-    if columns is None:
-        r_idx = [j for j in range(cols) if j != t_idx]
-    else:
-        keys = [c.strip() for c in columns.split(",")] if isinstance(columns, str) else list(columns)
-        r_idx = [_column_index(k, cols, "columns", path) for k in keys]
-    if not r_idx or len(set(r_idx)) != len(r_idx) or t_idx in r_idx:
-        raise ConfigError(f"{path}: choose distinct rate columns other than the time column; got columns={columns!r}")
-    if time_unit and time_unit not in TIME_UNITS:
-        raise ConfigError(f"unknown time unit {time_unit!r}; expected one of {list(TIME_UNITS)}")
-    t_scale = TIME_UNITS[time_unit] if time_unit else 1.0
-
-    def read(lo, hi):
-        if fortran:
-            mm = np.load(path, mmap_mode="r")
-            return np.array(mm[lo:hi], dtype=np.float64).reshape(hi - lo, cols)
-        with open(path, "rb") as fh:
-            fh.seek(offset + lo * cols * dtype.itemsize)
-            a = np.fromfile(fh, dtype=dtype, count=(hi - lo) * cols)
-        return a.reshape(hi - lo, cols).astype(np.float64, copy=False)
-
-    notes = [f"npy array, {rows} samples x {cols} columns, read in chunks"]
-    if t_idx is None:
-        if rate_hz is None:
-            raise ConfigError(f"{path}: cannot tell the sample interval: a .npy file has no time column unless "
-                              "one is named with {opt:time_column}; pass the sample rate in Hz as {opt:rate_hz}")
-        dt, t0 = 1.0 / float(rate_hz), 0.0
-        notes.append(f"sample interval {dt:.10g} s from the given rate (no time column)")
-    else:
-        head = read(0, min(rows, 65537))[:, t_idx] * t_scale
-        if head.size < 2:
-            raise DataFormatError("fewer than 2 samples; expected at least 2 to take the sample interval", path=path)
-        dt = float(f"{float(np.median(np.diff(head))):.10g}")
-        t0 = float(head[0])
-        if rate_hz is not None:
-            if abs(dt * float(rate_hz) - 1.0) > 0.01:
-                raise DataFormatError(f"time column disagrees with the given rate; expected steps of "
-                                      f"{1 / float(rate_hz):.10g} s, got {dt:.10g} s", path=path, column=f"col{t_idx}")
-            dt = 1.0 / float(rate_hz)
-        notes.append(f"sample interval {dt:.10g} s from the time column col{t_idx} (median of the first steps)")
-    if not (math.isfinite(dt) and dt > 0):
-        raise DataFormatError(f"sample interval {dt!r} s; expected a finite interval > 0", path=path)
-
-    def reader(scale, chunk):
-        prev_t = None
-        for lo in range(0, rows, chunk):
-            hi = min(rows, lo + chunk)
-            a = read(lo, hi)
-            x = a[:, r_idx]
-            bad = ~np.isfinite(x)
-            if bad.any():
-                i, j = np.argwhere(bad)[0]
-                raise DataFormatError(f"non-finite value at sample {lo + i}; expected a finite number, got "
-                                      f"{float(x[i, j])!r}", path=path, column=f"col{r_idx[j]}")
-            if t_idx is None:
-                t = t0 + np.arange(lo, hi) * dt
-            else:
-                t = a[:, t_idx] * t_scale
-                steps = np.diff(np.concatenate([[prev_t], t]) if prev_t is not None else t)
-                first = lo if prev_t is None else lo - 1
-                bad = ~(steps > 0) | (steps > 1.5 * dt)
-                if bad.any():
-                    i = int(np.argmax(bad)) + first + 1
-                    raise DataFormatError(f"time step at sample {i} is {float(steps[np.argmax(bad)])!r} s; expected "
-                                          f"increasing time without gaps (steps of {dt:.10g} s)", path=path,
-                                          column=f"col{t_idx}")
-                prev_t = t[-1]
-            with np.errstate(over="ignore"):
-                yield t, np.multiply(x, scale, dtype=np.float64)
-
-    return LogSource(path=path, axis_names=tuple(f"col{j}" for j in r_idx), declared_unit=None, dt_s=dt, t0_s=t0,
-                     n_samples=rows, sha256=file_sha256(path), notes=notes, _reader=reader)
-
-
-# ----------------------------------------------------------------------------------------------------------
-# everything else, via fogdrift.io.load
-# ----------------------------------------------------------------------------------------------------------
-def _open_loaded(path: Path, columns, time_column, rate_hz, time_unit) -> LogSource:
-    from ..io import load
-
-    tc = None if isinstance(time_column, str) and time_column.strip().lower() == "none" else time_column
-    try:
-        rec = load(path, columns=columns, time_column=tc, rate_hz=rate_hz, time_unit=time_unit)
-    except ConfigError as exc:
-        # a log that declares no unit: read its numbers as they are (deg/h = factor 1); match_log then takes
-        # --apply-unit or the bundle's unit and says so.  Any other configuration error stands.
-        try:
-            rec = load(path, columns=columns, time_column=tc, rate_hz=rate_hz, time_unit=time_unit, unit="deg/h")
-        except FogdriftError:
-            raise exc from None
-        if any(u is not None for u in rec.declared_units):
-            raise exc from None
-    declared = {u for u in rec.declared_units}
+def _one_declared(units, path) -> str | None:
+    declared = set(units)
     if len(declared) > 1:
         raise DataFormatError(f"rate columns declare different units {sorted(map(str, declared))}; expected one "
                               "unit (choose columns with {opt:columns})", path=path)
-    declared_unit = next(iter(declared))
-    # load() converted a declared unit to deg/h; undo it so that chunks() applies the unit finally chosen
-    raw_scale = rec.scale_to_dph
+    return next(iter(declared), None)
 
-    def reader(scale, chunk):
+
+def _streamed(path, load_kwargs) -> LogSource:
+    from ..io.chunked import open_rows
+
+    src = open_rows(path, columns=load_kwargs.get("columns"), time_column=load_kwargs.get("time_column", "auto"),
+                    rate_hz=load_kwargs.get("rate_hz"), time_unit=load_kwargs.get("time_unit"),
+                    unit=load_kwargs.get("unit"))
+    return LogSource(path=src.path, axis_names=src.axis_names, unit=src.unit, unit_given=True, declared_unit=None,
+                     scale_to_dph=src.scale_to_dph, dt_s=src.dt_s, t0_s=src.t0_s, n_samples=src.n_samples,
+                     sha256=src.sha256, notes=list(src.notes), _chunks=src.chunks)
+
+
+def _loaded(path, load_kwargs) -> LogSource:
+    from ..io import load
+
+    rec = load(path, **load_kwargs)
+    declared = _one_declared(rec.declared_units, rec.source)
+
+    def chunks(chunk):
         for lo in range(0, rec.n_samples, chunk):
             hi = min(rec.n_samples, lo + chunk)
-            x = rec.rate_dph[lo:hi]
-            if scale != raw_scale:
-                x = np.multiply(x / raw_scale if raw_scale != 1.0 else x, scale, dtype=np.float64)
-            yield rec.t0_s + np.arange(lo, hi) * rec.dt_s, np.array(x, dtype=np.float64)
+            yield rec.t0_s + np.arange(lo, hi) * rec.dt_s, rec.rate_dph[lo:hi]
 
-    return LogSource(path=path, axis_names=rec.axis_names, declared_unit=declared_unit, dt_s=rec.dt_s, t0_s=rec.t0_s,
-                     n_samples=rec.n_samples, sha256=rec.sha256, notes=list(rec.notes), _reader=reader)
+    return LogSource(path=Path(rec.source), axis_names=rec.axis_names, unit=rec.input_unit,
+                     unit_given=load_kwargs.get("unit") is not None, declared_unit=declared,
+                     scale_to_dph=rec.scale_to_dph, dt_s=rec.dt_s, t0_s=rec.t0_s, n_samples=rec.n_samples,
+                     sha256=rec.sha256, notes=list(rec.notes), _chunks=chunks)
 
 
-def open_log(path, *, columns=None, time_column="auto", rate_hz=None, time_unit=None) -> LogSource:
-    """Open a gyro log for chunked reading (see the module docstring).
+#: Options of :func:`fogdrift.io.load` the streamed ``.npy`` path takes; any other set option reads the file
+#: with :func:`fogdrift.io.load`.
+_STREAM_OPTIONS = ("columns", "time_column", "rate_hz", "unit", "time_unit")
+
+
+def open_log(path, *, unit=None, columns=None, time_column="auto", rate_hz=None, time_unit=None, format=None,
+             reader_options=None, temperature=None, gaps="error", bundle_unit=None) -> LogSource:
+    """Open a gyro log for chunked reading (see the module docstring); the file is parsed once.
+
+    Parameters
+    ----------
+    path : str or Path
+    unit, columns, time_column, rate_hz, time_unit, format, reader_options, temperature, gaps
+        As for :func:`fogdrift.io.load` (``gaps="split"`` keeps the longest gap-free segment, with a warning).
+    bundle_unit : str, optional
+        The bundle's unit, suggested in the refusal of a log that declares no unit.
 
     Raises
     ------
-    ConfigError, DataFormatError, InsufficientDataError
+    ConfigError
+        No unit given and none declared (one line suggesting ``bundle_unit``); as :func:`fogdrift.io.load`.
+    DataFormatError, InsufficientDataError
         As :func:`fogdrift.io.load`.
     """
     from ..io._checks import check_path
 
     p = check_path(path)
+    kwargs = dict(unit=unit, columns=columns, time_column=time_column, rate_hz=rate_hz, time_unit=time_unit,
+                  format=format, reader_options=reader_options or None, temperature=temperature, gaps=gaps)
     with open(p, "rb") as fh:
         magic = fh.read(6)
-    if magic == b"\x93NUMPY":
-        return _open_npy(p, columns, time_column, rate_hz, time_unit)
-    return _open_loaded(p, columns, time_column, rate_hz, time_unit)
+    stream = magic == b"\x93NUMPY" and format in (None, "npy") and not reader_options and temperature is None \
+        and gaps == "error"
+    try:
+        if stream:
+            return _streamed(p, {k: kwargs[k] for k in _STREAM_OPTIONS})
+        return _loaded(p, {k: v for k, v in kwargs.items() if v is not None})
+    except ConfigError as exc:
+        if unit is not None or bundle_unit is None or "{opt:unit}" not in str(exc.args[0] if exc.args else ""):
+            raise
+        raise ConfigError(f"{p}: the log declares no rate unit and none was given; pass {{opt:unit}} {bundle_unit} "
+                          f"(the bundle was trained on {bundle_unit}) or the unit of its numbers (units are never "
+                          "guessed)") from None
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -297,7 +206,7 @@ def parse_axis_map(text) -> dict:
     return out
 
 
-def match_log(source: LogSource, bundle, *, apply_unit=None, axis_map=None, accept_rate=False) -> LogMatch:
+def match_log(source: LogSource, bundle, *, axis_map=None, accept_rate=False) -> LogMatch:
     """Check a log against a bundle (unit, rate, axes) and say how it maps; see the module docstring.
 
     Raises
@@ -308,21 +217,18 @@ def match_log(source: LogSource, bundle, *, apply_unit=None, axis_map=None, acce
     from ..io import decimation_factor
 
     notes = []
-    if apply_unit is not None:
-        unit = apply_unit.strip()
-        unit_scale_to_dph(unit, source.dt_s)  # validates
+    unit = source.unit
+    if source.unit_given:
+        if source.declared_unit is not None and source.declared_unit.strip() != unit:
+            notes.append(f"unit: the log declares {source.declared_unit.strip()}; its numbers are read as {unit} "
+                         "({opt:unit} takes precedence)")
         if unit != bundle.input_unit:
-            notes.append(f"unit: the log is read as {unit} (apply_unit) and converted; the bundle was trained on "
+            notes.append(f"unit: the log is read as {unit} ({{opt:unit}}) and converted; the bundle was trained on "
                          f"{bundle.input_unit}")
-    elif source.declared_unit is not None:
-        unit = source.declared_unit.strip()
-        if unit != bundle.input_unit:
-            raise ConfigError(f"{source.path}: the log declares unit {unit} but the bundle was trained on "
-                              f"{bundle.input_unit}; pass {{opt:apply_unit}} {unit} to convert it")
-    else:
-        unit = bundle.input_unit
-        notes.append(f"unit: the log declares none; taking the bundle's {unit} (pass {{opt:apply_unit}} to override)")
-    scale = unit_scale_to_dph(unit, source.dt_s)
+    elif unit != bundle.input_unit:
+        raise ConfigError(f"{source.path}: the log declares unit {unit} but the bundle was trained on "
+                          f"{bundle.input_unit}; pass {{opt:unit}} {unit} to convert it")
+    scale = source.scale_to_dph
 
     rel = abs(source.dt_s - bundle.native_dt_s) / bundle.native_dt_s
     if rel <= 1e-6:

@@ -24,7 +24,7 @@ from .readers._columns import unit_list
 from .readers.base import require
 from .readers.hdf5 import UNIT_ATTRS
 
-__all__ = ["ChunkSource", "open_source"]
+__all__ = ["ChunkSource", "open_source", "RowSource", "open_rows"]
 
 
 @dataclass
@@ -280,3 +280,250 @@ def open_source(path, *, column=None, unit=None, rate_hz=None, dt_s=None, layout
     factor = unit_scale(kind, base, dt)
     return ChunkSource(path=p, n_samples=int(n), dt_s=dt, name=str(name), scale_to_dph=factor,
                        describe=f"{what}, unit {unit}", _read=read, check=check)
+
+
+# ----------------------------------------------------------------------------------------------------------
+# several columns of a .npy, row chunk by row chunk, with the time base checked as it streams
+# ----------------------------------------------------------------------------------------------------------
+#: Rows per chunk when a caller gives none.
+DEFAULT_ROWS = 1 << 20
+#: Time steps the sample interval (their median) and their scatter are taken from.
+HEAD_STEPS = 1 << 16
+
+
+@dataclass
+class RowSource:
+    """Rate columns of a ``.npy`` file read in row chunks, in the internal unit (:func:`open_rows`).
+
+    Attributes
+    ----------
+    path : Path
+    axis_names : tuple of str
+        ``col<j>`` of each rate column.
+    n_samples : int
+    dt_s, t0_s : float
+        Sample interval and time of the first sample [s].
+    unit : str
+        Unit of the stored numbers (given: a ``.npy`` declares none).
+    declared_units : tuple of None
+        What the file declares per rate column (nothing).
+    scale_to_dph : float
+        Factor from ``unit`` to deg/h, applied once by :meth:`chunks`.
+    sha256 : str
+        SHA-256 of the file's bytes.
+    notes : list of str
+    """
+
+    path: Path
+    axis_names: tuple
+    n_samples: int
+    dt_s: float
+    t0_s: float
+    unit: str
+    declared_units: tuple
+    scale_to_dph: float
+    sha256: str
+    notes: list = field(default_factory=list)
+    _reader: Callable = field(repr=False, default=None)
+
+    def chunks(self, chunk_samples: int = DEFAULT_ROWS):
+        """Yield ``(t_s (n,), rate_dph (n, n_axes))`` in order, ``chunk_samples`` rows at a time.
+
+        The time base (a time column's steps and span) and the finiteness of every value are checked as the rows
+        stream: an error names the sample.
+        """
+        if isinstance(chunk_samples, bool) or not isinstance(chunk_samples, (int, np.integer)) or chunk_samples < 1:
+            raise ConfigError(f"chunk_samples must be an integer >= 1; got {chunk_samples!r}")
+        yield from self._reader(int(chunk_samples))
+
+
+def _npy_layout(p: Path):
+    """(rows, columns, dtype, Fortran order, data offset) of a real numeric 1-D or 2-D ``.npy``."""
+    try:
+        with open(p, "rb") as fh:
+            version = np.lib.format.read_magic(fh)
+            header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+            shape, fortran, dtype = header(fh)
+            offset = fh.tell()
+    except (ValueError, OSError, EOFError) as exc:
+        raise DataFormatError(f"unreadable .npy header; expected a NumPy array file, got {exc}", path=p) from None
+    if dtype.kind not in "biuf" or dtype.hasobject or len(shape) not in (1, 2):
+        raise DataFormatError(f"array of dtype {dtype} and shape {shape}; expected a real numeric 1-D or 2-D array",
+                              path=p)
+    rows = int(shape[0])
+    cols = 1 if len(shape) == 1 else int(shape[1])
+    if p.stat().st_size < offset + rows * cols * dtype.itemsize:
+        raise DataFormatError(f"file holds {p.stat().st_size - offset} data bytes; expected "
+                              f"{rows * cols * dtype.itemsize} for shape {shape} (truncated?)", path=p)
+    return rows, cols, dtype, bool(fortran) and cols > 1, offset
+
+
+def _row_column(key, cols: int, option: str, p: Path) -> int:
+    if isinstance(key, (int, np.integer)) and not isinstance(key, bool) and -cols <= int(key) < cols:
+        return int(key) % cols
+    if isinstance(key, str):
+        k = key.strip()
+        if k.isdigit() and int(k) < cols:
+            return int(k)
+        if k.startswith("col") and k[3:].isdigit() and int(k[3:]) < cols:
+            return int(k[3:])
+    raise DataFormatError(f"unknown column {key!r}; expected one of col0..col{cols - 1} or an index in "
+                          f"{{opt:{option}}}", path=p, column=key)
+
+
+def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None, time_unit=None,
+              unit=None) -> RowSource:
+    """Open the rate columns of a ``.npy`` file for streaming in row chunks (memory bounded by the chunk).
+
+    The columns are ``col0, col1, ...`` as for :func:`fogdrift.io.load`.  A time column is used only when named
+    (``time_column``; ``"auto"`` finds none in an array); its steps are checked as the rows stream by the rules
+    of :func:`fogdrift.io.load` (:data:`~fogdrift.io.load.SHORT_STEP_FACTOR`,
+    :data:`~fogdrift.io.load.GAP_FACTOR`, :data:`~fogdrift.io.load.JITTER_TOLERANCE` on the first
+    :data:`HEAD_STEPS` steps, the span against ``(n - 1) dt`` within :data:`~fogdrift.io.load.DT_TOLERANCE`).
+
+    Parameters
+    ----------
+    path : str or Path
+    columns : None, int, str or sequence
+        Rate columns (``"col0,col2"``, ``"1"``, ``[0, 2]``); default every column but the time column.
+    time_column : "auto", None, int or str
+    rate_hz, dt_s : float, optional
+        Sample rate [Hz] or interval [s]; required without a time column, else checked against it (1 %).
+    time_unit : {"s", "ms", "us", "ns"}, optional
+        Unit of the time column (default s).
+    unit : str
+        Unit of the numbers (:func:`fogdrift.units.parse_unit`); required: a ``.npy`` declares none and units
+        are never guessed.
+
+    Returns
+    -------
+    RowSource
+
+    Raises
+    ------
+    ConfigError
+        No unit, unknown unit or time unit, no way to know the sample interval, the same column twice.
+    DataFormatError
+        Not a real numeric 1-D/2-D array, truncated file, unknown column, a time column that contradicts the
+        rate; while streaming: a non-finite value, a time step out of the rules, a span that does not match.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> p = os.path.join(tempfile.mkdtemp(), "g.npy")
+    >>> np.save(p, np.array([[0.0, 1.0], [0.5, 2.0], [1.0, 3.0]]))
+    >>> src = open_rows(p, time_column="col0", unit="deg/s")
+    >>> src.axis_names, src.dt_s, src.scale_to_dph
+    (('col1',), 0.5, 3600.0)
+    >>> [x[:, 0].tolist() for _, x in src.chunks(2)]
+    [[3600.0, 7200.0], [10800.0]]
+    """
+    from ..units import TIME_UNITS, parse_unit, valid_units
+    from .hashing import file_sha256
+    from .load import DT_TOLERANCE, GAP_FACTOR, JITTER_TOLERANCE, SHORT_STEP_FACTOR, _interval_option
+
+    p = check_path(path)
+    rows, cols, dtype, fortran, offset = _npy_layout(p)
+    t_idx = None
+    if time_column is not None and not (isinstance(time_column, str) and time_column.strip().lower() in ("auto",
+                                                                                                          "none")):
+        t_idx = _row_column(time_column, cols, "time_column", p)
+    if columns is None:
+        r_idx = [j for j in range(cols) if j != t_idx]
+    else:
+        keys = [c.strip() for c in columns.split(",") if c.strip()] if isinstance(columns, str) else list(columns)
+        r_idx = [_row_column(k, cols, "columns", p) for k in keys]
+    if not r_idx or len(set(r_idx)) != len(r_idx) or t_idx in r_idx:
+        raise ConfigError(f"{p}: choose distinct rate columns other than the time column with {{opt:columns}}; got "
+                          f"columns={columns!r}")
+    if unit is None:
+        raise ConfigError(f"{p}: no rate unit: a .npy array declares none; pass {{opt:unit}} "
+                          f"({', '.join(valid_units())}; units are never guessed)")
+    spec = parse_unit(unit)
+    if time_unit is not None and time_unit not in TIME_UNITS:
+        raise ConfigError(f"unknown time unit {time_unit!r}; expected one of {list(TIME_UNITS)} ({{opt:time_unit}})")
+    t_scale = TIME_UNITS[time_unit] if time_unit else 1.0
+    dt_user = _interval_option(dt_s, rate_hz)
+
+    def read(lo, hi):
+        if fortran:
+            mm = np.load(p, mmap_mode="r")
+            return np.array(mm[lo:hi], dtype=np.float64).reshape(hi - lo, cols)
+        with open(p, "rb") as fh:
+            a = np.fromfile(fh, dtype=dtype, count=(hi - lo) * cols, offset=offset + lo * cols * dtype.itemsize)
+        return a.reshape(hi - lo, cols)
+
+    notes = [f"npy array, {rows} samples x {cols} columns, read in chunks"]
+    tcol = f"col{t_idx}"
+    if t_idx is None:
+        if dt_user is None:
+            raise ConfigError(f"{p}: cannot tell the sample interval: a .npy file has no time column unless one is "
+                              "named with {opt:time_column}; pass the sample rate in Hz as {opt:rate_hz}")
+        dt, t0 = dt_user, 0.0
+        notes.append(f"sample interval {dt:.10g} s from the given rate (no time column)")
+    else:
+        head = np.asarray(read(0, min(rows, HEAD_STEPS + 1))[:, t_idx], dtype=np.float64) * t_scale
+        if head.size < 2:
+            raise DataFormatError("fewer than 2 samples; expected at least 2 to take the sample interval", path=p)
+        steps = np.diff(head)
+        dt = float(f"{float(np.median(steps)):.10g}")
+        t0 = float(head[0])
+        if not (np.isfinite(dt) and dt > 0):
+            raise DataFormatError(f"time steps' median {dt!r} s; expected strictly increasing time", path=p,
+                                  column=tcol)
+        if dt_user is not None:
+            if abs(dt - dt_user) > DT_TOLERANCE * dt_user:
+                raise DataFormatError(f"time column disagrees with the given sample interval; expected steps of "
+                                      f"{dt_user:.10g} s within 1 %, got {dt:.10g} s", path=p, column=tcol)
+            dt = dt_user
+        spread = float(np.median(np.abs(steps - dt))) / dt
+        if steps.size >= 8 and spread > JITTER_TOLERANCE:
+            raise DataFormatError(f"time steps scatter by {100 * spread:.3g} % of the sample interval {dt:.10g} s "
+                                  f"(median absolute deviation of the first {steps.size} steps); expected a uniform "
+                                  f"grid within {100 * JITTER_TOLERANCE:g} %", path=p, column=tcol)
+        notes.append(f"sample interval {dt:.10g} s from the time column {tcol} (median of the first steps)")
+    from ..units import check_dt_s
+
+    check_dt_s(dt, "the sample interval")
+    scale = float(spec.scale_to_internal(dt))
+
+    def reader(chunk):
+        prev_t = None
+        for lo in range(0, rows, chunk):
+            hi = min(rows, lo + chunk)
+            a = read(lo, hi)
+            with np.errstate(over="ignore", invalid="ignore"):
+                x = np.multiply(a[:, r_idx], scale, dtype=np.float64)
+            bad = ~np.isfinite(x)
+            if bad.any():
+                i, j = np.argwhere(bad)[0]
+                raise DataFormatError(f"non-finite value at sample {lo + i} (in deg/h); expected a finite number, "
+                                      f"got {float(a[i, r_idx[j]])!r} {spec.text}", path=p, column=f"col{r_idx[j]}")
+            if t_idx is None:
+                t = t0 + np.arange(lo, hi) * dt
+            else:
+                t = np.asarray(a[:, t_idx], dtype=np.float64) * t_scale
+                with np.errstate(over="ignore", invalid="ignore"):
+                    steps = np.diff(t if prev_t is None else np.concatenate([[prev_t], t]))
+                first = lo + 1 if prev_t is None else lo
+                bad = ~(steps >= SHORT_STEP_FACTOR * dt) | (steps > GAP_FACTOR * dt)
+                if bad.any():
+                    k = int(np.argmax(bad))
+                    raise DataFormatError(
+                        f"time step at sample {first + k} is {float(steps[k])!r} s ({float(steps[k]) / dt:.3g} sample "
+                        f"intervals); expected increasing time in steps of {dt:.10g} s (between "
+                        f"{SHORT_STEP_FACTOR} and {GAP_FACTOR} intervals: no gap, no rate change)", path=p,
+                        column=tcol)
+                prev_t = float(t[-1])
+                if hi == rows and rows > 2:
+                    span, grid = prev_t - t0, (rows - 1) * dt
+                    if abs(span - grid) > DT_TOLERANCE * grid:
+                        raise DataFormatError(
+                            f"time column spans {span:.6g} s, but its {rows} samples at {dt:.10g} s span "
+                            f"{grid:.6g} s ({100 * (span / grid - 1):+.3g} %); expected agreement within "
+                            f"{100 * DT_TOLERANCE:g} %", path=p, column=tcol)
+            yield t, x
+
+    return RowSource(path=p, axis_names=tuple(f"col{j}" for j in r_idx), n_samples=rows, dt_s=dt, t0_s=t0,
+                     unit=spec.text, declared_units=(None,) * len(r_idx), scale_to_dph=scale, sha256=file_sha256(p),
+                     notes=notes, _reader=reader)
