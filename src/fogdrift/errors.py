@@ -23,6 +23,8 @@ __all__ = [
     "ConfigError",
     "NotFittedError",
     "ModelFileError",
+    "ResourceLimitError",
+    "ResourceError",
     "FogdriftWarning",
 ]
 
@@ -105,6 +107,35 @@ class NotFittedError(FogdriftError, AttributeError):
 
 class ModelFileError(FogdriftError, ValueError):
     """A saved model file is missing, corrupt, of another format version or another class."""
+
+
+class ResourceLimitError(DataFormatError):
+    """An input exceeds a reading limit (rows, line length, decompressed size, memory budget).
+
+    The message names the file, the limit, its value and how to raise it (an environment
+    variable, see :mod:`fogdrift.io.readers.limits`).  A :class:`DataFormatError`: the file is
+    refused before it can exhaust memory or time.
+
+    Parameters
+    ----------
+    message : str
+        What exceeded which limit, and how to raise it.
+    limit : str, optional
+        Name of the environment variable that sets the limit (``"FOGDRIFT_MAX_ROWS"``).
+    path, line, column : optional
+        Where (as :class:`DataFormatError`).
+    """
+
+    def __init__(self, message: str, *, limit=None, path=None, line=None, column=None):
+        self.limit = limit
+        super().__init__(message, path=path, line=line, column=column)
+
+
+class ResourceError(FogdriftError, RuntimeError):
+    """The machine ran out of a resource during a run (memory, disk space): not the input's fault.
+
+    Never cached as a result (a re-run with more memory or space may succeed).
+    """
 
 
 class FogdriftWarning(UserWarning):

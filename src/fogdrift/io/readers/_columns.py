@@ -9,7 +9,9 @@ scalars) are left out and listed in a note.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -96,6 +98,24 @@ def layout_columns(items: list[ArrayItem], path, what: str) -> Layout:
     if dup is not None:
         raise DataFormatError(f"two columns named {dup!r} in {what}; expected unique names", path=path, column=dup)
     return Layout(names=names, units=units, parts=parts, n_rows=n, left_out=left_out)
+
+
+def check_layout(layout: Layout, used, path) -> None:
+    """Refuse a layout whose used columns exceed the row limit, the memory budget or (as stored) the expansion
+    limit against the file's size, before anything is read (:mod:`fogdrift.io.readers.limits`)."""
+    from .limits import check_expansion, check_memory, check_rows
+
+    used = sorted(set(used))
+    check_rows(layout.n_rows, path)
+    check_memory(layout.n_rows * 8.0 * max(len(used), 1), path,
+                 f"{layout.n_rows} rows x {len(used)} used column(s) as float64")
+    items = {id(it): it for it, _ in (layout.parts[j] for j in used)}.values()
+    declared = sum(math.prod(int(s) for s in it.shape) * np.dtype(it.dtype).itemsize for it in items)
+    try:
+        size = Path(path).stat().st_size
+    except OSError:
+        return
+    check_expansion(declared, size, path, f"the arrays of {len(used)} used column(s)")
 
 
 def read_layout(layout: Layout, used) -> np.ndarray:

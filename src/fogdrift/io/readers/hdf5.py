@@ -26,7 +26,7 @@ import numpy as np
 
 from ...errors import DataFormatError
 from ..hashing import file_sha256
-from ._columns import ArrayItem, layout_columns, read_layout, unit_list
+from ._columns import ArrayItem, check_layout, layout_columns, read_layout, unit_list
 from .base import PARSER_ERRORS, Table, describe_exception, require
 
 __all__ = ["open_table", "HDF5Table", "UNIT_ATTRS", "NAME_ATTRS"]
@@ -67,6 +67,7 @@ class HDF5Table(Table):
 
     def read(self, used) -> np.ndarray:
         if self.data is None:
+            check_layout(self.layout, used, self.path)
             try:
                 self.data = read_layout(self.layout, used)
             except PARSER_ERRORS as exc:

@@ -17,14 +17,16 @@ as a matrix or a struct.  The SHA-256 is of the file's bytes.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
 
 from ...errors import DataFormatError
 from ..hashing import file_sha256
-from ._columns import ArrayItem, layout_columns, read_layout
+from ._columns import ArrayItem, check_layout, layout_columns, read_layout
 from .base import PARSER_ERRORS, Table, describe_exception, require
+from .limits import check_expansion, check_memory
 
 __all__ = ["open_table", "MatTable", "mat_version"]
 
@@ -59,6 +61,7 @@ class MatTable(Table):
 
     def read(self, used) -> np.ndarray:
         if self.data is None:
+            check_layout(self.layout, used, self.path)
             self.data = read_layout(self.layout, used)
         return self.data
 
@@ -67,15 +70,44 @@ class MatTable(Table):
         return f"MATLAB {self.what}, {n_rows} samples x {len(self.names)} columns{left}"
 
 
+#: Bytes per element of MATLAB's numeric classes (as :func:`scipy.io.whosmat` names them).
+_CLASS_BYTES = {"double": 8, "single": 4, "int8": 1, "uint8": 1, "int16": 2, "uint16": 2, "int32": 4, "uint32": 4,
+                "int64": 8, "uint64": 8, "logical": 1, "char": 2}
+
+
+def _unreadable(p: Path, exc: BaseException) -> DataFormatError:
+    return DataFormatError(
+        f"unreadable MATLAB file; expected a v4/v5/v7 .mat file, got {describe_exception(exc)}", path=p)
+
+
+def _check_sizes(p: Path) -> None:
+    """Refuse variables whose declared shapes exceed the expansion limit or the memory budget, before loading.
+
+    :func:`scipy.io.whosmat` reads only the variables' headers (a compressed variable's first bytes); struct and
+    cell contents are not listed there and are not checked.
+    """
+    from scipy.io import whosmat
+
+    try:
+        listing = whosmat(p)
+    except Exception as exc:  # noqa: BLE001 -- scipy's parser raises MatReadError, IndexError, struct.error...
+        raise _unreadable(p, exc) from exc
+    declared = 0
+    for name, shape, cls in listing:
+        n = math.prod(int(s) for s in shape) * _CLASS_BYTES.get(cls, 0)
+        check_memory(n / _CLASS_BYTES.get(cls, 1) * 8, p, f"variable {name!r} {tuple(shape)} as float64")
+        declared += n
+    check_expansion(declared, p.stat().st_size, p, f"the MATLAB file's {len(listing)} variable(s)")
+
+
 def _load_v5(p: Path) -> dict:
     from scipy.io import loadmat
 
+    _check_sizes(p)
     try:
         raw = loadmat(p, simplify_cells=True)
-    except (*PARSER_ERRORS, NotImplementedError) as exc:
-        raise DataFormatError(
-            f"unreadable MATLAB file; expected a v4/v5/v7 .mat file, got {describe_exception(exc)}", path=p
-        ) from exc
+    except Exception as exc:  # noqa: BLE001 -- scipy's parser raises MatReadError, IndexError, struct.error...
+        raise _unreadable(p, exc) from exc
     return {k: v for k, v in raw.items() if not k.startswith("__")}
 
 

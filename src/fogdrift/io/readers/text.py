@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import gzip
 import io
+from array import array
 import math
 import re
 import warnings
@@ -19,9 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import ConfigError, DataFormatError
+from ...errors import ConfigError, DataFormatError, ResourceLimitError
 from ..hashing import hashing_stream
 from .base import Table, describe_exception, split_unit_label
+from .limits import GuardedStream
 
 __all__ = ["open_table", "TextTable", "delimiter_option"]
 
@@ -37,6 +39,8 @@ _DELIM_NAMES = {",": "comma", ";": "semicolon", "\t": "tab", None: "whitespace"}
 _DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$|^[+-]?\d+,\d*([eE][+-]?\d+)?$")
 #: Errors of the text layers while streaming (decoding never fails: errors="replace").
 _STREAM_ERRORS = (OSError, EOFError, zlib.error)
+#: Rows the line-by-line scan collects as Python floats before packing them into a float64 block.
+_BLOCK = 1 << 16
 
 
 def delimiter_option(delimiter):
@@ -70,11 +74,25 @@ class TextTable(Table):
             self.sha256 = digest
 
     def stream(self) -> io.TextIOWrapper:
-        """Decoded text of the file; reading it to the end records ``sha256``."""
+        """Decoded text of the file; reading it to the end records ``sha256``.
+
+        The bytes pass through a :class:`~fogdrift.io.readers.limits.GuardedStream`: a line longer than the
+        line limit, more lines than the row limit or the memory budget allow (``8 x n_fields`` bytes per
+        line), or gzip content beyond the expansion limit stop the read with a ResourceLimitError.
+        """
         raw = hashing_stream(self.path, self._record_hash)
-        if self.is_gz:
-            raw = io.BufferedReader(gzip.GzipFile(fileobj=raw, mode="rb"), 1 << 20)
-        return io.TextIOWrapper(raw, encoding="utf-8-sig", errors="replace")
+        try:
+            if self.is_gz:
+                stored = self.path.stat().st_size
+                inner = gzip.GzipFile(fileobj=raw, mode="rb")
+                guard = GuardedStream(inner, self.path, stored_bytes=stored, bytes_per_row=8 * self.n_fields,
+                                      binary_check=True, closing=[raw])
+            else:
+                guard = GuardedStream(raw, self.path, bytes_per_row=8 * self.n_fields)
+        except BaseException:
+            raw.close()
+            raise
+        return io.TextIOWrapper(io.BufferedReader(guard, 1 << 20), encoding="utf-8-sig", errors="replace")
 
     def delimiter_name(self) -> str:
         return _DELIM_NAMES.get(self.delimiter, repr(self.delimiter))
@@ -97,6 +115,8 @@ class TextTable(Table):
                         lines, dtype=np.float64, delimiter=self.delimiter, comments=comments,
                         skiprows=self.header_line, ndmin=2,
                     )
+            except DataFormatError:  # a reading limit, binary content: the same on a second pass
+                raise
             except (ValueError, *_STREAM_ERRORS):
                 continue
             if data.shape[0] == 0 or data.shape[1] == self.n_fields:
@@ -128,7 +148,8 @@ class TextTable(Table):
 
         Cells that are not numbers are an error only in used columns; elsewhere they become NaN.
         """
-        rows, lines = [], []
+        rows, lines = [], array("q")
+        blocks = []  # rows as float64 arrays of _BLOCK rows each: 8 bytes per cell, not a Python float's 24+
         nf = self.n_fields
         try:
             with self.stream() as fh:
@@ -151,11 +172,15 @@ class TextTable(Table):
                             row.append(math.nan)
                     rows.append(row)
                     lines.append(lineno)
+                    if len(rows) == _BLOCK:
+                        blocks.append(np.array(rows, dtype=np.float64))
+                        rows = []
         except _STREAM_ERRORS as exc:
             raise DataFormatError(f"unreadable file; expected text or gzip text, got {describe_exception(exc)}",
                                   path=self.path) from exc
-        data = np.array(rows, dtype=np.float64).reshape(len(rows), nf)
-        return data, np.asarray(lines, dtype=np.int64)
+        blocks.append(np.array(rows, dtype=np.float64).reshape(len(rows), nf))
+        data = np.concatenate(blocks) if len(blocks) > 1 else blocks[0]
+        return data, np.frombuffer(lines, dtype=np.int64) if len(lines) else np.zeros(0, dtype=np.int64)
 
     def _ragged(self, lineno: int, got: int, lines: list) -> DataFormatError:
         nf = self.n_fields
@@ -180,12 +205,12 @@ class TextTable(Table):
 
     def _data_lines(self) -> np.ndarray:
         """Physical line number of every data row (used only to locate errors and segments)."""
-        lines = []
+        lines = array("q")
         with self.stream() as fh:
             for lineno, raw in enumerate(fh, start=1):
                 if lineno > self.header_line and _strip_comment(raw):
                     lines.append(lineno)
-        return np.asarray(lines, dtype=np.int64)
+        return np.frombuffer(lines, dtype=np.int64) if len(lines) else np.zeros(0, dtype=np.int64)
 
 
 def open_table(path: Path, *, delimiter=None) -> TextTable:
