@@ -10,7 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from fogdrift.cli import app
-from fogdrift.compensate.test_block import compensated_test_block
+from fogdrift.compensate.holdout import compensated_test_block
 from fogdrift.io import from_array, load
 from fogdrift.pipeline import AnalysisConfig, run_models
 from fogdrift.simulate import simulate

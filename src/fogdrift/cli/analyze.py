@@ -145,7 +145,7 @@ def analyze(
 
         bundle = write_bundle(r.out.path / "bundle", [ax.models for ax in result.axes], cfg, record)
         # the compensated test block (what each model's causal compensation gives; loadable by fogdrift.io.load)
-        from ..compensate.test_block import write_compensated_test_block
+        from ..compensate.holdout import write_compensated_test_block
 
         comp = write_compensated_test_block([ax.models for ax in result.axes], r.out.path, t0_s=record.t0_s)
         r.wrote()

@@ -2,7 +2,9 @@
 
 Modules: :mod:`.predictors` (a fitted model as a causal one-step drift estimator), :mod:`.engine` (the streaming
 compensator and its native-rate design), :mod:`.sources` (chunked reading; matching unit, rate and axes to the
-bundle), :mod:`.outputs` (streamed CSV/NPZ, the before/after Allan figure), :mod:`.run` (:func:`compensate_file`).
+bundle), :mod:`.outputs` (streamed CSV/NPZ, the before/after Allan figure), :mod:`.run` (:func:`compensate_file`),
+:mod:`.holdout` (the compensated held-out test block ``fogdrift analyze`` writes; named so that pytest does not
+collect it).
 """
 
 from .engine import AxisPlan, OutputBlock, StreamCompensator, segment_blocks

@@ -119,7 +119,7 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     single command), ``report.html``, ``analysis.json``, the model ``bundle/``, the compensated test block per
     axis (``compensated_test_<axis>.csv``) and one row per axis with the verdicts."""
     from ..bundle import write_bundle
-    from ..compensate.test_block import write_compensated_test_block
+    from ..compensate.holdout import write_compensated_test_block
     from ..evaluation import evaluate_analysis
     from ..pipeline import run_analysis
     from ..evaluation.verdicts import paper_measure_verdict
