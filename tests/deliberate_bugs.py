@@ -69,3 +69,73 @@ def main() -> None:
 
 if __name__ == "__main__":
     main()
+
+
+# H-tests24 (issue 24, round 2: the GMWM statistics, evaluation at dt != 1 s, edges of tables).  Each entry is one
+# realistic one-line bug and the test of tests/test_rules_*.py that must fail on it (docs/testing.md, "Round 2
+# (issue 24)").  Run as part of the whole script (after the entries above), or one at a time from Python:
+#     import runpy; m = runpy.run_path("tests/deliberate_bugs.py"); m["H_TESTS24"]   # then apply/run/restore by hand
+H_TESTS24 = [
+    ("GMWM J test: dof from every scale of the WV, not the scales used",
+     "src/fogdrift/gmwm/estimator.py", "    df = J - mdl.n_params\n", "    df = len(wv) - mdl.n_params\n",
+     ["tests/test_rules_gmwm.py", "-k", "chi2_survival"]),
+    ("GMWM J test: p-value with one degree of freedom too many",
+     "src/fogdrift/gmwm/estimator.py", "jp = float(stats.chi2.sf(q, df))", "jp = float(stats.chi2.sf(q, df + 1))",
+     ["tests/test_rules_gmwm.py", "-k", "chi2_survival"]),
+    ("GMWM J test: the chi2 cdf instead of the survival function",
+     "src/fogdrift/gmwm/estimator.py", "jp = float(stats.chi2.sf(q, df))", "jp = float(stats.chi2.cdf(q, df))",
+     ["tests/test_rules_gmwm.py", "-k", "uniform"]),
+    ("WIC without its penalty (Q alone)",
+     "src/fogdrift/gmwm/estimator.py", "penalty=penalty, wic=q + penalty,", "penalty=penalty, wic=q,",
+     ["tests/test_rules_gmwm.py", "-k", "nested"]),
+    ("WIC penalty 2 tr(P) (the Omega = V^-1 shortcut) under any Omega",
+     "src/fogdrift/gmwm/estimator.py", "    penalty = 2.0 * float(np.trace(proj @ WV))\n",
+     "    penalty = 2.0 * float(np.trace(proj))\n",
+     ["tests/test_rules_gmwm.py", "-k", "general_formula"]),
+    ("selection: each candidate under its own V (no common Omega)",
+     "src/fogdrift/gmwm/selection.py", "fit = _finish(wv, mdl, idx, *step1[mdl], V=V, omega_source=src)",
+     "fit = _finish(wv, mdl, idx, *step1[mdl])",
+     ["tests/test_rules_gmwm.py", "-k", "nested"]),
+    ("heading: angle error integrated without dt",
+     "src/fogdrift/evaluation/heading.py", "        return np.cumsum(resid) * (dt_s / 3600.0)\n",
+     "        return np.cumsum(resid) / 3600.0\n",
+     ["tests/test_rules_evaluation.py", "-k", "ramp_at_dt"]),
+    ("heading: horizons taken in samples, not seconds",
+     "src/fogdrift/evaluation/heading.py", "        H = int(round(h / dt))\n", "        H = int(round(h))\n",
+     ["tests/test_rules_evaluation.py", "-k", "ramp_at_dt"]),
+    ("heading: origin spacing passed to the non-overlapping count in samples",
+     "src/fogdrift/evaluation/heading.py", "horizon_s=h, step_s=step * dt,", "horizon_s=h, step_s=step,",
+     ["tests/test_rules_evaluation.py", "-k", "overlapping_origins_at_dt"]),
+    ("heading: a NaN error not counted as worse",
+     "src/fogdrift/evaluation/heading.py", "int(np.sum(~(ei <= ebi)))", "int(np.sum(ei > ebi))",
+     ["tests/test_rules_evaluation.py", "-k", "nan_forecast"]),
+    ("judge: a row without counts judged on all (overlapping) origins",
+     "src/fogdrift/evaluation/verdicts.py", "        n = independent_origins(row.n_origins, step_s, row.horizon_s)\n",
+     "        n = row.n_origins\n",
+     ["tests/test_rules_evaluation.py", "-k", "row_without_counts"]),
+    ("headline: a diverged horizon not counted as worsening",
+     "src/fogdrift/evaluation/verdicts.py", "            elif jd.worsens:\n",
+     "            elif jd.outcome == \"worsens\":\n",
+     ["tests/test_rules_evaluation.py", "-k", "mixed"]),
+    ("artefact check: ADEV claim read at tau = 1/f",
+     "src/fogdrift/evaluation/artefacts.py", "claims = {f: ratio_at(ALLAN_PEAK / f) for f in freqs}",
+     "claims = {f: ratio_at(1.0 / f) for f in freqs}",
+     ["tests/test_rules_evaluation.py", "-k", "artefact_adev"]),
+    ("artefact check: ADEV ratio interpolated on m instead of tau",
+     "src/fogdrift/evaluation/artefacts.py", "    lt = np.log(a.tau_s)\n", "    lt = np.log(a.tau_s / dt)\n",
+     ["tests/test_rules_evaluation.py", "-k", "artefact_adev"]),
+    ("decade tau grid drops m_max when it is a 1-2-5 value",
+     "src/fogdrift/allan/grid.py", "            m = m[m <= m_max]\n", "            m = m[m < m_max]\n",
+     ["tests/test_rules_table_edges.py", "-k", "decade"]),
+    ("Earth-rate rule on the sum of the axis means, not the vector length",
+     "src/fogdrift/plausibility.py", "and float(np.linalg.norm(means)) * factor < EARTH_FRACTION",
+     "and abs(float(np.sum(means))) * factor < EARTH_FRACTION",
+     ["tests/test_rules_table_edges.py", "-k", "quiet_triad"]),
+    ("GMWM batch row: fit_n_points counts the excluded scales too",
+     "src/fogdrift/fleet/commands.py", "fit_n_points=int(len(axis.wvar.scale_s) - len(sel.excluded)),",
+     "fit_n_points=int(len(axis.wvar.scale_s)),",
+     ["tests/test_rules_table_edges.py", "-k", "gmwm_batch"]),
+]
+if __name__ == "__main__":
+    BUGS[:] = H_TESTS24  # main() above ran the earlier entries; now this block's, with the same apply/run/restore
+    main()
