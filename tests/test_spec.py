@@ -1,0 +1,132 @@
+"""Datasheet comparison (issue 22 item 5): units parsed explicitly, judged with the interval."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+from fogdrift.errors import ConfigError
+from fogdrift.spec import (G0, B_COMPARED, Reading, compare, convert, judge, parse_quantity, parse_spec, read_spec,
+                           readings_from_noise_fit)
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _lim(kind, item, text):
+    return parse_spec({kind: {item: text}})["limits"][0]
+
+
+# -- conversions, by hand ------------------------------------------------------------------------------------------
+def test_conversions_by_hand():
+    assert parse_quantity("0.007 deg/s", "gyro", "bias_instability")[0] == pytest.approx(25.2, rel=1e-12)
+    assert parse_quantity("0.2 mg", "accel", "bias_instability")[0] == pytest.approx(1.96133e-3, rel=1e-12)
+    assert parse_quantity("200 µg", "accel", "bias_instability")[0] == pytest.approx(1.96133e-3, rel=1e-12)
+    assert parse_quantity("2 °/√hr", "gyro", "arw")[0] == 2.0
+    # 0.15 deg/sqrt(h) = 0.15/60 deg/sqrt(s) = 4.363e-5 rad/s/sqrt(Hz)
+    assert convert(4.3633e-5, "rad/s/sqrt(Hz)", "gyro", "arw") == pytest.approx(0.15, rel=1e-4)
+    assert convert(9.0, "deg/h/sqrt(Hz)", "gyro", "arw") == pytest.approx(0.15)
+    # 1 m/s^2/sqrt(Hz) = 1 m/s/sqrt(s) = 60 m/s/sqrt(h); 100 ug/sqrt(Hz) = 100e-6 g0 * 60
+    assert convert(1.0, "m/s²/√Hz", "accel", "vrw") == pytest.approx(60.0)
+    assert convert(100.0, "ug/sqrt(Hz)", "accel", "vrw") == pytest.approx(100e-6 * G0 * 60)
+    assert G0 == 9.80665
+
+
+@pytest.mark.parametrize("text, match", [
+    (2, "has no unit"), ("2", "has no unit"), ("2 furlongs", "unknown unit 'furlongs'"),
+    ("2 m/s/sqrt(h)", "unknown unit"), ("-1 deg/sqrt(h)", ">= 0"), ("fast", "not a number"),
+])
+def test_unitless_or_unknown_unit_is_one_line_error(text, match):
+    with pytest.raises(ConfigError, match=match) as exc:
+        parse_spec({"gyro": {"arw": text}})
+    assert "\n" not in str(exc.value)
+
+
+def test_unknown_section_and_item():
+    with pytest.raises(ConfigError, match="unknown section 'magnetometer'"):
+        parse_spec({"magnetometer": {"x": "1 uT"}})
+    with pytest.raises(ConfigError, match="unknown gyro item 'vrw'; expected one of arw, bias_instability"):
+        parse_spec({"gyro": {"vrw": "0.2 m/s/sqrt(h)"}})
+    with pytest.raises(ConfigError, match="no limits"):
+        parse_spec({"sensor": "x"})
+
+
+# -- the judge -------------------------------------------------------------------------------------------------
+def test_limit_inside_interval_cannot_tell():
+    j = judge(_lim("gyro", "arw", "2 deg/sqrt(h)"), Reading(2.1, 1.9, 2.3, "deg/sqrt(h)"))
+    assert j.verdict == "cannot tell" and "inside the 95 % interval" in j.reason
+
+
+def test_pass_and_fail_use_the_whole_interval():
+    lim = _lim("gyro", "bias_instability", "0.007 deg/s")  # 25.2 deg/h
+    assert judge(lim, Reading(20.0, 15.0, 25.0, "deg/h")).verdict == "pass"
+    assert judge(lim, Reading(30.0, 25.3, 35.0, "deg/h")).verdict == "fail"
+    # the value alone is below the limit, but the interval reaches beyond it: not a pass
+    assert judge(lim, Reading(24.0, 20.0, 26.0, "deg/h")).verdict == "cannot tell"
+    # the same numbers in deg/s are judged identically (units converted, not assumed)
+    assert judge(lim, Reading(20 / 3600, 15 / 3600, 25 / 3600, "deg/s")).verdict == "pass"
+
+
+def test_bounds_say_which_way_they_can_tell():
+    lim = _lim("gyro", "bias_instability", "25 deg/h")
+    assert judge(lim, Reading(20.0, None, None, "deg/h", "upper")).verdict == "pass"
+    j = judge(lim, Reading(30.0, None, None, "deg/h", "upper"))
+    assert j.verdict == "cannot tell" and "never a fail" in j.reason and j.estimate.startswith("< 30")
+    assert judge(lim, Reading(30.0, None, None, "deg/h", "lower")).verdict == "fail"
+    j = judge(lim, Reading(20.0, None, None, "deg/h", "lower"))
+    assert j.verdict == "cannot tell" and "never a pass" in j.reason
+    assert judge(lim, None).verdict == "cannot tell"
+    assert judge(lim, Reading(20.0, None, None, "deg/h")).verdict == "cannot tell"  # no interval
+
+
+def test_accelerometer_entry_on_an_accel_channel_hand_built():
+    spec = parse_spec({"gyro": {"arw": "2 deg/sqrt(h)"},
+                       "accel": {"vrw": "0.2 m/s/sqrt(h)", "bias_instability": "0.2 mg"}})
+    # VRW 0.35 [0.34, 0.36] m/s/sqrt(h): fail; B 1.5e-3 [1.2e-3, 1.8e-3] m/s^2 (0.153-0.184 mg): pass
+    acc = {"vrw": Reading(0.35, 0.34, 0.36, "m/s/sqrt(h)"), "bias_instability": Reading(150.0, 120.0, 180.0, "ug")}
+    js = compare(spec, {"ax": ("accel", acc), "gx": ("gyro", {"arw": Reading(1.5, 1.4, 1.6, "deg/sqrt(h)")})})
+    got = {(j.channel, j.limit.item): j.verdict for j in js}
+    assert got == {("ax", "vrw"): "fail", ("ax", "bias_instability"): "pass", ("gx", "arw"): "pass"}
+    # ug -> m/s^2 conversion visible in the estimate
+    b = next(j for j in js if j.limit.item == "bias_instability")
+    assert b.estimate.startswith("0.00147 [0.00118, 0.00177] m/s^2")
+    assert json.dumps([j.to_dict() for j in js])
+
+
+def test_readings_from_allan_fit_use_b_min():
+    n = SimpleNamespace(value=2.4, lo95=2.37, hi95=2.42, unit="deg/sqrt(h)", status="resolved", estimable=True)
+    fit = SimpleNamespace(terms={"N": n}, no_fit=None,
+                          b_min={"value": 28.0, "unit": "deg/h", "tau_s": 1310.7, "bound_only": True, "lo95": None,
+                                 "hi95": 58.0})
+    r = readings_from_noise_fit(fit)
+    assert r["arw"].value == 2.4 and r["arw"].bound is None
+    assert r["bias_instability"].bound == "upper" and "B_min" in r["bias_instability"].label
+    fit.no_fit = {"best_candidate": "N+B"}
+    assert readings_from_noise_fit(fit)["arw"].bound == "upper"
+    assert "B_min" in B_COMPARED and "0.664" in B_COMPARED
+
+
+def test_adis_spec_file_reads():
+    spec = read_spec(ROOT / "data" / "specs" / "adis16405.yaml")
+    vals = {(l.kind, l.item): l.value for l in spec["limits"]}
+    assert vals[("gyro", "arw")] == 2.0 and vals[("gyro", "bias_instability")] == pytest.approx(25.2)
+    assert vals[("accel", "vrw")] == 0.2 and vals[("accel", "bias_instability")] == pytest.approx(1.96133e-3)
+
+
+def test_spec_file_errors(tmp_path):
+    p = tmp_path / "s.json"
+    p.write_text('{"gyro": {"arw": 2}}')
+    with pytest.raises(ConfigError, match="has no unit"):
+        read_spec(p)
+    p.write_text("{oops")
+    with pytest.raises(ConfigError, match=r"s\.json:1: not valid JSON"):
+        read_spec(p)
+    y = tmp_path / "s.yaml"
+    y.write_text("gyro:\n  arw: [unclosed\n")
+    with pytest.raises(ConfigError, match="not valid YAML"):
+        read_spec(y)
+    with pytest.raises(ConfigError, match="no such file"):
+        read_spec(tmp_path / "missing.yaml")
