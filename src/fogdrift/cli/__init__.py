@@ -23,7 +23,7 @@ __all__ = ["app", "main"]
 
 
 def _commands():
-    from . import allan, analyze, batch, compensate, consistency, model, noise, separate  # noqa: F401  (register the commands)
+    from . import allan, analyze, batch, compensate, consistency, export, model, noise, separate  # noqa: F401  (register the commands)
     from ._app import app
 
     return app

@@ -1,0 +1,92 @@
+"""``fogdrift export``: write the noise model for Kalibr, OpenVINS, VINS-Fusion, ORB-SLAM3, KF-GINS, MATLAB
+imuSensor, gnss-ins-sim and a complete JSON (:mod:`fogdrift.export`), from saved ``allan`` / ``noise`` results
+(``--gyro`` / ``--accel``) or from a log (its Allan fit is run first and saved as ``allan.json`` beside the exports)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ._app import FLAGS, app, check_plausible, echo_record, progress, run, say, warn
+from .batch import _with_reader_options
+
+FLAGS.update({"missing": "--missing", "gyro": "--gyro", "accel": "--accel", "rate": "--update-rate",
+              "target": "--target"})
+
+DEFAULT_OUT = Path("out/export")
+
+
+def _targets_help() -> str:
+    from ..export.targets import TARGETS  # light: the table
+
+    return ("Targets, comma-separated, or 'all': " + "; ".join(f"{t.name} ({t.filename})" for t in TARGETS.values())
+            + ".")
+
+
+@app.command("export")
+@_with_reader_options
+def export(
+    log: Annotated[Optional[Path], typer.Argument(
+        help="A gyro or accelerometer log to fit first (its unit says which); or give saved results with "
+             "--gyro / --accel.")] = None,
+    load=None,
+    gyro: Annotated[Optional[list[Path]], typer.Option(
+        "--gyro", help="A saved gyro result: allan.json or noise.json of a fogdrift run (repeatable).")] = None,
+    accel: Annotated[Optional[list[Path]], typer.Option(
+        "--accel", help="A saved accelerometer result (allan.json / noise.json), repeatable.")] = None,
+    target: Annotated[str, typer.Option("--target", help=_targets_help())] = "all",
+    update_rate: Annotated[Optional[float], typer.Option(
+        "--update-rate", help="The filter's IMU rate [Hz] for the discrete values (default: the record's rate).")]
+    = None,
+    missing: Annotated[str, typer.Option(
+        "--missing", help="A term the record does not resolve (not in the selected model, or no model fits): "
+                          "bound (default: its 95 % upper bound, said as a bound), refuse (stop with the reason) or "
+                          "zero (write 0, with a warning).")] = "bound",
+    rostopic: Annotated[str, typer.Option("--rostopic", help="IMU topic written into Kalibr / OpenVINS files.")]
+    = "/imu0",
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = DEFAULT_OUT,
+):
+    """Export the noise model to the estimators' own files, every number with its source, interval, continuous and
+    discrete value and conversion in a comment."""
+    from ..errors import ConfigError
+    from ..export import build_context, parse_targets, render
+    from ..export.model import channels_from_result
+    from ..export.targets import TARGETS
+
+    gyro, accel = list(gyro or []), list(accel or [])
+    names = [t.name for t in TARGETS.values()]
+    with run("export", out, default_out=DEFAULT_OUT, inputs=[p for p in [log, *gyro, *accel] if p is not None],
+             expect=[TARGETS[n].filename for n in names]) as r:
+        chosen = parse_targets(target)
+        if log is None and not gyro and not accel:
+            raise ConfigError("nothing to export: give a log, or saved results with --gyro / --accel")
+        channels = []
+        if log is not None:
+            from .._util import json_default
+            from ..pipeline import AnalysisConfig, run_allan
+            from ..report import write_allan_outputs
+
+            opts = dataclasses.replace(load, file=log)
+            record = opts.load()
+            echo_record(opts, record)
+            check_plausible(record)
+            with progress("export", record.axis_names) as (allan_cb, _):
+                results = run_allan(record, AnalysisConfig(), progress=allan_cb)
+            doc = json.loads(json.dumps({"source": record.source, "record": record.metadata(),
+                                         "axes": [a.to_dict() for a in results]}, default=json_default))
+            channels = channels_from_result(doc, str(log))
+            write_allan_outputs(results, record, r.out.path)
+        ctx = build_context(gyro, accel, channels=channels, rate_hz=update_rate, missing=missing, topic=rostopic)
+        texts = {n: render(n, ctx) for n in chosen}  # everything is rendered before any file is written
+        for n, text in texts.items():
+            with r.out.file(TARGETS[n].filename) as tmp:
+                Path(tmp).write_text(text, encoding="utf-8")
+        chans = ", ".join(f"{c.label} ({c.method})" for c in ctx.gyro + ctx.accel)
+        say(f"exported {chans} at {ctx.rate_hz:g} Hz, --missing {ctx.missing}")
+        for line in ctx.notes:
+            warn(line)
+        r.wrote()
