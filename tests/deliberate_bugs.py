@@ -44,6 +44,20 @@ BUGS = [
      "                            noise_alpha=resolve_alpha(noise_alpha, m * source.dt_s, sums / (2.0 * m**2 * (n - 2 * m + 1)), "
      "slopes=get_statistic(\"adev\").dev_slopes, candidates=IEEE952_ALPHAS)[0] if noise_alpha == \"auto\" else noise_alpha)\n",
      ["tests/test_allan_result_shared.py", "-k", "quantization_long_tau"]),
+    # H-compensate (issue 24: compensation with a declared unit and with a latitude; issue 21: the scale carried)
+    ("compensate: bias re-estimated without removing the bundle's Earth-rate projection",
+     "src/fogdrift/compensate/engine.py", "                a.bias_out_dph = float(level[k]) - earth\n",
+     "                a.bias_out_dph = float(level[k])\n",
+     ["tests/test_compensate_io.py", "-k", "earth_rate"]),
+    ("compensate: the declared unit labels numbers read in the --unit given (output header/unit wrong)",
+     "src/fogdrift/compensate/sources.py",
+     "    return LogSource(path=Path(rec.source), axis_names=rec.axis_names, unit=rec.input_unit,",
+     "    return LogSource(path=Path(rec.source), axis_names=rec.axis_names, unit=declared or rec.input_unit,",
+     ["tests/test_compensate_io.py", "-k", "another_unit"]),
+    ("compensate: the .npy reader's scale not carried to the writers (deg/s written as deg/h)",
+     "src/fogdrift/compensate/sources.py", "                     scale_to_dph=src.scale_to_dph, dt_s=src.dt_s,",
+     "                     scale_to_dph=1.0, dt_s=src.dt_s,",
+     ["tests/test_compensate_io.py", "-k", "npy_stream"]),
 ]
 
 

@@ -1,0 +1,227 @@
+"""``fogdrift compensate`` at its edges: reading through :mod:`fogdrift.io` (units, the .npy stream, one parse),
+the bias re-estimated under a bundle that removed the Earth rate, and the atomic output edge (Ctrl-C).
+
+Independent references: every expected number is written out by hand from the log's own numbers, the bundle's
+bias and the Earth rate w_ie sin(L) computed here from w_ie = 7.2921150e-5 rad/s (not from fogdrift.units).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from fogdrift.bundle import load_bundle, write_bundle
+from fogdrift.compensate import compensate_file
+from fogdrift.errors import ConfigError, DataFormatError
+from fogdrift.io import from_array
+from fogdrift.output import MANIFEST, TMP_PREFIX
+from fogdrift.pipeline import AnalysisConfig, run_models
+from fogdrift.simulate import simulate
+
+LAT = 45.0
+#: w_ie sin(45 deg) in deg/h, by hand: 7.2921150e-5 rad/s * (180 / pi) deg/rad * 3600 s/h * sin(pi / 4)
+EARTH_UP_45 = 7.2921150e-5 * 180.0 / math.pi * 3600.0 * math.sin(math.pi / 4)
+BIAS = 40.0  # deg/h, the training log's bias before the Earth rate
+
+
+@pytest.fixture(scope="module")
+def bundle(tmp_path_factory):
+    """A 1-Hz deg/h bundle of one axis 'gz' pointing up at 45 deg latitude (the Earth rate removed)."""
+    x = simulate(4000, 1.0, arw_dprh=0.05, rrw_dphrh=0.5, bias_dph=BIAS + EARTH_UP_45, seed=3)
+    rec = from_array(x, dt_s=1.0, unit="deg/h", axis_names=("gz",))
+    cfg = AnalysisConfig(models=("ar",), latitude_deg=LAT, earth_axes={"gz": "up"})
+    out = tmp_path_factory.mktemp("bundle") / "bundle"
+    write_bundle(out, run_models(rec, cfg), cfg, rec)
+    return out
+
+
+def _csv(path, header, x, dt=1.0):
+    t = np.arange(x.shape[0]) * dt
+    np.savetxt(path, np.column_stack([t, x]), delimiter=",", header=header, comments="", fmt="%.17g")
+    return path
+
+
+def _read(out):
+    with np.load(Path(out) / "compensated.npz") as z:
+        return {k: z[k] for k in z.files}
+
+
+def _kw(**kw):
+    return dict(dict(heading=False, artefacts=False, figures=False, model="bias"), **kw)
+
+
+def test_the_bundle_removed_the_earth_rate_by_hand(bundle):
+    ax = load_bundle(bundle).axis("gz")
+    assert ax.earth_rate_dph == pytest.approx(EARTH_UP_45, rel=1e-9)
+    assert EARTH_UP_45 == pytest.approx(10.635, abs=1e-3)
+
+
+def test_unit_on_a_log_that_declares_another_unit(bundle, tmp_path):
+    """Declared deg/s, bundle deg/h: refused without --unit; --unit deg/s converts (x3600 in, /3600 out); --unit
+    deg/h takes precedence over the declared unit (the numbers are read as deg/h), as for every command."""
+    b = load_bundle(bundle).axis("gz").bias_dph
+    v = 0.0125 + 1e-4 * np.sin(np.arange(600) / 7.0)  # deg/s as the file says
+    log = _csv(tmp_path / "s.csv", "t_s,gz[deg/s]", v)
+    with pytest.raises(ConfigError) as info:
+        compensate_file(bundle, log, tmp_path / "o0", **_kw())
+    assert "declares unit deg/s but the bundle was trained on deg/h; pass --unit deg/s" in \
+        info.value.render({"unit": "--unit"})
+
+    res = compensate_file(bundle, log, tmp_path / "o1", **_kw(unit="deg/s"))
+    got = _read(tmp_path / "o1")
+    assert res.summary["unit"] == "deg/s" and str(got["unit"]) == "deg/s"
+    assert res.summary["scale_to_dph"] == 3600.0
+    np.testing.assert_allclose(got["compensated"][:, 0], v - b / 3600.0, rtol=0, atol=1e-13)
+    assert (tmp_path / "o1" / "compensated.csv").read_text().splitlines()[0] == "t_s,gz[deg/s],gz_drift[deg/s]"
+
+    res = compensate_file(bundle, log, tmp_path / "o2", **_kw(unit="deg/h"))
+    got = _read(tmp_path / "o2")
+    assert res.summary["unit"] == "deg/h" and res.summary["scale_to_dph"] == 1.0 and str(got["unit"]) == "deg/h"
+    np.testing.assert_allclose(got["compensated"][:, 0], v - b, rtol=0, atol=1e-12)
+    assert any("declares deg/s; its numbers are read as deg/h" in m for m in res.messages)
+    assert (tmp_path / "o2" / "compensated.csv").read_text().splitlines()[0] == "t_s,gz[deg/h],gz_drift[deg/h]"
+
+
+def test_increment_unit_scale_is_carried_from_the_reader(bundle, tmp_path):
+    """inc:arcsec per 1-s sample = arcsec/s = deg/h: the reader's scale (1/3600 * 3600 = 1 deg/h per arcsec/s) is the
+    one the output divides by."""
+    b = load_bundle(bundle).axis("gz").bias_dph
+    v = np.full(300, 50.0)  # 50 arcsec per second = 50 deg/h
+    log = _csv(tmp_path / "inc.csv", "t_s,gz", v)
+    res = compensate_file(bundle, log, tmp_path / "o", **_kw(unit="inc:arcsec"))
+    assert res.summary["scale_to_dph"] == pytest.approx(1.0, rel=1e-15)
+    np.testing.assert_allclose(_read(tmp_path / "o")["compensated"][:, 0], 50.0 - b, atol=1e-12)
+
+
+def test_bias_re_estimated_under_a_bundle_that_removed_the_earth_rate(bundle, tmp_path):
+    """bias = mean of the first S s - w_ie sin(L); the output keeps the Earth rate: x - bias after the window."""
+    bb = load_bundle(bundle).axis("gz").bias_dph
+    n, s = 1200, 300
+    x = 55.0 + EARTH_UP_45 + 0.3 * np.cos(np.arange(n) * 0.37)  # a new turn-on bias of 55 deg/h
+    log = _csv(tmp_path / "e.csv", "t_s,gz[deg/h]", x)
+    res = compensate_file(bundle, log, tmp_path / "o", **_kw(bias=f"re-estimate:{s}"))
+    ax = res.summary["axes"][0]
+    level = math.fsum(x[:s]) / s
+    assert ax["bias_plus_earth_dph"] == pytest.approx(level, rel=1e-13)
+    assert ax["bias_dph"] == pytest.approx(level - EARTH_UP_45, rel=1e-12)
+    assert ax["earth_rate_dph"] == pytest.approx(EARTH_UP_45, rel=1e-9)
+    comp = _read(tmp_path / "o")["compensated"][:, 0]
+    np.testing.assert_allclose(comp[:s], x[:s] - bb, atol=1e-9)  # calibrating: the bundle's bias
+    np.testing.assert_allclose(comp[s:], x[s:] - (level - EARTH_UP_45), atol=1e-9)
+    assert np.mean(comp[s:]) == pytest.approx(EARTH_UP_45, abs=0.05)  # the Earth rate stays in the output
+    line = next(m for m in res.messages if m.startswith("bias:"))
+    assert "minus the Earth rate" in line and f"{level - EARTH_UP_45:.6g}" in line
+
+
+def test_a_log_without_a_unit_is_parsed_once_and_refused_without_unit(bundle, tmp_path, monkeypatch):
+    io_load = sys.modules["fogdrift.io.load"]  # the module (fogdrift.io.load is also the function's name)
+
+    calls = []
+    real = io_load._load_records
+    monkeypatch.setattr(io_load, "_load_records", lambda path, opts: calls.append(path) or real(path, opts))
+    log = _csv(tmp_path / "plain.csv", "t_s,gz", np.full(200, 45.0))
+    with pytest.raises(ConfigError) as info:
+        compensate_file(bundle, log, tmp_path / "o1", **_kw())
+    assert "pass --unit deg/h (the bundle was trained on deg/h)" in info.value.render({"unit": "--unit"})
+    assert len(calls) == 1 and not (tmp_path / "o1" / "compensated.csv").exists()
+    calls.clear()
+    compensate_file(bundle, log, tmp_path / "o2", **_kw(unit="deg/h"))
+    assert len(calls) == 1
+
+
+def test_npy_stream_needs_a_unit_and_checks_the_time_base(bundle, tmp_path):
+    x = np.full(500, 45.0)
+    np.save(tmp_path / "r.npy", x)
+    with pytest.raises(ConfigError) as info:
+        compensate_file(bundle, tmp_path / "r.npy", tmp_path / "o1", **_kw(rate_hz=1.0, axis_map="col0=gz"))
+    assert "pass --unit deg/h (the bundle was trained on deg/h)" in info.value.render({"unit": "--unit"})
+    b = load_bundle(bundle).axis("gz").bias_dph
+    compensate_file(bundle, tmp_path / "r.npy", tmp_path / "o2",
+                    **_kw(rate_hz=1.0, unit="deg/s", axis_map="col0=gz", chunk_samples=77))
+    np.testing.assert_allclose(_read(tmp_path / "o2")["compensated"][:, 0], 45.0 - b / 3600.0, atol=1e-13)
+    # a time column whose rate halves after 300 samples (1 s -> 2 s steps): refused, naming the sample
+    t = np.concatenate([np.arange(300.0), 300.0 + 2 * np.arange(200.0)])
+    np.save(tmp_path / "t.npy", np.column_stack([t, x]))
+    with pytest.raises(DataFormatError, match="time step at sample 301 is 2.0 s"):
+        compensate_file(bundle, tmp_path / "t.npy", tmp_path / "o3",
+                        **_kw(unit="deg/h", time_column="col0", axis_map="col1=gz", chunk_samples=128))
+    assert not (tmp_path / "o3" / "compensated.csv").exists()
+    assert not list((tmp_path / "o3").glob(TMP_PREFIX + "*"))
+
+
+def test_outputs_are_atomic_and_listed_in_a_manifest(bundle, tmp_path):
+    log = _csv(tmp_path / "m.csv", "t_s,gz[deg/h]", 45.0 + np.sin(np.arange(300) * 0.9))
+    compensate_file(bundle, log, tmp_path / "o", heading=False, artefacts=False, model="bias")
+    doc = json.loads((tmp_path / "o" / MANIFEST).read_text())
+    assert doc["complete"] is True and doc["command"] == "compensate"
+    assert set(doc["files"]) == {"compensated.csv", "compensated.npz", "compensation.json", "compensation_allan.png"}
+    assert not list((tmp_path / "o").glob(TMP_PREFIX + "*"))
+
+
+def test_cli_unit_flag_and_the_deprecated_alias(bundle, tmp_path):
+    from fogdrift.cli import app
+
+    log = _csv(tmp_path / "plain.csv", "t_s,gz", 45.0 + np.sin(np.arange(300) * 0.9))
+    runner = CliRunner()
+    base = ["compensate", str(bundle), str(log), "--model", "bias", "--no-heading", "--no-artefacts"]
+    r = runner.invoke(app, base + ["--out", str(tmp_path / "o1")])
+    assert r.exit_code == 1 and "Traceback" not in r.output
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "pass --unit deg/h (the bundle was trained on deg/h)" in lines[0]
+    r = runner.invoke(app, base + ["--unit", "deg/h", "--out", str(tmp_path / "o2")])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, base + ["--apply-unit", "deg/h", "--out", str(tmp_path / "o3")])
+    assert r.exit_code == 0, r.output
+    assert len([ln for ln in r.output.splitlines() if "deprecated" in ln]) == 1
+    assert "--apply-unit is deprecated; use --unit" in r.output
+    np.testing.assert_array_equal(_read(tmp_path / "o2")["compensated"], _read(tmp_path / "o3")["compensated"])
+    r = runner.invoke(app, ["compensate", "--help"])
+    assert "--unit" in r.output and "--apply-unit" not in r.output and "--layout" in r.output
+
+
+def test_ctrl_c_while_the_csv_is_written_leaves_no_partial_file(bundle, tmp_path):
+    """SIGINT to a real process once its temporary CSV has rows: exit 130, one 'interrupted:' line, no CSV (or NPZ)
+    under a final name, no temporary file left."""
+    n = 3_000_000
+    np.save(tmp_path / "big.npy", np.full(n, 45.0))
+    out = tmp_path / "o"
+    cmd = [sys.executable, "-m", "fogdrift", "compensate", str(bundle), str(tmp_path / "big.npy"), "--rate", "1",
+           "--unit", "deg/h", "--axis-map", "col0=gz", "--model", "bias", "--no-heading", "--no-artefacts",
+           "--chunk", "2000", "--out", str(out)]
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "src"))
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        deadline = time.monotonic() + 300
+        started = False
+        while time.monotonic() < deadline and proc.poll() is None:
+            tmp = list(out.glob(TMP_PREFIX + "*compensated.csv")) if out.is_dir() else []
+            if tmp and tmp[0].exists() and tmp[0].stat().st_size > 100_000:
+                started = True
+                break
+            time.sleep(0.01)
+        assert started, "the temporary CSV never grew (the run ended or never started writing)"
+        proc.send_signal(signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 130, stderr
+    assert "Traceback" not in stderr
+    lines = [ln for ln in stderr.splitlines() if ln.startswith("interrupted:")]
+    assert len(lines) == 1 and ("no partial file left" in lines[0] or "nothing was written" in lines[0]), stderr
+    assert "compensated.csv" not in lines[0].split("; not written")[0].split(str(out))[-1], lines[0]
+    assert not (out / "compensated.csv").exists() and not (out / "compensated.npz").exists()
+    assert not list(out.glob(TMP_PREFIX + "*"))
+    manifest = out / MANIFEST
+    assert not manifest.exists() or json.loads(manifest.read_text())["complete"] is False
