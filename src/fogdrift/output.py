@@ -26,6 +26,7 @@ refused.
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
 import re
@@ -34,8 +35,9 @@ import threading
 import time
 from pathlib import Path
 
-from .errors import ConfigError
+from .errors import ConfigError, FogdriftError, ResourceError
 from .interrupt import check, critical
+from .interrupt import requested as check_requested
 
 try:  # POSIX; elsewhere runs are not serialised (said in the docstring of _FolderLock)
     import fcntl
@@ -77,6 +79,7 @@ def check_out_dir(path, *, create_parents: bool = False) -> Path:
     fogdrift.errors.ConfigError: out= .../missing/run1: its parent folder .../missing does not exist; ...
     """
     p = Path(path).expanduser().absolute()
+    _check_links(p)
     if p.exists() and not p.is_dir():
         raise ConfigError(f"{{opt:out}} {p} exists and is not a folder; choose a folder (new or one fogdrift wrote "
                           "before)")
@@ -94,6 +97,28 @@ def check_out_dir(path, *, create_parents: bool = False) -> Path:
                           "another folder")
     _probe(existing, p)
     return p
+
+
+def _check_links(p: Path) -> None:
+    """ConfigError if ``p`` or one of its parents is a symbolic link that leads nowhere (dangling, or a loop).
+
+    Checked before any work: such a folder can be neither used nor created (``mkdir`` would fail after the
+    whole computation).  A link to an existing folder is fine.
+    """
+    for q in reversed((p, *p.parents)):  # from the root down: the first component that fails is the culprit
+        try:
+            os.stat(q)
+            continue
+        except FileNotFoundError:
+            if not q.is_symlink():
+                return  # a folder that does not exist yet: the parent rules of check_out_dir apply
+            reason = f"a symbolic link to {os.readlink(q)}, which does not exist (a dangling link)"
+        except OSError as exc:
+            if exc.errno != errno.ELOOP:
+                return  # below a file (ENOTDIR), no permission: check_out_dir's own rules say it
+            reason = "a symbolic link loop (the link leads back to itself)"
+        where = "is" if q == p else f"cannot be used: {q} is"
+        raise ConfigError(f"{{opt:out}} {p} {where} {reason}; remove or fix the link, or choose another folder")
 
 
 def _probe(folder: Path, target: Path) -> None:
@@ -162,10 +187,26 @@ def atomic_path(path):
     try:
         yield tmp
         os.replace(tmp, final)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise _write_error(final.parent, final.name, exc, "no partial file left") from exc
         raise
+
+
+#: Write failures that mean the machine ran out of room, not a wrong folder.
+_NO_ROOM = {errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC), errno.EFBIG}
+
+
+def _write_error(folder: Path, rel: str, exc: OSError, left: str) -> FogdriftError:
+    """One-line error for a file that could not be written (disk full, quota, read-only, permissions)."""
+    code = errno.errorcode.get(exc.errno, "") if exc.errno else ""
+    why = f"{exc.strerror or exc}" + (f" ({code})" if code else "")
+    if exc.errno in _NO_ROOM:
+        return ResourceError(f"{{opt:out}} {folder}: cannot write {rel}: {why}; {left}; free space on that disk "
+                             "or choose another folder")
+    return ConfigError(f"{{opt:out}} {folder}: cannot write {rel}: {why}; {left}; choose another folder")
 
 
 class _FolderLock:
@@ -276,11 +317,25 @@ class OutputDir:
             if exc_type is None and self._opened:
                 with self._lock:
                     self.complete = True
-                    self._write_manifest()
+                    try:
+                        self._write_manifest()
+                    except OSError as err:
+                        self.complete = False
+                        raise _write_error(self.path, MANIFEST, err, self.summary()) from err
         finally:
             self._discard_pending()
             _active.remove(self)
             self._folder_lock.release()
+        if exc is not None and not check_requested():
+            if isinstance(exc, MemoryError):
+                inputs = ", ".join(sorted(str(p) for p in self.protect)) or "its input"
+                raise ResourceError(
+                    f"out of memory in 'fogdrift {self.command}' on {inputs}; {self.summary()}; run it on a "
+                    "machine with more memory, or on a shorter log (limit what a reader may take with the "
+                    "environment variable FOGDRIFT_MAX_MEMORY)") from exc
+            if isinstance(exc, OSError) and not isinstance(exc, FogdriftError) and exc.errno in _NO_ROOM:
+                raise _write_error(self.path, getattr(exc, "filename", None) or "a file", exc,
+                                   self.summary()) from exc
         return False
 
     def expect(self, *names) -> None:
@@ -304,8 +359,11 @@ class OutputDir:
         with self._lock:
             if self._aborted:
                 raise RuntimeError("output folder closed after an interruption")
-            self._open()
-            self._make_dirs(final.parent)
+            try:
+                self._open()
+                self._make_dirs(final.parent)
+            except OSError as exc:
+                raise _write_error(self.path, rel, exc, self.summary()) from exc
             tmp = final.with_name(f"{TMP_PREFIX}{os.getpid()}-{final.name}")
             self._pending.add(tmp)
         try:
@@ -318,11 +376,13 @@ class OutputDir:
                 if rel not in self.written:
                     self.written.append(rel)
                 self._write_manifest()
-        except BaseException:
+        except BaseException as exc:
             with self._lock:
                 self._pending.discard(tmp)
                 with contextlib.suppress(OSError):
                     os.unlink(tmp)
+            if isinstance(exc, OSError) and not check_requested():  # disk full, quota: one line, no traceback
+                raise _write_error(self.path, rel, exc, self.summary()) from exc
             raise
 
     def _make_dirs(self, folder: Path) -> None:
@@ -401,8 +461,13 @@ class OutputDir:
                "dirs": self._created_dirs}
         target = self.path / MANIFEST
         tmp = target.with_name(f"{TMP_PREFIX}{os.getpid()}-{MANIFEST}")
-        tmp.write_text(json.dumps(doc, indent=1), encoding="utf-8")
-        os.replace(tmp, target)
+        try:
+            tmp.write_text(json.dumps(doc, indent=1), encoding="utf-8")
+            os.replace(tmp, target)
+        except BaseException:  # disk full: no 0-byte temporary manifest left behind
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+            raise
 
     def _discard_pending(self) -> None:
         with self._lock:

@@ -20,7 +20,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import FogdriftError
+from ..errors import FogdriftError, ResourceError
 
 __all__ = ["FileTask", "run_file", "load_record", "MANIFEST"]
 
@@ -121,6 +121,8 @@ def run_file(task: FileTask) -> list[dict]:
                 notes = _plausibility(record, task.flags)
                 rows = command_spec(task.command).run(record, task.settings, od.path)
             status, error, cache = "ok", None, True
+        except ResourceError as exc:         # out of memory / disk space: the machine's state, never cached
+            rows, status, error, cache = [{}], "error", f"{type(exc).__name__}: {exc.render(task.flags)}", False
         except FogdriftError as exc:         # bad input or settings: deterministic, cached like a result
             rows, status, error, cache = [{}], "error", f"{type(exc).__name__}: {exc.render(task.flags)}", True
         except Exception as exc:  # noqa: BLE001 -- one file must never crash the batch
