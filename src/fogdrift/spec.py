@@ -192,9 +192,9 @@ def read_spec(path) -> dict:
     try:
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise ConfigError(f"{{opt:spec}}: no such file {p}") from None
+        raise ConfigError(f"spec file: no such file {p}") from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{{opt:spec}}: cannot read {p} ({exc})") from None
+        raise ConfigError(f"spec file: cannot read {p} ({exc})") from None
     if p.suffix.lower() in (".yaml", ".yml"):
         try:
             import yaml

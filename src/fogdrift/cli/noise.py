@@ -6,6 +6,8 @@ and sigma, one B named by its rule) with 95 % intervals, the J statistic with it
 per quantity saying whether N and B agree with the Allan fit of the same record (or why not).  ``--curve TABLE``
 fits a published wavelet- or Allan-variance table (the SMAC formats) instead of a log; its unit is the table's
 ``unit`` column or ``--unit`` (never its ``unit_inferred`` column) and is printed first.  ``--method allan`` runs the Allan noise fit of ``fogdrift allan``.
+``--spec FILE`` compares every channel with datasheet limits (:mod:`fogdrift.spec`): pass / fail / cannot tell, judged
+with the 95 % interval, B as the IEEE reading B_min; written to spec.json.
 """
 
 from __future__ import annotations
@@ -36,6 +38,10 @@ CurveOpt = Annotated[Optional[Path], typer.Option("--curve", help="Fit a publish
                                                                   "adev, n_samples, sample_rate_hz); the unit comes "
                                                                   "from its 'unit' column or --unit.")]
 SensorOpt = Annotated[Optional[str], typer.Option("--sensor", help="With --curve: the table's sensor_key to fit.")]
+SpecOpt = Annotated[Optional[Path], typer.Option(
+    "--spec", help="Datasheet limits (YAML or JSON, each with its unit, e.g. gyro: {arw: \"2 deg/sqrt(h)\", "
+                   "bias_instability: \"0.007 deg/s\"}): pass / fail / cannot tell per channel, judged with the 95 % "
+                   "interval (data/specs/adis16405.yaml is an example).")]
 
 
 def _optional_file(func):
@@ -56,6 +62,39 @@ def _fmt(x, digits=4):
 
 def _interval(lo, hi) -> str:
     return "–" if lo is None or hi is None else f"[{_fmt(lo)}, {_fmt(hi)}]"
+
+
+def channel_kinds(record) -> dict:
+    """Axis name -> ``"gyro"`` or ``"accel"`` from the record's channel quantities (gyro when not stated)."""
+    from ..spec import channel_kind
+
+    sig = getattr(record, "signal", None)
+    chans = {c.name: getattr(c, "quantity", None) for c in getattr(sig, "channels", ())} if sig is not None else {}
+    return {name: channel_kind(chans.get(name)) for name in record.axis_names}
+
+
+def print_spec_comparison(spec: dict, channels: dict, out_dir=None, *, source: str = "") -> list:
+    """Judge ``spec`` (:func:`fogdrift.spec.read_spec`) on ``channels`` (name -> (kind, {item: Reading})), print the
+    table and the line saying which B was compared; write spec.json into ``out_dir`` when given.  Returns the
+    judgements.  (Callable from any command that has Allan or GMWM readings.)"""
+    from ..report import write_json
+    from ..spec import B_COMPARED, compare
+
+    js = compare(spec, channels)
+    title = f"datasheet comparison: {spec['sensor'] or source}" + (f" ({source})" if spec["sensor"] and source else "")
+    if not js:
+        say(f"{title}: no limit applies to these channels (the spec has "
+            f"{', '.join(sorted({l.kind for l in spec['limits']}))} limits only)", style="yellow")
+    else:
+        console.print(fitted_table(title + "; every limit read as an upper limit",
+                                   ["channel", "term", "limit", "estimate, 95 % interval", "verdict", "why"],
+                                   [[j.channel, j.limit.item, j.limit.text, j.estimate, j.verdict, j.reason]
+                                    for j in js]))
+    say(f"  {B_COMPARED}", style="dim")
+    if out_dir is not None:
+        write_json({"fogdrift_result": "spec", "spec": source, "sensor": spec["sensor"],
+                    "b_compared": B_COMPARED, "judgements": [j.to_dict() for j in js]}, out_dir / "spec.json")
+    return js
 
 
 def print_gmwm(title, axes):
@@ -100,14 +139,16 @@ def noise(
     robust: RobustOpt = False,
     curve: CurveOpt = None,
     sensor: SensorOpt = None,
+    spec: SpecOpt = None,
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
 ):
     """Noise model of every axis: GMWM model selection (wavelet variance) with the IEEE-952 table and 95 %
-    intervals, or the Allan fit; writes noise.json, wvar.csv (gmwm) and noise.png."""
+    intervals, or the Allan fit; writes noise.json, wvar.csv (gmwm) and noise.png (and spec.json with --spec)."""
     method = method.lower()
     expect = ("noise.json", "wvar.csv", "noise.png") if method == "gmwm" else ("noise.json", "noise.png")
-    with run("noise", out, default_out=DEFAULT_OUT, inputs=[load.file, curve], json_out=json_out,
+    expect += ("spec.json",) if spec is not None else ()
+    with run("noise", out, default_out=DEFAULT_OUT, inputs=[load.file, curve, spec], json_out=json_out,
              expect=expect) as r:
         from ..gmwm.analysis import analyse_gmwm, analyse_wvar, candidates_for, read_curve_table
         from ..gmwm.compare import attach_allan_checks
@@ -117,11 +158,16 @@ def noise(
             raise ConfigError(f"{{opt:method}} must be 'gmwm' or 'allan'; got {method!r}")
         if (curve is None) == (load.file is None):
             raise ConfigError("give either a log FILE or {opt:curve} TABLE (one of them)")
+        limits = None
+        if spec is not None:  # refuse a bad spec before any work
+            from ..spec import read_spec
+
+            limits = read_spec(spec)
         if method == "allan":
             if curve is not None or model.lower() != "auto" or scales is not None or robust:
                 raise ConfigError("--curve, --model, --scales and --robust belong to --method gmwm; the Allan "
                                   "fit selects its terms itself (use 'fogdrift allan --terms' to fix them)")
-            return _allan(load, r)
+            return _allan(load, r, limits, spec)
         candidates_for(model)  # refuse a bad --model before reading anything
         if scales is not None and scales < 1:
             raise ConfigError(f"{{opt:scales}} must be >= 1; got {scales}")
@@ -140,6 +186,7 @@ def noise(
             with progress("noise"):
                 axes = [analyse_wvar(w.axis_names[0], w, model=model) for w in wvs]
             source, meta = str(curve), None
+            kinds = {a.name: "gyro" for a in axes}
         else:
             if sensor is not None:
                 raise ConfigError("--sensor belongs to --curve")
@@ -151,13 +198,19 @@ def noise(
                         for name in record.axis_names]
                 attach_allan_checks(record, axes)
             source, meta = str(record.source), record.metadata()
+            kinds = channel_kinds(record)
         print_gmwm((curve or load.file).name, axes)
+        if limits is not None:
+            from ..spec import readings_from_gmwm
+
+            print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_gmwm(a, kinds[a.name]))
+                                           for a in axes}, r.out.path, source=spec.name)
         files = write_gmwm_outputs(axes, r.out.path, source=source, record=meta)
         r.wrote()
         r.print_json(files["json"])
 
 
-def _allan(load, r):
+def _allan(load, r, limits=None, spec_path=None):
     """--method allan: the Allan noise fit of every axis (as 'fogdrift allan'), written as noise.json/noise.png."""
     from ..pipeline import AnalysisConfig, run_allan
     from ..report import noise_row, plot_allan, write_json
@@ -172,6 +225,12 @@ def _allan(load, r):
                               [[a.name] + noise_row(a.noise) for a in results]))
     for a in results:
         print_noise_notes(a.name, a.noise, a.outliers, record.dt_s)
+    if limits is not None:
+        from ..spec import readings_from_noise_fit
+
+        kinds = channel_kinds(record)
+        print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_noise_fit(a.noise, kinds[a.name]))
+                                       for a in results}, r.out.path, source=spec_path.name)
     path = write_json({"fogdrift_result": "noise", "method": "allan", "source": str(record.source),
                        "record": record.metadata(), "axes": [a.to_dict() for a in results]}, r.out.path / "noise.json")
     plot_allan(results, r.out.path / "noise.png")
