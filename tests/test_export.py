@@ -1,0 +1,318 @@
+"""fogdrift export: conversions by hand, the --missing policy, every target read back by the parser its project uses
+(OpenCV's FileStorage for OpenVINS / VINS-Fusion / ORB-SLAM3, PyYAML for Kalibr and KF-GINS, the MATLAB name-value
+pairs, gnss-ins-sim's dictionary executed), and the CLI's one-line errors."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from fogdrift.cli import app
+from fogdrift.errors import ConfigError, DataFormatError
+from fogdrift.export import build_context, parse_targets, render
+from fogdrift.export.conversions import (arw_to_density, density_to_arw, gm_discrete, rrw_to_density,
+                                         single_gm_from_flicker, to_si, vrw_to_density, walk_discrete,
+                                         white_discrete)
+from fogdrift.export.model import channels_from_result, resolve
+from fogdrift.models.statespace import gm_avar_dph2
+
+cv2 = pytest.importorskip("cv2")
+
+D = math.pi / 180.0
+G = 9.80665
+runner = CliRunner()
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# result files built by hand (the shapes fogdrift allan writes)
+# ------------------------------------------------------------------------------------------------------------------
+def _term(name, value, lo, hi, unit, status, reason=""):
+    return {"name": name, "value": value, "unit": unit, "lo95": lo, "hi95": hi, "status": status,
+            "estimable": status in ("resolved", "unresolved"), "reason": reason}
+
+
+def _allan_axis(name, terms, *, b_tau=100.0, selected=("N", "B", "K"), no_fit=None, units=None):
+    units = units or {"Q": "urad", "N": "deg/sqrt(h)", "B": "deg/h", "K": "deg/h^1.5", "R": "deg/h^2"}
+    t = {}
+    for k in ("Q", "N", "B", "K", "R"):
+        spec = terms.get(k)
+        if spec is None:
+            t[k] = _term(k, None, 0.0, 0.3, units[k], "absent", "not in the model: the curve shows no sign of it")
+        else:
+            t[k] = _term(k, *spec[:3], units[k], spec[3], spec[4] if len(spec) > 4 else "")
+    return {"name": name, "noise": {
+        "statistic": "adev", "dt_s": 0.01, "selected": list(selected), "terms": t, "A": [0, 0, 0, 0, 0],
+        "fit": {"tau_min_s": 0.1, "tau_max_s": 1000.0, "chi2_red": 1.1, "quality": "good"},
+        "b_min": {"value": None, "unit": units["B"], "tau_s": b_tau, "bound_only": False, "lo95": None, "hi95": None,
+                  "rule": "min of the fitted ADEV / 0.664"},
+        "shaped": {}, "no_fit": no_fit}}
+
+
+def _gyro_result(tmp_path, name="gyro.json", **kw):
+    axes = [_allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved"), "B": (2.0, 1.5, 2.5, "resolved"),
+                               "K": (0.5, 0.3, 0.7, "resolved")}, **kw),
+            _allan_axis("gy", {"N": (0.20, 0.19, 0.21, "resolved"), "B": (3.0, 2.5, 3.5, "resolved"),
+                               "K": (0.4, 0.2, 0.6, "resolved")}, **kw),
+            _allan_axis("gz", {"N": (0.10, 0.09, 0.11, "resolved"), "B": (1.0, 0.5, 1.5, "resolved")},
+                        selected=("N", "B"), **kw)]
+    doc = {"source": "sim", "record": {"fs_hz": 100.0, "sha256": "ab" * 32}, "axes": axes}
+    p = tmp_path / name
+    p.write_text(json.dumps(doc))
+    return p
+
+
+_ACC_UNITS = {"Q": "m/s", "N": "m/s/sqrt(h)", "B": "ug", "K": "m/s^2/sqrt(s)", "R": "m/s^3"}
+
+
+def _accel_result(tmp_path):
+    axes = [_allan_axis(a, {"N": (0.06 * (i + 1), 0.05, 0.2, "resolved"), "B": (50.0 * (i + 1), 40.0, 200.0, "resolved"),
+                            "K": (1e-4 * (i + 1), 5e-5, 4e-4, "resolved")}, units=_ACC_UNITS)
+            for i, a in enumerate(("ax", "ay", "az"))]
+    p = tmp_path / "accel.json"
+    p.write_text(json.dumps({"source": "sim", "record": {"fs_hz": 100.0}, "axes": axes}))
+    return p
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# conversions (hand-computed)
+# ------------------------------------------------------------------------------------------------------------------
+def test_arw_density_hand_values():
+    # 0.15 deg/sqrt(h) = 0.15 * (pi/180) rad / sqrt(3600 s) = 0.15 * 0.01745329 / 60 = 4.3633e-5 rad/s/sqrt(Hz)
+    assert arw_to_density(0.15) == pytest.approx(4.3633e-5, rel=1e-4)
+    assert density_to_arw(4.3633e-5) == pytest.approx(0.15, rel=1e-4)
+    assert vrw_to_density(0.06) == pytest.approx(0.001, rel=1e-12)          # 0.06 m/s/sqrt(h) / 60
+    # 1 deg/h^1.5 = (pi/180) / 3600^1.5 rad/s^1.5 = 0.01745329 / 216000 = 8.0802e-8
+    assert rrw_to_density(1.0) == pytest.approx(8.0802e-8, rel=1e-4)
+
+
+def test_to_si_units_and_unknown_unit():
+    assert to_si(0.2, "B", "mg")[0] == pytest.approx(0.2e-3 * G, rel=1e-12)
+    assert to_si(50.0, "B", "ug")[0] == pytest.approx(50e-6 * G, rel=1e-12)
+    assert to_si(1.0, "B", "mGal")[0] == pytest.approx(1e-5, rel=1e-12)
+    assert to_si(3.6, "B", "deg/h")[0] == pytest.approx(1e-3 * D, rel=1e-12)   # 3.6 deg/h = 0.001 deg/s
+    assert to_si(2.0, "N", "deg/√h")[0] == pytest.approx(2 * D / 60, rel=1e-12)
+    with pytest.raises(ConfigError, match="not one fogdrift can convert; expected one of"):
+        to_si(1.0, "N", "furlong/fortnight")
+
+
+def test_continuous_to_discrete_directions():
+    # white noise grows with the rate, a random walk's per-sample step shrinks with it (Kalibr wiki)
+    assert white_discrete(1e-3, 400.0) == pytest.approx(0.02)
+    assert walk_discrete(1e-3, 400.0) == pytest.approx(5e-5)
+    phi, q = gm_discrete(2.0, 10.0, 10.0)   # dt = 0.1 s, T_c = 10 s
+    assert phi == pytest.approx(math.exp(-0.01))
+    assert q == pytest.approx(2.0 * math.sqrt(1 - math.exp(-0.02)))
+
+
+def test_single_gm_peak_is_the_flicker_floor():
+    b, tau_b = 5.0, 300.0
+    sigma, tc = single_gm_from_flicker(b, tau_b)
+    taus = np.geomspace(tau_b / 10, tau_b * 10, 2001)
+    adev = np.sqrt(gm_avar_dph2(taus, tc, sigma))
+    assert adev.max() == pytest.approx(0.664282 * b, rel=1e-4)     # flicker ADEV floor sqrt(2 ln2 / pi) B
+    assert taus[adev.argmax()] == pytest.approx(tau_b, rel=5e-3)
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# targets read back by their projects' parsers
+# ------------------------------------------------------------------------------------------------------------------
+@pytest.fixture
+def ctx(tmp_path):
+    return build_context([_gyro_result(tmp_path)], [_accel_result(tmp_path)])
+
+
+def test_kalibr_pyyaml(ctx):
+    d = yaml.safe_load(render("kalibr", ctx))
+    # one value for all axes: the largest (gy N 0.20 deg/sqrt(h), gx K 0.5 deg/h^1.5; az VRW 0.18, az K 3e-4)
+    assert d["gyroscope_noise_density"] == pytest.approx(0.20 * D / 60, rel=1e-5)
+    assert d["gyroscope_random_walk"] == pytest.approx(0.5 * D / 216000, rel=1e-5)
+    assert d["accelerometer_noise_density"] == pytest.approx(0.18 / 60, rel=1e-5)
+    assert d["accelerometer_random_walk"] == pytest.approx(3e-4, rel=1e-5)
+    assert d["update_rate"] == 100.0 and d["rostopic"] == "/imu0"
+
+
+def _cv(text, tmp_path, name):
+    p = tmp_path / name
+    p.write_text(text)
+    fs = cv2.FileStorage(str(p), cv2.FILE_STORAGE_READ)
+    assert fs.isOpened()
+    return fs
+
+
+def test_openvins_vins_orbslam3_read_by_opencv(ctx, tmp_path):
+    fs = _cv(render("openvins", ctx), tmp_path, "ov.yaml")
+    imu0 = fs.getNode("imu0")
+    assert imu0.getNode("gyroscope_noise_density").real() == pytest.approx(0.20 * D / 60, rel=1e-5)
+    assert imu0.getNode("accelerometer_random_walk").real() == pytest.approx(3e-4, rel=1e-5)
+    assert imu0.getNode("update_rate").real() == 100.0
+    assert imu0.getNode("T_i_b").size() == 4
+    fs.release()
+    fs = _cv(render("vins-fusion", ctx), tmp_path, "vins.yaml")
+    assert fs.getNode("gyr_n").real() == pytest.approx(0.20 * D / 60, rel=1e-5)
+    assert fs.getNode("acc_n").real() == pytest.approx(0.18 / 60, rel=1e-5)
+    assert fs.getNode("gyr_w").real() == pytest.approx(0.5 * D / 216000, rel=1e-5)
+    assert fs.getNode("acc_w").real() == pytest.approx(3e-4, rel=1e-5)
+    fs.release()
+    fs = _cv(render("orbslam3", ctx), tmp_path, "orb.yaml")
+    assert fs.getNode("IMU.NoiseGyro").real() == pytest.approx(0.20 * D / 60, rel=1e-5)
+    assert fs.getNode("IMU.NoiseAcc").real() == pytest.approx(0.18 / 60, rel=1e-5)
+    assert fs.getNode("IMU.GyroWalk").real() == pytest.approx(0.5 * D / 216000, rel=1e-5)
+    assert fs.getNode("IMU.AccWalk").real() == pytest.approx(3e-4, rel=1e-5)
+    assert fs.getNode("IMU.Frequency").real() == 100.0
+    fs.release()
+
+
+def test_kfgins_units(ctx):
+    d = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
+    assert d["arw"] == pytest.approx([0.15, 0.20, 0.10], rel=1e-5)            # deg/sqrt(h), per axis
+    assert d["vrw"] == pytest.approx([0.06, 0.12, 0.18], rel=1e-5)            # m/s/sqrt(h)
+    # one GM per bias matched to B: sigma = 1.0760 B [deg/h]; abstd in mGal (1 ug = 0.980665 mGal)
+    assert d["gbstd"] == pytest.approx([1.0760 * 2.0, 1.0760 * 3.0, 1.0760 * 1.0], rel=1e-4)
+    assert d["abstd"] == pytest.approx([1.0760 * 50 * 0.980665, 1.0760 * 100 * 0.980665, 1.0760 * 150 * 0.980665],
+                                       rel=1e-4)
+    assert d["corrtime"] == pytest.approx(100.0 / 1.8926 / 3600.0, rel=1e-4)  # hours
+    assert "gsstd" not in d and "asstd" not in d
+
+
+def test_matlab_name_value_pairs(ctx):
+    text = render("matlab", ctx)
+
+    def vec(obj, key):
+        block = text[text.index(f"{obj} = "):]
+        m = re.search(rf"'{key}', \[([^\]]*)\]", block)
+        return [float(v) for v in m.group(1).split()]
+
+    assert vec("gyro", "NoiseDensity") == pytest.approx([0.15 * D / 60, 0.20 * D / 60, 0.10 * D / 60], rel=1e-5)
+    assert vec("gyro", "BiasInstability") == pytest.approx([2.0 * D / 3600, 3.0 * D / 3600, 1.0 * D / 3600], rel=1e-5)
+    assert vec("accel", "BiasInstability") == pytest.approx([50e-6 * G, 100e-6 * G, 150e-6 * G], rel=1e-5)
+    assert vec("accel", "RandomWalk") == pytest.approx([1e-4, 2e-4, 3e-4], rel=1e-5)
+    assert "imuSensor('accel-gyro', 'SampleRate', 100.0, 'Gyroscope', gyro, 'Accelerometer', accel)" in text
+
+
+def test_gnss_ins_sim_dictionary(ctx):
+    ns = {}
+    exec(render("gnss-ins-sim", ctx), ns)  # noqa: S102 - our own generated file
+    err = ns["imu_err"]
+    assert err["gyro_arw"] == pytest.approx([0.15, 0.20, 0.10], rel=1e-5)            # deg/sqrt(h)
+    assert err["gyro_b_stability"] == pytest.approx([1.0760 * 2, 1.0760 * 3, 1.0760], rel=1e-4)  # deg/h
+    assert err["gyro_b_corr"] == pytest.approx([100 / 1.8926] * 3, rel=1e-4)          # s
+    assert err["accel_vrw"] == pytest.approx([0.06, 0.12, 0.18], rel=1e-5)
+    assert err["accel_b_stability"][0] == pytest.approx(1.0760 * 50e-6 * G, rel=1e-4)  # m/s^2
+    assert list(err["gyro_b"]) == [0.0, 0.0, 0.0]
+
+
+def test_every_number_carries_its_provenance(ctx):
+    text = render("kalibr", ctx)
+    i = text.index("gyroscope_noise_density:")
+    before = text[:i]
+    assert "gy: N = 0.2 [0.19, 0.21] deg/sqrt(h) [resolved]" in before
+    assert "continuous 5.81776e-05 rad/s/sqrt(Hz)" in before                 # 0.2 * pi/180 / 60
+    assert "discrete 0.000581776 rad/s per sample at 100.0 Hz" in before     # x sqrt(100)
+    assert "x 0.000290888 (deg/sqrt(h) -> rad/s/sqrt(Hz))" in before
+
+
+def test_json_has_terms_and_van_loan_state_space(ctx):
+    d = json.loads(render("json", ctx))
+    gx = next(c for c in d["channels"] if c["name"] == "gx")
+    assert gx["export_values"]["N"]["si"] == pytest.approx(0.15 * D / 60, rel=1e-9)
+    assert gx["export_values"]["N"]["discrete_sigma"] == pytest.approx(0.15 * D / 60 * 10, rel=1e-9)
+    ss = gx["state_space"]
+    assert ss["check_max_abs"] < 1e-12
+    states = ss["discrete"]["states"]
+    assert states[:2] == ["bias", "random_walk"]
+    i = states.index("random_walk")
+    k = 0.5 * D / 216000                                                     # K in rad/s^2/sqrt(Hz)
+    assert ss["discrete"]["Qd"][i][i] == pytest.approx(k * k * 0.01, rel=1e-9)
+    assert ss["discrete"]["r"] == pytest.approx((0.15 * D / 60) ** 2 / 0.01, rel=1e-9)
+    for j, s in enumerate(states):
+        if s.startswith("gm_"):
+            tc = -1.0 / ss["continuous"]["F"][j][j]
+            assert ss["discrete"]["Phi"][j][j] == pytest.approx(math.exp(-0.01 / tc), rel=1e-12)
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# the --missing policy, missing quantities, no model fits
+# ------------------------------------------------------------------------------------------------------------------
+def test_missing_policies(tmp_path):
+    chans = channels_from_result(json.loads(_gyro_result(tmp_path).read_text()), "g")
+    gz = next(c for c in chans if c.name == "gz")                 # K absent, 95 % upper bound 0.3 deg/h^1.5
+    r = resolve(gz, "K", "bound")
+    assert r.how == "bound" and r.si == pytest.approx(0.3 * D / 216000)
+    assert "95 % upper bound" in r.note
+    assert resolve(gz, "K", "zero").si == 0.0
+    with pytest.raises(ConfigError, match=r"gyro gz: K is not resolved by the record: not in the model.*upper bound is 0.3 deg/h"):
+        resolve(gz, "K", "refuse")
+    ctx = build_context([_gyro_result(tmp_path)], missing="zero")
+    d = yaml.safe_load(render("kalibr", ctx))
+    assert d["gyroscope_random_walk"] == pytest.approx(0.5 * D / 216000)   # the largest axis, not gz's 0
+    assert any("gz: K written as 0" in n for n in ctx.notes)
+
+
+def test_no_accel_result_leaves_the_keys_out(tmp_path):
+    ctx = build_context([_gyro_result(tmp_path)])
+    text = render("kalibr", ctx)
+    d = yaml.safe_load(text)
+    assert "accelerometer_noise_density" not in d and "accelerometer_random_walk" not in d
+    assert "not written: no accelerometer result was given" in text
+    assert any("no accelerometer result given" in n for n in ctx.notes)
+
+
+def test_no_model_fits_makes_every_term_missing(tmp_path):
+    p = _gyro_result(tmp_path, no_fit={"best_candidate": "N+B+K"})
+    chans = channels_from_result(json.loads(p.read_text()), "g")
+    with pytest.raises(ConfigError, match="no model fits the record"):
+        resolve(chans[0], "N", "refuse")
+    assert resolve(chans[0], "N", "bound").si == pytest.approx(0.16 * D / 60)   # its upper end, said as a bound
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# errors: one line each
+# ------------------------------------------------------------------------------------------------------------------
+def test_errors(tmp_path):
+    with pytest.raises(ConfigError, match="unknown export target 'kalibur'; expected one of kalibr, openvins"):
+        parse_targets("kalibur")
+    assert parse_targets("all")[0] == "kalibr" and len(parse_targets("all")) == 8
+    with pytest.raises(DataFormatError, match="no such result file"):
+        build_context([tmp_path / "nope.json"])
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(DataFormatError, match="not a JSON file"):
+        build_context([bad])
+    bad.write_text('{"hello": 1}')
+    with pytest.raises(DataFormatError, match="not a fogdrift allan or noise result"):
+        build_context([bad])
+    with pytest.raises(DataFormatError, match="--accel was given a gyro result"):
+        build_context(accel=[_gyro_result(tmp_path)])
+    with pytest.raises(ConfigError, match="--missing must be one of bound, refuse, zero|missing= must be one of"):
+        build_context([_gyro_result(tmp_path)], missing="maybe")
+
+
+def test_cli_errors_are_one_line(tmp_path):
+    g = _gyro_result(tmp_path)
+    res = runner.invoke(app, ["export", "--gyro", str(g), "--target", "kalibur", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 1
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "unknown export target 'kalibur'; expected one of kalibr" in lines[0]
+    res = runner.invoke(app, ["export", "--gyro", str(tmp_path / "x.json"), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 1 and "no such result file" in res.output and "Traceback" not in res.output
+    res = runner.invoke(app, ["export", "--gyro", str(g), "--missing", "refuse", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 1 and "pass --missing bound or zero" in res.output
+    assert not (tmp_path / "o" / "imu.yaml").exists()              # refused before any file was written
+
+
+def test_cli_writes_every_target(tmp_path):
+    res = runner.invoke(app, ["export", "--gyro", str(_gyro_result(tmp_path)), "--accel", str(_accel_result(tmp_path)),
+                              "--update-rate", "200", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    names = sorted(p.name for p in (tmp_path / "o").iterdir() if not p.name.startswith("."))
+    assert names == sorted(["imu.yaml", "kalibr_imu_chain.yaml", "vins_imu.yaml", "orbslam3_imu.yaml",
+                            "kf-gins_imunoise.yaml", "imu_params.m", "gnss_ins_sim_imu_err.py", "noise_model.json"])
+    d = yaml.safe_load((tmp_path / "o" / "imu.yaml").read_text())
+    assert d["update_rate"] == 200.0
+    assert "K is its 95 % upper bound" in res.output                   # gz: the bound is said, not hidden
