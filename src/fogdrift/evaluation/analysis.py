@@ -1,6 +1,6 @@
 """The evaluation as part of an analysis result: heading error, artefact check and verdicts of every axis.
 
-:func:`evaluate_analysis` runs :func:`fogdrift.evaluation.evaluate_axis` on the test block of every axis of a
+:func:`evaluate_analysis` runs :func:`evaluate_axis` on the test block of every axis of a
 :class:`fogdrift.pipeline.AnalysisResult` (and of its ``apply_to`` result: the models applied unchanged to a
 second recording) and stores an :class:`AxisEvaluation` in ``axis.evaluation``, so that
 ``AnalysisResult.to_dict()`` (``analysis.json``) and the report carry it.
@@ -11,9 +11,13 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-from .heading import HORIZONS_S
+from ..errors import FogdriftError
+from ..interrupt import checkpoint
+from .artefacts import artefact_check
+from .heading import HORIZONS_S, heading_errors
+from .verdicts import compensation_verdicts, headline_verdict, table2_verdict
 
-__all__ = ["AxisEvaluation", "evaluate_analysis"]
+__all__ = ["AxisEvaluation", "evaluate_analysis", "evaluate_axis"]
 
 
 @dataclass
@@ -88,10 +92,6 @@ def evaluate_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, h
         The fitted recording's axes first, then the ``apply_to`` recording's; each is also stored as
         ``axis.evaluation``.
     """
-    from ..interrupt import checkpoint
-    from . import evaluate_axis
-    from .verdicts import headline_verdict, table2_verdict
-
     out = []
     for res in (result, getattr(result, "apply_to", None)):
         if res is None:
@@ -113,4 +113,44 @@ def evaluate_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, h
                           "horizons_s": [float(h) for h in horizons_s], "artefacts": bool(artefacts)},
                 wall_s=time.perf_counter() - t0)
             out.append(ax.evaluation)
+    return out
+
+
+def evaluate_axis(model_axis, cfg, *, heading=True, artefacts=True, calib_s=300.0, step_s=300.0,
+                  horizons_s=HORIZONS_S):
+    """Heading error and artefact check on the test block of one pipeline axis, with the verdicts in order.
+
+    Parameters
+    ----------
+    model_axis : fogdrift.pipeline.ModelAxis
+        From :func:`~fogdrift.pipeline.run_models` / ``run_analysis(...).axes[i].models``.
+    cfg : fogdrift.pipeline.AnalysisConfig
+        The settings of that run (wavelet, level, mode, causal window).
+
+    Returns
+    -------
+    dict
+        ``{"heading": HeadingResult or None, "artefacts": ArtefactResult or None, "verdicts": [Verdict, ...],
+        "notes": [str]}``; an evaluation the test block is too short for is None with a note.
+    """
+    from ..bundle import _causal_window, _level_of  # H-signal: a public function replaces these
+
+    level = _level_of(model_axis, cfg)
+    window = _causal_window(model_axis, cfg, level)
+    e, f = model_axis.split["test"]
+    z = model_axis.rate_dph[e:f]
+    opts = dict(causal_window=window, wavelet=cfg.wavelet, level=level, mode=cfg.mode, axis=model_axis.name)
+    out = {"heading": None, "artefacts": None, "notes": []}
+    if heading:
+        try:
+            out["heading"] = heading_errors(z, model_axis.dt_s, model_axis.fitted, calib_s=calib_s, step_s=step_s,
+                                            horizons_s=horizons_s, **opts)
+        except FogdriftError as exc:
+            out["notes"].append(f"{model_axis.name}: heading evaluation skipped ({exc})")
+    if artefacts:
+        try:
+            out["artefacts"] = artefact_check(z, model_axis.dt_s, model_axis.fitted, **opts)
+        except FogdriftError as exc:
+            out["notes"].append(f"{model_axis.name}: artefact check skipped ({exc})")
+    out["verdicts"] = compensation_verdicts(heading=out["heading"], artefacts=out["artefacts"], model_axis=model_axis)
     return out

@@ -19,6 +19,9 @@ Units: N in deg/sqrt(h), B in deg/h, tau in s.
 
 from __future__ import annotations
 
+from ..errors import InsufficientDataError
+from ..pipeline import AnalysisConfig, run_allan
+
 __all__ = ["compare_with_allan", "attach_allan_checks"]
 
 
@@ -175,8 +178,6 @@ def attach_allan_checks(record, axes) -> list:
     """Set ``allan_check`` on each GMWM axis of a record: its comparison with the Allan fit of the same axis (the
     default fit of ``fogdrift allan``, :func:`fogdrift.pipeline.run_allan`).  Used by ``fogdrift noise`` and
     ``fogdrift batch --command noise`` alike; returns ``axes``."""
-    from ..errors import InsufficientDataError
-    from ..pipeline import AnalysisConfig, run_allan
 
     try:
         fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate())}

@@ -8,7 +8,7 @@ every Dask worker of ``fogdrift batch``) compiled them again (~5 s).
 import numba
 import numpy as np
 
-from .engine import HUBER_K
+from .huber import HUBER_K
 
 __all__ = ["pgn"]
 

@@ -27,14 +27,11 @@ import math
 import numpy as np
 from scipy.optimize import brentq, nnls
 
+from .huber import HUBER_K
+
 __all__ = ["ScoreProblem", "projected_gauss_newton", "fit_subsets", "profile_interval"]
 
 _KERNEL = {}
-
-#: Huber constant of the objective: a whitened residual beyond HUBER_K standard deviations counts linearly, not
-#: quadratically, so one extreme innovation (typically the last, 1-3 EDF octave, whose distribution is far from
-#: normal) cannot drag the whole fit.  Normal residuals exceed it with probability 0.27 %.
-HUBER_K = 3.0
 
 
 def _wh_kernel():

@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..units import B_FACTOR, URAD_PER_ARCSEC
+from .covariance import expected_variance
 
 __all__ = [
     "TermSpec",
@@ -363,7 +364,6 @@ def markov_shape(tau_s, tc_s, statistic="adev", dt_s=None) -> np.ndarray:
     laws_of(statistic)
     if dt_s is None:
         raise ConfigError("the Gauss-Markov law of hdev/mdev needs the sample interval dt_s")
-    from .covariance import expected_variance
 
     dt = float(dt_s)
     phi = math.exp(-dt / tc)

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .._util import json_default
+from ..noise import TERM_TABLE
 from ..output import atomic_path
 from .figures import _safe, plot_allan, plot_models, plot_residuals, plot_separation, plot_separation_allan
 
@@ -41,7 +42,6 @@ def _noise_csv_rows(label, aa):
 
 
 def _noise_csv_header():
-    from ..noise import TERM_TABLE
 
     head = ["signal"]
     for name, spec in TERM_TABLE.items():

@@ -16,7 +16,9 @@ import struct
 from datetime import datetime, timezone
 from pathlib import Path
 
+from ..evaluation.verdicts import judge, table2_marks
 from ..output import atomic_path
+from ..temperature import summary_line, temperature_summary
 from .figures import (_safe, plot_allan, plot_models, plot_residuals, plot_separation, plot_separation_allan,
                       plot_signal, plot_spectrum)
 from .files import write_json
@@ -25,6 +27,9 @@ from .settings import settings_rows
 from .summary import OUTCOME_LABELS, cannot_support, noise_headline, recording_rows, summary_dict, verdict_items
 from .tables import (METRICS_HEADERS, NOISE_HEADERS, _fmt, causal_metrics_rows, fit_cell, metrics_rows, noise_notes, noise_row,
                      readout_text, verdict)
+from .gmwm import gmwm_noise_html
+from .pdf import write_pdf
+from .temperature import plot_rate_and_temperature
 
 __all__ = ["write_report", "render_report"]
 
@@ -186,7 +191,6 @@ def _settings_section(result, generated) -> str:
 
 
 def _heading_table(h) -> str:
-    from ..evaluation.verdicts import judge
 
     headers = ["horizon", "compensator", "origins (independent)", "RMS angle error [deg]", "ratio to constant bias",
                "median |E| [deg]", "90th pct |E| [deg]", "better than constant bias at", "Kalman 1σ [deg] / inside"]
@@ -239,7 +243,6 @@ def _measure(title, lines) -> str:
 
 
 def _compensation_section(ax, fig_dir, pre, fig_offset, evaluated) -> str:
-    from ..evaluation import table2_marks
 
     ma, ev = ax.models, getattr(ax, "evaluation", None)
     name = _safe(ax.name)
@@ -325,7 +328,6 @@ def _axis_section(ax, result, fig_dir, pre, fig_offset, evaluated) -> str:
              _img(plot_separation_allan(ax.separation, fig_dir / f"{pre}fig6_allan_{name}.png")),
              _compensation_section(ax, fig_dir, pre, fig_offset, evaluated), "</section>"]
     if getattr(ax, "gmwm", None) is not None:  # analyze --noise-method gmwm: the GMWM table first
-        from .gmwm import gmwm_noise_html
 
         parts.insert(2, gmwm_noise_html(ax.gmwm))
     return "\n".join(parts)
@@ -349,8 +351,6 @@ def _temperature_block(record, fig_dir) -> str:
     temp = getattr(record, "temperature_c", None)
     if temp is None:
         return ""
-    from ..temperature import summary_line, temperature_summary
-    from .temperature import plot_rate_and_temperature
 
     line = summary_line(temperature_summary(temp, record.dt_s))
     return (f'<h3>Temperature</h3><p class="note">{_e(line)}. The noise fit and the drift models use the '
@@ -408,7 +408,6 @@ def write_report(result, record, out_dir, apply_record=None, *, sensor=None, eva
     with atomic_path(path) as tmp:
         tmp.write_text(page, encoding="utf-8")
     if pdf:
-        from .pdf import write_pdf
 
         write_pdf(path, out / "report.pdf")
     return path

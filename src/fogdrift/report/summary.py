@@ -9,7 +9,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .tables import _fmt, term_text
+import numpy as np
+
+from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
+from ..gmwm.compare import compare_with_allan
+from ..noise import TERM_TABLE
+from ..noise.terms import DISPLAY_UNITS
+from .tables import _fmt, noise_row, shaped_cell, term_text
 
 __all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "recording_rows", "noise_headline", "verdict_items",
            "cannot_support", "summary_dict"]
@@ -72,7 +78,6 @@ def noise_headline(result) -> tuple:
 
     The cells are the allan table's (:func:`~fogdrift.report.tables.noise_row`): when no model fits, every
     coefficient is an upper bound, never a value."""
-    from .tables import noise_row, shaped_cell
 
     axes = list(result.axes)
     if axes and all(getattr(ax, "gmwm", None) is not None for ax in axes):
@@ -98,7 +103,6 @@ def noise_headline(result) -> tuple:
 
 def _term_label(name) -> str:
     """``"N angle random walk [deg/√h]"``: symbol, long name and displayed unit of a term."""
-    from ..noise import TERM_TABLE
 
     spec = TERM_TABLE[name]
     return f"{spec.header.split(' [')[0]} {spec.long_name} [{spec.header.split('[')[1]}"
@@ -130,7 +134,6 @@ def _gmwm_headline(axes) -> tuple:
 
 def _allan_check(ax) -> dict:
     """The GMWM axis's comparison with the Allan fit of the same record (made once, kept on the GMWM axis)."""
-    from ..gmwm.compare import compare_with_allan
 
     if ax.gmwm.allan_check is None:
         ax.gmwm.allan_check = compare_with_allan(ax.gmwm, ax.original.noise)
@@ -138,7 +141,6 @@ def _allan_check(ax) -> dict:
 
 
 def _scales_used(g) -> str:
-    import numpy as np
 
     excluded = {e.level for e in g.selection.excluded}
     used = [s for lv, s in zip(np.asarray(g.wvar.level), np.asarray(g.wvar.scale_s)) if int(lv) not in excluded]
@@ -168,8 +170,6 @@ def verdict_items(result, *, evaluated: bool = True) -> list:
 
 def _term_limits(result) -> list:
     """Rows ``[axis, term, status, 95 % bound, reason]`` of every term that is not resolved."""
-    from ..noise import TERM_TABLE
-    from ..noise.terms import DISPLAY_UNITS
 
     rows = []
     for ax in result.axes:
@@ -204,7 +204,6 @@ def cannot_support(result) -> dict:
     """What the record cannot support: ``terms`` (rows of :func:`_term_limits`, with their headers) and
     ``items`` (sentences: horizons too long or with too few origins, evaluations skipped, the longest tau,
     metrics that are NaN by design)."""
-    from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
 
     items = []
     for ax in result.axes:
