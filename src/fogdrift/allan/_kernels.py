@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["phase_dph_samples", "operator_sums", "OPERATORS", "BLOCK"]
+__all__ = ["phase_dph_samples", "operator_sums", "block_sums2", "OPERATORS", "BLOCK"]
 
 #: Start indices per block of the ``diff`` kernel (also the unit of pairwise summation).
 BLOCK = 65536
@@ -31,7 +31,13 @@ BLOCK = 65536
 #: re-initialising the m-point windows at each block costs at most 3/4 of the block's work.
 WINDOW_BLOCK = 4096
 
+#: numba fast-math flags of the sum-of-squares helpers: reassociation lets LLVM vectorise the reduction,
+#: contraction fuses d*d + acc into one FMA.  Results differ from a sequential sum by rounding only
+#: (< 1e-14 relative at 10^7 samples; tests compare with allantools to 1e-12).
+SUM_FASTMATH = frozenset({"reassoc", "contract"})
+
 prange = range  # replaced by numba.prange in _compiled()
+_sq2 = _sq3 = None  # replaced by the compiled helpers in _compiled()
 _KERNELS: dict = {}
 
 
@@ -88,11 +94,37 @@ def _phase_py(y, mu, out, block):  # pragma: no cover - runs compiled
             out[i + 1] = base + run
 
 
+def _sq2_py(a, b, c):  # pragma: no cover - runs compiled
+    """sum_k (a[k] - 2 b[k] + c[k])^2 over three contiguous arrays of one length.
+
+    Compiled with :data:`SUM_FASTMATH` (reassociation and FMA contraction): LLVM then vectorises the reduction
+    (8 doubles per AVX-512 instruction, several accumulators), 4-5x the speed of the strictly sequential sum
+    whose every addition waits for the previous one.  The order of the additions is fixed by the compiled code
+    and the block start, so the in-memory kernel (:func:`_diff2_py`) and the out-of-core one
+    (:func:`block_sums2`, same helper on the same blocks) give the same bits.
+    """
+    acc = 0.0
+    for k in range(c.size):
+        d = a[k] - 2.0 * b[k] + c[k]
+        acc += d * d
+    return acc
+
+
+def _sq3_py(a, b, e, f):  # pragma: no cover - runs compiled
+    """sum_k ((f[k] - a[k]) + 3 (b[k] - e[k]))^2 over four contiguous arrays (as :func:`_sq2_py`)."""
+    acc = 0.0
+    for k in range(a.size):
+        d = (f[k] - a[k]) + 3.0 * (b[k] - e[k])
+        acc += d * d
+    return acc
+
+
 def _diff2_py(p, ms, strides, block):  # pragma: no cover - runs compiled
     """Per-block sums of (p[k+2m] - 2 p[k+m] + p[k])^2 over k = 0, s, 2s, ... < len(p) - 2m.
 
     Operator (1, -2, 1) (Allan).  Returns an array (n_blocks, n_tau); blocks of ``block`` start
-    indices run in parallel.
+    indices run in parallel.  Stride 1 (overlapping): contiguous slices summed by the vectorised
+    :func:`_sq2_py`; other strides: a sequential sum over strided slices.
     """
     n_phase = p.size
     ntau = ms.size
@@ -105,9 +137,12 @@ def _diff2_py(p, ms, strides, block):  # pragma: no cover - runs compiled
             m = ms[j]
             s = strides[j]
             kend = min(k0 + block, n_phase - 2 * m)
+            if kend <= k0:
+                continue
+            if s == 1:
+                part[ib, j] = _sq2(p[k0 + 2 * m : kend + 2 * m], p[k0 + m : kend + m], p[k0:kend])
+                continue
             kstart = ((k0 + s - 1) // s) * s
-            # slices give the loop unit-stride (s == 1) arrays that LLVM vectorises: ~2.4x faster
-            # than indexing p three times per term
             a = p[kstart + 2 * m : kend + 2 * m : s]
             b = p[kstart + m : kend + m : s]
             c = p[kstart:kend:s]
@@ -117,6 +152,32 @@ def _diff2_py(p, ms, strides, block):  # pragma: no cover - runs compiled
                 acc += d * d
             part[ib, j] = acc
     return part
+
+
+def _block_sums2_py(a, b, c, k_first, s, block, out):  # pragma: no cover - runs compiled
+    """The out-of-core form of :func:`_diff2_py`: per-block sums of (a[q] - 2 b[q] + c[q])^2, k = k_first + q.
+
+    ``a, b, c`` hold the angle at k + 2m, k + m and k for k = k_first .. k_first + len - 1; ``out[j]``
+    receives the sum over the k (on the stride-s lattice) of block ``k_first // block + j``: the same
+    additions in the same order as :func:`_diff2_py`, so the two engines agree bit for bit.
+    """
+    n = c.size
+    b0 = k_first // block
+    nb = out.size
+    for j in prange(nb):
+        lo = max((b0 + j) * block, k_first)
+        hi = min((b0 + j + 1) * block, k_first + n)
+        if s == 1:
+            out[j] = _sq2(a[lo - k_first : hi - k_first], b[lo - k_first : hi - k_first],
+                          c[lo - k_first : hi - k_first])
+            continue
+        kstart = ((lo + s - 1) // s) * s
+        acc = 0.0
+        for k in range(kstart, hi, s):
+            q = k - k_first
+            d = a[q] - 2.0 * b[q] + c[q]
+            acc += d * d
+        out[j] = acc
 
 
 def _diff3_py(p, ms, strides, block):  # pragma: no cover - runs compiled
@@ -133,6 +194,12 @@ def _diff3_py(p, ms, strides, block):  # pragma: no cover - runs compiled
             m = ms[j]
             s = strides[j]
             kend = min(k0 + block, n_phase - 3 * m)
+            if kend <= k0:
+                continue
+            if s == 1:
+                part[ib, j] = _sq3(p[k0:kend], p[k0 + m : kend + m], p[k0 + 2 * m : kend + 2 * m],
+                                   p[k0 + 3 * m : kend + 3 * m])
+                continue
             kstart = ((k0 + s - 1) // s) * s
             a = p[kstart:kend:s]
             b = p[kstart + m : kend + m : s]
@@ -204,10 +271,14 @@ def _compiled():
 
         # ``prange`` is a module global (plain ``range`` until here) that numba reads at compile time
         globals()["prange"] = numba.prange
+        # the helpers are module globals (None until here) that the kernels below call compiled
+        globals()["_sq2"] = numba.njit(cache=True, fastmath=set(SUM_FASTMATH))(_sq2_py)
+        globals()["_sq3"] = numba.njit(cache=True, fastmath=set(SUM_FASTMATH))(_sq3_py)
         _KERNELS["phase"] = numba.njit(cache=True, parallel=True)(_phase_py)
         _KERNELS["diff2"] = numba.njit(cache=True, parallel=True)(_diff2_py)
         _KERNELS["diff3"] = numba.njit(cache=True, parallel=True)(_diff3_py)
         _KERNELS["window2"] = numba.njit(cache=True, parallel=True)(_window2_py)
+        _KERNELS["block_sums2"] = numba.njit(cache=True, parallel=True)(_block_sums2_py)
     return _KERNELS
 
 
@@ -253,3 +324,16 @@ def operator_sums(p: np.ndarray, m: np.ndarray, strides: np.ndarray, coefficient
         part = kern(p, item_m, k0, k1)
         return np.array([part[owner == j].sum() for j in range(np.asarray(m).size)], dtype=np.float64)
     return kern(p, m, strides, BLOCK).sum(axis=0)
+
+
+def block_sums2(a: np.ndarray, b: np.ndarray, c: np.ndarray, k_first: int, s: int, block: int,
+                out: np.ndarray) -> None:
+    """Per-block sums of the squared Allan second difference for the out-of-core engine, into ``out``.
+
+    ``a``, ``b``, ``c``: float64 angle [(deg/h) x samples] at start index k + 2m, k + m and k for
+    k = ``k_first`` .. ``k_first + len(c) - 1``; ``out[j]`` [(deg/h)^2 x samples^2] receives the sum over
+    the k on the stride-``s`` lattice of block ``k_first // block + j``.  The same compiled additions as the
+    in-memory kernel, block for block, so :mod:`fogdrift.allan.chunked` stays equal to
+    :func:`fogdrift.allan.allan_variance` bit for bit.
+    """
+    _compiled()["block_sums2"](a, b, c, k_first, s, block, out)
