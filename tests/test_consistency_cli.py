@@ -1,0 +1,78 @@
+"""``fogdrift consistency`` end to end on small simulated logs (the truth known)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from fogdrift.cli import app
+
+runner = CliRunner()
+DT = 0.1
+N_DPRH = 0.5  # deg/sqrt(h)
+
+
+def _write(path, seed, n=30_000):
+    y = np.random.default_rng(seed).normal(0.0, 60.0 * N_DPRH / math.sqrt(DT), n) + 50.0
+    np.savetxt(path, np.column_stack([np.arange(n) * DT, y]), delimiter=",", header="t_s,gz", comments="",
+               fmt="%.6f")
+    return path
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory):
+    d = tmp_path_factory.mktemp("cons")
+    return [_write(d / f"s{i}.csv", i) for i in range(3)]
+
+
+def test_consistency_with_given_components(logs, tmp_path):
+    comps = tmp_path / "model.json"
+    comps.write_text(json.dumps({"axes": {"gz": [{"kind": "white", "arw_dprh": N_DPRH / 2}]}}))  # N halved
+    res = runner.invoke(app, ["consistency", str(logs[0]), "--unit", "deg/h", "--held-out", str(logs[1]),
+                              "--held-out", str(logs[2]), "--components", str(comps), "--calibration", "20",
+                              "--horizons", "5,20", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    out = res.output
+    assert "full model (model.json)" in out and "in 68 % band" in out
+    assert "inflate the variances by λ" in out  # N halved: lambda about 4
+    doc = json.loads((tmp_path / "o" / "consistency.json").read_text())
+    assert doc["fogdrift_result"] == "consistency" and doc["horizons_s"] == [5.0, 20.0]
+    full = doc["targets"][0]
+    assert full["target"] == "full"
+    for row in full["axes"]["gz"]["rows"]:
+        # non-overlapping origins per log: floor((n - k - m) / s) + 1 (m, k, s in samples), two logs pooled
+        assert row["n_origins"] == {5.0: 2 * 120, 20.0: 2 * 75}[row["horizon_s"]]
+        assert 3.0 < row["inflation"]["68 %"]["lambda"] < 5.5
+    # white-only model: the covering random walk is 0 and no target is skipped
+    assert doc["covering_random_walk"]["gz"]["k_eff_dphrh"] == 0.0
+
+
+def test_consistency_from_the_allan_fit_covers_white_noise(logs, tmp_path):
+    res = runner.invoke(app, ["consistency", str(logs[0]), "--unit", "deg/h", "--held-out", str(logs[1]),
+                              "--held-out", str(logs[2]), "--calibration", "20", "--horizons", "5,20",
+                              "--out", str(tmp_path / "p")])
+    assert res.exit_code == 0, res.output
+    doc = json.loads((tmp_path / "p" / "consistency.json").read_text())
+    rows = doc["targets"][0]["axes"]["gz"]["rows"]
+    for row in rows:
+        n = row["n_origins"]
+        assert abs(row["coverage"]["68 %"] - 0.6827) < 4 * math.sqrt(0.68 * 0.32 / n)
+    assert "to cover the bias wander over 60 s" in res.output
+
+
+@pytest.mark.parametrize("extra, match", [
+    ([], "give at least one --held-out log"),
+    (["--held-out", "X", "--horizons", "5,-1"], "--horizons must be comma-separated numbers > 0"),
+    (["--held-out", "X", "--calibration", "0"], "--calibration must be a number > 0"),
+])
+def test_consistency_bad_options_one_line(logs, tmp_path, extra, match):
+    args = ["consistency", str(logs[0]), "--unit", "deg/h", "--out", str(tmp_path / "q")]
+    args += [str(logs[1]) if a == "X" else a for a in extra]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 1
+    lines = [l for l in res.output.splitlines() if l.strip()]
+    assert len(lines) == 1 and match in lines[0], res.output
