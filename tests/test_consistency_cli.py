@@ -76,3 +76,17 @@ def test_consistency_bad_options_one_line(logs, tmp_path, extra, match):
     assert res.exit_code == 1
     lines = [l for l in res.output.splitlines() if l.strip()]
     assert len(lines) == 1 and match in lines[0], res.output
+
+
+def test_consistency_reads_an_export_json(logs, tmp_path):
+    """The complete JSON of 'fogdrift export': gyro channels' state_space components; accel channels ignored."""
+    exp = tmp_path / "export.json"
+    exp.write_text(json.dumps({"fogdrift_export": "json", "channels": [
+        {"name": "gz", "quantity": "gyro", "state_space": {"components": [{"kind": "white", "arw_dprh": N_DPRH}]}},
+        {"name": "az", "quantity": "accel", "state_space": {"components": [{"kind": "white", "arw_dprh": 1.0}]}}]}))
+    res = runner.invoke(app, ["consistency", str(logs[0]), "--unit", "deg/h", "--held-out", str(logs[1]),
+                              "--components", str(exp), "--calibration", "20", "--horizons", "20",
+                              "--out", str(tmp_path / "e")])
+    assert res.exit_code == 0, res.output
+    doc = json.loads((tmp_path / "e" / "consistency.json").read_text())
+    assert doc["targets"][0]["axes"]["gz"]["components"] == [{"kind": "white", "arw_dprh": N_DPRH}]

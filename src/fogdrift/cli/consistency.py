@@ -35,8 +35,9 @@ CoverOpt = Annotated[float, typer.Option("--cover", help="Horizon [s] over which
 StepOpt = Annotated[Optional[float], typer.Option("--origin-step", help="Origin spacing [s]; default calibration + "
                                                                         "horizon (non-overlapping windows).")]
 ComponentsOpt = Annotated[Optional[Path], typer.Option(
-    "--components", help="JSON noise model instead of the training log's Allan fit: {axis: [components]} or "
-                         "{\"axes\": {axis: [components]}} (IEEE-952 units, fogdrift.models.statespace).")]
+    "--components", help="JSON noise model instead of the training log's Allan fit: the JSON of 'fogdrift export' "
+                         "(its gyro channels' state_space components), {axis: [components]} or {\"axes\": {axis: "
+                         "[components]}} (IEEE-952 units, fogdrift.models.statespace).")]
 
 
 def _parse_horizons(text: str) -> list[float]:
@@ -59,6 +60,9 @@ def _read_components(path: Path) -> dict:
         raise ConfigError(f"--components: no such file {path}") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ConfigError(f"--components: {path} is no JSON file ({exc})") from None
+    if isinstance(data, dict) and isinstance(data.get("channels"), list):  # a 'fogdrift export --target json' file
+        data = {ch.get("name"): (ch.get("state_space") or {}).get("components") for ch in data["channels"]
+                if isinstance(ch, dict) and ch.get("quantity", "gyro") == "gyro"}
     if isinstance(data, dict) and isinstance(data.get("axes"), dict):
         data = data["axes"]
     if not isinstance(data, dict) or not data:
