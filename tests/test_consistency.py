@@ -227,3 +227,10 @@ def test_coverage_rows_shapes():
     assert [r.n_origins for r in rows] == [2, 1]
     assert rows[0].coverage["68 %"] == 0.5 and rows[1].coverage["68 %"] == 0.0
     assert rows[1].to_dict()["inflation"]["68 %"]["lambda"] == pytest.approx(2.25)
+
+
+def test_random_walk_covering_against_the_k_bound():
+    comps = [{"kind": "white", "arw_dprh": 0.1}, {"kind": "gauss_markov", "tc_s": 50.0, "sigma_dph": 1.0}]
+    d = random_walk_covering(comps, 60.0, 60.0, k_bound_dphrh=2.0)
+    assert d["ratio"] is None and d["ratio_to_bound"] == pytest.approx(d["k_eff_dphrh"] / 2.0)
+    assert "× the random walk's 95 % upper bound (2 deg/h^1.5" in d["sentence"]

@@ -176,7 +176,7 @@ def consistency(
         record = load.load()
         echo_record(load, record)
         check_plausible(record)
-        notes = {}
+        notes, k_bounds = {}, {}
         if given is None:
             from ..pipeline import AnalysisConfig, run_allan
 
@@ -185,6 +185,9 @@ def consistency(
             full = {}
             for a in fits:
                 full[a.name], notes[a.name] = components_from_noise_fit(a.noise)
+                k = a.noise.terms.get("K")
+                if k is not None and k.value is None and k.hi95:
+                    k_bounds[a.name] = k.hi95
             source = f"the Allan fit of {load.file.name}"
         else:
             missing = [a for a in record.axis_names if a not in given]
@@ -210,7 +213,8 @@ def consistency(
         say(f"held out: {', '.join(p.name for p in held_out)}; calibration {calibration:g} s, horizons "
             f"{', '.join(f'{x:g}' for x in h)} s; origins {'calibration + horizon' if origin_step is None else f'{origin_step:g} s'} "
             "apart (non-overlapping windows), pooled over the held-out logs")
-        covering = {a: random_walk_covering(c, cover, calibration) for a, c in full.items()}
+        covering = {a: random_walk_covering(c, cover, calibration, k_bound_dphrh=k_bounds.get(a))
+                    for a, c in full.items()}
         cov_models = {a: [c for c in reduced_model(full[a]) if c["kind"] == "white"]
                       + [{"kind": "random_walk", "rrw_dphrh": covering[a]["k_eff_dphrh"]}] for a in full}
         targets = [("full", f"full model ({source})", full),

@@ -333,19 +333,23 @@ def reduced_model(components, keep=("white", "random_walk")) -> list[dict]:
     return [c for c in check_components(components) if c["kind"] in keep]
 
 
-def random_walk_covering(components, horizon_s: float, t_cal_s: float) -> dict:
+def random_walk_covering(components, horizon_s: float, t_cal_s: float, *, k_bound_dphrh=None) -> dict:
     """The random walk K_eff [deg/h^1.5] that, with the model's white noise, covers the whole drift at ``horizon_s``.
 
     K_eff solves ``K_s^2 (h^3/3 + h^2 T/3) = Var_full(h) - Var_white(h)``: the white + K_eff model predicts the
     same angle-error variance after the calibration as the full model (its flicker / Gauss-Markov /
     quantization / ramp / random-walk parts folded into one random walk).
 
+    ``k_bound_dphrh``: the fit's 95 % upper bound on K when the model has no random walk (the sentence then
+    compares K_eff with that bound).
+
     Returns
     -------
     dict
         ``k_eff_dphrh``, ``k_alone_dphrh`` (the model's own random walk, 0 when it has none), ``ratio`` (K_eff /
-        K alone; None without a random walk), ``horizon_s``, ``t_cal_s``, and ``sentence``: "to cover the bias
-        wander over 60 s, use gyroscope_random_walk = X rad/s^2/sqrt(Hz) (Y deg/h^1.5): Z x the random walk alone".
+        K alone; None without a random walk), ``ratio_to_bound`` (K_eff / ``k_bound_dphrh`` or None),
+        ``horizon_s``, ``t_cal_s``, and ``sentence``: "to cover the bias wander over 60 s, use
+        gyroscope_random_walk = X rad/s^2/sqrt(Hz) (Y deg/h^1.5): Z x the random walk alone".
 
     Examples
     --------
@@ -366,11 +370,19 @@ def random_walk_covering(components, horizon_s: float, t_cal_s: float) -> dict:
     k_alone = math.sqrt(sum(c["rrw_dphrh"] ** 2 for c in comps if c["kind"] == "random_walk"))
     ratio = k_eff / k_alone if k_alone > 0 else None
     si = k_eff / 216000.0 * math.pi / 180.0  # rad/s^1.5 = rad/s^2/sqrt(Hz)
-    tail = (f"{ratio:.3g}× the random walk alone ({k_alone:.3g} deg/h^1.5)" if ratio is not None
-            else "the model has no random walk of its own (K alone = 0)")
+    kb = None if k_bound_dphrh is None or not k_bound_dphrh > 0 else float(k_bound_dphrh)
+    to_bound = None if kb is None or ratio is not None else k_eff / kb
+    if ratio is not None:
+        tail = f"{ratio:.3g}× the random walk alone ({k_alone:.3g} deg/h^1.5)"
+    elif to_bound is not None:
+        tail = (f"{to_bound:.3g}× the random walk's 95 % upper bound ({kb:.3g} deg/h^1.5; the fit has no random "
+                "walk of its own)")
+    else:
+        tail = "the model has no random walk of its own (K alone = 0)"
     sentence = (f"to cover the bias wander over {h:g} s (after a {T:g} s calibration), use gyroscope_random_walk = "
                 f"{si:.3g} rad/s^2/sqrt(Hz) ({k_eff:.3g} deg/h^1.5): {tail}")
-    return {"k_eff_dphrh": k_eff, "k_alone_dphrh": k_alone, "ratio": ratio, "horizon_s": h, "t_cal_s": T,
+    return {"k_eff_dphrh": k_eff, "k_alone_dphrh": k_alone, "ratio": ratio, "ratio_to_bound": to_bound,
+            "k_bound_dphrh": kb, "horizon_s": h, "t_cal_s": T,
             "k_eff_si": si, "sentence": sentence}
 
 
