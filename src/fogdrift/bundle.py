@@ -6,7 +6,9 @@ Layout (no pickle; every file is JSON or NPZ)::
     bundle/
       manifest.json          format, format_version, fogdrift version, the training input (source,
                              SHA-256, time range, split), input unit, native and modelling sample
-                             intervals, wavelet / mode, the analysis settings, and per axis: bias and
+                             intervals, the training log's signal description (sampling, channels,
+                             where each came from; :mod:`fogdrift.signal`), wavelet / mode, the
+                             analysis settings, and per axis: bias and
                              how it was estimated, Earth-rate setting, level, causal-drift window,
                              noise model, and the model files with their SHA-256
       <axis>/<model>.json    one fitted drift model (:meth:`fogdrift.models.DriftModel.save`)
@@ -51,6 +53,7 @@ from . import __version__
 from ._util import json_default, safe_name
 from .errors import ConfigError, FogdriftError, ModelFileError
 from .output import atomic_path
+from .signal import Channel, Sampling, SignalDescription
 
 __all__ = [
     "BUNDLE_FORMAT",
@@ -188,6 +191,10 @@ class Bundle:
     created_utc : str
     path : Path or None
         Directory it was loaded from or saved to.
+    signal : fogdrift.signal.SignalDescription or None
+        The training log's signal description as loaded (native sampling, channels, where the rate and the
+        unit came from).  A bundle written before the manifest carried one gets one made from
+        ``input_unit`` and ``native_dt_s`` with the sources ``"bundle"``.
     """
 
     axes: tuple
@@ -204,6 +211,7 @@ class Bundle:
     format_version: int = BUNDLE_FORMAT_VERSION
     created_utc: str = ""
     path: Path | None = field(default=None, compare=False)
+    signal: SignalDescription | None = None
 
     @property
     def axis_names(self) -> tuple:
@@ -237,22 +245,20 @@ def _registry_name(label: str) -> str:
     raise ConfigError(f"fitted model {label!r} is not in the model registry")
 
 
-def _level_of(ma, cfg) -> int:
-    """The level the pipeline used for this axis (resolved again, on the same series, if it was "auto")."""
-    if cfg.level != "auto":
-        return int(cfg.level)
-    from .lifting import choose_level, level_scan
+def _level_of(ma, cfg=None) -> int:
+    """The lifting level the pipeline decided for this axis (:attr:`fogdrift.pipeline.ModelAxis.level`).
 
-    return int(choose_level(level_scan(ma.rate_dph, ma.dt_s, wavelet=cfg.wavelet, mode=cfg.mode)))
+    Kept for callers that imported it; read ``ma.level``.
+    """
+    return int(ma.level)
 
 
-def _causal_window(ma, cfg, level: int) -> int:
-    """The causal-drift window of ``pipeline._fit_axis_models`` (warm-up inside the training block)."""
-    from .lifting import get_wavelet
+def _causal_window(ma, cfg=None, level=None) -> int:
+    """The causal-drift window the pipeline decided (:attr:`fogdrift.pipeline.ModelAxis.causal_window`).
 
-    reach = (get_wavelet(cfg.wavelet).filter_length - 1) * 2**level
-    b = ma.split["train"][1]
-    return int(min(max(int(round(cfg.causal_window_s / ma.dt_s)), reach), b))
+    Kept for callers that imported it; read ``ma.causal_window``.
+    """
+    return int(ma.causal_window)
 
 
 def _allan_noise_model(x, dt_s) -> dict:
@@ -289,10 +295,10 @@ def bundle_from_model_axes(model_axes, cfg, record) -> Bundle:
     if not model_axes:
         raise ConfigError("no fitted axes to bundle")
     dt_m = float(model_axes[0].dt_s)
-    factor = int(round(dt_m / record.dt_s))
+    factor = int(model_axes[0].block_average_factor)  # decided once by the pipeline, read back
     axes = []
     for ma in model_axes:
-        level = _level_of(ma, cfg)
+        level = int(ma.level)
         a, b = ma.split["train"]
         orient = cfg.earth_axes.get(ma.name) if cfg.latitude_deg is not None else None
         t0 = record.t0_s
@@ -305,7 +311,7 @@ def bundle_from_model_axes(model_axes, cfg, record) -> Bundle:
                  "gmwm": None}
         axes.append(BundleAxis(
             name=ma.name, bias_dph=float(ma.bias_dph), bias_method=method, earth_rate_dph=float(ma.earth_rate_dph),
-            earth_orientation=orient, level=level, causal_window=_causal_window(ma, cfg, level), noise_model=noise,
+            earth_orientation=orient, level=level, causal_window=int(ma.causal_window), noise_model=noise,
             models={_registry_name(label): model for label, model in ma.fitted.items()},
         ))
     split = {k: {"samples": list(v), "t_s": [record.t0_s + v[0] * dt_m, record.t0_s + v[1] * dt_m]}
@@ -320,6 +326,7 @@ def bundle_from_model_axes(model_axes, cfg, record) -> Bundle:
         block_average_factor=factor, wavelet=cfg.wavelet, mode=cfg.mode,
         latitude_deg=None if cfg.latitude_deg is None else float(cfg.latitude_deg), training=training,
         settings=cfg.to_dict(), created_utc=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        signal=record.signal,
     )
 
 
@@ -359,6 +366,8 @@ def save_bundle(bundle: Bundle, out_dir) -> Path:
         "latitude_deg": bundle.latitude_deg, "training": bundle.training, "settings": bundle.settings,
         "axes": axes_doc,
     }
+    if bundle.signal is not None:
+        doc["signal"] = bundle.signal.to_dict()
     text = json.dumps(seal_manifest(_finite(json.loads(json.dumps(doc, default=json_default)))), indent=2,
                       allow_nan=False)
     # the manifest last and whole (temporary name, renamed): a bundle without one is incomplete, never half-read
@@ -444,18 +453,24 @@ def load_bundle(path) -> Bundle:
     from .lifting import MODES, max_level, wavelist
     from .models import load_model, model_spec
     from .models.base import model_file_paths
-    from .units import INCREMENT_UNITS, RATE_UNITS
+    from .units import check_dt_s, parse_unit
 
     p = Path(path)
+    if p.name != MANIFEST and p.is_file():
+        raise ModelFileError(f"{p}: is a file; expected a bundle directory (OUT/bundle, written by 'fogdrift analyze' "
+                             f"or 'fogdrift model') or its {MANIFEST}")
     root = p.parent if p.name == MANIFEST else p
     mpath = root / MANIFEST
     try:
         raw = json.loads(mpath.read_text())
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):
         raise ModelFileError(f"{mpath}: bundle manifest not found; expected the directory written by "
                              "'fogdrift analyze' or 'fogdrift model' (OUT/bundle)") from None
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ModelFileError(f"{mpath}: not valid JSON ({exc})") from None
+    except (OSError, RecursionError, MemoryError) as exc:
+        raise ModelFileError(f"{mpath}: cannot read the bundle manifest ({type(exc).__name__}: "
+                             f"{getattr(exc, 'strerror', None) or exc})") from None
     d = _Doc(mpath)
     if not isinstance(raw, dict) or raw.get("format") != BUNDLE_FORMAT:
         raise ModelFileError(f"{mpath}: not a fogdrift bundle (format {raw.get('format') if isinstance(raw, dict) else None!r})")
@@ -478,13 +493,21 @@ def load_bundle(path) -> Bundle:
         raise ModelFileError(f"{mpath}: the manifest does not match its integrity seal ({SEAL_KEY}): it was edited "
                              "or damaged after the bundle was written; re-create the bundle")
     unit = d.get(raw, "input_unit", str, "")
-    if unit not in RATE_UNITS and not (unit.startswith("inc:") and unit[4:] in INCREMENT_UNITS):
+    try:
+        unit_spec = parse_unit(unit)
+    except ConfigError:
         d.fail("input_unit", f"unknown unit {unit!r}")
     native = d.get(raw, "native_dt_s", "positive", "")
     model_dt = d.get(raw, "model_dt_s", "positive", "")
+    for key, value in (("native_dt_s", native), ("model_dt_s", model_dt)):
+        try:
+            check_dt_s(value, key)
+        except ConfigError as exc:
+            d.fail(key, str(exc))
     factor = d.get(raw, "block_average_factor", "int", "")
     if factor < 1 or abs(factor * native - model_dt) > 1e-9 * model_dt:
         d.fail("block_average_factor", f"model_dt_s {model_dt!r} is not {factor} x native_dt_s {native!r}")
+    signal = _signal_of(raw, d, unit_spec, native)
     wavelet = d.get(raw, "wavelet", str, "")
     if wavelet not in wavelist():
         d.fail("wavelet", f"unknown wavelet {wavelet!r}; expected one of {wavelist()}")
@@ -492,7 +515,10 @@ def load_bundle(path) -> Bundle:
     if mode not in MODES:
         d.fail("mode", f"unknown mode {mode!r}; expected one of {list(MODES)}")
     latitude = d.get(raw, "latitude_deg", "number", "", optional=True)
+    if latitude is not None and not -90.0 <= latitude <= 90.0:
+        d.fail("latitude_deg", f"expected a latitude in [-90, 90] deg, got {latitude!r}")
     training = d.get(raw, "training", dict, "")
+    train_stop = _train_stop(training)
     settings = d.get(raw, "settings", dict, "")
     axes_raw = d.get(raw, "axes", list, "")
     if not axes_raw:
@@ -508,6 +534,10 @@ def load_bundle(path) -> Bundle:
         level = d.get(ax, "level", "int", w)
         if window < 2:
             d.fail(f"{w}causal_window", f"expected an integer >= 2, got {window}")
+        if window > (train_stop or MAX_CAUSAL_WINDOW):
+            limit = (f"the {train_stop}-sample training block it must warm up in" if train_stop
+                     else f"{MAX_CAUSAL_WINDOW} samples")
+            d.fail(f"{w}causal_window", f"expected at most {limit}, got {window}")
         if not 1 <= level <= max_level(window, wavelet, mode):
             d.fail(f"{w}level", f"level {level} is not valid for a {window}-sample window with {wavelet}")
         models_raw = d.get(ax, "models", dict, w)
@@ -539,9 +569,14 @@ def load_bundle(path) -> Bundle:
             if type(model).__name__ != spec.cls:
                 raise ModelFileError(f"{base}.json: holds a {type(model).__name__}, the manifest says {spec.cls}")
             models[spec.name] = model
+        bias = d.get(ax, "bias_dph", "number", w)
+        earth = d.get(ax, "earth_rate_dph", "number", w)
+        for key, value in (("bias_dph", bias), ("earth_rate_dph", earth)):
+            if abs(value) > MAX_ABS_RATE_DPH:
+                d.fail(f"{w}{key}", f"expected |{key}| <= {MAX_ABS_RATE_DPH:g} deg/h, got {value!r}")
         axes.append(BundleAxis(
-            name=name, bias_dph=d.get(ax, "bias_dph", "number", w), bias_method=d.get(ax, "bias_method", str, w),
-            earth_rate_dph=d.get(ax, "earth_rate_dph", "number", w),
+            name=name, bias_dph=bias, bias_method=d.get(ax, "bias_method", str, w),
+            earth_rate_dph=earth,
             earth_orientation=ax.get("earth_orientation"), level=level, causal_window=window,
             noise_model=d.get(ax, "noise_model", dict, w), models=models,
         ))
@@ -549,5 +584,49 @@ def load_bundle(path) -> Bundle:
         axes=tuple(axes), input_unit=unit, native_dt_s=native, model_dt_s=model_dt, block_average_factor=factor,
         wavelet=wavelet, mode=mode, latitude_deg=latitude, training=training, settings=settings,
         fogdrift_version=str(raw.get("fogdrift_version", "")), format_version=version,
-        created_utc=str(raw.get("created_utc", "")), path=root,
+        created_utc=str(raw.get("created_utc", "")), path=root, signal=signal,
     )
+
+
+#: The largest causal window [samples] a bundle without a readable training split may hold (2^31).
+MAX_CAUSAL_WINDOW = 2**31
+#: The largest |bias| or |Earth rate| a bundle may hold [deg/h]: 1e9 deg/h is about 770 revolutions per
+#: second, beyond any gyro's range; a larger value is damage, not a measurement.
+MAX_ABS_RATE_DPH = 1e9
+
+
+def _train_stop(training) -> int | None:
+    """End of the training block [samples at the modelling rate] from ``training.split``, or None."""
+    try:
+        stop = training["split"]["train"]["samples"][1]
+    except (KeyError, IndexError, TypeError):
+        return None
+    return stop if isinstance(stop, int) and not isinstance(stop, bool) and stop > 0 else None
+
+
+def _signal_of(raw: dict, d: _Doc, unit_spec, native_dt_s: float) -> SignalDescription:
+    """The manifest's signal description (checked against ``input_unit`` and ``native_dt_s``), or, for a
+    manifest without one, a description made from those two with the sources "bundle"."""
+    doc = raw.get("signal")
+    if doc is None:
+        names = raw.get("training", {}).get("axis_names") if isinstance(raw.get("training"), dict) else None
+        if not (isinstance(names, list) and names and all(isinstance(n, str) for n in names)):
+            names = [a.get("name") for a in raw.get("axes", []) if isinstance(a, dict) and isinstance(a.get("name"), str)]
+        scale = unit_spec.scale_to_internal(native_dt_s)
+        try:
+            return SignalDescription(Sampling(dt_s=native_dt_s, dt_source="bundle"), tuple(
+                Channel(name=n, unit=unit_spec, unit_source="bundle", declared_unit=None, scale_to_internal=scale)
+                for n in dict.fromkeys(names)))
+        except ConfigError as exc:
+            d.fail("axes", str(exc))
+    try:
+        signal = SignalDescription.from_dict(doc)
+    except ConfigError as exc:
+        d.fail("signal", str(exc))
+    smp = signal.sampling
+    if abs(smp.dt_s - native_dt_s) > 1e-9 * native_dt_s:
+        d.fail("signal.sampling.dt_s", f"{smp.dt_s!r} differs from native_dt_s {native_dt_s!r}")
+    odd = [c.name for c in signal.channels if c.unit_as_read != unit_spec.text]
+    if odd:
+        d.fail("signal.channels", f"channels {odd} are not in input_unit {unit_spec.text!r}")
+    return signal

@@ -23,13 +23,14 @@ Order of operations in :func:`run_analysis`, per axis (method notes §5–6):
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.metadata
 import platform
 import time
 import warnings
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
@@ -38,6 +39,13 @@ from .interrupt import checkpoint  # a stop point between stages/axes/models; re
 from .io import file_sha256
 from .models import MODEL_NAMES  # registry order = report order
 from .models import build_model as make_model  # make_model(name, cfg, progress=None), old name kept for now
+
+if TYPE_CHECKING:  # result types of other stages, for the annotations only (no import at run time)
+    from .allan import AllanResult
+    from .evaluation import AxisEvaluation
+    from .gmwm.analysis import GmwmAxis
+    from .noise import NoiseFit
+    from .outliers import OutlierReport
 
 __all__ = [
     "AnalysisConfig",
@@ -53,6 +61,9 @@ __all__ = [
     "run_separation",
     "run_models",
     "run_analysis",
+    "drift_reach",
+    "causal_window_samples",
+    "model_factor",
 ]
 
 
@@ -185,9 +196,9 @@ class AllanAxis:
     OutlierReport of the rate that was analysed (None when not checked)."""
 
     name: str
-    allan: object
-    noise: object
-    outliers: object = None
+    allan: AllanResult
+    noise: NoiseFit
+    outliers: OutlierReport | None = None
 
     def to_dict(self) -> dict:
         return {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict(),
@@ -247,7 +258,12 @@ class CompensatedSignal:
 
 @dataclass
 class ModelAxis:
-    """Drift models of one axis: split, drift per block, predictions and metrics on the test block."""
+    """Drift models of one axis: split, drift per block, predictions and metrics on the test block.
+
+    ``level`` (the lifting level), ``causal_window`` (samples at the modelling rate of the causal drift) and
+    ``block_average_factor`` (native samples per modelling sample) are decided once, by the pipeline, and
+    stored here: the bundle, the evaluation and the reports read them back and never recompute them.
+    """
 
     name: str
     dt_s: float
@@ -264,13 +280,20 @@ class ModelAxis:
     p0_as_measured: dict  # model label -> (p0 model, p0 persistence) with bias + Earth rate added back [%]
     fitted: dict  # model label -> fitted DriftModel
     fit_seconds: dict
+    level: int  # lifting level of the drift separation (resolved when the config says "auto")
+    causal_window: int  # window [samples at the modelling rate] of the causal drift, warm-up inside training
     notes: list = field(default_factory=list)  # distinct warnings raised while evaluating
     score_from: int = 0  # first test-block index that the metrics and Table 2 score
+    block_average_factor: int = 1  # native samples per modelling sample (decided once, see model_factor)
 
     def to_dict(self) -> dict:
         return {
             "name": self.name,
             "dt_s": self.dt_s,
+            "level": self.level,
+            "causal_window": self.causal_window,
+            "causal_window_s": self.causal_window * self.dt_s,
+            "block_average_factor": self.block_average_factor,
             "split": self.split,
             "bias_dph": self.bias_dph,
             "earth_rate_dph": self.earth_rate_dph,
@@ -293,8 +316,8 @@ class AnalysisAxis:
     separation: SeparationAxis  # whole record at the modelling rate (figures 5, 6)
     models: ModelAxis
     table2: list  # CompensatedSignal rows, test block at the modelling rate
-    evaluation: object = None  # fogdrift.evaluation.AxisEvaluation, set by evaluation.evaluate_analysis
-    gmwm: object = None  # fogdrift.gmwm.analysis.GmwmAxis of the native-rate record (noise_method "gmwm")
+    evaluation: AxisEvaluation | None = None  # compensation evidence (fogdrift.evaluation.evaluate_analysis)
+    gmwm: GmwmAxis | None = None  # GMWM noise model of the native-rate record (noise_method "gmwm")
 
     def to_dict(self) -> dict:
         return {
@@ -378,7 +401,7 @@ def library_versions() -> dict:
 
 
 def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False,
-                  spectrum="auto") -> AllanAxis:
+                  spectrum="auto", outliers=None) -> AllanAxis:
     """Allan-family variance and noise identification of one 1-D rate series.
 
     The curve is computed on the configured grid (``cfg.taus``) for display; the noise fit always uses an octave
@@ -390,13 +413,15 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     the fit; the fit curve then also holds the taus at whole multiples of each period (a sinusoid vanishes there,
     so quantization and a periodic error are told apart), and no tau gets a phase-noise (white-PM) EDF
     (:func:`fogdrift.allan.ci.periodic_alpha`).
+
+    ``outliers``: the OutlierReport of a rate already treated by the caller (stored in the result as if
+    ``check_outliers`` had found it); the results are complete when built, nothing is patched afterwards.
     """
     from .allan import allan_variance
     from .allan.ci import periodic_alpha
     from .noise import fit_noise
     from .noise.periodic import null_taus, periodic_content
 
-    outliers = None
     if check_outliers:
         from .outliers import treat_outliers
 
@@ -428,15 +453,13 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     tau_range = None if lo is None and hi is None else (lo, hi)
     noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range,
                       spectrum=spectrum, markov=True)
-    if outliers is not None:
-        noise.outliers = outliers.to_dict()
+    if outliers is not None:  # a new, complete NoiseFit carrying the report (the fit's own object is not edited)
+        noise = dataclasses.replace(noise, outliers=outliers.to_dict())
     return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers)
 
 
 def _treated_record(record, cfg: AnalysisConfig):
     """The record with outliers clipped or replaced per ``cfg.outliers`` (unchanged for "warn"), and the reports."""
-    import dataclasses
-
     from .outliers import treat_outliers
 
     data = np.array(record.rate_dph, dtype=np.float64)
@@ -449,13 +472,37 @@ def _treated_record(record, cfg: AnalysisConfig):
     return dataclasses.replace(record, rate_dph=data, notes=tuple(record.notes) + (note,)), reports
 
 
-def _model_record(record, cfg: AnalysisConfig):
-    """Block-average a record to the modelling rate by an integer factor (``GyroRecord.to_rate``), or keep it.
+def model_factor(record, cfg: AnalysisConfig) -> int:
+    """The block-average factor that takes ``record`` to the modelling rate ``cfg.model_rate_hz`` (1 for None).
 
-    A rate that does not divide the native rate by an integer, or lies above it, is a ConfigError naming the
-    nearest valid rates; the averaged record's metadata state the effective rate and the factor.
+    The one place the factor is decided (:func:`fogdrift.io.decimation_factor`): the CLI calls it before
+    any work, to refuse a rate that does not divide the native rate by an integer (the message names the
+    nearest valid rates), and hands the result to :func:`run_analysis` / :func:`run_models` /
+    :func:`run_separation` (``factor=``), which then do not decide it again.  It is stored on every
+    :class:`ModelAxis`, in the bundle, and in the modelling record's signal description.
     """
-    return record if cfg.model_rate_hz is None else record.to_rate(cfg.model_rate_hz)
+    from .io import record as _record
+
+    return 1 if cfg.model_rate_hz is None else _record.decimation_factor(record.dt_s, cfg.model_rate_hz)
+
+
+def _model_record(record, cfg: AnalysisConfig, factor: int | None = None):
+    """Block-average a record to the modelling rate by the integer factor (decided once), or keep it."""
+    return record.average_by(model_factor(record, cfg) if factor is None else factor)
+
+
+def drift_reach(wavelet: str, level: int) -> int:
+    """Support [samples] of the level-``level`` drift filter of ``wavelet``: ``(filter_length - 1) 2^level``."""
+    from .lifting import get_wavelet
+
+    return (get_wavelet(wavelet).filter_length - 1) * 2**int(level)
+
+
+def causal_window_samples(causal_window_s: float, dt_s: float, wavelet: str, level: int, train_stop: int) -> int:
+    """Window [samples] of the causal drift: ``causal_window_s`` at ``dt_s``, at least the filter's reach,
+    at most the training block (its warm-up must end inside it).  Decided once per axis by the pipeline and
+    stored as :attr:`ModelAxis.causal_window`; read that, do not call this again on a result."""
+    return int(min(max(int(round(causal_window_s / dt_s)), drift_reach(wavelet, level)), train_stop))
 
 
 def _separate(x, cfg: AnalysisConfig, dt_s):
@@ -510,10 +557,13 @@ def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | No
     return out
 
 
-def run_separation(record, cfg: AnalysisConfig | None = None) -> list[SeparationAxis]:
-    """Lifting separation of every axis (whole record, at the modelling rate) with Allan tables."""
+def run_separation(record, cfg: AnalysisConfig | None = None, *, factor: int | None = None) -> list[SeparationAxis]:
+    """Lifting separation of every axis (whole record, at the modelling rate) with Allan tables.
+
+    ``factor``: the block-average factor to the modelling rate when already decided (:func:`model_factor`).
+    """
     cfg = (cfg or AnalysisConfig()).validate()
-    rec = _model_record(record, cfg)
+    rec = _model_record(record, cfg, factor)
     out = []
     for name in rec.axis_names:
         checkpoint("separation", axis=name)
@@ -538,7 +588,8 @@ def _with_level(cfg: AnalysisConfig, level: int) -> AnalysisConfig:
     return AnalysisConfig(**{**cfg.to_dict(), "level": int(level)})
 
 
-def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progress=None, fitted=None) -> ModelAxis:
+def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progress=None, fitted=None,
+                     factor: int = 1) -> ModelAxis:
     """Split, separate inside each block, fit (unless ``fitted`` models are given) and evaluate one axis."""
     from .lifting import causal_drift
     from .metrics import evaluate, p0
@@ -546,9 +597,7 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
 
     level = int(cfg.level)
     split = _split_indices(rate.size, cfg)
-    from .lifting import get_wavelet
-
-    reach = (get_wavelet(cfg.wavelet).filter_length - 1) * 2**level  # support of the level-J drift filter
+    reach = drift_reach(cfg.wavelet, level)  # support of the level-J drift filter
     need = max(reach, cfg.lags + 2)
     for block, (lo, hi) in split.items():
         if hi - lo < need:
@@ -565,7 +614,7 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
     history = np.concatenate([drift["train"], drift["val"]])
 
     # The causal drift's warm-up (one window) must end inside the training block.
-    window = min(max(int(round(cfg.causal_window_s / dt_s)), reach), b)
+    window = causal_window_samples(cfg.causal_window_s, dt_s, cfg.wavelet, level, b)
     causal = causal_drift(rate, window, wavelet=cfg.wavelet, level=level, mode=cfg.mode)
     causal_hist = causal[:e][np.isfinite(causal[:e])]
     causal_test = causal[e:f]
@@ -622,7 +671,8 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
         name=name, dt_s=dt_s, split=split, bias_dph=bias, earth_rate_dph=earth, rate_dph=rate,
         drift_blocks=drift, causal_drift_dph=causal, predictions=predictions,
         causal_predictions=causal_predictions, metrics=metrics, causal_metrics=causal_metrics,
-        p0_as_measured=p0_meas, fitted=models, fit_seconds=fit_s, notes=notes, score_from=skip,
+        p0_as_measured=p0_meas, fitted=models, fit_seconds=fit_s, level=level, causal_window=window, notes=notes,
+        score_from=skip, block_average_factor=int(factor),
     )
 
 
@@ -635,17 +685,21 @@ def _prepared_axis(record_m, name, cfg):
     return x - earth - bias, bias, earth
 
 
-def run_models(record, cfg: AnalysisConfig | None = None, progress=None) -> list[ModelAxis]:
-    """Fit every configured drift model on every axis (training block) and evaluate on the test block."""
+def run_models(record, cfg: AnalysisConfig | None = None, progress=None, *, factor: int | None = None) -> list[ModelAxis]:
+    """Fit every configured drift model on every axis (training block) and evaluate on the test block.
+
+    ``factor``: the block-average factor to the modelling rate when already decided (:func:`model_factor`).
+    """
     cfg = (cfg or AnalysisConfig()).validate()
     _check_earth_axes(record, cfg)
-    rec = _model_record(record, cfg)
+    factor = model_factor(record, cfg) if factor is None else int(factor)
+    rec = _model_record(record, cfg, factor)
     out = []
     for name in rec.axis_names:
         checkpoint("separation", axis=name)
         rate, bias, earth = _prepared_axis(rec, name, cfg)
         lvl_cfg = _with_level(cfg, _resolved_level(rate, cfg, rec.dt_s)[0])
-        out.append(_fit_axis_models(name, rate, rec.dt_s, lvl_cfg, bias, earth, progress))
+        out.append(_fit_axis_models(name, rate, rec.dt_s, lvl_cfg, bias, earth, progress, factor=factor))
     return out
 
 
@@ -674,24 +728,27 @@ def _table2(ma: ModelAxis, cfg: AnalysisConfig) -> list[CompensatedSignal]:
 
 
 def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | None = None, sha256: str | None = None,
-                 apply_to=None, progress=None, fitted_from: "AnalysisResult | None" = None) -> AnalysisResult:
+                 apply_to=None, progress=None, fitted_from: "AnalysisResult | list | None" = None,
+                 factor: int | None = None, apply_to_factor: int | None = None) -> AnalysisResult:
     """The whole method on one record (see the module docstring); ``apply_to`` is a second GyroRecord.
 
     ``progress(epoch, n_epochs, train_loss, val_loss)`` is passed to the neural models.
     With ``fitted_from`` (used for ``apply_to``), no model is fitted: the models of that analysis are applied
-    unchanged to the axes of the same name.
+    unchanged to the axes of the same name.  ``factor`` / ``apply_to_factor``: the block-average factors to
+    the modelling rate of ``record`` / ``apply_to`` when already decided (:func:`model_factor`); decided here
+    otherwise, once.
     """
     t_start = time.perf_counter()
     cfg = (cfg or AnalysisConfig()).validate()
     _check_earth_axes(record, cfg)
+    factor = model_factor(record, cfg) if factor is None else int(factor)
     record, outlier_reports = _treated_record(record, cfg)
-    rec_m = _model_record(record, cfg)
+    rec_m = _model_record(record, cfg, factor)
     axes = []
     for name in record.axis_names:
         checkpoint("Allan variance (native rate)", axis=name)
-        original = analyse_allan(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s, cfg)
-        original.outliers = outlier_reports[name]
-        original.noise.outliers = outlier_reports[name].to_dict()
+        original = analyse_allan(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s, cfg,
+                                 outliers=outlier_reports[name])
         gmwm = None
         if cfg.noise_method == "gmwm":
             from .gmwm.analysis import analyse_gmwm
@@ -703,9 +760,13 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
         sep = _separation_axis(name, rate, rec_m.dt_s, cfg)
         lvl_cfg = _with_level(cfg, sep.level)
         ma = _fit_axis_models(name, rate, rec_m.dt_s, lvl_cfg, bias, earth, progress,
-                              fitted=None if fitted_from is None else _fitted_models_for(name, fitted_from))
+                              fitted=None if fitted_from is None else _fitted_models_for(name, fitted_from),
+                              factor=factor)
         axes.append(AnalysisAxis(name, original, sep, ma, _table2(ma, lvl_cfg), gmwm=gmwm))
-    result = AnalysisResult(
+    applied = None
+    if apply_to is not None:
+        applied = run_analysis(apply_to, cfg, progress=progress, fitted_from=axes, factor=apply_to_factor)
+    return AnalysisResult(
         config=cfg,
         source=source or record.source,
         sha256=sha256 or record.sha256 or (file_sha256(record.source) if Path(str(record.source)).is_file() else ""),
@@ -713,17 +774,15 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
         model_record=rec_m.metadata(),
         axes=axes,
         versions=library_versions(),
-        wall_s=0.0,
+        wall_s=time.perf_counter() - t_start,
+        apply_to=applied,
         applied=fitted_from is not None,
     )
-    if apply_to is not None:
-        result.apply_to = run_analysis(apply_to, cfg, progress=progress, fitted_from=result)
-    result.wall_s = time.perf_counter() - t_start
-    return result
 
 
-def _fitted_models_for(name: str, fitted_from: AnalysisResult) -> dict:
-    source_axes = {a.name: a for a in fitted_from.axes}
+def _fitted_models_for(name: str, fitted_from) -> dict:
+    """The fitted models of axis ``name`` in an AnalysisResult or a list of AnalysisAxis."""
+    source_axes = {a.name: a for a in getattr(fitted_from, "axes", fitted_from)}
     if name not in source_axes:
         raise ConfigError(
             f"--apply-to: axis {name!r} has no fitted models; the fitted recording has axes {list(source_axes)}"

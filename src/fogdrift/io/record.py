@@ -352,6 +352,24 @@ class GyroRecord:
         """
         return self._averaged(decimation_factor(self.dt_s, rate_hz))
 
+    def average_by(self, factor: int) -> "GyroRecord":
+        """The record block-averaged by the integer ``factor`` (``self`` when it is 1).
+
+        For a factor already decided, e.g. by :func:`decimation_factor` once per run: the pipeline
+        and the CLI hand the factor on instead of deciding it again.
+
+        Raises
+        ------
+        ConfigError
+            If ``factor`` is not an integer >= 1.
+        InsufficientDataError
+            If the record is shorter than one block.
+        """
+        m = int_arg(factor, "factor")
+        if m < 1:
+            raise ConfigError(f"factor must be an integer >= 1; got {factor!r}")
+        return self._averaged(m)
+
     def _averaged(self, m: int) -> "GyroRecord":
         if m == 1:
             return self
