@@ -61,8 +61,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import FogdriftWarning, render_options
-from .units import EARTH_RATE_DPH, INCREMENT_UNITS, RATE_UNITS
+from .errors import ConfigError, FogdriftWarning, render_options
+from .units import EARTH_RATE_DPH, parse_unit
 
 __all__ = [
     "Finding",
@@ -203,12 +203,17 @@ def gyro_class(n_dprh: float) -> str:
 
 
 def _factor(unit: str, record) -> float:
-    """Multiply the record's deg/h values by this to get what they would be were the file in ``unit``."""
-    if unit.startswith("inc:"):
-        scale = INCREMENT_UNITS[unit[4:]] / record.dt_s
-    else:
-        scale = RATE_UNITS[unit]
-    return scale / float(record.scale_to_dph)
+    """Multiply the record's deg/h values by this to get what they would be were the file in ``unit``
+    (parsed by :func:`fogdrift.units.parse_unit`, the one unit parser)."""
+    return parse_unit(unit).scale_to_internal(record.dt_s) / float(record.scale_to_dph)
+
+
+def _read_as_increments(unit) -> bool:
+    """True when the record was read in an increment unit (``inc:...``); False for a rate or no declared unit."""
+    try:
+        return parse_unit(unit).kind == "increment"
+    except ConfigError:
+        return False
 
 
 def _fmt(x: float) -> str:
@@ -261,7 +266,7 @@ def check_record(record) -> list[Finding]:
     if broken:
         likely = []
         for cand in CANDIDATE_UNITS:
-            if cand == unit or (cand.startswith("inc:") and not str(unit).startswith("inc:")):
+            if cand == unit or (parse_unit(cand).kind == "increment" and not _read_as_increments(unit)):
                 continue  # increments are named only when the data were read as increments
             f = _factor(cand, record)
             if not _violations(floors, peaks, means, f) and not any(math.isclose(f, _factor(u, record))
