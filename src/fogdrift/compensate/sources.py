@@ -219,7 +219,9 @@ def match_log(source: LogSource, bundle, *, axis_map=None, accept_rate=False) ->
     notes = []
     unit = source.unit
     if source.unit_given:
-        if source.declared_unit is not None and source.declared_unit.strip() != unit:
+        if source.declared_unit is None:
+            notes.append(f"unit: the log declares none; its numbers are read as {unit} ({{opt:unit}})")
+        elif source.declared_unit.strip() != unit:
             notes.append(f"unit: the log declares {source.declared_unit.strip()}; its numbers are read as {unit} "
                          "({opt:unit} takes precedence)")
         if unit != bundle.input_unit:
