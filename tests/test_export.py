@@ -316,3 +316,19 @@ def test_cli_writes_every_target(tmp_path):
     d = yaml.safe_load((tmp_path / "o" / "imu.yaml").read_text())
     assert d["update_rate"] == 200.0
     assert "K is its 95 % upper bound" in res.output                   # gz: the bound is said, not hidden
+
+
+def test_six_channel_result_split_by_units(tmp_path):
+    g = json.loads(_gyro_result(tmp_path).read_text())
+    a = json.loads(_accel_result(tmp_path).read_text())
+    six = tmp_path / "six.json"
+    six.write_text(json.dumps({"record": {"fs_hz": 100.0}, "axes": g["axes"] + a["axes"]}))
+    ctx = build_context(results=[six])
+    assert [c.name for c in ctx.gyro] == ["gx", "gy", "gz"] and [c.name for c in ctx.accel] == ["ax", "ay", "az"]
+    d = yaml.safe_load(render("kalibr", ctx))
+    assert d["accelerometer_noise_density"] == pytest.approx(0.18 / 60, rel=1e-5)
+    res = runner.invoke(app, ["export", "--result", str(six), "--target", "orbslam3", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    fs = cv2.FileStorage(str(tmp_path / "o" / "orbslam3_imu.yaml"), cv2.FILE_STORAGE_READ)
+    assert fs.getNode("IMU.NoiseAcc").real() == pytest.approx(0.18 / 60, rel=1e-5)
+    fs.release()

@@ -14,8 +14,8 @@ import typer
 from ._app import FLAGS, app, check_plausible, echo_record, progress, run, say, warn
 from .batch import _with_reader_options
 
-FLAGS.update({"missing": "--missing", "gyro": "--gyro", "accel": "--accel", "rate": "--update-rate",
-              "target": "--target"})
+FLAGS.update({"missing": "--missing", "gyro": "--gyro", "accel": "--accel", "result": "--result",
+              "rate": "--update-rate", "target": "--target"})
 
 DEFAULT_OUT = Path("out/export")
 
@@ -38,6 +38,9 @@ def export(
         "--gyro", help="A saved gyro result: allan.json or noise.json of a fogdrift run (repeatable).")] = None,
     accel: Annotated[Optional[list[Path]], typer.Option(
         "--accel", help="A saved accelerometer result (allan.json / noise.json), repeatable.")] = None,
+    result: Annotated[Optional[list[Path]], typer.Option(
+        "--result", help="A saved result whose axes are gyros and/or accelerometers (a six-channel log's): each axis "
+                         "is taken as what its units say (repeatable).")] = None,
     target: Annotated[str, typer.Option("--target", help=_targets_help())] = "all",
     update_rate: Annotated[Optional[float], typer.Option(
         "--update-rate", help="The filter's IMU rate [Hz] for the discrete values (default: the record's rate).")]
@@ -57,13 +60,13 @@ def export(
     from ..export.model import channels_from_result
     from ..export.targets import TARGETS
 
-    gyro, accel = list(gyro or []), list(accel or [])
+    gyro, accel, result = list(gyro or []), list(accel or []), list(result or [])
     names = [t.name for t in TARGETS.values()]
-    with run("export", out, default_out=DEFAULT_OUT, inputs=[p for p in [log, *gyro, *accel] if p is not None],
+    with run("export", out, default_out=DEFAULT_OUT, inputs=[p for p in [log, *gyro, *accel, *result] if p is not None],
              expect=[TARGETS[n].filename for n in names]) as r:
         chosen = parse_targets(target)
-        if log is None and not gyro and not accel:
-            raise ConfigError("nothing to export: give a log, or saved results with --gyro / --accel")
+        if log is None and not gyro and not accel and not result:
+            raise ConfigError("nothing to export: give a log, or saved results with --gyro / --accel / --result")
         channels = []
         if log is not None:
             from .._util import json_default
@@ -80,7 +83,7 @@ def export(
                                          "axes": [a.to_dict() for a in results]}, default=json_default))
             channels = channels_from_result(doc, str(log))
             write_allan_outputs(results, record, r.out.path)
-        ctx = build_context(gyro, accel, channels=channels, rate_hz=update_rate, missing=missing, topic=rostopic)
+        ctx = build_context(gyro, accel, results=result, channels=channels, rate_hz=update_rate, missing=missing, topic=rostopic)
         texts = {n: render(n, ctx) for n in chosen}  # everything is rendered before any file is written
         for n, text in texts.items():
             with r.out.file(TARGETS[n].filename) as tmp:

@@ -22,16 +22,18 @@ __all__ = ["MISSING_POLICIES", "TARGETS", "ExportContext", "ChannelModel", "buil
            "target_names", "parse_targets", "channels_from_files"]
 
 
-def channels_from_files(paths, quantity: str) -> list[ChannelModel]:
-    """Channels of ``quantity`` (``"gyro"`` / ``"accel"``) from result files (each file's every axis)."""
+def channels_from_files(paths, quantity: str | None) -> list[ChannelModel]:
+    """Channels of ``quantity`` (``"gyro"`` / ``"accel"``; None: each axis as its units say) from result files."""
     out = []
     for p in paths or ():
         out += channels_from_result(load_result(p), str(p), expect=quantity)
     return out
 
 
-def build_context(gyro=(), accel=(), *, channels=(), rate_hz=None, missing="bound", topic="/imu0") -> ExportContext:
-    """An :class:`ExportContext` from ``--gyro`` / ``--accel`` result files and/or ready channels.
+def build_context(gyro=(), accel=(), *, results=(), channels=(), rate_hz=None, missing="bound",
+                  topic="/imu0") -> ExportContext:
+    """An :class:`ExportContext` from ``--gyro`` / ``--accel`` result files, ``--result`` files (each axis taken as
+    what its units say: a six-channel result), and/or ready channels.
 
     ``rate_hz`` defaults to the records' sample rate (one rate for all channels, else it must be given).
 
@@ -42,9 +44,11 @@ def build_context(gyro=(), accel=(), *, channels=(), rate_hz=None, missing="boun
     """
     if missing not in MISSING_POLICIES:
         raise ConfigError(f"{{opt:missing}} must be one of {', '.join(MISSING_POLICIES)}; got {missing!r}")
-    chans = list(channels) + channels_from_files(gyro, "gyro") + channels_from_files(accel, "accel")
+    chans = (list(channels) + channels_from_files(gyro, "gyro") + channels_from_files(accel, "accel")
+             + channels_from_files(results, None))
     if not chans:
-        raise ConfigError("nothing to export: pass a log, or a result file with {opt:gyro} / {opt:accel}")
+        raise ConfigError("nothing to export: pass a log, or a result file with {opt:gyro} / {opt:accel} / "
+                          "{opt:result}")
     names = {}
     for ch in chans:
         key = (ch.quantity, ch.name)
