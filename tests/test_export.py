@@ -332,3 +332,35 @@ def test_six_channel_result_split_by_units(tmp_path):
     fs = cv2.FileStorage(str(tmp_path / "o" / "orbslam3_imu.yaml"), cv2.FILE_STORAGE_READ)
     assert fs.getNode("IMU.NoiseAcc").real() == pytest.approx(0.18 / 60, rel=1e-5)
     fs.release()
+
+
+def _gmwm_axis(name, n, k, gms):
+    terms = {"N_dprh": {"name": "N_dprh", "value": n, "lo95": n * 0.9, "hi95": n * 1.1, "unit": "deg/sqrt(h)",
+                        "component": "WN"}}
+    if k is not None:
+        terms["K_dphrh"] = {"name": "K_dphrh", "value": k, "lo95": 0.0, "hi95": 2 * k, "unit": "deg/h/sqrt(h)",
+                            "component": "RW"}
+    gm = [{"component": f"GM{i + 1}",
+           "tc_s": {"name": "tc_s", "value": tc, "lo95": tc / 2, "hi95": tc * 2, "unit": "s"},
+           "sigma_gm_dph": {"name": "sigma_gm_dph", "value": s, "lo95": s / 2, "hi95": s * 2, "unit": "deg/h"}}
+          for i, (tc, s) in enumerate(gms)]
+    b = {"rule": "min-avar", "value_dph": None, "lo95_dph": None, "hi95_dph": None, "tau_s": 1000.0,
+         "bound_dph": 9.0, "reason": "95 % upper bound", "label": "min of the model's ADEV / 0.664"}
+    return {"name": name, "method": "gmwm", "selected": "WN+RW+2GM",
+            "selection": {"ieee": {"model": "WN+RW+2GM", "terms": terms, "gm": gm, "b_headline": b,
+                                   "tau_range_s": [0.1, 1000.0], "dt_s": 0.01}}}
+
+
+def test_gmwm_result_slowest_gm_is_the_bias(tmp_path):
+    p = tmp_path / "noise.json"
+    p.write_text(json.dumps({"fogdrift_result": "noise", "method": "gmwm", "record": {"fs_hz": 100.0},
+                             "axes": [_gmwm_axis("gx", 0.3, 2.0, [(0.2, 50.0), (150.0, 4.0)]),
+                                      _gmwm_axis("gy", 0.3, None, [(80.0, 3.0)])]}))
+    ctx = build_context([p], missing="zero")
+    d = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
+    assert d["gbstd"] == pytest.approx([4.0, 3.0], rel=1e-5)          # the slow GM, not the 0.2-s one
+    assert d["corrtime"] == pytest.approx(150.0 / 3600.0, rel=1e-5)
+    k = yaml.safe_load(render("kalibr", ctx))["gyroscope_random_walk"]
+    assert k == pytest.approx(2.0 * D / 216000, rel=1e-5)             # gy has no RW: 0 under --missing zero
+    with pytest.raises(ConfigError, match="gyro gy: K is not resolved by the record: not in the GMWM model"):
+        render("kalibr", build_context([p]))                           # no bound from GMWM: refused, not guessed
