@@ -130,3 +130,17 @@ def test_spec_file_errors(tmp_path):
         read_spec(y)
     with pytest.raises(ConfigError, match="no such file"):
         read_spec(tmp_path / "missing.yaml")
+
+
+def test_summary_columns_and_line_for_batch_and_first_screen():
+    from fogdrift.spec import judge_noise_fit, judgement_line, spec_columns
+
+    spec = parse_spec({"gyro": {"arw": "2 deg/sqrt(h)", "bias_instability": "0.007 deg/s"}})
+    n = SimpleNamespace(value=2.4, lo95=2.37, hi95=2.42, unit="deg/sqrt(h)", status="resolved", estimable=True)
+    fit = SimpleNamespace(terms={"N": n}, no_fit=None,
+                          b_min={"value": 20.0, "unit": "deg/h", "tau_s": 100.0, "bound_only": False, "lo95": 15.0,
+                                 "hi95": 24.0})
+    js = judge_noise_fit(spec, "gx", fit)
+    cols = spec_columns(js)
+    assert cols["spec_arw"] == "fail" and cols["spec_bias_instability"] == "pass"
+    assert judgement_line(js[0]).startswith("gx arw: fail: 2.4 [2.37, 2.42] deg/sqrt(h) against 2 deg/sqrt(h)")

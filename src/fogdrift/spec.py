@@ -46,7 +46,7 @@ from .errors import ConfigError
 
 __all__ = ["ITEMS", "G0", "SpecLimit", "Reading", "Judgement", "parse_quantity", "convert", "read_spec",
            "parse_spec", "judge", "readings_from_noise_fit", "readings_from_gmwm", "compare", "B_COMPARED",
-           "channel_kind"]
+           "channel_kind", "judgement_line", "spec_columns", "judge_noise_fit"]
 
 #: Standard gravity [m/s^2] (CGPM 1901; ISO 80000-3).
 G0 = 9.80665
@@ -376,3 +376,25 @@ def compare(spec: dict, channels: dict) -> list[Judgement]:
             if lim.kind == kind:
                 out.append(judge(lim, readings.get(lim.item), name))
     return out
+
+
+def judgement_line(j: Judgement) -> str:
+    """One line for a first screen or a log: ``gx arw: fail: 2.4 [2.37, 2.42] deg/sqrt(h) against 2 deg/sqrt(h)
+    (the whole 95 % interval exceeds the limit 2 deg/sqrt(h))``."""
+    return f"{j.channel} {j.limit.item}: {j.verdict}: {j.estimate} against {j.limit.text} ({j.reason})"
+
+
+def spec_columns(judgements) -> dict:
+    """Summary-table columns of one channel's judgements: ``spec_<item>`` -> verdict, ``spec_<item>_why`` -> reason
+    (e.g. ``spec_arw = "fail"``); every item of the spec for that channel's kind."""
+    out = {}
+    for j in judgements:
+        out[f"spec_{j.limit.item}"] = j.verdict
+        out[f"spec_{j.limit.item}_why"] = j.reason
+    return out
+
+
+def judge_noise_fit(spec: dict, name: str, noise, kind: str = "gyro") -> list[Judgement]:
+    """The judgements of one channel's Allan noise fit (:func:`readings_from_noise_fit`): the call a batch row or a
+    report's first screen needs."""
+    return compare(spec, {name: (kind, readings_from_noise_fit(noise, kind))})

@@ -97,6 +97,16 @@ def print_spec_comparison(spec: dict, channels: dict, out_dir=None, *, source: s
     return js
 
 
+def print_spec_for_allan(limits: dict, results, record, out_dir, source: str) -> list:
+    """``--spec`` after an Allan fit (``fogdrift allan``, ``noise --method allan``): the comparison of every axis of
+    ``results`` (:func:`fogdrift.pipeline.run_allan`), printed and written to ``out_dir/spec.json``."""
+    from ..spec import readings_from_noise_fit
+
+    kinds = channel_kinds(record)
+    return print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_noise_fit(a.noise, kinds[a.name]))
+                                          for a in results}, out_dir, source=source)
+
+
 def print_gmwm(title, axes):
     """Per axis: IEEE table (one B, by its rule), the other B readings as details, the comparison with the Allan
     fit when one was made, candidates (WIC, why rejected), excluded scales, J with its caveat."""
@@ -226,11 +236,7 @@ def _allan(load, r, limits=None, spec_path=None):
     for a in results:
         print_noise_notes(a.name, a.noise, a.outliers, record.dt_s)
     if limits is not None:
-        from ..spec import readings_from_noise_fit
-
-        kinds = channel_kinds(record)
-        print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_noise_fit(a.noise, kinds[a.name]))
-                                       for a in results}, r.out.path, source=spec_path.name)
+        print_spec_for_allan(limits, results, record, r.out.path, spec_path.name)
     path = write_json({"fogdrift_result": "noise", "method": "allan", "source": str(record.source),
                        "record": record.metadata(), "axes": [a.to_dict() for a in results]}, r.out.path / "noise.json")
     plot_allan(results, r.out.path / "noise.png")
