@@ -364,3 +364,23 @@ def test_gmwm_result_slowest_gm_is_the_bias(tmp_path):
     assert k == pytest.approx(2.0 * D / 216000, rel=1e-5)             # gy has no RW: 0 under --missing zero
     with pytest.raises(ConfigError, match="gyro gy: K is not resolved by the record: not in the GMWM model"):
         render("kalibr", build_context([p]))                           # no bound from GMWM: refused, not guessed
+
+
+@pytest.mark.parametrize("cut", ["noise", "terms", "N", "unit", "fit", "record", "value", "selection"])
+def test_damaged_results_give_one_line_errors(tmp_path, cut):
+    def strip(obj):
+        if isinstance(obj, dict):
+            return {k: strip(v) for k, v in obj.items() if k != cut}
+        if isinstance(obj, list):
+            return [strip(v) for v in obj]
+        return obj
+
+    doc = strip(json.loads(_gyro_result(tmp_path).read_text()))
+    p = tmp_path / "damaged.json"
+    p.write_text(json.dumps(doc))
+    try:
+        ctx = build_context([p])
+        for t in ("kalibr", "kf-gins", "json"):
+            render(t, ctx)
+    except (ConfigError, DataFormatError) as exc:
+        assert "\n" not in str(exc)

@@ -321,7 +321,14 @@ def channels_from_result(data: dict, path="result", *, expect: str | None = None
         if not isinstance(ax, dict):
             raise DataFormatError("an entry of 'axes' is not an object", path=path)
         method = ax.get("method") or ("gmwm" if "selection" in ax else "allan")
-        ch = _gmwm_channel(ax, record, str(path)) if method == "gmwm" else _allan_channel(ax, record, str(path))
+        try:
+            ch = _gmwm_channel(ax, record, str(path)) if method == "gmwm" else _allan_channel(ax, record, str(path))
+        except (KeyError, TypeError, ValueError, AttributeError, ZeroDivisionError) as exc:
+            if isinstance(exc, DataFormatError):
+                raise
+            raise DataFormatError(f"axis {ax.get('name')!r} is not a complete fogdrift {method} result "
+                                  f"({exc.__class__.__name__}: {exc}); expected the allan.json or noise.json of a "
+                                  "fogdrift run", path=path) from None
         if expect is not None and ch.quantity != expect:
             flag = {"gyro": "--gyro", "accel": "--accel"}[expect]
             raise DataFormatError(f"{flag} was given a {ch.quantity} result (axis {ch.name}: N in "
