@@ -384,3 +384,16 @@ def test_damaged_results_give_one_line_errors(tmp_path, cut):
             render(t, ctx)
     except (ConfigError, DataFormatError) as exc:
         assert "\n" not in str(exc)
+
+
+@pytest.mark.parametrize("term, unit, quantity, factor", [
+    ("N", "deg/√h", "gyro", D / 60), ("N", "(deg/h)·sqrt(s)", "gyro", D / 3600), ("N", "µg/√Hz", "accel", G * 1e-6),
+    ("N", "(m/s^2)/sqrt(Hz)", "accel", 1.0), ("N", "m/s/√hr", "accel", 1 / 60), ("K", "deg/h/√h", "gyro", D / 216000),
+    ("K", "m/s/h^1.5", "accel", 1 / 216000), ("B", "µg", "accel", G * 1e-6), ("B", "mGal", "accel", 1e-5),
+    ("Q", "arcsec", "gyro", D / 3600), ("R", "m/s^2/h", "accel", 1 / 3600)])
+def test_unit_spellings(term, unit, quantity, factor):
+    v, _, _ = to_si(1.0, term, unit)
+    assert v == pytest.approx(factor, rel=1e-12)
+    from fogdrift.export.conversions import quantity_of_unit
+
+    assert quantity_of_unit(term, unit) == quantity

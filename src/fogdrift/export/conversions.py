@@ -185,6 +185,7 @@ UNIT_TABLE: dict[tuple[str, str], tuple[str, float]] = {
     ("N", "rad/sqrt(s)"): ("gyro", 1.0),
     ("N", "deg/s/sqrt(Hz)"): ("gyro", DEG),
     ("N", "deg/h/sqrt(Hz)"): ("gyro", DEG / 3600.0),
+    ("N", "deg/h*sqrt(s)"): ("gyro", DEG / 3600.0),
     ("K", "deg/h^1.5"): ("gyro", DEG / 216000.0),
     ("K", "deg/h/sqrt(h)"): ("gyro", DEG / 216000.0),
     ("K", "rad/s^2/sqrt(Hz)"): ("gyro", 1.0),
@@ -202,6 +203,7 @@ UNIT_TABLE: dict[tuple[str, str], tuple[str, float]] = {
     ("N", "m/s/sqrt(h)"): ("accel", 1.0 / 60.0),
     ("N", "m/s^2/sqrt(Hz)"): ("accel", 1.0),
     ("N", "m/s/sqrt(s)"): ("accel", 1.0),
+    ("N", "m/s^2*sqrt(s)"): ("accel", 1.0),
     ("N", "ug/sqrt(Hz)"): ("accel", G0 * 1e-6),
     ("N", "mg/sqrt(Hz)"): ("accel", G0 * 1e-3),
     ("K", "m/s^3/sqrt(Hz)"): ("accel", 1.0),
@@ -233,8 +235,10 @@ SI_UNITS = {
     ("accel", "Q"): "m/s", ("accel", "R"): "m/s^3", ("accel", "sigma"): "m/s^2", ("accel", "q_c"): "m/s^2/sqrt(s)",
 }
 
-_REPLACE = (("µ", "u"), ("μ", "u"), (" ", ""), ("√", "sqrt"), ("sqrt(hr)", "sqrt(h)"), ("/hr", "/h"),
-            ("²", "^2"), ("³", "^3"), ("s2", "s^2"), ("s3", "s^3"), ("sqrth", "sqrt(h)"), ("sqrtHz", "sqrt(Hz)"),
+_REPLACE = (("µ", "u"), ("μ", "u"), (" ", ""), ("(m/s^2)", "m/s^2"), ("(rad/s)", "rad/s"), ("(deg/h)", "deg/h"),
+            ("(deg/s)", "deg/s"), ("·", "*"), ("√", "sqrt"), ("sqrt(hr)", "sqrt(h)"), ("/hr", "/h"),
+            ("²", "^2"), ("³", "^3"), ("s2", "s^2"), ("s3", "s^3"), ("sqrthr", "sqrt(h)"), ("sqrth", "sqrt(h)"),
+            ("sqrtHz", "sqrt(Hz)"),
             ("sqrts", "sqrt(s)"), ("sqrt(hz)", "sqrt(Hz)"))
 
 
