@@ -234,3 +234,28 @@ def test_random_walk_covering_against_the_k_bound():
     d = random_walk_covering(comps, 60.0, 60.0, k_bound_dphrh=2.0)
     assert d["ratio"] is None and d["ratio_to_bound"] == pytest.approx(d["k_eff_dphrh"] / 2.0)
     assert "× the random walk's 95 % upper bound (2 deg/h^1.5" in d["sentence"]
+
+
+def test_components_from_gmwm_ieee_reading():
+    from fogdrift.evaluation.consistency import components_from_gmwm
+
+    v = lambda x: SimpleNamespace(value=x)  # noqa: E731
+    ie = SimpleNamespace(terms={"N_dprh": v(0.2), "K_dphrh": v(3.0), "Q_urad": v(5.0)},
+                         gm=[{"tc_s": v(12.0), "sigma_gm_dph": v(4.0)}], tau_range_s=(0.02, 500.0))
+    comps, notes = components_from_gmwm(SimpleNamespace(selection=SimpleNamespace(ieee=ie)))
+    assert comps == [{"kind": "white", "arw_dprh": 0.2}, {"kind": "quantization", "q_urad": 5.0},
+                     {"kind": "random_walk", "rrw_dphrh": 3.0},
+                     {"kind": "gauss_markov", "tc_s": 12.0, "sigma_dph": 4.0}]
+    assert notes == []
+
+
+def test_components_from_a_real_gmwm_fit_recover_the_simulated_truth():
+    """GMWM on a simulated WN+GM log: the components predict the angle variance of the truth within 10 %."""
+    from fogdrift.evaluation.consistency import components_from_gmwm
+    from fogdrift.gmwm.analysis import analyse_gmwm
+
+    y = _simulate(3, 200_000, DT, 0.2, 4.0, 15.0)
+    comps, _ = components_from_gmwm(analyse_gmwm("x", y - y.mean(), DT, model="WN+GM"))
+    got = angle_error_variance_deg2(comps, [5.0, 30.0], T_CAL)
+    want = angle_error_variance_deg2(TRUE, [5.0, 30.0], T_CAL)
+    np.testing.assert_allclose(got, want, rtol=0.1)

@@ -90,3 +90,16 @@ def test_consistency_reads_an_export_json(logs, tmp_path):
     assert res.exit_code == 0, res.output
     doc = json.loads((tmp_path / "e" / "consistency.json").read_text())
     assert doc["targets"][0]["axes"]["gz"]["components"] == [{"kind": "white", "arw_dprh": N_DPRH}]
+
+
+def test_consistency_from_the_gmwm_model(logs, tmp_path):
+    res = runner.invoke(app, ["consistency", str(logs[0]), "--unit", "deg/h", "--method", "gmwm", "--held-out",
+                              str(logs[1]), "--calibration", "20", "--horizons", "20", "--out", str(tmp_path / "g")])
+    assert res.exit_code == 0, res.output
+    doc = json.loads((tmp_path / "g" / "consistency.json").read_text())
+    assert doc["model_source"].startswith("the GMWM model of")
+    white = [c for c in doc["targets"][0]["axes"]["gz"]["components"] if c["kind"] == "white"]
+    assert white and white[0]["arw_dprh"] == pytest.approx(N_DPRH, rel=0.05)
+    res = runner.invoke(app, ["consistency", str(logs[0]), "--unit", "deg/h", "--method", "kalman", "--held-out",
+                              str(logs[1]), "--out", str(tmp_path / "h")])
+    assert res.exit_code == 1 and "--method must be 'allan' or 'gmwm'" in res.output

@@ -1,6 +1,7 @@
 """``fogdrift consistency``: will these noise numbers work in my filter?  Measured on held-out static logs.
 
-The noise model of every axis comes from the training log's own Allan fit (or ``--components FILE``: a JSON of
+The noise model of every axis comes from the training log's own Allan fit (``--method gmwm``: its GMWM model; or
+``--components FILE``: a JSON of
 noise components per axis, e.g. from an export); three target models are checked on every ``--held-out`` log
 (same sensor, same axes): the full model, the white + random-walk model that Kalibr / VINS / ORB-SLAM3 keep, and
 the white + random-walk model whose random walk covers the bias wander over ``--cover`` seconds.  Per target,
@@ -34,6 +35,9 @@ CoverOpt = Annotated[float, typer.Option("--cover", help="Horizon [s] over which
                                                          "random walk must cover the bias wander.")]
 StepOpt = Annotated[Optional[float], typer.Option("--origin-step", help="Origin spacing [s]; default calibration + "
                                                                         "horizon (non-overlapping windows).")]
+MethodOpt = Annotated[str, typer.Option("--method", help="Noise model of the training log: allan (the Allan fit of "
+                                                       "'fogdrift allan') or gmwm (the GMWM model of 'fogdrift "
+                                                       "noise').")]
 ComponentsOpt = Annotated[Optional[Path], typer.Option(
     "--components", help="JSON noise model instead of the training log's Allan fit: the JSON of 'fogdrift export' "
                          "(its gyro channels' state_space components), {axis: [components]} or {\"axes\": {axis: "
@@ -148,6 +152,7 @@ def consistency(
     horizons: HorizonsOpt = "1,10,30,60,300",
     cover: CoverOpt = 60.0,
     origin_step: StepOpt = None,
+    method: MethodOpt = "allan",
     components: ComponentsOpt = None,
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
@@ -172,12 +177,29 @@ def consistency(
             raise ConfigError(f"--cover must be a number > 0 [s]; got {cover!r}")
         if origin_step is not None and not (math.isfinite(origin_step) and origin_step > 0):
             raise ConfigError(f"--origin-step must be a number > 0 [s]; got {origin_step!r}")
+        method = method.lower()
+        if method not in ("allan", "gmwm"):
+            raise ConfigError(f"--method must be 'allan' or 'gmwm'; got {method!r}")
         given = None if components is None else _read_components(components)
         record = load.load()
         echo_record(load, record)
         check_plausible(record)
         notes, k_bounds = {}, {}
-        if given is None:
+        if given is None and method == "gmwm":
+            from ..evaluation.consistency import components_from_gmwm
+            from ..gmwm.analysis import analyse_gmwm
+
+            full = {}
+            with progress("consistency", record.axis_names):
+                for name in record.axis_names:
+                    ax = analyse_gmwm(name, record.axis(name), record.dt_s)
+                    full[name], notes[name] = components_from_gmwm(ax)
+                    if "K_dphrh" not in ax.selection.ieee.terms:
+                        k = ax.ieee_terms().get("K")
+                        if k is not None and k.hi95:
+                            k_bounds[name] = k.hi95
+            source = f"the GMWM model of {load.file.name}"
+        elif given is None:
             from ..pipeline import AnalysisConfig, run_allan
 
             with progress("consistency", record.axis_names) as (allan_cb, _):

@@ -60,6 +60,7 @@ __all__ = [
     "random_walk_covering",
     "reduced_model",
     "components_from_noise_fit",
+    "components_from_gmwm",
     "CoverageRow",
     "ConsistencyResult",
     "check_consistency",
@@ -411,6 +412,37 @@ def components_from_noise_fit(noise) -> tuple[list[dict], list[str]]:
         notes.append("periodic term S left out (it integrates to a bounded angle)")
     if noise.no_fit:
         notes.append("no model fits this record's Allan curve: the components are the best candidate's")
+    return check_components(comps), notes
+
+
+def components_from_gmwm(ieee) -> tuple[list[dict], list[str]]:
+    """Noise components of a GMWM model's IEEE reading (:class:`fogdrift.gmwm.ieee.IEEEResult`, or a GMWM axis).
+
+    WN -> white (N), QN -> quantization (Q), RW -> random walk (K), each GM -> a Gauss-Markov component (T_c,
+    sigma), DR -> a ramp with a random slope of 1-sigma R, FLICKER -> Gauss-Markov terms over the fitted tau range
+    (:func:`fogdrift.models.statespace.flicker_as_gauss_markov`).
+    """
+    from ..models.statespace import flicker_as_gauss_markov
+
+    ie = getattr(getattr(ieee, "selection", None), "ieee", ieee)
+    t = ie.terms
+    comps, notes = [], []
+    if "N_dprh" in t:
+        comps.append({"kind": "white", "arw_dprh": float(t["N_dprh"].value)})
+    if "Q_urad" in t:
+        comps.append({"kind": "quantization", "q_urad": float(t["Q_urad"].value)})
+    if "K_dphrh" in t:
+        comps.append({"kind": "random_walk", "rrw_dphrh": float(t["K_dphrh"].value)})
+    for g in ie.gm:
+        comps.append({"kind": "gauss_markov", "tc_s": float(g["tc_s"].value), "sigma_dph": float(g["sigma_gm_dph"].value)})
+    if "R_dph2" in t:
+        comps.append({"kind": "ramp", "ramp_dph2": float(t["R_dph2"].value)})
+    if "B_dph" in t:
+        lo, hi = (float(x) for x in ie.tau_range_s)
+        if not (0 < lo < hi and math.isfinite(hi)):
+            raise ConfigError("the GMWM fit has a flicker term but no fitted tau range to replace it over")
+        comps.extend(flicker_as_gauss_markov(float(t["B_dph"].value), lo, hi))
+        notes.append("flicker B replaced by Gauss-Markov terms over the fitted tau range")
     return check_components(comps), notes
 
 
