@@ -246,7 +246,7 @@ def test_missing_policies(tmp_path):
     assert r.how == "bound" and r.si == pytest.approx(0.3 * D / 216000)
     assert "95 % upper bound" in r.note
     assert resolve(gz, "K", "zero").si == 0.0
-    with pytest.raises(ConfigError, match=r"gyro gz: K is not resolved by the record: not in the model.*upper bound is 0.3 deg/h"):
+    with pytest.raises(ConfigError, match=r"gyro gz: K is not resolved by the record: not in the model.*upper bound is 0.3"):
         resolve(gz, "K", "refuse")
     ctx = build_context([_gyro_result(tmp_path)], missing="zero")
     d = yaml.safe_load(render("kalibr", ctx))

@@ -6,6 +6,7 @@
 % gyro gz: allan no model fits; best candidate Q+N+B+K+S (chi2_red 6.12, poor)
 % continuous -> discrete: white sigma_d = N sqrt(f), random-walk step sigma_bd = K / sqrt(f) (Kalibr wiki 'IMU Noise Model')
 % Units per the gyroparams / accelparams reference pages: NoiseDensity (rad/s)/sqrt(Hz) and (m/s^2)/sqrt(Hz), RandomWalk (rad/s)*sqrt(Hz) and (m/s^2)*sqrt(Hz), BiasInstability rad/s and m/s^2
+% (MathWorks Answers 1631045: RandomWalk is the rate random walk K, NoiseDensity the white density N)
 % BiasInstability is B (the flicker floor); BiasInstabilityCoefficients is left at its default
 % gx: N = 2.402 [2.374, 2.417] deg/sqrt(h) [resolved]; from allan fit: N (selected model N+B+S+M, fit good)
 %   continuous 0.000698605 rad/s/sqrt(Hz) (the estimate; x 0.000290888 (deg/sqrt(h) -> rad/s/sqrt(Hz))); discrete 0.00698605 rad/s per sample at 100.0 Hz (x sqrt(f))

@@ -83,7 +83,8 @@ def export(
                                          "axes": [a.to_dict() for a in results]}, default=json_default))
             channels = channels_from_result(doc, str(log))
             write_allan_outputs(results, record, r.out.path)
-        ctx = build_context(gyro, accel, results=result, channels=channels, rate_hz=update_rate, missing=missing, topic=rostopic)
+        ctx = build_context(gyro, accel, results=result, channels=channels, rate_hz=update_rate, missing=missing,
+                            topic=rostopic)
         texts = {n: render(n, ctx) for n in chosen}  # everything is rendered before any file is written
         for n, text in texts.items():
             with r.out.file(TARGETS[n].filename) as tmp:

@@ -265,7 +265,8 @@ def _gmwm_channel(ax: dict, record: dict, path: str) -> ChannelModel:
                                    "", f"gmwm {model}: B, {bh.get('label', '')}")
             else:
                 terms["B"] = _term("B", None, 0.0, bh.get("bound_dph"), "deg/h", "absent",
-                                   bh.get("reason", "no bias-instability reading"), f"gmwm {model}: B, {bh.get('label', '')}")
+                                   bh.get("reason", "no bias-instability reading"),
+                                   f"gmwm {model}: B, {bh.get('label', '')}")
             continue
         if t is None:
             terms[name] = _term(name, None, None, None, unit_default[name], "absent",
@@ -393,7 +394,8 @@ def resolve(ch: ChannelModel, name: str, policy: str) -> Resolved:
             f"; its 95 % upper bound is {t.hi95:.4g} {t.unit}" if t.hi95 is not None else "")
     raise ConfigError(f"{ch.label}: {name} is not resolved by the record: {why}{more}; pass {{opt:missing}} "
                       f"{'zero' if policy == 'bound' else 'bound or zero'} to write "
-                      f"{'0 with a warning' if policy == 'bound' else 'its bound or 0'}, or export from a record that resolves it")
+                      f"{'0 with a warning' if policy == 'bound' else 'its bound or 0'}, "
+                      "or export from a record that resolves it")
 
 
 def bias_gm(ch: ChannelModel, policy: str) -> tuple[GaussMarkov, str]:

@@ -91,7 +91,8 @@ def _term_lines(ctx: ExportContext, ch: ChannelModel, name: str, prefix: str, ou
            "zero": "0 (--missing zero)"}[r.how]
     cont = f"continuous {fmt(r.si)} {si_unit} ({how}; {r.term.conversion})"
     if kind == "white":
-        disc = f"discrete {fmt(white_discrete(r.si, ctx.rate_hz))} {_SI_RATE[ch.quantity]} per sample at {fmt(ctx.rate_hz)} Hz (x sqrt(f))"
+        disc = (f"discrete {fmt(white_discrete(r.si, ctx.rate_hz))} {_SI_RATE[ch.quantity]} per sample at "
+                f"{fmt(ctx.rate_hz)} Hz (x sqrt(f))")
     elif kind == "walk":
         disc = (f"discrete {fmt(walk_discrete(r.si, ctx.rate_hz))} {_SI_RATE[ch.quantity]} per-sample bias step at "
                 f"{fmt(ctx.rate_hz)} Hz (/ sqrt(f))")
@@ -183,8 +184,8 @@ _VINS_KEYS = (("accel", "N", "acc_n", "m/s^2/sqrt(Hz)", "white"), ("gyro", "N", 
 
 def write_vins(ctx: ExportContext) -> str:
     lines = ["%YAML:1.0", ""] + _header(ctx, "vins-fusion", "# ", "VINS-Fusion config (IMU noise block; cv::FileStorage)")
-    lines += ["# merge these keys into your VINS-Fusion config.  Its comments call them 'measurement noise standard deviation'",
-              "# and 'bias random work noise standard deviation' without saying continuous or discrete time (questions open",
+    lines += ["# merge these keys into your VINS-Fusion config.  Its comments call them 'measurement noise standard",
+              "# deviation' and 'bias random work noise standard deviation' without saying continuous or discrete time (questions open",
               "# in VINS-Mono issues #102, #327); written here: the continuous-time densities, the Kalibr values; the",
               "# per-sample (discrete) values at the update rate are in the comments.  VINS's own EuRoC config uses values",
               "# 10-100x the EuRoC Kalibr densities (inflated by hand)."]
@@ -229,7 +230,8 @@ def _gm_vectors(ctx, quantity, prefix, sigma_factor, sigma_unit, tc_factor, tc_u
               f" [{fmt(g.sigma_lo95_si * sigma_factor)}, {fmt(g.sigma_hi95_si * sigma_factor)}]")
         tiv = "" if g.tc_lo95_s is None or g.tc_hi95_s is None else f" [{fmt(g.tc_lo95_s)}, {fmt(g.tc_hi95_s)}] s"
         lines += [f"{prefix}{ch.name}: bias Gauss-Markov: {how}",
-                  f"{prefix}  sigma = {fmt(g.sigma_si)} {_SI_RATE[quantity]}{iv and ' (95 %' + iv + ' ' + sigma_unit + ')'}, "
+                  f"{prefix}  sigma = {fmt(g.sigma_si)} {_SI_RATE[quantity]}"
+                  f"{iv and ' (95 %' + iv + ' ' + sigma_unit + ')'}, "
                   f"T_c = {fmt(g.tc_s)} s{tiv}; discrete at {fmt(ctx.rate_hz)} Hz: phi = exp(-dt/T_c) = {phi:.9f}, "
                   f"driving sigma = sigma sqrt(1 - phi^2) = {fmt(qd)} {_SI_RATE[quantity]}"]
         sig.append(g.sigma_si * sigma_factor)
@@ -280,6 +282,7 @@ def write_matlab(ctx: ExportContext) -> str:
     lines = _header(ctx, "matlab", pre, "MATLAB imuSensor (gyroparams / accelparams, Navigation / Sensor Fusion Toolbox)")
     lines += [f"{pre}Units per the gyroparams / accelparams reference pages: NoiseDensity (rad/s)/sqrt(Hz) and "
               "(m/s^2)/sqrt(Hz), RandomWalk (rad/s)*sqrt(Hz) and (m/s^2)*sqrt(Hz), BiasInstability rad/s and m/s^2",
+              f"{pre}(MathWorks Answers 1631045: RandomWalk is the rate random walk K, NoiseDensity the white density N)",
               f"{pre}BiasInstability is B (the flicker floor); BiasInstabilityCoefficients is left at its default"]
     objs = []
     for quantity, fn, var in (("gyro", "gyroparams", "gyro"), ("accel", "accelparams", "accel")):
@@ -309,8 +312,8 @@ def write_gnss_ins_sim(ctx: ExportContext) -> str:
     for quantity, pfx, nunit, nfac, bunit, bfac in (("gyro", "gyro", "deg/sqrt(h)", 60.0 / DEG, "deg/h", 3600.0 / DEG),
                                                     ("accel", "accel", "m/s/sqrt(h)", 60.0, "m/s^2", 1.0)):
         if not ctx.channels(quantity):
-            lines += _missing_quantity(ctx, "gnss-ins-sim", quantity, [f"{pfx}_b", f"{pfx}_{'arw' if pfx == 'gyro' else 'vrw'}",
-                                                                      f"{pfx}_b_stability", f"{pfx}_b_corr"], "    # ")
+            keys = [f"{pfx}_b", f"{pfx}_{'arw' if pfx == 'gyro' else 'vrw'}", f"{pfx}_b_stability", f"{pfx}_b_corr"]
+            lines += _missing_quantity(ctx, "gnss-ins-sim", quantity, keys, "    # ")
             continue
         n, ln = _vector(ctx, quantity, "N", "    # ", nunit, nfac, "white")
         sig, tcs, lg = _gm_vectors(ctx, quantity, "    # ", bfac, bunit, 1.0, "s")
