@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..output import atomic_path
+from ..report.figures import literal
 from .commands import TERMS
 from .summary import UNITS
 
@@ -124,13 +125,13 @@ def _chart(rows, name, unit, axes_names):
         for k in outliers(vals, [r.get(lo) for r in sel], [r.get(hi) for r in sel]):
             ax.plot([k], [vals[k]], "o", ms=9, mfc="none", color="C3", mew=1.5)
             right = k >= len(sel) / 2          # label towards the middle, inside the panel
-            ax.annotate(files[k], (k, vals[k]), textcoords="offset points", xytext=(-7 if right else 7, 5),
+            ax.annotate(literal(files[k]), (k, vals[k]), textcoords="offset points", xytext=(-7 if right else 7, 5),
                         ha="right" if right else "left", fontsize=7, color="C3")
             flagged.append((axis, files[k], vals[k]))
         ax.set_xticks(x)
-        ax.set_xticklabels([f if len(f) <= 18 else "…" + f[-17:] for f in files], rotation=60, ha="right",
+        ax.set_xticklabels([literal(f if len(f) <= 18 else "…" + f[-17:]) for f in files], rotation=60, ha="right",
                            fontsize=7)
-        ax.set_title(f"{name}, axis {axis}", fontsize=9)
+        ax.set_title(literal(f"{name}, axis {axis}"), fontsize=9)
         ax.set_ylabel(f"{name} [{_UNIT_TEXT[unit]}]")
         ax.grid(alpha=0.3)
     fig.tight_layout()

@@ -69,6 +69,23 @@ def _safe(name) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._") or "axis"
 
 
+def literal(text) -> str:
+    r"""``text`` (a column, axis, model or file name: user text) drawn as written by matplotlib.
+
+    Matplotlib reads a string with an even number of ``$`` as mathtext, and a bad expression (a column named
+    ``$\bogus{$``) raises only when the figure is drawn, after the JSON was written.  An escaped ``\$`` is drawn
+    as ``$`` and never starts mathtext.  Every label, title, legend entry and tick label that carries user text
+    goes through this function (the figures of :mod:`fogdrift.report`, :mod:`fogdrift.report.gmwm`,
+    :mod:`fogdrift.report.temperature` and the fleet page).
+
+    Examples
+    --------
+    >>> print(literal(r"$\bogus{$"), literal("gx"))
+    \$\bogus{\$ gx
+    """
+    return str(text).replace("$", r"\$")
+
+
 def _envelope(t, y, max_points=4000):
     """Bin a long series: (t of each bin, min, max, mean); short series come back unbinned."""
     y = np.asarray(y, dtype=float)
@@ -86,7 +103,7 @@ def _draw_split(ax, split_s, *, label=True):
         ax.axvspan(a, b, color=BLOCK_COLOURS.get(name, "0.9"), alpha=0.10, lw=0, zorder=0)
         ax.axvline(a, color=BLOCK_COLOURS.get(name, "0.5"), lw=1.0, ls="--", zorder=1)
         if label:
-            ax.text((a + b) / 2, 1.02, BLOCK_LABELS.get(name, name), transform=ax.get_xaxis_transform(),
+            ax.text((a + b) / 2, 1.02, literal(BLOCK_LABELS.get(name, name)), transform=ax.get_xaxis_transform(),
                     ha="center", va="bottom", fontsize=11, color=BLOCK_COLOURS.get(name, "k"))
 
 
@@ -129,8 +146,8 @@ def plot_allan(axes_list, path, title=None) -> Path:
                         ) * fit.dt_s
         no_fit = getattr(fit, "no_fit", None)
         ax.loglog(tau, fit.model_dev_dph(tau), "r--" if no_fit else "r-", lw=2.0,
-                  label=(f"best candidate {'+'.join(fit.selected)} (no model fits)" if no_fit else
-                         f"fit {'+'.join(fit.selected)}"))
+                  label=literal(f"best candidate {'+'.join(fit.selected)} (no model fits)" if no_fit else
+                                f"fit {'+'.join(fit.selected)}"))
         for name, style in zip(("Q", "N", "B", "K", "R", "S", "M"), ("--", "-.", ":", "--", "-.", ":", "--")):
             t = fit.terms.get(name)
             if name in fit.selected and t is not None and t.value:
@@ -142,8 +159,8 @@ def plot_allan(axes_list, path, title=None) -> Path:
         ax.set_yscale("log")
         ax.set_xlabel("τ [s]")
         ax.set_ylabel(f"{label} σ(τ) [deg/h]")
-        ax.set_title(f"{title or label}: {aa.name}   χ²_red {fit.chi2_red:.3g}, p = {fit.p_value:.2g} "
-                     f"({'no model fits' if no_fit else fit.quality})")
+        ax.set_title(literal(f"{title or label}: {aa.name}   χ²_red {fit.chi2_red:.3g}, p = {fit.p_value:.2g} "
+                     f"({'no model fits' if no_fit else fit.quality})"))
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(ncols=2 if n == 1 else 1)
     return _save(fig, path)
@@ -164,7 +181,7 @@ def plot_signal(record, path, split_s=None) -> Path:
         ax.plot(tb, mean, lw=0.6, color="C0", label="mean per bin" if tb is not t else None)
         if split_s:
             _draw_split(ax, split_s, label=i == 0)
-        ax.set_ylabel(f"{name} [deg/h]")
+        ax.set_ylabel(literal(f"{name} [deg/h]"))
     axs[-1, 0].set_xlabel("t [s]")
     fig.suptitle("Gyro output (Fig. 1)" + ("; dashed: train / validation / test split" if split_s else ""))
     return _save(fig, path)
@@ -180,7 +197,7 @@ def plot_spectrum(record, path) -> Path:
     for name in record.axis_names:
         x = np.asarray(record.axis(name), dtype=float)
         f, p = welch(x - x.mean(), fs=record.fs_hz, nperseg=min(len(x), 4096))
-        ax.loglog(f[1:], p[1:], lw=1.0, label=name)
+        ax.loglog(f[1:], p[1:], lw=1.0, label=literal(name))
     ax.set_xlabel("f [Hz]")
     ax.set_ylabel("PSD [(deg/h)²/Hz]")
     ax.set_title("Spectrum of the output (Fig. 2)")
@@ -215,7 +232,7 @@ def plot_separation(sep, path, split=None) -> Path:
     if split:
         for i, ax in enumerate(axs):
             _draw_split(ax, {k: (a * sep.dt_s, b * sep.dt_s) for k, (a, b) in split.items()}, label=i == 0)
-    fig.suptitle(f"Drift and white noise of the whole record, axis {sep.name}, dt = {sep.dt_s:g} s (Fig. 5)")
+    fig.suptitle(literal(f"Drift and white noise of the whole record, axis {sep.name}, dt = {sep.dt_s:g} s (Fig. 5)"))
     return _save(fig, path)
 
 
@@ -227,12 +244,12 @@ def plot_separation_allan(sep, path) -> Path:
     for (label, aa), color in zip(sep.rows, ("k", "C3", "C0")):
         r = aa.allan
         yerr = np.vstack([r.dev_dph - r.dev_lo68_dph, r.dev_hi68_dph - r.dev_dph])
-        ax.errorbar(r.tau_s, r.dev_dph, yerr=yerr, fmt="o-", ms=4, lw=1.0, color=color, label=label)
+        ax.errorbar(r.tau_s, r.dev_dph, yerr=yerr, fmt="o-", ms=4, lw=1.0, color=color, label=literal(label))
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("τ [s]")
     ax.set_ylabel("σ(τ) [deg/h]")
-    ax.set_title(f"Allan deviation of drift and noise, axis {sep.name} (Fig. 6)")
+    ax.set_title(literal(f"Allan deviation of drift and noise, axis {sep.name} (Fig. 6)"))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     return _save(fig, path)
@@ -247,8 +264,8 @@ def _test_axis(model_axis):
 def _label(model_axis, label):
     model = model_axis.fitted.get(label)
     if getattr(model, "input_kind", "drift") == "rate":
-        return f"{label} (estimates the rate's drift, not the wavelet drift)"
-    return label
+        return literal(f"{label} (estimates the rate's drift, not the wavelet drift)")
+    return literal(label)
 
 
 def _shade_unscored(ax, t, k, dt):
@@ -282,7 +299,7 @@ def plot_models(model_axis, path, fig_no=8, *, residual=False) -> Path:
             ax.set_ylim(*lim)
         ax.set_xlabel("t [s]")
         ax.set_ylabel("drift [deg/h]")
-    axs[0].set_title(f"One-step drift models, axis {model_axis.name} (Fig. {fig_no}): test block")
+    axs[0].set_title(literal(f"One-step drift models, axis {model_axis.name} (Fig. {fig_no}): test block"))
     axs[1].set_title(f"zoom on the largest drift excursion, t = {t[lo]:g} – {t[hi - 1]:g} s")
     axs[0].legend(ncols=2, loc="best")
     return _save(fig, path)
@@ -308,11 +325,11 @@ def plot_residuals(model_axis, path, fig_no=9) -> Path:
         lim = _limits(rs, pad=0.1)
         if lim:
             ax.set_ylim(*lim)
-        ax.text(0.005, 0.95, f"{_label(model_axis, label)}: RMS {rms:.3g} deg/h (scored part)",
+        ax.text(0.005, 0.95, _label(model_axis, label) + f": RMS {rms:.3g} deg/h (scored part)",
                 transform=ax.transAxes, va="top", fontsize=11,
                 bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "none"})
         ax.set_ylabel("[deg/h]")
     axs[-1, 0].set_xlabel("t [s]")
-    fig.suptitle(f"Residual drift after one-step compensation, axis {model_axis.name} (Fig. {fig_no}); "
-                 f"y scales differ between panels; grey: not scored")
+    fig.suptitle(literal(f"Residual drift after one-step compensation, axis {model_axis.name} (Fig. {fig_no}); "
+                         "y scales differ between panels; grey: not scored"))
     return _save(fig, path)

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
 from ..output import atomic_path
+from .figures import literal
 from .files import write_json
 
 __all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
@@ -50,15 +51,15 @@ def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
             ax.plot(wv.scale_s[~used], wv.nu2_dph2[~used], "o", ms=4, mfc="white", color="k", label="excluded")
         tau, scale = wv.tau_samples[used], wv.scale_s[used]  # the model over the scales it was fitted to
         fit = sel.fit
-        ax.loglog(scale, fit.latent_model.wv(fit.theta, tau), "r-", lw=1.6, label=f"GMWM {sel.selected}")
+        ax.loglog(scale, fit.latent_model.wv(fit.theta, tau), "r-", lw=1.6, label=literal(f"GMWM {sel.selected}"))
         for label, comp in zip(fit.latent_model.labels, fit.component_wv(tau)):
             ok = comp > np.nanmin(wv.nu2_dph2) * 1e-3
-            ax.loglog(scale[ok], comp[ok], "--", lw=0.9, label=label)
+            ax.loglog(scale[ok], comp[ok], "--", lw=0.9, label=literal(label))
         ax.set_ylim(np.nanmin(wv.ci_lo95_dph2[wv.ci_lo95_dph2 > 0]) / 5, np.nanmax(wv.ci_hi95_dph2) * 3)
         ax.set_xlabel("scale [s]")
         ax.set_ylabel("wavelet variance [(deg/h)²]")
-        ax.set_title(f"{a.name}: {sel.selected}{'' if sel.passed_checks else ' (no candidate passed the checks)'}\n"
-                     f"J = {fit.q:.3g}, df {fit.df}, p = {fit.j_pvalue:.2g}", fontsize=9)
+        ax.set_title(literal(f"{a.name}: {sel.selected}{'' if sel.passed_checks else ' (no candidate passed the checks)'}\n"
+                             f"J = {fit.q:.3g}, df {fit.df}, p = {fit.j_pvalue:.2g}"), fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     path = Path(path)

@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import ConfigError
 from ..output import atomic_path
 from ..temperature import summary_line, temperature_summary
+from .figures import literal
 
 __all__ = ["plot_rate_and_temperature", "MAX_POINTS"]
 
@@ -71,7 +72,7 @@ def plot_rate_and_temperature(record, path) -> Path:
                             squeeze=False)
     for j, name in enumerate(record.axis_names):
         axs[j, 0].plot(t, rate[:, j], lw=0.5)
-        axs[j, 0].set_ylabel(f"{name} [deg/h]")
+        axs[j, 0].set_ylabel(literal(f"{name} [deg/h]"))
         axs[j, 0].grid(alpha=0.3)
     ax = axs[-1, 0]
     ax.plot(t, temp_d, color="C3", lw=1.0)
