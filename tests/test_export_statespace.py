@@ -90,3 +90,23 @@ def test_adis16405_session1_all_targets(tmp_path):
     assert 2.2 * D / 60 < d["gyroscope_noise_density"] < 2.7 * D / 60
     # gx has no K in its model: its bound is written and said as a bound
     assert "gx: K is its 95 % upper bound" in res.output
+
+
+def test_discrete_values_simulate_back_to_the_continuous_densities():
+    """The comments' discrete values, used the way Kalibr's wiki simulates (white sigma_d = N sqrt(f), bias steps
+    K / sqrt(f)), give back N as the ADEV at tau = 1 s (allantools, independent of fogdrift) and K^2 T as the
+    variance of the bias change over T."""
+    import allantools
+
+    from fogdrift.export.conversions import walk_discrete, white_discrete
+
+    n_si, k_si, f = 1e-3, 2e-5, 50.0                          # rad/s/sqrt(Hz), rad/s^2/sqrt(Hz), Hz
+    rng = np.random.default_rng(3)
+    m = 2 ** 18
+    bias = np.cumsum(rng.standard_normal(m) * walk_discrete(k_si, f))
+    y = rng.standard_normal(m) * white_discrete(n_si, f) + bias
+    _, adev, _, _ = allantools.oadev(y, rate=f, data_type="freq", taus=np.array([1.0]))
+    assert adev[0] == pytest.approx(math.sqrt(n_si ** 2 / 1.0 + k_si ** 2 * 1.0 / 3), rel=0.03)
+    t_s = 10.0                                                # 524 independent 10-s changes: about 6 % scatter
+    change = np.diff(bias[:: int(t_s * f)])
+    assert np.mean(change ** 2) == pytest.approx(k_si ** 2 * t_s, rel=0.2)
