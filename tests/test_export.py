@@ -224,6 +224,10 @@ def test_json_has_terms_and_van_loan_state_space(ctx):
     assert gx["export_values"]["N"]["discrete_sigma"] == pytest.approx(0.15 * D / 60 * 10, rel=1e-9)
     ss = gx["state_space"]
     assert ss["check_max_abs"] < 1e-12
+    white = next(t for t in ss["continuous_terms"] if t["kind"] == "white")
+    assert white["density"] == pytest.approx(0.15 * D / 60, rel=1e-9) and white["unit"] == "rad/s/sqrt(Hz)"
+    rw = next(t for t in ss["continuous_terms"] if t["kind"] == "random_walk")
+    assert rw["density"] == pytest.approx(0.5 * D / 216000, rel=1e-9)
     states = ss["discrete"]["states"]
     assert states[:2] == ["bias", "random_walk"]
     i = states.index("random_walk")

@@ -161,8 +161,23 @@ def discrete_model(ch: ChannelModel, rate_hz: float) -> dict:
         s2 = scale * scale
         check = float(max(np.max(np.abs(ss.F - phi)), np.max(np.abs(ss.Q * s2 - qd)) / max(np.max(np.abs(qd)), 1e-300),
                           abs(ss.r * s2 - r) / max(r, 1e-300)))
+    terms_si = []
+    for c in comps:
+        k = c["kind"]
+        if k == "white":
+            terms_si.append({"kind": k, "density": 60.0 * c["arw_dprh"] * scale, "unit": f"{si_rate}/sqrt(Hz)"})
+        elif k == "quantization":
+            terms_si.append({"kind": k, "q": c["q_urad"] / (1e6 * DEG / 3600.0) * scale,
+                             "unit": "rad" if ch.quantity == "gyro" else "m/s"})
+        elif k == "random_walk":
+            terms_si.append({"kind": k, "density": c["rrw_dphrh"] / 60.0 * scale, "unit": f"{si_rate}/s/sqrt(Hz)"})
+        elif k == "gauss_markov":
+            terms_si.append({"kind": k, "sigma": c["sigma_dph"] * scale, "unit": si_rate, "tc_s": c["tc_s"]})
+        else:
+            terms_si.append({"kind": k, "slope_sigma": c["ramp_dph2"] / 3600.0 * scale, "unit": f"{si_rate}/s"})
     return {
         "rate_unit": si_rate,
+        "continuous_terms": terms_si,
         "components": comps,
         "components_rate_unit": unit,
         "components_note": ("statespace components (fogdrift.models.statespace) in "
