@@ -259,3 +259,29 @@ def test_components_from_a_real_gmwm_fit_recover_the_simulated_truth():
     got = angle_error_variance_deg2(comps, [5.0, 30.0], T_CAL)
     want = angle_error_variance_deg2(TRUE, [5.0, 30.0], T_CAL)
     np.testing.assert_allclose(got, want, rtol=0.1)
+
+
+def test_accelerometer_velocity_error_by_hand_and_by_simulation():
+    """Specific force in m/s^2 (components in m/s^2 in place of deg/h): velocity error in m/s, no 1/3600."""
+    # arw_dprh = 1/60 -> density 60 * (1/60) = 1 (m/s^2) sqrt(s) = 1 m/s/sqrt(s); h = T = 1 s: 1 + 1 = 2 (m/s)^2
+    v = angle_error_variance_deg2([{"kind": "white", "arw_dprh": 1 / 60}], 1.0, 1.0, quantity="accel")
+    assert v[0] == pytest.approx(2.0, rel=1e-12)
+    # a random walk of K = 60 (m/s^2)/sqrt(h) = 1 m/s^2.5: h = 3, T = 6: 27 (m/s)^2
+    v = angle_error_variance_deg2([{"kind": "random_walk", "rrw_dphrh": 60.0}], 3.0, 6.0, quantity="accel")
+    assert v[0] == pytest.approx(27.0, rel=1e-12)
+    # observed: 0.1 m/s^2 above the calibrated mean for 10 s -> 1 m/s
+    _, e = observed_angle_errors_deg(np.r_[np.zeros(10), np.full(10, 0.1)], 1.0, 10.0, [10.0], quantity="accel")
+    assert e[0, 0] == pytest.approx(1.0)
+    # seeded: white specific force of density 0.01 m/s/sqrt(s) (per 0.1-s sample sigma 0.01/sqrt(0.1) m/s^2)
+    rng = np.random.default_rng(11)
+    logs = [({"ax": rng.normal(9.8, 0.01 / math.sqrt(DT), 200_000)}, DT) for _ in range(2)]
+    comps = {"ax": [{"kind": "white", "arw_dprh": 0.01 / 60}]}
+    res = check_consistency("truth", comps, logs, t_cal_s=T_CAL, horizons_s=H, quantity="accel")
+    for row in res.axes["ax"]["rows"]:
+        n = row.n_origins
+        assert abs(row.coverage["68 %"] - BANDS[0][1]) < 4 * math.sqrt(0.68 * 0.32 / n)
+    d = random_walk_covering([{"kind": "white", "arw_dprh": 0.01}, {"kind": "random_walk", "rrw_dphrh": 6.0}],
+                             60.0, 60.0, quantity="accel")
+    assert "accelerometer_random_walk = 0.1 m/s^3/sqrt(Hz)" in d["sentence"]  # 6 / 60
+    with pytest.raises(ConfigError, match="quantity must be 'gyro' or 'accel'"):
+        angle_error_variance_deg2([{"kind": "white", "arw_dprh": 1.0}], 1.0, 1.0, quantity="mag")

@@ -109,18 +109,22 @@ def verdict_line(res, axis: str) -> str:
             f"{n} origins, {h:g} s, {band} band): multiply N, K, σ by {_fmt(math.sqrt(lam))}")
 
 
-def print_result(res, label: str) -> None:
-    """The coverage table of one target model and its verdict lines."""
+def print_result(res, label: str, kinds=None) -> None:
+    """The coverage table of one target model and its verdict lines (angle error in deg for gyro axes, velocity
+    error in m/s for accelerometer axes)."""
+    kinds = kinds or {}
+    accel = {a for a in res.axes if kinds.get(a) == "accel"}
     rows = []
     for axis, v in res.axes.items():
         for r in v["rows"]:
-            rows.append([axis, f"{r.horizon_s:g}", r.n_origins, _fmt(r.sigma_pred_deg, 4), _fmt(r.rms_deg, 4),
+            rows.append([axis, f"{r.horizon_s:g}", r.n_origins, f"{_fmt(r.sigma_pred, 4)} {r.unit}",
+                         f"{_fmt(r.rms, 4)} {r.unit}",
                          f"{100 * r.coverage['68 %']:.1f} %", f"{100 * r.coverage['95 %']:.1f} %",
                          _lam_cell(r.inflation["68 %"]), _lam_cell(r.inflation["95 %"])])
     console.print(fitted_table(
-        f"{label}: angle error after a {res.t_cal_s:g} s calibration, coverage and smallest variance inflation λ "
-        "(95 % interval)",
-        ["axis", "h [s]", "origins", "σ pred [deg]", "RMS [deg]", "in 68 % band", "in 95 % band", "λ for 68 %",
+        f"{label}: {'velocity' if accel == set(res.axes) else 'angle' if not accel else 'angle / velocity'} error "
+        f"after a {res.t_cal_s:g} s calibration, coverage and smallest variance inflation λ (95 % interval)",
+        ["axis", "h [s]", "origins", "σ pred", "RMS", "in 68 % band", "in 95 % band", "λ for 68 %",
          "λ for 95 %"], rows))
     for axis in res.axes:
         say("  " + verdict_line(res, axis))
@@ -235,8 +239,11 @@ def consistency(
         say(f"held out: {', '.join(p.name for p in held_out)}; calibration {calibration:g} s, horizons "
             f"{', '.join(f'{x:g}' for x in h)} s; origins {'calibration + horizon' if origin_step is None else f'{origin_step:g} s'} "
             "apart (non-overlapping windows), pooled over the held-out logs")
-        covering = {a: random_walk_covering(c, cover, calibration, k_bound_dphrh=k_bounds.get(a))
-                    for a, c in full.items()}
+        from .noise import channel_kinds
+
+        kinds = channel_kinds(record)  # gyro: angle error [deg]; accel: velocity error [m/s]
+        covering = {a: random_walk_covering(c, cover, calibration, k_bound_dphrh=k_bounds.get(a),
+                                            quantity=kinds.get(a, "gyro")) for a, c in full.items()}
         cov_models = {a: [c for c in reduced_model(full[a]) if c["kind"] == "white"]
                       + [{"kind": "random_walk", "rrw_dphrh": covering[a]["k_eff_dphrh"]}] for a in full}
         targets = [("full", f"full model ({source})", full),
@@ -249,13 +256,14 @@ def consistency(
             if any(not comps[a] for a in comps):
                 say(f"{label}: skipped (an axis has no white or random-walk component)", style="yellow")
                 continue
-            res = check_consistency(key, comps, logs, t_cal_s=calibration, horizons_s=h, step_s=origin_step)
+            res = check_consistency(key, comps, logs, t_cal_s=calibration, horizons_s=h, step_s=origin_step,
+                                    quantity=kinds)
             res.notes = [f"{a}: {'; '.join(n)}" for a, n in notes.items() if n]
-            print_result(res, label)
+            print_result(res, label, kinds)
             results.append((res, label))
         for axis, d in covering.items():
             say(f"{axis}: {d['sentence']}")
-        payload = {"fogdrift_result": "consistency", "training": str(load.file),
+        payload = {"fogdrift_result": "consistency", "training": str(load.file), "quantities": kinds,
                    "held_out": [str(p) for p in held_out], "model_source": source,
                    "calibration_s": calibration, "horizons_s": h, "cover_s": cover,
                    "inflation_definition": "lambda multiplies every component's variance parameter (N^2, K^2, "

@@ -35,6 +35,10 @@ by lambda; the predicted variance scales by lambda exactly.  The smallest lambda
 below 1 means the model is conservative there: no inflation is needed.  Multiply *standard deviations* (N, K,
 ...) by ``sqrt(lambda)``.
 
+**Accelerometers** (``quantity="accel"``): the same formulas give the *velocity* error [m/s] of a specific force
+[m/s^2] whose components hold m/s^2 in place of deg/h (the convention of :mod:`fogdrift.export`: the statespace
+formulas are linear in the rate unit), i.e. every deg/h -> deg/s factor 1/3600 of the gyro case is 1.
+
 **White + random-walk targets** (Kalibr, VINS, ORB-SLAM3 keep only N and K): :func:`random_walk_covering`
 finds the random walk K_eff that makes the white + K_eff model predict the *same* angle-error variance at the
 user's horizon as the full model (flicker / Gauss-Markov / quantization / ramp parts folded into K), after the
@@ -70,6 +74,14 @@ __all__ = [
 BANDS = (("68 %", 0.6826894921370859, 1.0), ("95 %", 0.95, 1.959963984540054))
 
 _DEG_PER_URAD = 1e-6 * 180.0 / math.pi
+#: Integration factor of the internal rate unit per second: deg/h * s -> deg (gyro), m/s^2 * s -> m/s (accel).
+_INTEGRATE = {"gyro": 1.0 / 3600.0, "accel": 1.0}
+
+
+def _quantity(quantity) -> str:
+    if quantity not in _INTEGRATE:
+        raise ConfigError(f"quantity must be 'gyro' or 'accel'; got {quantity!r}")
+    return quantity
 
 
 def _horizons(horizons_s) -> np.ndarray:
@@ -119,8 +131,10 @@ def _component_variance_deg2(c: dict, h: np.ndarray, T: float) -> np.ndarray:
     raise ConfigError(f"unknown noise component kind {kind!r}")  # pragma: no cover - check_components refuses it
 
 
-def angle_error_variance_deg2(components, horizons_s, t_cal_s, *, by_component: bool = False):
+def angle_error_variance_deg2(components, horizons_s, t_cal_s, *, by_component: bool = False, quantity="gyro"):
     """Predicted variance [deg^2] of the angle error after a static calibration (module docstring table).
+
+    With ``quantity="accel"``: the velocity error [(m/s)^2] of components in m/s^2 in place of deg/h.
 
     Parameters
     ----------
@@ -132,6 +146,7 @@ def angle_error_variance_deg2(components, horizons_s, t_cal_s, *, by_component: 
         Calibration window T [s]; the bias is its mean.
     by_component : bool
         Also return the variance of each component (list of arrays, same order).
+    quantity : {"gyro", "accel"}
 
     Returns
     -------
@@ -150,12 +165,16 @@ def angle_error_variance_deg2(components, horizons_s, t_cal_s, *, by_component: 
     h = _horizons(horizons_s)
     T = _t_cal(t_cal_s)
     parts = [_component_variance_deg2(c, h, T) for c in comps]
+    if _quantity(quantity) == "accel":  # the formulas carry (1/3600)^2 for deg/h -> deg/s; m/s^2 needs none
+        parts = [p * 3600.0**2 for p in parts]
     total = np.sum(parts, axis=0) if parts else np.zeros_like(h)
     return (total, parts) if by_component else total
 
 
-def observed_angle_errors_deg(rate_dph, dt_s, t_cal_s, horizons_s, *, step_s=None):
+def observed_angle_errors_deg(rate_dph, dt_s, t_cal_s, horizons_s, *, step_s=None, quantity="gyro"):
     """Angle errors [deg] at rolling origins of a static rate series, after a window-mean calibration.
+
+    With ``quantity="accel"``: velocity errors [m/s] of a specific force [m/s^2].
 
     Parameters
     ----------
@@ -213,7 +232,7 @@ def observed_angle_errors_deg(rate_dph, dt_s, t_cal_s, horizons_s, *, step_s=Non
     bias = (c[origins] - c[origins - m]) / m
     errors = np.empty((origins.size, k.size))
     for j, kk in enumerate(k):
-        errors[:, j] = (c[origins + kk] - c[origins] - kk * bias) * (dt / 3600.0)
+        errors[:, j] = (c[origins + kk] - c[origins] - kk * bias) * (dt * _INTEGRATE[_quantity(quantity)])
     return origins * dt, errors
 
 
@@ -265,35 +284,38 @@ class CoverageRow:
     horizon_s : float
     n_origins : int
         Independent (non-overlapping) origins counted.
-    sigma_pred_deg : float
-        Predicted 1-sigma of the angle error [deg].
-    rms_deg : float
-        Measured RMS of the angle error [deg].
+    sigma_pred : float
+        Predicted 1-sigma of the error, in ``unit``.
+    rms : float
+        Measured RMS of the error, in ``unit``.
     coverage : dict
         Band name -> measured fraction of origins inside the band.
     inflation : dict
         Band name -> (lambda, lo95, hi95): the smallest variance factor giving nominal coverage.
+    unit : str
+        ``"deg"`` (angle error of a gyro) or ``"m/s"`` (velocity error of an accelerometer).
     """
 
     horizon_s: float
     n_origins: int
-    sigma_pred_deg: float
-    rms_deg: float
+    sigma_pred: float
+    rms: float
     coverage: dict
     inflation: dict
+    unit: str = "deg"
 
     def to_dict(self) -> dict:
         def f(x):
             return None if x is None or not math.isfinite(x) else float(x)
 
         return {"horizon_s": float(self.horizon_s), "n_origins": int(self.n_origins),
-                "sigma_pred_deg": f(self.sigma_pred_deg), "rms_deg": f(self.rms_deg),
+                "sigma_pred": f(self.sigma_pred), "rms": f(self.rms), "unit": self.unit,
                 "coverage": {k: f(v) for k, v in self.coverage.items()},
                 "inflation": {k: {"lambda": f(v[0]), "lo95": f(v[1]), "hi95": f(v[2])}
                               for k, v in self.inflation.items()}}
 
 
-def coverage_rows(errors_deg, sigma_pred_deg, horizons_s) -> list[CoverageRow]:
+def coverage_rows(errors_deg, sigma_pred_deg, horizons_s, *, unit: str = "deg") -> list[CoverageRow]:
     """Coverage of the 68 % / 95 % bands and the inflation factors, one row per horizon.
 
     Parameters
@@ -304,6 +326,8 @@ def coverage_rows(errors_deg, sigma_pred_deg, horizons_s) -> list[CoverageRow]:
     sigma_pred_deg : array_like, shape (n_horizons,)
         Predicted 1-sigma [deg].
     horizons_s : array_like, shape (n_horizons,)
+    unit : str
+        Unit of the errors (``"deg"``; ``"m/s"`` for velocity errors), carried into the rows.
     """
     h = _horizons(horizons_s)
     if isinstance(errors_deg, np.ndarray) and errors_deg.ndim == 2:
@@ -317,9 +341,9 @@ def coverage_rows(errors_deg, sigma_pred_deg, horizons_s) -> list[CoverageRow]:
         ratio = np.abs(e) / sig[j]
         cov = {name: float(np.mean(ratio <= z)) if e.size else math.nan for name, _, z in BANDS}
         infl = {name: inflation_factor(ratio, p, z) for name, p, z in BANDS}
-        rows.append(CoverageRow(horizon_s=float(hj), n_origins=int(e.size), sigma_pred_deg=float(sig[j]),
-                                rms_deg=float(np.sqrt(np.mean(e**2))) if e.size else math.nan, coverage=cov,
-                                inflation=infl))
+        rows.append(CoverageRow(horizon_s=float(hj), n_origins=int(e.size), sigma_pred=float(sig[j]),
+                                rms=float(np.sqrt(np.mean(e**2))) if e.size else math.nan, coverage=cov,
+                                inflation=infl, unit=unit))
     return rows
 
 
@@ -334,7 +358,8 @@ def reduced_model(components, keep=("white", "random_walk")) -> list[dict]:
     return [c for c in check_components(components) if c["kind"] in keep]
 
 
-def random_walk_covering(components, horizon_s: float, t_cal_s: float, *, k_bound_dphrh=None) -> dict:
+def random_walk_covering(components, horizon_s: float, t_cal_s: float, *, k_bound_dphrh=None,
+                         quantity="gyro") -> dict:
     """The random walk K_eff [deg/h^1.5] that, with the model's white noise, covers the whole drift at ``horizon_s``.
 
     K_eff solves ``K_s^2 (h^3/3 + h^2 T/3) = Var_full(h) - Var_white(h)``: the white + K_eff model predicts the
@@ -370,18 +395,23 @@ def random_walk_covering(components, horizon_s: float, t_cal_s: float, *, k_boun
     k_eff = math.sqrt(max(drift, 0.0) / unit) * 216000.0
     k_alone = math.sqrt(sum(c["rrw_dphrh"] ** 2 for c in comps if c["kind"] == "random_walk"))
     ratio = k_eff / k_alone if k_alone > 0 else None
-    si = k_eff / 216000.0 * math.pi / 180.0  # rad/s^1.5 = rad/s^2/sqrt(Hz)
+    accel = _quantity(quantity) == "accel"
+    # SI: gyro K [deg/h^1.5] -> rad/s^1.5 = rad/s^2/sqrt(Hz); accel K [(m/s^2)/sqrt(h)] -> m/s^2.5 = m/s^3/sqrt(Hz)
+    si = k_eff / 60.0 if accel else k_eff / 216000.0 * math.pi / 180.0
+    ku = "(m/s^2)/sqrt(h)" if accel else "deg/h^1.5"
     kb = None if k_bound_dphrh is None or not k_bound_dphrh > 0 else float(k_bound_dphrh)
     to_bound = None if kb is None or ratio is not None else k_eff / kb
     if ratio is not None:
-        tail = f"{ratio:.3g}× the random walk alone ({k_alone:.3g} deg/h^1.5)"
+        tail = f"{ratio:.3g}× the random walk alone ({k_alone:.3g} {ku})"
     elif to_bound is not None:
-        tail = (f"{to_bound:.3g}× the random walk's 95 % upper bound ({kb:.3g} deg/h^1.5; the fit has no random "
+        tail = (f"{to_bound:.3g}× the random walk's 95 % upper bound ({kb:.3g} {ku}; the fit has no random "
                 "walk of its own)")
     else:
         tail = "the model has no random walk of its own (K alone = 0)"
-    sentence = (f"to cover the bias wander over {h:g} s (after a {T:g} s calibration), use gyroscope_random_walk = "
-                f"{si:.3g} rad/s^2/sqrt(Hz) ({k_eff:.3g} deg/h^1.5): {tail}")
+    name, si_unit = ("accelerometer_random_walk", "m/s^3/sqrt(Hz)") if accel else ("gyroscope_random_walk",
+                                                                                  "rad/s^2/sqrt(Hz)")
+    sentence = (f"to cover the bias wander over {h:g} s (after a {T:g} s calibration), use {name} = "
+                f"{si:.3g} {si_unit} ({k_eff:.3g} {ku}): {tail}")
     return {"k_eff_dphrh": k_eff, "k_alone_dphrh": k_alone, "ratio": ratio, "ratio_to_bound": to_bound,
             "k_bound_dphrh": kb, "horizon_s": h, "t_cal_s": T,
             "k_eff_si": si, "sentence": sentence}
@@ -478,12 +508,12 @@ class ConsistencyResult:
     def to_dict(self) -> dict:
         return {"target": self.target, "t_cal_s": self.t_cal_s, "horizons_s": list(self.horizons_s),
                 "notes": list(self.notes),
-                "axes": {a: {"components": v["components"], "n_logs": v["n_logs"],
+                "axes": {a: {"components": v["components"], "n_logs": v["n_logs"], "quantity": v.get("quantity"),
                              "rows": [r.to_dict() for r in v["rows"]]} for a, v in self.axes.items()}}
 
 
 def check_consistency(target: str, components_by_axis: dict, held_out: list, *, t_cal_s: float, horizons_s,
-                      step_s=None) -> ConsistencyResult:
+                      step_s=None, quantity="gyro") -> ConsistencyResult:
     """Run one target model per axis over held-out static logs and count its coverage.
 
     Parameters
@@ -500,13 +530,17 @@ def check_consistency(target: str, components_by_axis: dict, held_out: list, *, 
     step_s : float or None
         Origin spacing [s]; default ``t_cal_s + h`` for each horizon (non-overlapping windows, so more origins
         count at short horizons).
+    quantity : "gyro", "accel" or dict
+        Per axis (a dict) or for all: gyro rates [deg/h] give angle errors [deg], accelerometer specific forces
+        [m/s^2] velocity errors [m/s].
     """
     h = _horizons(horizons_s)
     T = _t_cal(t_cal_s)
     axes = {}
     for axis, comps in components_by_axis.items():
         comps = check_components(comps)
-        sigma = np.sqrt(angle_error_variance_deg2(comps, h, T))
+        q = quantity.get(axis, "gyro") if isinstance(quantity, dict) else quantity
+        sigma = np.sqrt(angle_error_variance_deg2(comps, h, T, quantity=q))
         if not np.all(sigma > 0):
             raise ConfigError(f"axis {axis}: the {target} model predicts no angle error (no components)")
         errs = [[] for _ in h]
@@ -514,7 +548,9 @@ def check_consistency(target: str, components_by_axis: dict, held_out: list, *, 
             if axis not in rates:
                 raise ConfigError(f"the held-out log has no axis {axis!r} (has {', '.join(rates)})")
             for j, hj in enumerate(h):  # per horizon: origins T_cal + h apart (independent windows)
-                errs[j].append(observed_angle_errors_deg(rates[axis], dt, T, [hj], step_s=step_s)[1][:, 0])
+                errs[j].append(observed_angle_errors_deg(rates[axis], dt, T, [hj], step_s=step_s,
+                                                         quantity=q)[1][:, 0])
         e = [np.concatenate(x) for x in errs]
-        axes[axis] = {"components": comps, "rows": coverage_rows(e, sigma, h), "n_logs": len(held_out)}
+        axes[axis] = {"components": comps, "rows": coverage_rows(e, sigma, h, unit="m/s" if q == "accel" else "deg"),
+                      "n_logs": len(held_out), "quantity": q}
     return ConsistencyResult(target=target, axes=axes, t_cal_s=T, horizons_s=tuple(float(x) for x in h))
