@@ -409,7 +409,9 @@ TARGETS: dict[str, Target] = {t.name: t for t in (
            "UZ-SLAMLab/ORB_SLAM3 src/Tracking.cc (Ng*sf, Ngw/sf with sf = sqrt(IMU.Frequency)), Examples/*.yaml"),
     Target("kf-gins", write_kfgins, "kf-gins_imunoise.yaml",
            "arw deg/sqrt(h), vrw m/s/sqrt(h), gbstd deg/h, abstd mGal, corrtime h (gsstd/asstd ppm not written)",
-           "yaml-cpp (KF-GINS)", "i2Nav-WHU/KF-GINS dataset/kf-gins.yaml (imunoise block)"),
+           "yaml-cpp (KF-GINS)",
+           "i2Nav-WHU/KF-GINS dataset/kf-gins.yaml (imunoise block); src/kf-gins/gi_engine.cpp (Qc of a bias = "
+           "2 std^2 / corr_time: a first-order Gauss-Markov of 1-sigma gbstd / abstd)"),
     Target("matlab", write_matlab, "imu_params.m",
            "NoiseDensity (rad/s)/sqrt(Hz), RandomWalk (rad/s)*sqrt(Hz), BiasInstability rad/s (and m/s^2 for accel)",
            "MATLAB", "MathWorks gyroparams / accelparams / imuSensor reference pages"),
