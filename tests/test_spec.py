@@ -144,3 +144,10 @@ def test_summary_columns_and_line_for_batch_and_first_screen():
     cols = spec_columns(js)
     assert cols["spec_arw"] == "fail" and cols["spec_bias_instability"] == "pass"
     assert judgement_line(js[0]).startswith("gx arw: fail: 2.4 [2.37, 2.42] deg/sqrt(h) against 2 deg/sqrt(h)")
+
+
+def test_estimate_in_a_foreign_unit_is_cannot_tell_not_a_crash():
+    lim = _lim("accel", "vrw", "0.2 m/s/sqrt(h)")
+    j = judge(lim, Reading(2.4, 2.3, 2.5, "deg/sqrt(h)"))
+    assert j.verdict == "cannot tell" and "not a accel vrw unit" in j.reason
+    assert convert(0.3, "(m/s)/sqrt(h)", "accel", "vrw") == pytest.approx(0.3)

@@ -84,6 +84,7 @@ def _norm_unit(text: str) -> str:
     u = str(text).strip().lower().replace(" ", "")
     u = u.replace("°", "deg").replace("µ", "u").replace("μ", "u").replace("²", "^2").replace("**", "^")
     u = re.sub(r"degrees?", "deg", u)
+    u = u.replace("(m/s)", "m/s").replace("(deg/h)", "deg/h").replace("(deg/s)", "deg/s").replace("(rad/s)", "rad/s")
     u = re.sub(r"(?<![a-z])(hr|hour|hours)(?![a-z])", "h", u)
     u = re.sub(r"(?<![a-z])(sec|second|seconds)(?![a-z])", "s", u)
     u = re.sub(r"(√|sqrt|rt-?)\(?(hz|h|s)\)?(?![a-z])", r"sqrt(\2)", u)
@@ -278,7 +279,11 @@ def judge(limit: SpecLimit, reading: Reading | None, channel: str = "") -> Judge
     L = limit.value
     if reading is None or reading.value is None or not math.isfinite(reading.value):
         return Judgement(channel, limit, reading, "cannot tell", "no estimate of this term in the record", "–")
-    c = convert(1.0, reading.unit, limit.kind, limit.item)
+    try:
+        c = convert(1.0, reading.unit, limit.kind, limit.item)
+    except ConfigError:  # an estimate in a unit this table lacks (e.g. a gyro unit on an accel limit): say so
+        return Judgement(channel, limit, reading, "cannot tell",
+                         f"the estimate's unit {reading.unit!r} is not a {limit.kind} {limit.item} unit", "–")
     v = reading.value * c
     lo = None if reading.lo95 is None else reading.lo95 * c
     hi = None if reading.hi95 is None else reading.hi95 * c
