@@ -407,24 +407,33 @@ def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool
 
 # -- what was read --------------------------------------------------------------------------------------------
 def echo_record(load: "LoadOptions", record, path=None) -> None:
-    """One line: the file, samples, axes, duration, the sample rate and where it came from, the units and theirs."""
-    import re
+    """One line: the file, samples, axes, duration, the sample rate and where it came from, the units and theirs.
 
+    Where the rate and the units came from is read from the record's signal description
+    (:attr:`fogdrift.io.GyroRecord.signal`), made by :func:`fogdrift.io.load` while reading.
+    """
     path = Path(path or load.file)
-    notes = list(getattr(record, "notes", ()))
-    time_note = next((m for m in (re.match(r"time column '(.*)' in (\w+)$", n) for n in notes) if m), None)
-    if load.rate is not None:
-        rate_src = "from --rate"
-    elif time_note is not None:
-        rate_src = f"from time column '{time_note.group(1)}'"
+    smp = record.signal.sampling
+    chan = record.signal.channels[0]
+    if smp.dt_source == "rate option":
+        rate_src = f"from {FLAGS['rate_hz']}"
+    elif smp.dt_source == "time column":
+        rate_src = f"from time column '{smp.time_column}'"
     else:
         rate_src = "from the file's time stamps"
-    units = f"rate {record.input_unit} ({'--unit' if load.unit else 'declared in the header'})"
-    if time_note is not None:
-        units += f", time {time_note.group(2)} ({'--time-unit' if load.time_unit else 'declared in the header'})"
+    units = f"rate {record.input_unit} ({_SOURCE_WORDS['unit'].get(chan.unit_source, chan.unit_source)})"
+    if smp.time_unit is not None:
+        units += f", time {smp.time_unit} ({_SOURCE_WORDS['time_unit'].get(smp.time_unit_source, smp.time_unit_source)})"
     say(f"{path.name}: {record.n_samples} samples x {record.n_axes} {'axis' if record.n_axes == 1 else 'axes'} ({', '.join(record.axis_names)}), "
         f"{record.duration_s:.6g} s at {record.fs_hz:.6g} Hz (dt {record.dt_s:.6g} s {rate_src}); units: {units}; "
         "rates converted to deg/h")
+
+
+#: How :func:`echo_record` words a unit's source (:data:`fogdrift.signal.UNIT_SOURCES`).
+_SOURCE_WORDS = {
+    "unit": {"option": "--unit", "header": "declared in the header"},
+    "time_unit": {"option": "--time-unit", "header": "declared in the header"},
+}
 
 
 def check_plausible(record) -> None:
@@ -435,37 +444,26 @@ def check_plausible(record) -> None:
         warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
 
 
-def check_model_rate(record, model_rate_hz) -> None:
-    """A modelling rate that does not divide the native rate by an integer is refused before any work."""
-    if model_rate_hz:
-        from ..io import decimation_factor
+def check_model_rate(record, cfg) -> int:
+    """The block-average factor to the modelling rate, decided once (:func:`fogdrift.pipeline.model_factor`).
 
-        decimation_factor(record.dt_s, model_rate_hz)
+    A modelling rate that does not divide the native rate by an integer is refused here, before any work;
+    the factor returned is handed to the pipeline (``factor=``), which does not decide it again.
+    """
+    from ..pipeline import model_factor
+
+    return model_factor(record, cfg)
 
 
 def precheck(*, wavelet=None, mode=None, training=None, estimator=None, terms=None) -> None:
-    """Refuse bad option values before the file is read (the library would refuse them only later)."""
-    if wavelet is not None:
-        from ..lifting import get_wavelet
+    """Refuse bad option values before the file is read, for commands without a full analysis configuration.
 
-        get_wavelet(wavelet)
-    if mode is not None:
-        from ..lifting import MODES
+    The checks are :func:`fogdrift.pipeline.check_options`, the ones :meth:`AnalysisConfig.validate` makes
+    (a command that validates a config needs no precheck).
+    """
+    from ..pipeline import check_options
 
-        if mode not in MODES:
-            raise ConfigError(f"{{opt:mode}} must be one of {list(MODES)}; got {mode!r}")
-    if training is not None and training not in ("bptt", "bp"):
-        raise ConfigError(f"{{opt:training}} must be 'bptt' or 'bp'; got {training!r}")
-    if estimator is not None:
-        from .. import allan
-
-        known = getattr(allan, "ESTIMATORS", None)
-        if known is not None and estimator not in known:
-            raise ConfigError(f"{{opt:estimator}} must be one of {list(known)}; got {estimator!r}")
-    if terms is not None:
-        bad = [t for t in terms if t not in ("Q", "N", "B", "K", "R")]
-        if bad or not terms:
-            raise ConfigError(f"{{opt:terms}} must list noise terms among Q, N, B, K, R; got {','.join(terms)!r}")
+    check_options(wavelet=wavelet, mode=mode, training=training, estimator=estimator, terms=terms)
 
 
 # -- progress ---------------------------------------------------------------------------------------------------

@@ -12,7 +12,7 @@ from ..errors import ConfigError
 from ._app import (EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutliersOpt, OutOpt,
                    StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_model_rate, check_plausible, console,
                    csv_list, echo_record, fitted_table, parse_fit_taus, parse_level, parse_taus, parse_terms,
-                   precheck, progress, run, say, with_load_options)
+                   progress, run, say, with_load_options)
 from ._tables import metrics_table, noise_table
 from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt, model_axes_text
 
@@ -101,7 +101,6 @@ def analyze(
                 raise ConfigError(f"--earth-axis must look like AXIS=ORIENTATION (e.g. gz=up), got {item!r}")
             earth[name.strip()] = orient.strip()
         term_list = parse_terms(terms)
-        precheck(wavelet=wavelet, mode=mode, training=training, estimator=estimator, terms=term_list)
         cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
                              training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
                              model_rate_hz=model_rate or None, taus=parse_taus(taus), estimator=estimator,
@@ -113,20 +112,21 @@ def analyze(
         if apply_to is not None and not apply_to.is_file():
             raise ConfigError(f"--apply-to {apply_to}: no such file")
         record = load.load()
-        check_model_rate(record, cfg.model_rate_hz)
+        factor = check_model_rate(record, cfg)
         echo_record(load, record)
         check_plausible(record)
-        other = None
+        other, other_factor = None, None
         if apply_to:
             other = load.load(apply_to, unit=apply_unit, time_unit=apply_time_unit)
             other = _match_axes(record, other, apply_to)
-            check_model_rate(other, cfg.model_rate_hz)
+            other_factor = check_model_rate(other, cfg)
             echo_record(load, other, apply_to)
             check_plausible(other)
         elif apply_unit or apply_time_unit:
             raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
         with progress("analyze", record.axis_names) as (_, epoch_cb):
-            result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb)
+            result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb, factor=factor,
+                                  apply_to_factor=other_factor)
         evaluations = []
         if heading:  # compensation evidence on the held-out test block, stored in the result (fogdrift.evaluation)
             from ..evaluation import evaluate_analysis

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from ._app import (JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app, check_model_rate,
-                   check_plausible, console, csv_list, echo_record, parse_level, precheck, progress, run, say,
+                   check_plausible, console, csv_list, echo_record, parse_level, progress, run, say,
                    with_load_options)
 from ._tables import metrics_table
 
@@ -36,7 +36,7 @@ def model_axes_text(model_axes, record) -> str:
         if ma.earth_rate_dph:
             text += f" + Earth rate {ma.earth_rate_dph:.6g} deg/h"
         parts.append(text)
-    return (f"modelling rate {modelling_rate_text(record, model_axes[0].dt_s)}; removed before modelling, the "
+    return (f"modelling rate {modelling_rate_text(record, model_axes[0].dt_s, model_axes[0].block_average_factor)}; removed before modelling, the "
             f"training-block mean of each axis: {', '.join(parts)}")
 
 
@@ -64,16 +64,15 @@ def model(
 
     with run("model", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
              expect=("metrics.json",)) as r:
-        precheck(wavelet=wavelet, mode=mode, training=training)
         cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
                              training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
                              model_rate_hz=model_rate or None).validate()
         record = load.load()
-        check_model_rate(record, cfg.model_rate_hz)
+        factor = check_model_rate(record, cfg)
         echo_record(load, record)
         check_plausible(record)
         with progress("model", record.axis_names) as (_, epoch_cb):
-            results = run_models(record, cfg, progress=epoch_cb)
+            results = run_models(record, cfg, progress=epoch_cb, factor=factor)
         say(model_axes_text(results, record))
         for ma in results:
             console.print(metrics_table(f"axis {ma.name}: one-step metrics on the test block, paper's measure "

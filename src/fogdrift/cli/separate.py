@@ -5,17 +5,20 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._app import (JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, check_model_rate,
-                   check_plausible, console, echo_record, parse_level, parse_taus, precheck, progress, run, say,
+                   check_plausible, console, echo_record, parse_level, parse_taus, progress, run, say,
                    with_load_options)
 from ._tables import noise_table
 
 DEFAULT_OUT = Path("out/separate")
 
 
-def modelling_rate_text(record, dt_s: float) -> str:
-    """'1 Hz (100 Hz block-averaged in blocks of 100)' or '100 Hz (the native rate)'."""
+def modelling_rate_text(record, dt_s: float, factor: int) -> str:
+    """'1 Hz (100 Hz block-averaged in blocks of 100)' or '100 Hz (the native rate)'.
+
+    ``factor``: the block-average factor the pipeline used (decided once, read back, not recomputed).
+    """
     fs = 1.0 / dt_s
-    k = int(round(record.fs_hz * dt_s))
+    k = int(factor)
     if k <= 1:
         return f"{fs:.6g} Hz (the native rate)"
     return f"{fs:.6g} Hz ({record.fs_hz:.6g} Hz block-averaged in blocks of {k})"
@@ -39,17 +42,16 @@ def separate(
 
     with run("separate", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
              expect=("separation.npz", "separation.csv", "separation_table.csv", "separation.json")) as r:
-        precheck(wavelet=wavelet, mode=mode)
         cfg = AnalysisConfig(wavelet=wavelet, level=parse_level(level), mode=mode,
                              model_rate_hz=model_rate or None, taus=parse_taus(taus)).validate()
         record = load.load()
-        check_model_rate(record, cfg.model_rate_hz)
+        factor = check_model_rate(record, cfg)
         echo_record(load, record)
         check_plausible(record)
         with progress("separate", record.axis_names):
-            seps = run_separation(record, cfg)
+            seps = run_separation(record, cfg, factor=factor)
         removed = ", ".join(f"{s.name} {s.mean_removed_dph:.6g} deg/h" for s in seps)
-        say(f"modelling rate {modelling_rate_text(record, seps[0].dt_s)}; the mean of each axis was removed before "
+        say(f"modelling rate {modelling_rate_text(record, seps[0].dt_s, factor)}; the mean of each axis was removed before "
             f"separating (a constant would go wholly into the drift): {removed}")
         for s in seps:
             console.print(noise_table(

@@ -90,6 +90,15 @@ class DriftModel:
         if not self._is_fitted():
             raise NotFittedError(f"{type(self).__name__} is not fitted yet; call fit(y_train) first")
 
+    def _validate(self):
+        """The one validation hook of a model: check the hyper-parameters, raise ConfigError naming the bad one.
+
+        Called by ``fit`` (and wherever a model needs its checked settings); it may return what it derived
+        (the Elman models their training configuration, the Kalman filter its ``dt_s``).  The default checks
+        nothing.
+        """
+        return None
+
     def _get_state(self):  # pragma: no cover - abstract
         raise NotImplementedError
 

@@ -595,7 +595,7 @@ class GM11(DriftModel):
         self.shift_margin = shift_margin
 
     # -- validation --------------------------------------------------------------------------
-    def _validate_params(self):
+    def _validate(self):
         if self.mode not in _MODES:
             raise ConfigError(f"GM11 mode must be one of {_MODES}; got {self.mode!r}")
         if (
@@ -634,7 +634,7 @@ class GM11(DriftModel):
         InsufficientDataError
             Fewer than ``window`` (rolling) or 4 (whole) training samples.
         """
-        self._validate_params()
+        self._validate()
         y = check_series(y_train, "y_train")
         need = int(self.window) if self.mode == "rolling" else GM11_MIN_LENGTH
         need = max(need, GM11_MIN_LENGTH)

@@ -136,7 +136,7 @@ class Kalman(DriftModel):
         self.terms = terms
 
     # -- fit ------------------------------------------------------------------------------------
-    def _check_params(self) -> float:
+    def _validate(self) -> float:
         try:
             dt = float(self.dt_s)
         except (TypeError, ValueError):
@@ -157,7 +157,7 @@ class Kalman(DriftModel):
         DataFormatError
             ``y_train`` not 1-D or not finite.
         """
-        dt = self._check_params()
+        dt = self._validate()
         y = check_series(y_train, "y_train", min_length=2)
         if self.components is None:
             comps, info = identify_components(y, dt, terms=tuple(self.terms or "QNBKR"))
@@ -256,7 +256,7 @@ class Kalman(DriftModel):
         self.components_ = check_components(meta["components_"])
         self.identification_ = dict(meta["identification_"])
         self.bias_prior_dph_ = float(meta["bias_prior_dph_"])
-        self._ss = state_space(self.components_, dt_s=self._check_params(), bias_prior_dph=self.bias_prior_dph_)
+        self._ss = state_space(self.components_, dt_s=self._validate(), bias_prior_dph=self.bias_prior_dph_)
         self.state_names_ = self._ss.names
         if tuple(meta["state_names_"]) != self.state_names_:
             from ..errors import ModelFileError

@@ -1,0 +1,285 @@
+"""The signal description (issue 21 item 1) and complete results (item 6): one rule per test.
+
+Each fact about the numbers is made once and read back: the unit is parsed once per load, the decimation
+factor decided once per run and read back by the bundle and the CLI, the lifting level and causal window
+stored on the model axis where the pipeline decides them.  Independent references: the causal window from the
+documented rule ``min(max(round(T_w / dt), (L - 1) 2^J), n_train)`` computed here by hand; scales from the
+unit definitions (1 deg/s = 3600 deg/h).
+"""
+
+from __future__ import annotations
+
+import json
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from fogdrift import units
+from fogdrift.bundle import load_bundle, seal_manifest, write_bundle
+from fogdrift.errors import ConfigError, ModelFileError
+from fogdrift.io import from_array, load
+from fogdrift.io import record as io_record
+from fogdrift.pipeline import AnalysisAxis, AnalysisConfig, AllanAxis, ModelAxis, run_models
+from fogdrift.signal import Channel, Sampling, SignalDescription
+from fogdrift.simulate import simulate
+
+runner = CliRunner()
+
+
+def _csv(tmp_path, header="t_s,gz[deg/s]", n=400, dt=0.01, name="log.csv"):
+    rng = np.random.default_rng(3)
+    rows = [header] + [f"{k * dt:.6f},{v:.9f}" for k, v in enumerate(rng.normal(0.0, 1e-3, n))]
+    p = tmp_path / name
+    p.write_text("\n".join(rows) + "\n")
+    return p
+
+
+# -- made once by io --------------------------------------------------------------------------------------------
+def test_load_describes_where_rate_and_unit_came_from(tmp_path):
+    rec = load(_csv(tmp_path))
+    smp, (ch,) = rec.signal.sampling, rec.signal.channels
+    assert (smp.dt_source, smp.time_column, smp.time_unit, smp.time_unit_source) == ("time column", "t_s", "s",
+                                                                                    "header")
+    assert smp.dt_s == pytest.approx(0.01, rel=1e-9) and smp.block_average_factor == 1
+    assert (ch.name, ch.quantity, ch.unit_as_read, ch.unit_source, ch.declared_unit) == (
+        "gz", "angular_rate", "deg/s", "header", "deg/s")
+    assert ch.scale_to_internal == 3600.0 and ch.internal_unit == "deg/h"
+    meta = rec.metadata()["signal"]
+    assert meta["sampling"]["dt_source"] == "time column" and meta["channels"][0]["unit_source"] == "header"
+    assert json.loads(json.dumps(meta)) == meta  # JSON-ready
+
+
+def test_rate_and_unit_options_are_recorded_as_options(tmp_path):
+    p = tmp_path / "x.txt"
+    p.write_text("\n".join(str(v) for v in range(50)) + "\n")
+    rec = load(p, rate_hz=50.0, unit="inc:arcsec")
+    assert rec.signal.sampling.dt_source == "rate option" and rec.signal.sampling.time_column is None
+    ch = rec.signal.channels[0]
+    assert ch.unit_source == "option" and ch.unit.kind == "increment"
+    assert ch.scale_to_internal == pytest.approx(50.0)  # 1 arcsec per 20 ms = 50 deg/h
+
+
+def test_the_unit_is_parsed_once_per_load(tmp_path, monkeypatch):
+    calls = []
+    real = units.parse_unit
+    monkeypatch.setattr(units, "parse_unit", lambda *a, **k: calls.append(a) or real(*a, **k))
+    load(_csv(tmp_path))  # declared in the header
+    assert len(calls) == 1
+    calls.clear()
+    load(_csv(tmp_path, header="t_s,gz", name="b.csv"), unit="deg/s")  # given as an option
+    assert len(calls) == 1
+
+
+def test_description_follows_select_and_block_averaging():
+    rec = from_array(np.ones((100, 2)), dt_s=0.01, unit="deg/s", axis_names=["gx", "gz"])
+    low = rec.select("gz").to_rate(25.0)
+    assert low.signal.names == ("gz",)
+    smp = low.signal.sampling
+    assert smp.block_average_factor == 4 and smp.dt_s == pytest.approx(0.04) and smp.native_dt_s == 0.01
+    assert smp.rate_hz == pytest.approx(25.0) and smp.native_rate_hz == pytest.approx(100.0)
+
+
+def test_a_description_that_does_not_match_the_record_is_refused():
+    rec = from_array(np.ones(10), dt_s=0.01, unit="deg/s")
+    wrong = SignalDescription(Sampling(dt_s=0.02, dt_source="argument"), rec.signal.channels)
+    with pytest.raises(ConfigError, match="signal does not describe this record: dt_s"):
+        io_record.GyroRecord(rec.rate_dph, 0.01, ("axis0",), "<array>", "deg/s", 3600.0, signal=wrong)
+
+
+def test_description_round_trips_through_json_and_is_designed_for_specific_force():
+    acc = Channel(name="ax", unit=units.parse_unit("mg", "specific_force"), unit_source="option",
+                  declared_unit=None, scale_to_internal=9.80665e-3)
+    d = SignalDescription(Sampling(dt_s=0.005, dt_source="rate option", native_dt_s=0.0025,
+                                   block_average_factor=2), (acc,))
+    back = SignalDescription.from_dict(json.loads(json.dumps(d.to_dict())))
+    assert back == d and back.channels[0].internal_unit == "m/s^2"
+    with pytest.raises(ConfigError, match="not block_average_factor 3"):
+        Sampling(dt_s=0.005, dt_source="argument", native_dt_s=0.0025, block_average_factor=3)
+    with pytest.raises(ConfigError, match="dt_source must be one of"):
+        Sampling(dt_s=0.005, dt_source="guess")
+
+
+# -- the one dt validator ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("kw", [{"rate_hz": 1e-300}, {"rate_hz": 1e300}, {"dt_s": 1e-300}, {"dt_s": 1e300}])
+def test_absurd_sample_rates_are_one_line(tmp_path, kw):
+    p = tmp_path / "x.txt"
+    p.write_text("1\n2\n3\n")
+    with pytest.raises(ConfigError) as ei:
+        load(p, unit="deg/h", **kw)
+    assert "\n" not in str(ei.value) and "between 1e-09" in str(ei.value)
+    with pytest.raises(ConfigError, match="between 1e-09 s and 1e"):
+        from_array([1.0, 2.0], dt_s=1e-300)
+
+
+@pytest.mark.parametrize("rate", ["1e-300", "1e300"])
+def test_cli_rate_absurd_is_one_line_naming_the_flag(tmp_path, rate):
+    from fogdrift.cli import app
+
+    p = tmp_path / "x.txt"
+    p.write_text("\n".join(str(v) for v in range(64)) + "\n")
+    res = runner.invoke(app, ["allan", str(p), "--rate", rate, "--unit", "deg/h", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 1
+    text = res.output.strip()
+    assert len(text.splitlines()) == 1 and "--rate" in text and "Traceback" not in text, res.output
+
+
+# -- decided once, read back ------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def small():
+    rate = simulate(3000, 0.5, arw_dprh=0.05, rrw_dphrh=0.5, bias_dph=2.0, seed=4)
+    rec = from_array(rate, dt_s=0.5, unit="deg/h", axis_names=["gz"])
+    cfg = AnalysisConfig(models=("ar", "persistence"), model_rate_hz=1.0, level=2, lags=3, causal_window_s=40.0)
+    return rec, cfg
+
+
+def test_decimation_factor_decided_once_and_read_back(small, monkeypatch, tmp_path):
+    rec, cfg = small
+    calls = []
+    real = io_record.decimation_factor
+    monkeypatch.setattr(io_record, "decimation_factor", lambda *a: calls.append(a) or real(*a))
+    (ma,) = run_models(rec, cfg)
+    assert calls == [(0.5, 1.0)] and ma.block_average_factor == 2
+    calls.clear()
+    (ma,) = run_models(rec, cfg, factor=2)  # the CLI hands the factor it decided: not decided again
+    assert calls == []
+    b = write_bundle(tmp_path / "bundle", [ma], cfg, rec)
+    assert calls == [] and b.block_average_factor == 2 and load_bundle(b.path).block_average_factor == 2
+
+
+def test_level_and_causal_window_are_stored_where_decided(small, tmp_path):
+    rec, cfg = small
+    (ma,) = run_models(rec, cfg)
+    # db2 has filter length 4: reach (4 - 1) * 2**2 = 12 samples; 40 s at 1 s = 40; training 900 samples
+    assert (ma.level, ma.causal_window) == (2, 40)
+    d = ma.to_dict()
+    assert (d["level"], d["causal_window"], d["causal_window_s"], d["block_average_factor"]) == (2, 40, 40.0, 2)
+    back = load_bundle(write_bundle(tmp_path / "b", [ma], cfg, rec).path)
+    assert (back.axis("gz").level, back.axis("gz").causal_window) == (2, 40)
+
+
+def test_cli_model_decides_the_factor_once(tmp_path, monkeypatch):
+    from fogdrift.cli import app
+
+    calls = []
+    real = io_record.decimation_factor
+    monkeypatch.setattr(io_record, "decimation_factor", lambda *a: calls.append(a) or real(*a))
+    x = simulate(4000, 0.5, arw_dprh=0.05, rrw_dphrh=0.5, bias_dph=2.0, seed=5)
+    p = tmp_path / "g.csv"
+    p.write_text("t_s,gz[deg/h]\n" + "".join(f"{k * 0.5:.3f},{v:.9f}\n" for k, v in enumerate(x)))
+    res = runner.invoke(app, ["model", str(p), "--models", "persistence", "--level", "2", "--out",
+                              str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    assert calls == [(0.5, 1.0)]
+    assert "1 Hz (2 Hz block-averaged in blocks of 2)" in res.output
+
+
+# -- the bundle carries the description; hostile manifests are one line -------------------------------------------
+@pytest.fixture(scope="module")
+def bundle_dir(tmp_path_factory):
+    rate = simulate(3000, 0.5, arw_dprh=0.05, rrw_dphrh=0.5, bias_dph=2.0, seed=4)
+    rec = from_array(rate / 3600.0, dt_s=0.5, unit="deg/s", axis_names=["gz"])
+    cfg = AnalysisConfig(models=("persistence",), model_rate_hz=1.0, level=2, lags=3, causal_window_s=40.0)
+    out = tmp_path_factory.mktemp("sb") / "bundle"
+    write_bundle(out, run_models(rec, cfg), cfg, rec)
+    return out
+
+
+def _edited(bundle_dir, tmp_path, edit):
+    import shutil
+
+    d = tmp_path / "edited"
+    shutil.copytree(bundle_dir, d)
+    doc = json.loads((d / "manifest.json").read_text())
+    edit(doc)
+    (d / "manifest.json").write_text(json.dumps(seal_manifest(doc)))
+    return d
+
+
+def test_bundle_carries_the_signal_description(bundle_dir):
+    b = load_bundle(bundle_dir)
+    ch = b.signal.channel("gz")
+    assert (ch.unit_as_read, ch.scale_to_internal, ch.unit_source) == ("deg/s", 3600.0, "argument")
+    assert b.signal.sampling.dt_s == 0.5
+
+
+def test_bundle_without_a_description_still_loads(bundle_dir, tmp_path):
+    b = load_bundle(_edited(bundle_dir, tmp_path, lambda d: d.pop("signal")))
+    assert b.signal.sampling.dt_source == "bundle" and b.signal.channel("gz").unit_as_read == "deg/s"
+
+
+@pytest.mark.parametrize("edit, where", [
+    (lambda d: d["axes"][0].update(causal_window=10**12), "causal_window: expected at most"),
+    (lambda d: d["axes"][0].update(bias_dph=1e300), "bias_dph: expected |bias_dph|"),
+    (lambda d: d.update(native_dt_s=1e-300, model_dt_s=2e-300), "native_dt_s"),
+    (lambda d: d.update(latitude_deg=400.0), "latitude_deg"),
+    (lambda d: d["signal"]["channels"][0].update(unit_as_read="rad/s"), "signal.channels"),
+    (lambda d: d["signal"]["sampling"].update(dt_source="magic"), "signal: dt_source"),
+])
+def test_absurd_bundle_fields_are_refused_in_one_line(bundle_dir, tmp_path, edit, where):
+    with pytest.raises(ModelFileError) as ei:
+        load_bundle(_edited(bundle_dir, tmp_path, edit))
+    assert where in str(ei.value) and "\n" not in str(ei.value)
+
+
+def test_bundle_argument_that_is_a_file_is_one_line(bundle_dir, tmp_path):
+    f = tmp_path / "not_a_bundle.csv"
+    f.write_text("1\n")
+    with pytest.raises(ModelFileError, match="is a file; expected a bundle directory"):
+        load_bundle(f)
+    assert load_bundle(bundle_dir / "manifest.json").axis_names == ("gz",)
+
+
+# -- item 6: one validation point, results complete when built -----------------------------------------------------
+def test_validate_checks_without_mutating():
+    cfg = AnalysisConfig(models=("AR", "ar", "Persistence"))
+    v = cfg.validate()
+    assert cfg.models == ("AR", "ar", "Persistence") and v.models == ("ar", "persistence")
+    assert v.validate() is v
+
+
+@pytest.mark.parametrize("bad, opt", [
+    (dict(wavelet="db99"), "wavelet"), (dict(mode="wrap"), "mode"), (dict(training="sgd"), "training"),
+    (dict(estimator="fancy"), "estimator"), (dict(terms=("N", "X")), "terms"), (dict(level=0), "level"),
+    (dict(level="high"), "level"), (dict(taus="weekly"), "taus"), (dict(fit_tau_s=(10.0, 1.0)), "fit_tau_s"),
+    (dict(gm_window=2), "gm_window"), (dict(model_rate_hz=float("inf")), "model_rate_hz"),
+    (dict(model_rate_hz=1e300), "model_rate_hz"), (dict(causal_window_s=float("nan")), "causal_window_s"),
+    (dict(latitude_deg=10.0, earth_axes={"gz": "sideways"}), "axis orientation"), (dict(seed=1.5), "seed"),
+])
+def test_validate_checks_every_setting(bad, opt):
+    with pytest.raises(ConfigError, match=opt):
+        AnalysisConfig(**bad).validate()
+
+
+def test_result_fields_are_typed_not_object():
+    for cls in (AllanAxis, AnalysisAxis, ModelAxis):
+        assert all("object" not in str(t) for t in cls.__annotations__.values()), cls.__annotations__
+    assert AnalysisAxis.__annotations__["evaluation"] == "AxisEvaluation | None"
+    assert AnalysisAxis.__annotations__["gmwm"] == "GmwmAxis | None"
+
+
+def test_noise_fit_built_complete_with_outliers():
+    from fogdrift.pipeline import analyse_allan
+
+    x = np.random.default_rng(0).normal(0.0, 1.0, 4096)
+    x[100] = 50.0
+    from fogdrift.outliers import treat_outliers
+
+    treated, report = treat_outliers(x, "clip")
+    ax = analyse_allan("gz", treated, 1.0, AnalysisConfig(), outliers=report)
+    assert ax.outliers is report and ax.noise.outliers == report.to_dict() and report.count >= 1
+
+
+def test_models_have_one_validation_hook():
+    import fogdrift.models.ar
+    import fogdrift.models.grey
+    import fogdrift.models.kalman  # noqa: F401  (the subclasses below)
+    from fogdrift.models.base import DriftModel
+
+    def subclasses(c):
+        return [c] + [s for k in c.__subclasses__() for s in subclasses(k)]
+
+    classes = subclasses(DriftModel)
+    assert len(classes) >= 4
+    for cls in classes:
+        assert callable(cls._validate)
+        assert not hasattr(cls, "_validate_params") and not hasattr(cls, "_check_params"), cls
