@@ -9,7 +9,8 @@ depth; this module covers the breadth of the registry.
 
 Budget: ``HOSTILE_EXAMPLES`` (default 100) examples per magic prefix, half that per extension and per forced
 reader, derandomized (about 20 s).  The long run
-(``FOGDRIFT_HOSTILE_EXAMPLES=4000``) is run by hand; its count is in the commit that added this module.
+(``FOGDRIFT_HOSTILE_EXAMPLES=400``: 7 200 examples, derandomized; with ``FOGDRIFT_HYPOTHESIS=explore``
+randomized) is run by hand; its counts are in the commit messages of this module.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ from fogdrift.io import GyroRecord, load
 from fogdrift.io.registry import READERS
 
 HOSTILE_EXAMPLES = int(os.environ.get("FOGDRIFT_HOSTILE_EXAMPLES", "100"))
-HOSTILE = settings(max_examples=HOSTILE_EXAMPLES, deadline=None, derandomize=True,
+HOSTILE = settings(max_examples=HOSTILE_EXAMPLES, deadline=None,
+                   derandomize=os.environ.get("FOGDRIFT_HYPOTHESIS") != "explore",  # conftest's profiles
                    suppress_health_check=[HealthCheck.too_slow])
 #: Half the budget for the cases that reach the same parsers by another door (extension, format forced by name).
 HOSTILE_HALF = settings(HOSTILE, max_examples=max(HOSTILE_EXAMPLES // 2, 1))
@@ -59,7 +61,7 @@ def check(path, options) -> None:
         except FogdriftError as exc:
             msg = str(exc)
             assert msg and "\n" not in msg and "{opt:" not in msg, msg
-            assert str(path) in msg or "unknown reader option" in msg or "environment variable" in msg, msg
+            assert str(path) in msg, msg
             return
     assert isinstance(rec, GyroRecord) and rec.n_samples >= 1
 

@@ -70,7 +70,8 @@ class ReaderSpec:
         unknown = sorted(set(options) - set(self.options))
         if unknown:
             raise ConfigError(
-                f"unknown reader option(s) {unknown} for {self.name} files; expected some of {list(self.options)}"
+                f"{path}: unknown reader option(s) {unknown} for {self.name} files; expected some of "
+                f"{list(self.options)}"
             )
         name = self.module if "." in self.module else f"{__package__}.readers.{self.module}"
         return importlib.import_module(name).open_table(path, **options)
