@@ -7,7 +7,8 @@ Modules, one concept each:
   the ``--missing`` policy for terms the record does not resolve;
 * :mod:`~fogdrift.export.discretize`: the filter-ready continuous-time state-space model and its exact (Van Loan)
   discretisation;
-* :mod:`~fogdrift.export.targets`: the one registry of targets (name -> writer, file name, units, source).
+* :mod:`~fogdrift.export.targets`: the one registry of targets (name -> writer, file name, units, source);
+* :mod:`~fogdrift.export.writers`: one writer per target.
 
 :func:`build_context` gathers channels from result files; :func:`render` returns the text of one target.
 """
