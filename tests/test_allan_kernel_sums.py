@@ -72,3 +72,14 @@ def test_large_offset_does_not_cost_precision():
     a = K.operator_sums(K.phase_dph_samples(y), m, np.ones_like(m), (1, -2, 1), False)
     b = K.operator_sums(K.phase_dph_samples(y + 1e4), m, np.ones_like(m), (1, -2, 1), False)
     np.testing.assert_allclose(a, b, rtol=1e-9)
+
+
+def test_one_thread_and_two_give_the_same_bits(monkeypatch):
+    """Small work runs serially (PARALLEL_MIN); the blocks and their order do not change, so neither do the sums."""
+    p = _angle(300_000, 11)
+    m = np.array([1, 9, 500, 70_000], dtype=np.int64)
+    monkeypatch.setattr(K, "PARALLEL_MIN", 0)             # always parallel
+    par = (K.phase_dph_samples(p[:200_000]), K.operator_sums(p, m, np.ones_like(m), (1, -2, 1), False))
+    monkeypatch.setattr(K, "PARALLEL_MIN", 1 << 62)       # always serial
+    ser = (K.phase_dph_samples(p[:200_000]), K.operator_sums(p, m, np.ones_like(m), (1, -2, 1), False))
+    assert np.array_equal(par[0], ser[0]) and np.array_equal(par[1], ser[1])

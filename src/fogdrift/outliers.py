@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._util import check_series
+from .allan._kernels import threads_for
 from .errors import ConfigError
 
 __all__ = ["OutlierReport", "find_outliers", "treat_outliers", "OUTLIER_ACTIONS"]
@@ -253,7 +254,9 @@ def _as_rate(rate_dph) -> np.ndarray:
 def block_medians(x: np.ndarray, block: int) -> np.ndarray:
     """Median [deg/h, float64] of each block of ``block`` samples of ``x`` (the last block may be shorter)."""
     out = np.empty(-(-x.size // block))
-    _compiled()["medians"](x, int(block), out)
+    kern = _compiled()["medians"]
+    with threads_for(10 * x.size):  # a quickselect touches each sample a few times
+        kern(x, int(block), out)
     return out
 
 
@@ -268,12 +271,13 @@ def _select_abs_dev(x, med, block, ranks) -> list:
 
     kern = _compiled()["hist"]
     out = []
-    nchunk = max(1, numba.get_num_threads())
+    nchunk = max(1, numba.get_num_threads())  # per-thread histograms; the counts do not depend on it
     for rank in ranks:
         prefix, r = 0, int(rank)
         for shift in (48, 32, 16, 0):
             hist = np.zeros((nchunk, 1 << 16), dtype=np.int64)
-            kern(x, med, int(block), shift, prefix, shift + 16 if shift < 48 else -1, hist)
+            with threads_for(x.size):
+                kern(x, med, int(block), shift, prefix, shift + 16 if shift < 48 else -1, hist)
             cum = np.cumsum(hist.sum(axis=0))
             digit = int(np.searchsorted(cum, r, side="right"))
             r -= int(cum[digit - 1]) if digit else 0
