@@ -566,9 +566,14 @@ def headline_verdict(heading=None, artefacts=None, *, axis: str = "", reason: st
               and judge(rows[CONSTANT_BIAS_LABEL], step_s=step, min_origins=min_origins).n >= min_origins]
     if not judged:
         h0 = heading.horizons_s[0]
-        n0 = by_h[h0][CONSTANT_BIAS_LABEL].n_origins if CONSTANT_BIAS_LABEL in by_h[h0] else 0
+        base0 = by_h[h0].get(CONSTANT_BIAS_LABEL)
+        n0 = base0.n_origins if base0 is not None else 0
+        # origins closer than the horizon overlap: say how many count, or "17 origins ... need 10" reads as enough
+        n_ind0 = judge(base0, step_s=step, min_origins=min_origins).n if base0 is not None else 0
+        count = f"{n0} calibration origin(s)" + ("" if n_ind0 == n0 else
+                                                 f", {n_ind0} of them with non-overlapping horizons,")
         line = (f"{axis}: cannot judge whether any model reduces the heading error: the held-out block gives "
-                f"{n0} calibration origin(s) at {h0:g} s ({heading.calib_s:g}-s calibrations every "
+                f"{count} at {h0:g} s ({heading.calib_s:g}-s calibrations every "
                 f"{heading.step_s:g} s; need {min_origins}).")
         return Verdict("headline", [line], {"outcome": "undetermined", "model": None, "judged_horizons_s": []})
     better, worse, judgements = {}, {}, {}
