@@ -400,3 +400,16 @@ def test_unit_spellings(term, unit, quantity, factor):
     from fogdrift.export.conversions import quantity_of_unit
 
     assert quantity_of_unit(term, unit) == quantity
+
+
+def test_accelerometer_only_and_duplicate_axes(tmp_path):
+    ctx = build_context(accel=[_accel_result(tmp_path)])
+    for t in parse_targets("all"):
+        render(t, ctx)                                                # every target writes without a gyro
+    d = yaml.safe_load(render("kalibr", ctx))
+    assert "gyroscope_noise_density" not in d and d["accelerometer_random_walk"] == pytest.approx(3e-4, rel=1e-5)
+    kf = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
+    assert "arw" not in kf and kf["corrtime"] == pytest.approx(100.0 / 1.8926 / 3600.0, rel=1e-4)
+    g = _gyro_result(tmp_path)
+    with pytest.raises(ConfigError, match="two gyro channels are called 'gx'"):
+        build_context([g, g])
