@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError, InsufficientDataError
-from ..models.statespace import check_components, components_from_allan
+from ..models.statespace import check_components, components_from_allan, flicker_as_gauss_markov
 
 __all__ = [
     "BANDS",
@@ -452,8 +452,6 @@ def components_from_gmwm(ieee) -> tuple[list[dict], list[str]]:
     sigma), DR -> a ramp with a random slope of 1-sigma R, FLICKER -> Gauss-Markov terms over the fitted tau range
     (:func:`fogdrift.models.statespace.flicker_as_gauss_markov`).
     """
-    from ..models.statespace import flicker_as_gauss_markov
-
     ie = getattr(getattr(ieee, "selection", None), "ieee", ieee)
     t = ie.terms
     comps, notes = [], []
