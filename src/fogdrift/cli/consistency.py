@@ -26,7 +26,7 @@ from ._app import with_load_options
 DEFAULT_OUT = Path("out/consistency")
 
 HeldOutOpt = Annotated[Optional[List[Path]], typer.Option(
-    "--held-out", help="A held-out static log of the same sensor (repeat the option for several); read with the "
+    "--held-out", metavar="<path>", help="A held-out static log of the same sensor (repeat the option for several); read with the "
                        "same reading options as FILE.")]
 CalOpt = Annotated[float, typer.Option("--calibration", help="Static calibration window [s] before each origin; "
                                                              "the bias is its mean.")]
