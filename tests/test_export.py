@@ -413,3 +413,21 @@ def test_accelerometer_only_and_duplicate_axes(tmp_path):
     g = _gyro_result(tmp_path)
     with pytest.raises(ConfigError, match="two gyro channels are called 'gx'"):
         build_context([g, g])
+
+
+def test_bias_gm_is_the_slowest_of_flicker_and_markov(tmp_path):
+    from fogdrift.export.model import bias_gm
+
+    doc = json.loads(_gyro_result(tmp_path).read_text())
+    ax = doc["axes"][0]                                   # gx: flicker B = 2 deg/h read at tau_B = 100 s
+    ax["noise"]["selected"] = ["N", "B", "K", "M"]
+    ax["noise"]["terms"]["M"] = _term("M", 0.5, 0.3, 0.7, "deg/h/sqrt(s)", "resolved")
+    ax["noise"]["shaped"] = {"M": {"tc_s": 3.0, "tc_lo95_s": 2.0, "tc_hi95_s": 4.5, "sigma_dph": 0.6124,
+                                   "q_unit": "deg/h/sqrt(s)"}}
+    gx = channels_from_result(doc, "g")[0]
+    assert len(gx.gms) == 1 and gx.gms[0].tc_s == 3.0
+    g, how = bias_gm(gx, "bound")                         # flicker GM T_c = 100/1.8926 = 52.8 s > 3 s
+    assert g.tc_s == pytest.approx(100.0 / 1.8926, rel=1e-4) and "matched to B" in how
+    ax["noise"]["shaped"]["M"]["tc_s"] = 500.0
+    g, how = bias_gm(channels_from_result(doc, "g")[0], "bound")
+    assert g.tc_s == 500.0 and g.sigma_si == pytest.approx(0.6124 * D / 3600) and "slowest" in how

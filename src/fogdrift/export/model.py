@@ -110,6 +110,8 @@ class ChannelModel:
         Gauss-Markov terms of the model (GMWM GMs, the Allan fit's M).
     b_tau_s : float or None
         Averaging time [s] of the B reading (the ADEV minimum, or the end of the fitted range when B is a bound).
+    b_is_flicker : bool
+        True when ``terms["B"]`` is the model's flicker term (not a reading of the whole curve's minimum).
     tau_range_s : (float, float)
         Fitted tau range [s].
     rate_hz : float
@@ -127,6 +129,7 @@ class ChannelModel:
     terms: dict
     gms: list = field(default_factory=list)
     b_tau_s: float | None = None
+    b_is_flicker: bool = False
     tau_range_s: tuple = (math.nan, math.nan)
     rate_hz: float = math.nan
     fit: str = ""
@@ -219,6 +222,7 @@ def _allan_channel(ax: dict, record: dict, path: str) -> ChannelModel:
                             f"allan fit: {name} (selected model {sel}, fit {fit.get('quality', '?')})")
     b_min = noise.get("b_min") or {}
     b_tau = _f(b_min.get("tau_s"))
+    b_flicker = "B" in terms and terms["B"].has_estimate
     if "B" in terms and not terms["B"].has_estimate and b_min.get("value") is not None and not no_fit:
         # no flicker term in the model: the IEEE reading at the ADEV minimum is the bias instability
         bound = bool(b_min.get("bound_only"))
@@ -239,7 +243,7 @@ def _allan_channel(ax: dict, record: dict, path: str) -> ChannelModel:
                                source="allan fit: M (exponentially correlated, IEEE-952 C.6)"))
     quality = f"chi2_red {fit.get('chi2_red', math.nan):.3g}, {fit.get('quality', '?')}"
     return ChannelModel(name=str(ax.get("name")), quantity=_quantity(terms, f"{path}: axis {ax.get('name')}"),
-                        method="allan", terms=terms, gms=gms, b_tau_s=b_tau,
+                        method="allan", terms=terms, gms=gms, b_tau_s=b_tau, b_is_flicker=b_flicker,
                         tau_range_s=(_f(fit.get("tau_min_s")), _f(fit.get("tau_max_s"))),
                         rate_hz=float(record.get("fs_hz") or 1.0 / float(noise.get("dt_s"))),
                         fit=("no model fits; best candidate " if no_fit else "model ") + f"{sel} ({quality})",
@@ -293,6 +297,7 @@ def _gmwm_channel(ax: dict, record: dict, path: str) -> ChannelModel:
     jp = (ax.get("j_statistic") or {}).get("p_value")
     return ChannelModel(name=str(ax.get("name")), quantity=_quantity(terms, f"{path}: axis {ax.get('name')}"),
                         method="gmwm", terms=terms, gms=gms, b_tau_s=_f(bh.get("tau_s")),
+                        b_is_flicker=ie["terms"].get("B_dph") is not None,
                         tau_range_s=(_f(tr[0]), _f(tr[1])),
                         rate_hz=float(record.get("fs_hz") or 1.0 / float(ie.get("dt_s"))),
                         fit=f"GMWM model {model} (J-test p = {jp:.2g})" if jp is not None else f"GMWM model {model}",
@@ -401,15 +406,20 @@ def resolve(ch: ChannelModel, name: str, policy: str) -> Resolved:
 def bias_gm(ch: ChannelModel, policy: str) -> tuple[GaussMarkov, str]:
     """The one Gauss-Markov bias process of a channel (what KF-GINS and gnss-ins-sim take), and how it was chosen.
 
-    The model's slowest Gauss-Markov term when it has one (GMWM GMs, the Allan fit's M: short correlation times are
-    coloured measurement noise, the slowest is the bias wander); otherwise the single GM whose Allan peak equals the
-    flicker floor of B at its averaging time (:func:`~fogdrift.export.conversions.single_gm_from_flicker`), B
-    resolved under ``policy``.
+    The slowest of the model's Gauss-Markov terms (GMWM GMs, the Allan fit's M: short correlation times are coloured
+    measurement noise, the slowest is the bias wander) and, when the model has a flicker term B, the single GM whose
+    Allan peak equals its floor at tau_B (:func:`~fogdrift.export.conversions.single_gm_from_flicker`).  With neither,
+    that GM is made from the B reading (the ADEV minimum), B resolved under ``policy``.
     """
-    if ch.gms:
-        g = max(ch.gms, key=lambda g: g.tc_s)
-        return g, f"the model's slowest Gauss-Markov term ({g.source}): sigma and T_c as fitted"
-    b = resolve(ch, "B", policy)
+    cands = [(g, f"the model's slowest Gauss-Markov term ({g.source}): sigma and T_c as fitted") for g in ch.gms]
+    if ch.b_is_flicker and ch.terms["B"].has_estimate:
+        cands.append(_gm_from_b(ch, resolve(ch, "B", policy)))
+    if cands:
+        return max(cands, key=lambda c: c[0].tc_s)
+    return _gm_from_b(ch, resolve(ch, "B", policy))
+
+
+def _gm_from_b(ch: ChannelModel, b: Resolved) -> tuple[GaussMarkov, str]:
     tau = ch.b_tau_s if ch.b_tau_s is not None else ch.tau_range_s[1]
     sigma, tc = single_gm_from_flicker(b.si, tau)
     lo = None if b.term.si_lo95 is None or b.how != "estimate" else single_gm_from_flicker(b.term.si_lo95, tau)[0]
