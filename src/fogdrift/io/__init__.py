@@ -46,6 +46,12 @@ declared is a :class:`~fogdrift.errors.ConfigError` naming ``{opt:unit}``
 (``{opt:time_unit}``), never a default.  The record keeps each axis's declared unit
 (``GyroRecord.declared_units``).
 
+Every record carries its signal description (:attr:`GyroRecord.signal`, :mod:`fogdrift.signal`): the
+sampling and each channel's unit, quantity and scale, and where the interval and the units came from
+(time column, ``rate_hz``, header, ``unit``), made here once while reading; later stages read it back.
+Units are parsed by :func:`fogdrift.units.parse_unit` and intervals checked by
+:func:`fogdrift.units.check_dt_s` (the one parser and the one validator).
+
 Conventions: sample ``k`` of a record covers ``[t0_s + k dt_s, t0_s + (k+1) dt_s)``, so
 ``duration_s = n_samples * dt_s`` and block averages keep ``t0_s``.  A record is brought to a
 modelling rate only by integer block averaging (:meth:`GyroRecord.to_rate`,
