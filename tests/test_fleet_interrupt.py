@@ -8,6 +8,7 @@ to a real ``fogdrift batch`` on a local Dask cluster of two worker processes.
 from __future__ import annotations
 
 import json
+import os
 import re
 import signal
 import subprocess
@@ -124,18 +125,24 @@ BOOT = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_han
 
 
 @pytest.mark.slow
-def test_ctrl_c_during_a_local_dask_batch(tmp_path):
+@pytest.mark.parametrize("group", [False, True], ids=["to-the-batch", "to-the-process-group"])
+def test_ctrl_c_during_a_local_dask_batch(tmp_path, group):
+    # group: as a terminal's Ctrl-C, SIGINT to the batch and every worker process (the workers printed their own
+    # KeyboardInterrupt tracebacks in 5 of 5 runs, issue 23; measured clean in 4 of 4 by hand before this test)
     files = _logs(tmp_path / "in", 6, 400_000, seed=32)
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-c", BOOT, "batch", *map(str, files), "--unit", "deg/h", "--rate",
                              "100", "--workers", "2", "--out", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=group)
     try:
         deadline = time.monotonic() + 300
         while not list(out.glob(f"*/{BATCH_JSON}")) and proc.poll() is None and time.monotonic() < deadline:
             time.sleep(0.01)
         assert proc.poll() is None, "the batch ended before the signal; the test needs longer files"
-        proc.send_signal(signal.SIGINT)
+        if group:
+            os.killpg(proc.pid, signal.SIGINT)
+        else:
+            proc.send_signal(signal.SIGINT)
         _, err = proc.communicate(timeout=120)  # a hang guard only (measured 0.06 s when idle)
     finally:
         if proc.poll() is None:
