@@ -285,3 +285,8 @@ def test_accelerometer_velocity_error_by_hand_and_by_simulation():
     assert "accelerometer_random_walk = 0.1 m/s^3/sqrt(Hz)" in d["sentence"]  # 6 / 60
     with pytest.raises(ConfigError, match="quantity must be 'gyro' or 'accel'"):
         angle_error_variance_deg2([{"kind": "white", "arw_dprh": 1.0}], 1.0, 1.0, quantity="mag")
+
+
+def test_random_walk_covering_white_only_model_says_nothing_to_cover():
+    d = random_walk_covering([{"kind": "white", "arw_dprh": 0.1}], 60.0, 60.0, k_bound_dphrh=3.0)
+    assert d["k_eff_dphrh"] == 0.0 and "no drift beyond its white noise" in d["sentence"]

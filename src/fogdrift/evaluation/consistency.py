@@ -401,7 +401,9 @@ def random_walk_covering(components, horizon_s: float, t_cal_s: float, *, k_boun
     ku = "(m/s^2)/sqrt(h)" if accel else "deg/h^1.5"
     kb = None if k_bound_dphrh is None or not k_bound_dphrh > 0 else float(k_bound_dphrh)
     to_bound = None if kb is None or ratio is not None else k_eff / kb
-    if ratio is not None:
+    if k_eff == 0.0:
+        tail = "the model has no drift beyond its white noise, so nothing to cover (a filter may still want a small K)"
+    elif ratio is not None:
         tail = f"{ratio:.3g}× the random walk alone ({k_alone:.3g} {ku})"
     elif to_bound is not None:
         tail = (f"{to_bound:.3g}× the random walk's 95 % upper bound ({kb:.3g} {ku}; the fit has no random "
