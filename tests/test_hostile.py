@@ -427,3 +427,24 @@ def test_errors_of_every_reader_limit_name_the_file(tmp_path, monkeypatch):
         with pytest.raises(FogdriftError) as ei:
             load(path, unit="deg/h", **kw)
         assert str(ei.value).startswith(f"{path}") and "FOGDRIFT_MAX_ROWS" in str(ei.value), str(ei.value)
+
+
+def test_npy_conversion_to_float64_is_held_to_the_memory_budget(tmp_path, monkeypatch):
+    p = tmp_path / "f32.npy"
+    np.save(p, np.zeros(200_000, dtype=np.float32))        # 0.8 MB on disk, 1.6 MB as float64
+    monkeypatch.setenv(limits.ENV_MEMORY, "1M")
+    with pytest.raises(ResourceLimitError, match=r"the float32 array \(200000,\) as float64 needs 1\.53 MiB"):
+        load(p, unit="deg/h", rate_hz=100.0)
+    q = tmp_path / "f64.npy"
+    np.save(q, np.zeros(200_000))                          # float64: memory-mapped, never copied: no budget
+    assert load(q, unit="deg/h", rate_hz=100.0).n_samples == 200_000
+
+
+def test_a_bomb_through_the_cli_is_one_line_naming_the_variable(tmp_path, monkeypatch):
+    p = gz_repeat(tmp_path / "rows.csv.gz", b"0.01,1\n" * (1 << 20), 4)
+    out = tmp_path / "o"
+    result = runner.invoke(app, ["allan", str(p), "--unit", "deg/h", "--rate", "100", "--out", str(out)])
+    assert result.exit_code == 1 and "Traceback" not in result.output
+    assert lines(result.output) == [ln for ln in lines(result.output) if ln.startswith("error:")]
+    assert len(lines(result.output)) == 1 and f"error: {p}: gzip content exceeds" in result.output
+    assert "FOGDRIFT_MAX_EXPANSION" in result.output and not out.exists()

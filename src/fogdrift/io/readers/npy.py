@@ -14,6 +14,7 @@ import numpy as np
 from ...errors import DataFormatError
 from ..hashing import file_sha256
 from .base import PARSER_ERRORS, Table, describe_exception, numeric_column
+from .limits import check_memory
 
 __all__ = ["open_table"]
 
@@ -25,6 +26,8 @@ def open_table(path: Path) -> Table:
     ------
     DataFormatError
         Unreadable file, object/string/complex dtype, or more than 2 dimensions.
+    ResourceLimitError
+        A dtype other than float64 (converted in memory) whose float64 copy exceeds the memory budget.
     """
     p = Path(path)
     try:
@@ -37,6 +40,8 @@ def open_table(path: Path) -> Table:
         raise DataFormatError(
             f"array has shape {arr.shape}; expected 1-D (one axis) or 2-D (samples x columns)", path=p
         )
+    if arr.dtype != np.float64 and arr.dtype.kind in "biuf":  # converted in memory: held to the budget
+        check_memory(arr.size * 8.0, p, f"the {arr.dtype} array {arr.shape} as float64")
     arr = numeric_column(arr, p, "array")
     if arr.ndim == 1:
         arr = arr.reshape(-1, 1)
