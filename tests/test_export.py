@@ -367,6 +367,19 @@ def test_gmwm_result_slowest_gm_is_the_bias(tmp_path):
     assert k == pytest.approx(2.0 * D / 216000, rel=1e-5)             # gy has no RW: 0 under --missing zero
     with pytest.raises(ConfigError, match="gyro gy: K is not resolved by the record: not in the GMWM model"):
         render("kalibr", build_context([p]))                           # no bound from GMWM: refused, not guessed
+    # with the wavelet variance in the result, K is bounded by its longest scale: tau = 2^17 samples at dt 0.01 s,
+    # WV 95 % upper end 3.0 (deg/h)^2: gamma^2 = 3 * 12 tau / (tau^2 + 2), K = 60 sqrt(gamma^2 / dt) deg/h^1.5
+    doc = json.loads(p.read_text())
+    doc["axes"][1]["wvar"] = {"tau_samples": [2, 2 ** 17], "ci_hi95_dph2": [9.0, 3.0], "dt_s": 0.01,
+                              "scale_s": [0.02, 1310.72]}
+    p.write_text(json.dumps(doc))
+    ctx = build_context([p])
+    gy = ctx.gyro[1]
+    tau = 2.0 ** 17
+    k_bound = 60 * math.sqrt(3.0 * 12 * tau / (tau * tau + 2) / 0.01)
+    assert gy.terms["K"].hi95 == pytest.approx(k_bound, rel=1e-12)
+    assert resolve(gy, "K", "bound").si == pytest.approx(k_bound * D / 216000, rel=1e-12)
+    assert "longest scale (1311 s)" in gy.terms["K"].reason
 
 
 @pytest.mark.parametrize("cut", ["noise", "terms", "N", "unit", "fit", "record", "value", "selection"])

@@ -273,8 +273,10 @@ def _gmwm_channel(ax: dict, record: dict, path: str) -> ChannelModel:
                                    f"gmwm {model}: B, {bh.get('label', '')}")
             continue
         if t is None:
-            terms[name] = _term(name, None, None, None, unit_default[name], "absent",
-                                f"not in the GMWM model {model} (GMWM gives no upper bound for a term it leaves out)",
+            bound, why = (_rw_bound_from_wv(ax.get("wvar")) if name == "K" else (None, ""))
+            terms[name] = _term(name, None, None if bound is None else 0.0, bound, unit_default[name], "absent",
+                                f"not in the GMWM model {model}"
+                                + (f"; {why}" if why else " (GMWM gives no upper bound for a term it leaves out)"),
                                 f"gmwm {model}: {name}")
             continue
         lo = t.get("lo95")
@@ -302,6 +304,25 @@ def _gmwm_channel(ax: dict, record: dict, path: str) -> ChannelModel:
                         rate_hz=float(record.get("fs_hz") or 1.0 / float(ie.get("dt_s"))),
                         fit=f"GMWM model {model} (J-test p = {jp:.2g})" if jp is not None else f"GMWM model {model}",
                         source_file=str(path), sha256=str(record.get("sha256", "")))
+
+
+def _rw_bound_from_wv(wv) -> tuple[float | None, str]:
+    """95 % upper bound of K [deg/h^1.5] from a Haar wavelet variance (``noise.json``'s ``wvar``): the upper end of
+    the measured WV's 95 % interval at the longest scale, all of it taken as random walk (every other process only
+    adds to the WV).  The random walk's Haar WV at tau samples is gamma^2 (tau^2 + 2) / (12 tau), gamma^2 = K^2 dt
+    (:mod:`fogdrift.gmwm.processes`)."""
+    try:
+        tau = float(wv["tau_samples"][-1])
+        hi = float(wv["ci_hi95_dph2"][-1])
+        dt = float(wv["dt_s"])
+        scale = float(wv["scale_s"][-1])
+    except (KeyError, TypeError, ValueError, IndexError):
+        return None, ""
+    if not (tau > 0 and hi > 0 and dt > 0 and math.isfinite(hi)):
+        return None, ""
+    k = 60.0 * math.sqrt(hi * 12.0 * tau / (tau * tau + 2.0) / dt)  # (deg/h)/sqrt(s) -> deg/h^1.5
+    return k, (f"95 % upper bound from the wavelet variance: the upper end of its 95 % interval at the longest scale "
+               f"({scale:.4g} s), all of it taken as random walk")
 
 
 def channels_from_result(data: dict, path="result", *, expect: str | None = None) -> list[ChannelModel]:
