@@ -444,3 +444,16 @@ def test_bias_gm_is_the_slowest_of_flicker_and_markov(tmp_path):
     ax["noise"]["shaped"]["M"]["tc_s"] = 500.0
     g, how = bias_gm(channels_from_result(doc, "g")[0], "bound")
     assert g.tc_s == 500.0 and g.sigma_si == pytest.approx(0.6124 * D / 3600) and "slowest" in how
+
+
+def test_gmwm_accelerometer_result(tmp_path):
+    ax = _gmwm_axis("ax", 0.1, None, [(300.0, 2e-4)])
+    ax["selection"]["ieee"]["terms"]["N_dprh"]["unit"] = "m/s/sqrt(h)"
+    ax["selection"]["ieee"]["gm"][0]["sigma_gm_dph"]["unit"] = "m/s^2"
+    ax["selection"]["ieee"]["b_headline"]["bound_dph"] = None
+    p = tmp_path / "acc_noise.json"
+    p.write_text(json.dumps({"record": {"fs_hz": 100.0}, "axes": [ax]}))
+    ctx = build_context(accel=[p], missing="zero")
+    assert ctx.accel[0].quantity == "accel"
+    d = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
+    assert d["vrw"] == pytest.approx([0.1]) and d["abstd"] == pytest.approx([2e-4 / 1e-5])   # mGal

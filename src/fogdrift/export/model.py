@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import ConfigError, DataFormatError
-from .conversions import single_gm_from_flicker, to_si
+from .conversions import quantity_of_unit, single_gm_from_flicker, to_si
 
 __all__ = ["TermValue", "GaussMarkov", "ChannelModel", "MISSING_POLICIES", "Resolved", "load_result",
            "channels_from_result", "resolve", "bias_gm"]
@@ -186,7 +186,7 @@ def _term(name, value, lo, hi, unit, status, reason, source) -> TermValue:
 
 
 def _quantity(terms: dict, where: str) -> str:
-    qs = {_q(t) for t in terms.values()}
+    qs = {_q(t) for t in terms.values() if t.value is not None or t.hi95 is not None}
     qs.discard(None)
     if len(qs) != 1:
         raise DataFormatError(f"{where}: the terms' units do not say one quantity (gyro or accelerometer): "
@@ -195,8 +195,6 @@ def _quantity(terms: dict, where: str) -> str:
 
 
 def _q(t: TermValue):
-    from .conversions import quantity_of_unit
-
     return quantity_of_unit(t.name, t.unit)
 
 
@@ -258,22 +256,25 @@ def _gmwm_channel(ax: dict, record: dict, path: str) -> ChannelModel:
     model = ie.get("model") or ax.get("selected") or "?"
     if not isinstance(ie.get("terms"), dict):
         raise DataFormatError(f"axis {ax.get('name')!r} has no GMWM IEEE reading ('selection.ieee.terms')", path=path)
-    unit_default = {"N": "deg/sqrt(h)", "K": "deg/h^1.5", "R": "deg/h^2", "Q": "urad", "B": "deg/h"}
+    n_unit = str((ie["terms"].get("N_dprh") or {}).get("unit", "deg/sqrt(h)"))
+    gyro = quantity_of_unit("N", n_unit) != "accel"
+    unit_default = ({"N": "deg/sqrt(h)", "K": "deg/h^1.5", "R": "deg/h^2", "Q": "urad", "B": "deg/h"} if gyro else
+                    {"N": "m/s/sqrt(h)", "K": "m/s^2/sqrt(s)", "R": "m/s^3", "Q": "m/s", "B": "m/s^2"})
     terms = {}
     for name, key in _GMWM_KEYS.items():
         t = ie["terms"].get(key)
         if name == "B" and t is None:
             bh = ie.get("b_headline") or {}
             if bh.get("value_dph") is not None:
-                terms["B"] = _term("B", bh["value_dph"], bh.get("lo95_dph"), bh.get("hi95_dph"), "deg/h", "resolved",
-                                   "", f"gmwm {model}: B, {bh.get('label', '')}")
+                terms["B"] = _term("B", bh["value_dph"], bh.get("lo95_dph"), bh.get("hi95_dph"), unit_default["B"],
+                                   "resolved", "", f"gmwm {model}: B, {bh.get('label', '')}")
             else:
-                terms["B"] = _term("B", None, 0.0, bh.get("bound_dph"), "deg/h", "absent",
+                terms["B"] = _term("B", None, 0.0, bh.get("bound_dph"), unit_default["B"], "absent",
                                    bh.get("reason", "no bias-instability reading"),
                                    f"gmwm {model}: B, {bh.get('label', '')}")
             continue
         if t is None:
-            bound, why = (_rw_bound_from_wv(ax.get("wvar")) if name == "K" else (None, ""))
+            bound, why = (_rw_bound_from_wv(ax.get("wvar")) if name == "K" and gyro else (None, ""))
             terms[name] = _term(name, None, None if bound is None else 0.0, bound, unit_default[name], "absent",
                                 f"not in the GMWM model {model}"
                                 + (f"; {why}" if why else " (GMWM gives no upper bound for a term it leaves out)"),
