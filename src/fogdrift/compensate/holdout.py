@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from .._util import safe_name
+from ..models.registry import MODELS
 from ..output import atomic_path
 
 __all__ = ["write_compensated_test_block", "compensated_test_block"]
@@ -57,8 +58,6 @@ def compensated_test_block(model_axis, t0_s: float = 0.0) -> dict[str, np.ndarra
     measured = np.asarray(ma.rate_dph[e:f], dtype=np.float64) + offset  # rate_dph has bias and Earth removed
     cols = {"t_s": t0_s + (e + np.arange(f - e)) * ma.dt_s, "measured": measured,
             "bias": measured - ma.bias_dph}
-    from ..models.registry import MODELS
-
     names = {spec.label: spec.name for spec in MODELS}
     for label, yhat in ma.causal_predictions.items():
         cols[names.get(label, label)] = measured - ma.bias_dph - np.asarray(yhat, dtype=np.float64)

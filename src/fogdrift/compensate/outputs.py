@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..output import TMP_PREFIX, atomic_path
+
 __all__ = ["CsvWriter", "NpzWriter", "AllanAccumulator", "plot_before_after"]
 
 
@@ -58,8 +60,6 @@ class NpzWriter:
     """
 
     def __init__(self, path, n_samples, axis_names, unit, scale_to_dph, with_sigma):
-        from ..output import TMP_PREFIX
-
         self.path = Path(path)
         k = len(axis_names)
         shapes = {"t_s": (n_samples,), "compensated": (n_samples, k), "drift_estimate": (n_samples, k)}
@@ -172,8 +172,6 @@ def plot_before_after(curves, path, title, caveats: dict | None = None) -> Path:
         if text:
             ax.text(0.0, -0.17, textwrap.fill(text, width=80), transform=ax.transAxes, ha="left", va="top",
                     fontsize=7, color="C3" if "not evidence" in text or "not checked" in text else "k")
-    from ..output import atomic_path
-
     path = Path(path)
     try:
         with atomic_path(path) as tmp:

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ConfigError
+from ..lifting import causal_drift
 
 __all__ = ["causal_weights", "history_length", "CausalPredictor"]
 
@@ -38,8 +39,6 @@ def causal_weights(window: int, wavelet: str, level: int, mode: str) -> np.ndarr
     >>> g.shape, round(float(g.sum()), 12)  # a constant passes unchanged
     ((128,), 1.0)
     """
-    from ..lifting import causal_drift
-
     return np.ascontiguousarray(causal_drift(np.eye(int(window)), int(window), wavelet, level, mode)[-1])
 
 

@@ -9,7 +9,12 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import ConfigError, FogdriftWarning, render_options
+from ..allan import allan_variance
+from ..bundle import Bundle, load_bundle
+from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
+from ..interrupt import checkpoint
+from ..models import model_spec
+from ..output import OutputDir, active, atomic_path
 from .engine import BIAS_ONLY, AxisPlan, StreamCompensator
 from .outputs import AllanAccumulator, CsvWriter, NpzWriter, plot_before_after
 from .sources import DEFAULT_CHUNK, match_log, open_log
@@ -50,8 +55,6 @@ def default_model(bundle) -> str:
 
 
 def _model_name(bundle, model) -> str:
-    from ..models import model_spec
-
     if model is None:
         return default_model(bundle)
     key = str(model).strip().lower()
@@ -80,8 +83,6 @@ class CompensationResult:
 
 
 def _allan_rows(before, after, dt):
-    from ..allan import allan_variance
-
     a = allan_variance(before, dt, taus="octave")
     b = allan_variance(after, dt, taus="octave")
     return a, b, [{"tau_s": float(t), "adev_before_dph": float(x), "adev_after_dph": float(y),
@@ -147,9 +148,6 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", unit=None
     -------
     CompensationResult
     """
-    from ..bundle import Bundle, load_bundle
-    from ..output import OutputDir, active
-
     if apply_unit is not None:
         if unit is not None and unit.strip() != apply_unit.strip():
             raise ConfigError(f"unit {unit!r} and its deprecated spelling apply_unit {apply_unit!r} disagree; pass "
@@ -160,7 +158,7 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", unit=None
     edge = contextlib.nullcontext() if active(Path(out_dir) / "compensation.json") is not None else \
         OutputDir(out_dir, command="compensate", protect=[path])
     with edge:
-        return _compensate(bundle, path, out_dir, Bundle=Bundle, load_bundle=load_bundle, model=model, bias=bias,
+        return _compensate(bundle, path, out_dir, model=model, bias=bias,
                            unit=unit, axis_map=axis_map, accept_rate=accept_rate,
                            load_kwargs=dict(columns=columns, time_column=time_column, rate_hz=rate_hz,
                                             time_unit=time_unit, format=format, reader_options=reader_options,
@@ -171,12 +169,9 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", unit=None
                            flags=flags)
 
 
-def _compensate(bundle, path, out_dir, *, Bundle, load_bundle, model, bias, unit, axis_map, accept_rate, load_kwargs,
+def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_rate, load_kwargs,
                 chunk_samples, formats, figures, heading, artefacts, calib_s, step_s, horizons_s,
                 max_model_rate_samples, segment, progress, flags) -> CompensationResult:
-    from ..interrupt import checkpoint
-    from ..output import atomic_path
-
     t_start = time.perf_counter()
     b = bundle if isinstance(bundle, Bundle) else load_bundle(bundle)
     bad = [f for f in formats if f not in FORMATS]
@@ -320,8 +315,6 @@ def _evaluate(result, b, plans, biases, z_all, *, heading, artefacts, calib_s, s
     from ..evaluation.artefacts import artefact_check
     from ..evaluation.heading import heading_errors
     from ..evaluation.verdicts import artefact_verdict, heading_verdict, headline_verdict
-    from ..errors import FogdriftError
-
     for k, (p, (_, bias_total)) in enumerate(zip(plans, biases)):
         h = a = None
         ax = p.bundle_axis

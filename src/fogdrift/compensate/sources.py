@@ -31,6 +31,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, DataFormatError
+from ..io import decimation_factor, load
+from ..io._checks import check_path
+from ..io.chunked import open_rows
 
 __all__ = ["LogSource", "open_log", "match_log", "LogMatch", "DEFAULT_CHUNK"]
 
@@ -89,8 +92,6 @@ def _one_declared(units, path) -> str | None:
 
 
 def _streamed(path, load_kwargs) -> LogSource:
-    from ..io.chunked import open_rows
-
     src = open_rows(path, columns=load_kwargs.get("columns"), time_column=load_kwargs.get("time_column", "auto"),
                     rate_hz=load_kwargs.get("rate_hz"), time_unit=load_kwargs.get("time_unit"),
                     unit=load_kwargs.get("unit"))
@@ -100,8 +101,6 @@ def _streamed(path, load_kwargs) -> LogSource:
 
 
 def _loaded(path, load_kwargs) -> LogSource:
-    from ..io import load
-
     rec = load(path, **load_kwargs)
     declared = _one_declared(rec.declared_units, rec.source)
 
@@ -140,8 +139,6 @@ def open_log(path, *, unit=None, columns=None, time_column="auto", rate_hz=None,
     DataFormatError, InsufficientDataError
         As :func:`fogdrift.io.load`.
     """
-    from ..io._checks import check_path
-
     p = check_path(path)
     kwargs = dict(unit=unit, columns=columns, time_column=time_column, rate_hz=rate_hz, time_unit=time_unit,
                   format=format, reader_options=reader_options or None, temperature=temperature, gaps=gaps)
@@ -214,8 +211,6 @@ def match_log(source: LogSource, bundle, *, axis_map=None, accept_rate=False) ->
     ConfigError
         A mismatch that was not mapped, in one line naming the option that maps it.
     """
-    from ..io import decimation_factor
-
     notes = []
     unit = source.unit
     if source.unit_given:

@@ -19,7 +19,10 @@ from typing import Callable
 import numpy as np
 
 from ..errors import ConfigError, DataFormatError
-from ._checks import check_path, parse_unit, unit_scale, valid_units
+from ..units import TIME_UNITS, check_dt_s, parse_unit, valid_units
+from ._checks import check_path
+from .hashing import file_sha256
+from .load import DT_TOLERANCE, GAP_FACTOR, JITTER_TOLERANCE, SHORT_STEP_FACTOR, _interval_option
 from .readers._columns import unit_list
 from .readers.base import require
 from .readers.hdf5 import UNIT_ATTRS
@@ -246,8 +249,6 @@ def open_source(path, *, column=None, unit=None, rate_hz=None, dt_s=None, layout
         Unreadable header, truncated file, unknown column or dataset.
     """
     p = check_path(path)
-    from .load import _interval_option
-
     dt = _interval_option(dt_s, rate_hz)
     if dt is None:
         raise ConfigError(f"{p}: the out-of-core path needs the sample rate; pass {{opt:rate_hz}} (or dt_s)")
@@ -276,8 +277,7 @@ def open_source(path, *, column=None, unit=None, rate_hz=None, dt_s=None, layout
             raise DataFormatError(f"unknown unit {declared!r} declared in the file; expected one of {valid_units()} "
                                   "(or pass {opt:unit})", path=p, column=str(name)) from None
         unit = declared
-    kind, base = parse_unit(unit)
-    factor = unit_scale(kind, base, dt)
+    factor = parse_unit(unit).scale_to_internal(dt)
     return ChunkSource(path=p, n_samples=int(n), dt_s=dt, name=str(name), scale_to_dph=factor,
                        describe=f"{what}, unit {unit}", _read=read, check=check)
 
@@ -418,10 +418,6 @@ def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None
     >>> [x[:, 0].tolist() for _, x in src.chunks(2)]
     [[3600.0, 7200.0], [10800.0]]
     """
-    from ..units import TIME_UNITS, parse_unit, valid_units
-    from .hashing import file_sha256
-    from .load import DT_TOLERANCE, GAP_FACTOR, JITTER_TOLERANCE, SHORT_STEP_FACTOR, _interval_option
-
     p = check_path(path)
     rows, cols, dtype, fortran, offset = _npy_layout(p)
     t_idx = None
@@ -482,8 +478,6 @@ def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None
                                   f"(median absolute deviation of the first {steps.size} steps); expected a uniform "
                                   f"grid within {100 * JITTER_TOLERANCE:g} %", path=p, column=tcol)
         notes.append(f"sample interval {dt:.10g} s from the time column {tcol} (median of the first steps)")
-    from ..units import check_dt_s
-
     check_dt_s(dt, "the sample interval")
     scale = float(spec.scale_to_internal(dt))
 
