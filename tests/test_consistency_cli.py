@@ -103,3 +103,21 @@ def test_consistency_from_the_gmwm_model(logs, tmp_path):
     res = runner.invoke(app, ["consistency", str(logs[0]), "--unit", "deg/h", "--method", "kalman", "--held-out",
                               str(logs[1]), "--out", str(tmp_path / "h")])
     assert res.exit_code == 1 and "--method must be 'allan' or 'gmwm'" in res.output
+
+
+def test_verdict_line_rules():
+    """Inflation is asked for only when some row under-covers beyond counting error; the factor is the largest λ."""
+    from types import SimpleNamespace
+
+    from fogdrift.cli.consistency import verdict_line
+    from fogdrift.evaluation.consistency import CoverageRow
+
+    def res(*infl):
+        rows = [CoverageRow(float(h), 100, 1.0, 1.0, {}, {"68 %": i}) for h, i in enumerate(infl, 1)]
+        return SimpleNamespace(axes={"gx": {"rows": rows}})
+
+    assert "no inflation needed: the model covers" in verdict_line(res((0.8, 0.6, 1.0), (0.9, 0.7, 1.1)), "gx")
+    assert "within counting error" in verdict_line(res((1.3, 0.9, 1.8), (0.9, 0.7, 1.1)), "gx")
+    line = verdict_line(res((1.2, 1.05, 1.4), (1.6, 0.9, 2.5)), "gx")
+    assert "inflate the variances by λ = 1.6 (2 s" in line and "beyond counting error at 1 s" in line
+    assert "multiply N, K, σ by 1.26" in line

@@ -92,21 +92,29 @@ def _lam_cell(t) -> str:
 
 
 def verdict_line(res, axis: str) -> str:
-    """One sentence per target and axis: the inflation the user needs, or that none is needed."""
+    """One sentence per target and axis: the inflation the user needs, or that none is needed.
+
+    Inflation is needed when some horizon and band under-covers beyond counting error (the 95 % interval of its
+    λ lies above 1); the factor to use is then the largest λ over horizons and bands (nominal coverage at every
+    one).  Otherwise: "no inflation needed" (every λ <= 1) or "... within counting error"."""
     rows = res.axes[axis]["rows"]
-    worst = max(((*row.inflation[b], row.horizon_s, b, row.n_origins) for row in rows
-                 for b in row.inflation if math.isfinite(row.inflation[b][0])), default=None)
-    if worst is None:
+    cells = [(*row.inflation[b], row.horizon_s, b, row.n_origins) for row in rows for b in row.inflation
+             if math.isfinite(row.inflation[b][0])]
+    if not cells:
         return f"{axis}: too few origins to count"
-    lam, lo, hi, h, band, n = worst
+    lam, lo, hi, h, band, n = max(cells)
     if lam <= 1.0:
         return (f"{axis}: no inflation needed: the model covers at least nominally at every horizon (largest "
                 f"λ {_fmt(lam)} at {h:g} s, {band} band)")
-    if not (lo > 1.0):
-        return (f"{axis}: no inflation needed within counting error: the largest λ {_fmt(lam)} ({h:g} s, {band} "
-                f"band, {n} origins) has a 95 % interval reaching 1 ({_fmt(lo)})")
-    return (f"{axis}: inflate the variances by λ = {_fmt(lam)} (95 % [{_fmt(lo)}, {_fmt(hi)}], "
-            f"{n} origins, {h:g} s, {band} band): multiply N, K, σ by {_fmt(math.sqrt(lam))}")
+    significant = [c for c in cells if c[1] > 1.0]
+    if not significant:
+        return (f"{axis}: no inflation needed within counting error: every λ's 95 % interval reaches 1 (largest "
+                f"λ {_fmt(lam)} at {h:g} s, {band} band, {n} origins, interval from {_fmt(lo)})")
+    sig = max(significant, key=lambda c: c[1])
+    where = "" if sig[3:5] == (h, band) else (f"; beyond counting error at {sig[3]:g} s, {sig[4]} band: λ "
+                                              f"{_fmt(sig[0])} [{_fmt(sig[1])}, {_fmt(sig[2])}]")
+    return (f"{axis}: inflate the variances by λ = {_fmt(lam)} ({h:g} s, {band} band, 95 % [{_fmt(lo)}, "
+            f"{_fmt(hi)}], {n} origins{where}): multiply N, K, σ by {_fmt(math.sqrt(lam))}")
 
 
 def print_result(res, label: str, kinds=None) -> None:
