@@ -448,3 +448,20 @@ def test_a_bomb_through_the_cli_is_one_line_naming_the_variable(tmp_path, monkey
     assert lines(result.output) == [ln for ln in lines(result.output) if ln.startswith("error:")]
     assert len(lines(result.output)) == 1 and f"error: {p}: gzip content exceeds" in result.output
     assert "FOGDRIFT_MAX_EXPANSION" in result.output and not out.exists()
+
+
+def test_the_line_by_line_scan_packs_rows_in_blocks_and_keeps_every_row(tmp_path):
+    # a non-numeric cell in an unused column sends the file through the line-by-line scan (rows packed into float64
+    # blocks of 65536): 70 001 rows cross a block boundary; every value and every line number must survive it
+    n = 70_001
+    gx = np.arange(n, dtype=np.float64) * 0.5
+    body = "".join(f"{i * 0.01:.2f},{float(gx[i])!r},{'x' if i == 3 else 1}\n" for i in range(n))
+    p = tmp_path / "scan.csv"
+    p.write_text("# a comment line\nt_s,gx,note\n" + body)
+    rec = load(p, columns="gx", unit="deg/h")
+    assert rec.n_samples == n
+    np.testing.assert_array_equal(rec.rate_dph[:, 0], gx)
+    bad = tmp_path / "scan_bad.csv"
+    bad.write_text("t_s,gx,note\n" + body + f"{n * 0.01:.2f},oops,1\n")
+    with pytest.raises(DataFormatError, match=rf"scan_bad\.csv:{n + 2}:gx: non-numeric value"):
+        load(bad, columns="gx", unit="deg/h")
