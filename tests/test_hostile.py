@@ -465,3 +465,18 @@ def test_the_line_by_line_scan_packs_rows_in_blocks_and_keeps_every_row(tmp_path
     bad.write_text("t_s,gx,note\n" + body + f"{n * 0.01:.2f},oops,1\n")
     with pytest.raises(DataFormatError, match=rf"scan_bad\.csv:{n + 2}:gx: non-numeric value"):
         load(bad, columns="gx", unit="deg/h")
+
+
+def test_matlab_v73_variable_declaring_gigabytes_is_refused_before_reading(tmp_path):
+    h5py = pytest.importorskip("h5py")
+    p = tmp_path / "bomb.mat"
+    with h5py.File(p, "w", userblock_size=512) as f:
+        ds = f.create_dataset("gx", shape=(1, 1 << 29), dtype="<f8", chunks=(1, 1 << 20), compression="gzip")
+        ds.attrs["MATLAB_class"] = b"double"         # 4 GiB declared, no chunk written: a few KB on disk
+    with open(p, "r+b") as fh:
+        fh.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64".ljust(128, b" "))
+    assert p.stat().st_size < 64 << 10
+    with pytest.raises(ResourceLimitError) as ei:
+        load(p, unit="deg/h", rate_hz=100.0)
+    assert str(ei.value).startswith(f"{p}: ") and ("FOGDRIFT_MAX_EXPANSION" in str(ei.value)
+                                                   or "FOGDRIFT_MAX_MEMORY" in str(ei.value))

@@ -113,6 +113,7 @@ def _load_v5(p: Path) -> dict:
 
 def _load_v73(p: Path) -> dict:
     h5py = require("h5py", "hdf5", "reading MATLAB v7.3 (.mat, HDF5-based) files")
+    size, declared = p.stat().st_size, [0]
 
     def convert(obj):
         if isinstance(obj, h5py.Group):
@@ -122,12 +123,18 @@ def _load_v73(p: Path) -> dict:
         if cls in ("char", "cell", "function_handle") or obj.dtype.kind not in "biuf" or obj.attrs.get(
                 "MATLAB_empty", 0):
             return np.asarray([], dtype=object)  # left out by the layout rule
+        # every variable is read at open: its declared size is checked first (a compressed dataset can claim GBs)
+        check_memory(obj.size * 8.0, p, f"variable {obj.name!r} {tuple(obj.shape)[::-1]} as float64")
+        declared[0] += obj.size * obj.dtype.itemsize
+        check_expansion(declared[0], size, p, "the MATLAB v7.3 file's variables")
         arr = np.asarray(obj[()]).T            # MATLAB is column-major: HDF5 holds the transpose
         return arr.reshape(-1) if arr.ndim == 2 and 1 in arr.shape else arr
 
     try:
         with h5py.File(p, "r") as fh:
             return {k: convert(fh[k]) for k in fh if not k.startswith("#")}
+    except DataFormatError:  # a reading limit (a ValueError too): as it is
+        raise
     except PARSER_ERRORS as exc:
         raise DataFormatError(
             f"unreadable MATLAB v7.3 file; expected HDF5 data after the MATLAB header, got {describe_exception(exc)}",
