@@ -480,3 +480,16 @@ def test_matlab_v73_variable_declaring_gigabytes_is_refused_before_reading(tmp_p
         load(p, unit="deg/h", rate_hz=100.0)
     assert str(ei.value).startswith(f"{p}: ") and ("FOGDRIFT_MAX_EXPANSION" in str(ei.value)
                                                    or "FOGDRIFT_MAX_MEMORY" in str(ei.value))
+
+
+def test_hdf5_dataset_declaring_gigabytes_is_refused_before_reading(tmp_path, monkeypatch):
+    h5py = pytest.importorskip("h5py")
+    monkeypatch.setenv(limits.ENV_MEMORY, "0")   # the expansion limit alone, whatever this machine's memory
+    p = tmp_path / "bomb.h5"
+    with h5py.File(p, "w") as f:
+        f.create_dataset("gx", shape=(1 << 29,), dtype="<f8", chunks=(1 << 20,), compression="gzip")
+    assert p.stat().st_size < 64 << 10
+    with pytest.raises(ResourceLimitError) as ei:
+        load(p, unit="deg/h", rate_hz=100.0)
+    assert str(ei.value).startswith(f"{p}: the arrays of 1 used column(s): 4 GiB declared in a ")
+    assert "refused before decompressing" in str(ei.value)
