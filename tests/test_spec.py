@@ -150,3 +150,20 @@ def test_estimate_in_a_foreign_unit_is_cannot_tell_not_a_crash():
     j = judge(lim, Reading(2.4, 2.3, 2.5, "deg/sqrt(h)"))
     assert j.verdict == "cannot tell" and "not a accel vrw unit" in j.reason
     assert convert(0.3, "(m/s)/sqrt(h)", "accel", "vrw") == pytest.approx(0.3)
+
+
+def test_readings_from_a_real_gmwm_fit():
+    """GMWM on simulated white noise of N = 1 deg/sqrt(h): the N reading holds 1 within its interval, and B_min is
+    a reading (a value or an upper bound), judged without error."""
+    import numpy as np
+
+    from fogdrift.gmwm.analysis import analyse_gmwm
+    from fogdrift.spec import readings_from_gmwm
+
+    dt = 0.1
+    y = np.random.default_rng(5).normal(0.0, 60.0 / dt**0.5, 50_000)
+    r = readings_from_gmwm(analyse_gmwm("gx", y, dt))
+    assert r["arw"].lo95 < 1.0 < r["arw"].hi95 and r["arw"].unit == "deg/sqrt(h)"
+    spec = parse_spec({"gyro": {"arw": "1.5 deg/sqrt(h)", "bias_instability": "1000 deg/h"}})
+    got = {j.limit.item: j.verdict for j in compare(spec, {"gx": ("gyro", r)})}
+    assert got["arw"] == "pass" and got["bias_instability"] in ("pass", "cannot tell")
