@@ -121,3 +121,17 @@ def test_verdict_line_rules():
     line = verdict_line(res((1.2, 1.05, 1.4), (1.6, 0.9, 2.5)), "gx")
     assert "inflate the variances by λ = 1.6 (2 s" in line and "beyond counting error at 1 s" in line
     assert "multiply N, K, σ by 1.26" in line
+
+
+def test_summary_cell_follows_the_verdict_rule():
+    from types import SimpleNamespace
+
+    from fogdrift.cli.consistency import summary_cell
+    from fogdrift.evaluation.consistency import CoverageRow
+
+    def res(*infl):
+        rows = [CoverageRow(float(h), 100, 1.0, 1.0, {}, {"68 %": i}) for h, i in enumerate(infl, 1)]
+        return SimpleNamespace(axes={"gx": {"rows": rows}})
+
+    assert summary_cell(res((1.3, 0.9, 1.8)), "gx") == "none (largest 1.3)"
+    assert summary_cell(res((1.2, 1.05, 1.4), (1.6, 0.9, 2.5)), "gx") == "1.6 [0.9, 2.5]"

@@ -117,6 +117,19 @@ def verdict_line(res, axis: str) -> str:
             f"{_fmt(hi)}], {n} origins{where}): multiply N, K, σ by {_fmt(math.sqrt(lam))}")
 
 
+def summary_cell(res, axis: str) -> str:
+    """``1.67 [1.14, 2.46]`` when inflation is needed (the rule of :func:`verdict_line`), else ``none (largest
+    1.19)``."""
+    cells = [(*row.inflation[b],) for row in res.axes[axis]["rows"] for b in row.inflation
+             if math.isfinite(row.inflation[b][0])]
+    if not cells:
+        return "–"
+    lam, lo, hi = max(cells)
+    if lam <= 1.0 or not any(c[1] > 1.0 for c in cells):
+        return f"none (largest {_fmt(lam)})"
+    return f"{_fmt(lam)} [{_fmt(lo)}, {_fmt(hi)}]"
+
+
 def print_result(res, label: str, kinds=None) -> None:
     """The coverage table of one target model and its verdict lines (angle error in deg for gyro axes, velocity
     error in m/s for accelerometer axes)."""
@@ -269,6 +282,12 @@ def consistency(
             res.notes = [f"{a}: {'; '.join(n)}" for a, n in notes.items() if n]
             print_result(res, label, kinds)
             results.append((res, label))
+        if results:
+            axes = list(results[0][0].axes)
+            console.print(fitted_table(
+                "inflation factor per target model: the largest λ over horizons and bands (95 % interval); "
+                "'none' when no row under-covers beyond counting error",
+                ["target"] + axes, [[res.target] + [summary_cell(res, a) for a in axes] for res, _ in results]))
         for axis, d in covering.items():
             say(f"{axis}: {d['sentence']}")
         payload = {"fogdrift_result": "consistency", "training": str(load.file), "quantities": kinds,
