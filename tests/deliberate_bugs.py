@@ -50,14 +50,13 @@ BUGS = [
      "                a.bias_out_dph = float(level[k])\n",
      ["tests/test_compensate_io.py", "-k", "earth_rate"]),
     ("compensate: the declared unit labels numbers read in the --unit given (output header/unit wrong)",
-     "src/fogdrift/compensate/sources.py",
-     "    return LogSource(path=Path(rec.source), axis_names=rec.axis_names, unit=rec.input_unit,",
-     "    return LogSource(path=Path(rec.source), axis_names=rec.axis_names, unit=declared or rec.input_unit,",
+     "src/fogdrift/compensate/sources.py", "        return self.signal.channels[0].unit_as_read\n",
+     "        return self.declared_unit or self.signal.channels[0].unit_as_read\n",
      ["tests/test_compensate_io.py", "-k", "another_unit"]),
-    ("compensate: the .npy reader's scale not carried to the writers (deg/s written as deg/h)",
-     "src/fogdrift/compensate/sources.py", "                     scale_to_dph=src.scale_to_dph, dt_s=src.dt_s,",
-     "                     scale_to_dph=1.0, dt_s=src.dt_s,",
-     ["tests/test_compensate_io.py", "-k", "npy_stream"]),
+    ("compensate: writers divide by the unit's factor, not the reader's scale (an increment unit ignores dt)",
+     "src/fogdrift/compensate/run.py", "    scale = match.scale_to_dph  #",
+     "    scale = source.signal.channels[0].unit.factor  #",
+     ["tests/test_compensate_io.py", "-k", "increment"]),
 ]
 
 

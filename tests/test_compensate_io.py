@@ -93,14 +93,19 @@ def test_unit_on_a_log_that_declares_another_unit(bundle, tmp_path):
 
 
 def test_increment_unit_scale_is_carried_from_the_reader(bundle, tmp_path):
-    """inc:arcsec per 1-s sample = arcsec/s = deg/h: the reader's scale (1/3600 * 3600 = 1 deg/h per arcsec/s) is the
-    one the output divides by."""
+    """inc:arcsec per 0.1-s sample: 5 arcsec per sample = 50 arcsec/s = 50 deg/h (1 arcsec/s = 3600 arcsec/h =
+    1 deg/h), so the reader's factor is 1 / 0.1 s = 10 deg/h per (arcsec per sample), and the output, in the log's
+    unit, divides by that same factor: 5 - b / 10."""
     b = load_bundle(bundle).axis("gz").bias_dph
-    v = np.full(300, 50.0)  # 50 arcsec per second = 50 deg/h
-    log = _csv(tmp_path / "inc.csv", "t_s,gz", v)
-    res = compensate_file(bundle, log, tmp_path / "o", **_kw(unit="inc:arcsec"))
-    assert res.summary["scale_to_dph"] == pytest.approx(1.0, rel=1e-15)
-    np.testing.assert_allclose(_read(tmp_path / "o")["compensated"][:, 0], 50.0 - b, atol=1e-12)
+    v = np.full(3000, 5.0)
+    log = _csv(tmp_path / "inc.csv", "t_s,gz", v, dt=0.1)
+    res = compensate_file(bundle, log, tmp_path / "o", **_kw(unit="inc:arcsec", accept_rate=True))
+    assert res.summary["scale_to_dph"] == pytest.approx(10.0, rel=1e-12)
+    assert res.summary["block_average_factor"] == 10
+    chan = res.summary["signal"]["channels"][0]
+    assert chan["unit_as_read"] == "inc:arcsec" and chan["unit_source"] == "option"
+    assert res.summary["signal"]["sampling"]["dt_source"] == "time column"
+    np.testing.assert_allclose(_read(tmp_path / "o")["compensated"][:, 0], 5.0 - b / 10.0, atol=1e-12)
 
 
 def test_bias_re_estimated_under_a_bundle_that_removed_the_earth_rate(bundle, tmp_path):

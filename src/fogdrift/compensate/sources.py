@@ -34,6 +34,7 @@ from ..errors import ConfigError, DataFormatError
 from ..io import decimation_factor, load
 from ..io._checks import check_path
 from ..io.chunked import open_rows
+from ..signal import SignalDescription
 
 __all__ = ["LogSource", "open_log", "match_log", "LogMatch", "DEFAULT_CHUNK"]
 
@@ -45,36 +46,57 @@ DEFAULT_CHUNK = 1 << 20
 class LogSource:
     """A log opened for chunked reading, its numbers converted to deg/h once by the reader.
 
+    The facts about its numbers are the reader's :class:`~fogdrift.signal.SignalDescription` (made once by
+    :func:`fogdrift.io.load` or :func:`fogdrift.io.chunked.open_rows`); the properties below read them back.
+
     Attributes
     ----------
     path : Path
-    axis_names : tuple of str
-    unit : str
-        Unit of the file's numbers: the one given, else the one the file declares.
-    unit_given : bool
-        True when ``unit`` was given (not declared by the file).
-    declared_unit : str or None
-        Unit the file declares for its rate columns (None: none).
-    scale_to_dph : float
-        Factor the reader applied to the file's numbers (``unit`` to deg/h).
-    dt_s, t0_s : float
+    signal : fogdrift.signal.SignalDescription
+        Sampling (interval, where it came from) and channels (unit as read, where it came from, the unit the file
+        declares, the factor to deg/h).
+    t0_s : float
     n_samples : int
     sha256 : str or None
     notes : list of str
     """
 
     path: Path
-    axis_names: tuple
-    unit: str
-    unit_given: bool
-    declared_unit: str | None
-    scale_to_dph: float
-    dt_s: float
+    signal: SignalDescription
     t0_s: float
     n_samples: int
     sha256: str | None
     notes: list = field(default_factory=list)
     _chunks: object = None
+
+    @property
+    def axis_names(self) -> tuple:
+        return self.signal.names
+
+    @property
+    def dt_s(self) -> float:
+        """Sample interval [s]."""
+        return self.signal.sampling.dt_s
+
+    @property
+    def unit(self) -> str:
+        """Unit of the file's numbers: the one given, else the one the file declares."""
+        return self.signal.channels[0].unit_as_read
+
+    @property
+    def unit_given(self) -> bool:
+        """True when the unit came from the ``unit`` option (not from the file)."""
+        return self.signal.channels[0].unit_source == "option"
+
+    @property
+    def declared_unit(self) -> str | None:
+        """Unit the file declares for its rate columns (None: none)."""
+        return _one_declared([c.declared_unit for c in self.signal.channels], self.path)
+
+    @property
+    def scale_to_dph(self) -> float:
+        """Factor the reader applied to the file's numbers (unit to deg/h)."""
+        return self.signal.channels[0].scale_to_internal
 
     def chunks(self, chunk_samples: int = DEFAULT_CHUNK):
         """Yield ``(t_s (n,), rate_dph (n, n_axes))`` in order, ``chunk_samples`` rows at a time."""
@@ -95,23 +117,20 @@ def _streamed(path, load_kwargs) -> LogSource:
     src = open_rows(path, columns=load_kwargs.get("columns"), time_column=load_kwargs.get("time_column", "auto"),
                     rate_hz=load_kwargs.get("rate_hz"), time_unit=load_kwargs.get("time_unit"),
                     unit=load_kwargs.get("unit"))
-    return LogSource(path=src.path, axis_names=src.axis_names, unit=src.unit, unit_given=True, declared_unit=None,
-                     scale_to_dph=src.scale_to_dph, dt_s=src.dt_s, t0_s=src.t0_s, n_samples=src.n_samples,
-                     sha256=src.sha256, notes=list(src.notes), _chunks=src.chunks)
+    return LogSource(path=src.path, signal=src.signal, t0_s=src.t0_s, n_samples=src.n_samples, sha256=src.sha256,
+                     notes=list(src.notes), _chunks=src.chunks)
 
 
 def _loaded(path, load_kwargs) -> LogSource:
     rec = load(path, **load_kwargs)
-    declared = _one_declared(rec.declared_units, rec.source)
+    _one_declared(rec.declared_units, rec.source)
 
     def chunks(chunk):
         for lo in range(0, rec.n_samples, chunk):
             hi = min(rec.n_samples, lo + chunk)
             yield rec.t0_s + np.arange(lo, hi) * rec.dt_s, rec.rate_dph[lo:hi]
 
-    return LogSource(path=Path(rec.source), axis_names=rec.axis_names, unit=rec.input_unit,
-                     unit_given=load_kwargs.get("unit") is not None, declared_unit=declared,
-                     scale_to_dph=rec.scale_to_dph, dt_s=rec.dt_s, t0_s=rec.t0_s, n_samples=rec.n_samples,
+    return LogSource(path=Path(rec.source), signal=rec.signal, t0_s=rec.t0_s, n_samples=rec.n_samples,
                      sha256=rec.sha256, notes=list(rec.notes), _chunks=chunks)
 
 

@@ -19,6 +19,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import ConfigError, DataFormatError
+from ..signal import Channel, Sampling, SignalDescription
 from ..units import TIME_UNITS, check_dt_s, parse_unit, valid_units
 from ._checks import check_path
 from .hashing import file_sha256
@@ -311,6 +312,9 @@ class RowSource:
         Factor from ``unit`` to deg/h, applied once by :meth:`chunks`.
     sha256 : str
         SHA-256 of the file's bytes.
+    signal : fogdrift.signal.SignalDescription
+        The sampling (interval and where it came from) and the channels (unit as given, its factor), made here
+        once.
     notes : list of str
     """
 
@@ -323,6 +327,7 @@ class RowSource:
     declared_units: tuple
     scale_to_dph: float
     sha256: str
+    signal: SignalDescription
     notes: list = field(default_factory=list)
     _reader: Callable = field(repr=False, default=None)
 
@@ -518,6 +523,12 @@ def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None
                             f"{100 * DT_TOLERANCE:g} %", path=p, column=tcol)
             yield t, x
 
-    return RowSource(path=p, axis_names=tuple(f"col{j}" for j in r_idx), n_samples=rows, dt_s=dt, t0_s=t0,
-                     unit=spec.text, declared_units=(None,) * len(r_idx), scale_to_dph=scale, sha256=file_sha256(p),
+    names = tuple(f"col{j}" for j in r_idx)
+    sampling = Sampling(dt_s=dt, dt_source="rate option" if t_idx is None else "time column",
+                        time_column=None if t_idx is None else tcol, time_unit=None if t_idx is None else (time_unit or "s"),
+                        time_unit_source=None if t_idx is None else ("option" if time_unit else None))
+    signal = SignalDescription(sampling=sampling, channels=tuple(
+        Channel(name=n, unit=spec, unit_source="option", declared_unit=None, scale_to_internal=scale) for n in names))
+    return RowSource(path=p, axis_names=names, n_samples=rows, dt_s=dt, t0_s=t0, unit=spec.text,
+                     declared_units=(None,) * len(r_idx), scale_to_dph=scale, sha256=file_sha256(p), signal=signal,
                      notes=notes, _reader=reader)
