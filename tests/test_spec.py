@@ -167,3 +167,22 @@ def test_readings_from_a_real_gmwm_fit():
     spec = parse_spec({"gyro": {"arw": "1.5 deg/sqrt(h)", "bias_instability": "1000 deg/h"}})
     got = {j.limit.item: j.verdict for j in compare(spec, {"gx": ("gyro", r)})}
     assert got["arw"] == "pass" and got["bias_instability"] in ("pass", "cannot tell")
+
+
+def test_accel_fit_with_gyro_labels_is_read_in_place_of_deg_h():
+    """An accelerometer fit whose terms carry deg/sqrt(h) and deg/h labels holds m/s^2 in place of deg/h:
+    N 1e-4 '(deg/h) sqrt(h)' = 1e-4 (m/s^2) sqrt(h) = 0.36 m/s/sqrt(h); B 0.003 'deg/h' = 0.003 m/s^2 = 0.306 mg."""
+    n = SimpleNamespace(value=1e-4, lo95=0.9e-4, hi95=1.1e-4, unit="deg/sqrt(h)", status="resolved", estimable=True)
+    fit = SimpleNamespace(terms={"N": n}, no_fit=None,
+                          b_min={"value": 0.003, "unit": "deg/h", "tau_s": 20.0, "bound_only": False,
+                                 "lo95": 0.0025, "hi95": 0.0035})
+    r = readings_from_noise_fit(fit, "accel")
+    assert r["vrw"].unit == "m/s/sqrt(h)" and r["vrw"].value == pytest.approx(0.36)
+    assert r["bias_instability"].unit == "m/s^2" and r["bias_instability"].hi95 == pytest.approx(0.0035)
+    spec = parse_spec({"accel": {"vrw": "0.2 m/s/sqrt(h)", "bias_instability": "0.2 mg"}})
+    got = {j.limit.item: j.verdict for j in compare(spec, {"ax": ("accel", r)})}
+    assert got == {"vrw": "fail", "bias_instability": "fail"}  # 0.32-0.40 > 0.2; 0.25-0.36 mg > 0.2 mg
+    # already accelerometer units: kept as they are
+    n2 = SimpleNamespace(value=0.3, lo95=0.25, hi95=0.35, unit="m/s/sqrt(h)", status="resolved", estimable=True)
+    fit2 = SimpleNamespace(terms={"N": n2}, no_fit=None, b_min={})
+    assert readings_from_noise_fit(fit2, "accel")["vrw"].value == 0.3

@@ -343,6 +343,26 @@ def readings_from_noise_fit(noise, kind: str = "gyro") -> dict:
         else:
             out["bias_instability"] = Reading(b["value"], b.get("lo95"), b.get("hi95"), b.get("unit", "deg/h"), None,
                                               f"B_min{at}")
+    return _accel_in_place_of_deg_h(out) if kind == "accel" else out
+
+
+#: An accelerometer fit whose terms still carry the gyro unit labels holds m/s^2 in place of deg/h (the internal unit
+#: of a specific force): deg/sqrt(h) = (deg/h) sqrt(h) -> (m/s^2) sqrt(h) = 3600 m/s/sqrt(h); deg/h -> m/s^2.
+_GYRO_LABEL_AS_ACCEL = {"deg/sqrt(h)": (3600.0, "m/s/sqrt(h)"), "deg/h": (1.0, "m/s^2")}
+
+
+def _accel_in_place_of_deg_h(readings: dict) -> dict:
+    """Re-read gyro-labelled readings of an accelerometer channel in m/s^2 units (a label that is already an
+    accelerometer unit is kept)."""
+    out = {}
+    for item, r in readings.items():
+        key = None if r is None else _norm_unit(r.unit)
+        if key not in _GYRO_LABEL_AS_ACCEL:
+            out[item] = r
+            continue
+        f, unit = _GYRO_LABEL_AS_ACCEL[key]
+        out[item] = Reading(*(None if x is None else x * f for x in (r.value, r.lo95, r.hi95)), unit, r.bound,
+                            r.label + f" (fit labelled {r.unit}: m/s^2 in place of deg/h)")
     return out
 
 
@@ -359,7 +379,7 @@ def readings_from_gmwm(axis, kind: str = "gyro") -> dict:
         out["bias_instability"] = Reading(b.value_dph, b.lo95_dph, b.hi95_dph, "deg/h", None, f"B_min{at} (GMWM)")
     elif b.bound_dph is not None:
         out["bias_instability"] = Reading(b.bound_dph, None, None, "deg/h", "upper", f"B_min, an upper bound ({b.reason})")
-    return out
+    return _accel_in_place_of_deg_h(out) if kind == "accel" else out
 
 
 def compare(spec: dict, channels: dict) -> list[Judgement]:
