@@ -209,6 +209,19 @@ def _write_error(folder: Path, rel: str, exc: OSError, left: str) -> FogdriftErr
     return ConfigError(f"{{opt:out}} {folder}: cannot write {rel}: {why}; {left}; choose another folder")
 
 
+def _out_of_memory(exc: BaseException) -> bool:
+    """A MemoryError, or an error caused by one: ENOMEM, a shared library that could not be mapped (a lazy import
+    of numba's LLVM under a memory limit raises OSError 'failed to map segment from shared object')."""
+    seen = 0
+    while exc is not None and seen < 8:
+        if isinstance(exc, MemoryError) or getattr(exc, "errno", None) == errno.ENOMEM:
+            return True
+        if isinstance(exc, OSError) and "failed to map segment" in str(exc):
+            return True
+        exc, seen = exc.__cause__ or exc.__context__, seen + 1
+    return False
+
+
 class _FolderLock:
     """Exclusive, non-blocking ``flock`` on ``folder/LOCK``; the holder's description is written into the file.
 
@@ -327,12 +340,11 @@ class OutputDir:
             _active.remove(self)
             self._folder_lock.release()
         if exc is not None and not check_requested():
-            if isinstance(exc, MemoryError):
+            if _out_of_memory(exc):
                 inputs = ", ".join(sorted(str(p) for p in self.protect)) or "its input"
                 raise ResourceError(
-                    f"out of memory in 'fogdrift {self.command}' on {inputs}; {self.summary()}; run it on a "
-                    "machine with more memory, or on a shorter log (limit what a reader may take with the "
-                    "environment variable FOGDRIFT_MAX_MEMORY)") from exc
+                    f"out of memory in 'fogdrift {self.command}' on {inputs}; {self.summary()}; run it with more "
+                    "memory (a process limit: ulimit -v), or on a shorter log") from exc
             if isinstance(exc, OSError) and not isinstance(exc, FogdriftError) and exc.errno in _NO_ROOM:
                 raise _write_error(self.path, getattr(exc, "filename", None) or "a file", exc,
                                    self.summary()) from exc

@@ -7,11 +7,12 @@ computed by reading it once in chunks (the memory map itself reads nothing up fr
 
 from __future__ import annotations
 
+import errno
 from pathlib import Path
 
 import numpy as np
 
-from ...errors import DataFormatError
+from ...errors import DataFormatError, ResourceError
 from ..hashing import file_sha256
 from .base import PARSER_ERRORS, Table, describe_exception, numeric_column
 from .limits import check_memory
@@ -33,6 +34,9 @@ def open_table(path: Path) -> Table:
     try:
         arr = np.load(p, mmap_mode="r", allow_pickle=False)
     except PARSER_ERRORS as exc:
+        if isinstance(exc, MemoryError) or getattr(exc, "errno", None) == errno.ENOMEM:
+            raise ResourceError(f"{p}: not enough memory to map the .npy file ({describe_exception(exc)}); run it "
+                                "with more memory (a process limit: ulimit -v)") from exc
         raise DataFormatError(
             f"unreadable .npy file; expected a numeric NumPy array, got {describe_exception(exc)}", path=p
         ) from exc
