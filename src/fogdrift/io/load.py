@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import units
+from .channel_quantity import UnitChoice, check_name, parse_unit_choice
 from ..errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
 from ..signal import Channel, Sampling, SignalDescription
 from ._checks import (
@@ -245,7 +246,7 @@ class _Options:
     columns: object
     time_column: object
     dt_s: float | None          # from dt_s or rate_hz
-    unit: units.UnitSpec | None  # parsed once here
+    unit: UnitChoice | None  # parsed once here (one unit, or one per quantity / column)
     time_unit: str | None
     split: bool
     min_samples: int
@@ -257,7 +258,7 @@ class _Options:
 def _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
              reader_options, temperature=None) -> _Options:
     """Validate every option before the file is touched."""
-    spec = None if unit is None else units.parse_unit(unit)
+    spec = None if unit is None else parse_unit_choice(unit)
     if time_unit is not None and time_unit not in units.TIME_UNITS:
         raise ConfigError(f"unknown time unit {time_unit!r}; expected one of {list(units.TIME_UNITS)}")
     if isinstance(min_samples, bool) or not isinstance(min_samples, (int, np.integer)) or min_samples < 1:
@@ -340,8 +341,8 @@ def _load_records(path, opts: _Options) -> list[GyroRecord]:
             "name one with {opt:time_column}) and no sample rate given; pass the sample rate in Hz as {opt:rate_hz}"
         )
     notes = []
-    spec, unit_source = _rate_unit(table, r_idx, opts.unit, notes)
-    unit = spec.text
+    specs, unit_source = _rate_unit(table, r_idx, opts.unit, notes)
+    unit = _unit_text(table, r_idx, specs)
     t_scale, time_unit = _time_scale(table, t_idx, opts.time_unit, notes)
     temp_offset = _temperature_offset(table, tm_idx, notes)
 
@@ -394,12 +395,17 @@ def _load_records(path, opts: _Options) -> list[GyroRecord]:
     sampling = Sampling(dt_s=dt, dt_source=dt_source, time_column=None if t_idx is None else table.names[t_idx],
                         time_unit=time_unit,
                         time_unit_source=None if time_unit is None else ("option" if opts.time_unit else "header"))
-    scale = spec.scale_to_internal(dt)
-    if scale != 1.0:
-        notes.append(f"input unit {unit!r} scaled by {scale:.10g} to deg/h")
+    scales = [sp.scale_to_internal(dt) for sp in specs]
+    if len({(sp.text, sc) for sp, sc in zip(specs, scales)}) == 1:
+        if scales[0] != 1.0:
+            notes.append(f"input unit {unit!r} scaled by {scales[0]:.10g} to {specs[0].internal_unit}")
+    else:
+        for j, sp, sc in zip(r_idx, specs, scales):
+            notes.append(f"input unit {sp.text!r} of {table.names[j]} scaled by {sc:.10g} to {sp.internal_unit}")
     signal = SignalDescription(sampling, tuple(
-        Channel(name=table.names[j], unit=spec, unit_source=unit_source, declared_unit=table.units[j],
-                scale_to_internal=scale) for j in r_idx))
+        Channel(name=table.names[j], unit=sp, unit_source=unit_source, declared_unit=table.units[j],
+                scale_to_internal=sc) for j, sp, sc in zip(r_idx, specs, scales)))
+    scale = scales[0] if len(set(scales)) == 1 else np.asarray(scales, dtype=np.float64)
     temp = None if tm_idx is None else (tm_idx, temp_offset)
     return _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes, opts.min_samples, temp,
                     signal)
@@ -434,7 +440,7 @@ def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes
                 continue
         raw = take_columns(data[a:b], r_idx)
         rate = to_dph(raw, scale)
-        if scale != 1.0:
+        if np.any(np.asarray(scale) != 1.0):
             bad = first_nonfinite(rate)
             if bad is not None:
                 i, j = bad
@@ -447,7 +453,8 @@ def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes
             temp_c = np.asarray(data[a:b, temp[0]], dtype=np.float64)
             temp_c = temp_c + temp[1] if temp[1] else temp_c.copy()
         records.append(GyroRecord(
-            rate_dph=rate, dt_s=dt, axis_names=names, source=str(p), input_unit=unit, scale_to_dph=scale,
+            rate_dph=rate, dt_s=dt, axis_names=names, source=str(p), input_unit=unit,
+            scale_to_dph=float(scale) if np.ndim(scale) == 0 else 1.0,
             t0_s=float(t[a]) if t is not None else 0.0, notes=tuple(seg_notes), sha256=sha256,
             declared_units=declared, temperature_c=temp_c, signal=signal,
         ))
@@ -540,43 +547,64 @@ def _header_error(table: Table, message: str, col: int) -> DataFormatError:
 
 
 def _rate_unit(table: Table, r_idx, unit, notes: list):
-    """(UnitSpec, "option" or "header") for the rate columns: the given unit, else the declared one; never a guess.
+    """([UnitSpec per rate column], "option" or "header"): the given unit, else the declared ones; never a guess.
 
-    ``unit`` is the option already parsed by :func:`fogdrift.units.parse_unit` (or None); a declared
-    unit is parsed here, once.
+    ``unit`` is the option already parsed by :func:`fogdrift.io.channel_quantity.parse_unit_choice` (or None); a
+    declared unit is parsed here, once, for any quantity.  Each channel's quantity is its unit's, checked against
+    what its name says (:mod:`fogdrift.io.channel_quantity`: an accelerometer-named channel in an angular-rate unit,
+    or the reverse, is refused in one line).
     """
     declared = {j: table.units[j] for j in r_idx}
     if unit is None and table.unit_hint and set(declared.values()) == {None}:
         raise ConfigError(f"{table.path}: {table.unit_hint} ({', '.join(valid_units())}; units are never guessed)")
     if unit is not None:
-        other = {table.names[j]: u for j, u in declared.items() if u is not None and u.strip() != unit.text}
+        specs = [unit.for_channel(table.names[j], str(table.path)) for j in r_idx]
+        other = {table.names[j]: declared[j] for j, sp in zip(r_idx, specs)
+                 if declared[j] is not None and declared[j].strip() != sp.text}
         if other:
             notes.append(f"the file declares {other}; unit {unit.text!r} given takes precedence")
-        return unit, "option"
+        return specs, "option"
     kinds = set(declared.values())
     if kinds == {None}:
         cols = [table.names[j] for j in r_idx]
         raise ConfigError(
             f"{table.path}: no rate unit: the file declares none for {', '.join(cols)}; pass {{opt:unit}} "
-            f"({', '.join(valid_units())}), or declare it in the header as {cols[0]}[deg/s] (units are never guessed)"
+            f"({', '.join(valid_units())}; accelerometers: {', '.join(units.valid_units('specific_force'))}; both: "
+            f"gyro=deg/s,accel=g), or declare it in the header as {cols[0]}[deg/s] (units are never guessed)"
         )
-    first = declared[r_idx[0]]
-    odd = next(j for j in r_idx if declared[j] != first) if len(kinds) > 1 else None
-    if odd is not None:
-        listing = {table.names[j]: u for j, u in declared.items()}
-        raise _header_error(
-            table, f"rate columns declare different units; expected one unit for all rate columns (choose them "
-                   f"with {{opt:columns}} or pass {{opt:unit}}), got {listing}", odd,
-        )
-    try:
-        spec = units.parse_unit(first)
-    except ConfigError:
-        raise _header_error(
-            table, f"unknown unit {first!r} declared in the header; expected one of {valid_units()} "
-                   f"(or pass {{opt:unit}}), got {first!r}", r_idx[0],
-        ) from None
-    notes.append(f"unit {first!r} declared in the file")
-    return spec, "header"
+    listing = {table.names[j]: u for j, u in declared.items()}
+    different = ("rate columns declare different units; expected one unit for all rate columns (choose them "
+                 f"with {{opt:columns}} or pass {{opt:unit}}), got {listing}")
+    missing = next((j for j in r_idx if declared[j] is None), None)
+    if missing is not None:
+        raise _header_error(table, different, missing)
+    specs, first_of = [], {}
+    for j in r_idx:
+        try:
+            spec = units.parse_unit(declared[j].strip(), None)
+        except ConfigError:
+            raise _header_error(
+                table, f"unknown unit {declared[j]!r} declared in the header; expected one of {valid_units()} "
+                       f"(or pass {{opt:unit}}), got {declared[j]!r}", j,
+            ) from None
+        check_name(table.names[j], spec, f"the unit {declared[j]!r} declared in the header", str(table.path))
+        # one unit per quantity: a gyro+accelerometer log may declare gx[deg/s] and ax[g], not gx[deg/s], gy[rad/s]
+        if first_of.setdefault(spec.quantity, spec.text) != spec.text:
+            raise _header_error(table, different, j)
+        specs.append(spec)
+    if len(kinds) == 1:
+        notes.append(f"unit {declared[r_idx[0]]!r} declared in the file")
+    else:
+        notes.append(f"units {', '.join(f'{table.names[j]}[{declared[j]}]' for j in r_idx)} declared in the file")
+    return specs, "header"
+
+
+def _unit_text(table: Table, r_idx, specs) -> str:
+    """The record's ``input_unit``: the one unit, or ``name=unit,...`` when the channels differ."""
+    texts = [sp.text for sp in specs]
+    if len(set(texts)) == 1:
+        return texts[0]
+    return ",".join(f"{table.names[j]}={t}" for j, t in zip(r_idx, texts))
 
 
 def _temperature_offset(table: Table, tm_idx, notes: list) -> float:

@@ -34,7 +34,8 @@ class GyroRecord:
     Parameters
     ----------
     rate_dph : ndarray, shape (n_samples, n_axes), float64
-        Angular rate in deg/h.  Stored as a read-only view (possibly of a memory map): copy
+        Angular rate in deg/h; an accelerometer channel (quantity ``"specific_force"`` in :attr:`signal`) holds
+        its specific force in m/s^2 here (the name is historical; :attr:`data_internal` is the same array).  Stored as a read-only view (possibly of a memory map): copy
         it before modifying.
     dt_s : float
         Sample interval in s (> 0).
@@ -137,9 +138,20 @@ class GyroRecord:
         else:
             self._check_signal()
 
+    @property
+    def data_internal(self) -> np.ndarray:
+        """:attr:`rate_dph` under the name that says what it holds: each channel in its quantity's internal unit
+        (deg/h for a gyro channel, m/s^2 for an accelerometer channel, :attr:`quantities`)."""
+        return self.rate_dph
+
+    @property
+    def quantities(self) -> tuple[str, ...]:
+        """Each channel's quantity (``"angular_rate"`` or ``"specific_force"``), from :attr:`signal`."""
+        return tuple(c.quantity for c in self.signal.channels)
+
     def _default_signal(self) -> SignalDescription:
         """The description of a record built from its fields (no file: every source is "argument")."""
-        spec = units.parse_unit(self.input_unit)
+        spec = units.parse_unit(self.input_unit, None)
         sampling = Sampling(dt_s=self.dt_s, dt_source="argument", block_average_factor=self.block_average_factor)
         return SignalDescription(sampling, tuple(
             Channel(name=n, unit=spec, unit_source="argument", declared_unit=d, scale_to_internal=self.scale_to_dph)
@@ -157,11 +169,16 @@ class GyroRecord:
             bad.append(f"block_average_factor {smp.block_average_factor} vs {self.block_average_factor}")
         if sig.names != self.axis_names:
             bad.append(f"channels {list(sig.names)} vs axes {list(self.axis_names)}")
+        mixed = len({(c.unit_as_read, c.scale_to_internal) for c in sig.channels}) > 1
         for c, d in zip(sig.channels, self.declared_units):
-            if c.quantity != "angular_rate" or c.unit_as_read != self.input_unit.strip() \
-                    or c.scale_to_internal != self.scale_to_dph or c.declared_unit != d:
+            # one unit for all channels: the legacy fields are that unit and its factor; channels of different
+            # units (a gyro+accelerometer log): input_unit lists name=unit and scale_to_dph is 1 (no one factor)
+            unit_ok = (f"{c.name}={c.unit_as_read}" in self.input_unit.split(",")) if mixed \
+                else c.unit_as_read == self.input_unit.strip()
+            scale_ok = self.scale_to_dph == 1.0 if mixed else c.scale_to_internal == self.scale_to_dph
+            if not unit_ok or not scale_ok or c.declared_unit != d:
                 bad.append(f"channel {c.name!r} ({c.quantity}, {c.unit_as_read}, x{c.scale_to_internal:.10g}) vs "
-                           f"the record (angular_rate, {self.input_unit}, x{self.scale_to_dph:.10g})")
+                           f"the record ({self.input_unit}, x{self.scale_to_dph:.10g})")
                 break
         if bad:
             raise ConfigError("signal does not describe this record: " + "; ".join(bad))
@@ -597,7 +614,7 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
     array([10., 10., 20.])
     """
     dt = positive_float(dt_s, "dt_s")
-    spec = units.parse_unit(unit)
+    spec = units.parse_unit(unit, None)  # any quantity: a gyro's deg/h or an accelerometer's m/s^2, g ...
     sampling = Sampling(dt_s=dt, dt_source="argument")
     try:
         arr = np.asarray(rate)
@@ -621,6 +638,10 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
             raise ConfigError(
                 f"axis_names must be {arr.shape[1]} unique names (one per column); got {axis_names!r}"
             )
+    from .channel_quantity import check_name
+
+    for name in names:
+        check_name(name, spec, f"unit {unit!r}", str(source))
     n = arr.shape[0]
     if n == 0:
         raise InsufficientDataError("rate has 0 samples; expected at least 1", needed=1, got=0, path=source)
