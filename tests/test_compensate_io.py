@@ -230,3 +230,23 @@ def test_ctrl_c_while_the_csv_is_written_leaves_no_partial_file(bundle, tmp_path
     assert not list(out.glob(TMP_PREFIX + "*"))
     manifest = out / MANIFEST
     assert not manifest.exists() or json.loads(manifest.read_text())["complete"] is False
+
+
+def test_cli_gaps_longest_compensates_the_longest_segment(bundle, tmp_path):
+    from fogdrift.cli import app
+
+    t = np.concatenate([np.arange(300.0), 310.0 + np.arange(500.0)])  # an 11-s gap after sample 299
+    v = 45.0 + np.sin(np.arange(t.size) * 0.9)
+    np.savetxt(tmp_path / "gap.csv", np.column_stack([t, v]), delimiter=",", header="t_s,gz[deg/h]", comments="",
+               fmt="%.10g")
+    base = ["compensate", str(bundle), str(tmp_path / "gap.csv"), "--model", "bias", "--no-heading", "--no-artefacts"]
+    r = CliRunner().invoke(app, base + ["--out", str(tmp_path / "o1")])
+    assert r.exit_code == 1 and "gap in time" in r.output and "--gaps" in r.output
+    r = CliRunner().invoke(app, base + ["--gaps", "longest", "--out", str(tmp_path / "o2")])
+    assert r.exit_code == 0, r.output
+    warn = [ln for ln in r.output.splitlines() if ln.startswith("warning:")]
+    assert len(warn) == 1 and "2 segments between gaps; compensating the longest (500 samples" in warn[0]
+    got = _read(tmp_path / "o2")
+    b = load_bundle(bundle).axis("gz").bias_dph
+    np.testing.assert_allclose(got["t_s"], 310.0 + np.arange(500.0))
+    np.testing.assert_allclose(got["compensated"][:, 0], v[300:] - b, atol=1e-9)

@@ -25,13 +25,14 @@ Matching (:func:`match_log`), each refusal one line naming the option that maps 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError, DataFormatError
-from ..io import decimation_factor, load
+from ..errors import ConfigError, DataFormatError, FogdriftWarning
+from ..io import decimation_factor, load, load_segments
 from ..io._checks import check_path
 from ..io.chunked import open_rows
 from ..signal import SignalDescription
@@ -122,7 +123,15 @@ def _streamed(path, load_kwargs) -> LogSource:
 
 
 def _loaded(path, load_kwargs) -> LogSource:
-    rec = load(path, **load_kwargs)
+    if load_kwargs.get("gaps") == "split":  # the longest gap-free segment, said in one warning line
+        kwargs = {k: v for k, v in load_kwargs.items() if k != "gaps"}
+        segs = load_segments(path, **kwargs)
+        rec = max(segs, key=lambda r: r.n_samples)
+        if len(segs) > 1:
+            warnings.warn(f"{path}: {len(segs)} segments between gaps; compensating the longest ({rec.n_samples} "
+                          f"samples, {rec.notes[-1]})", FogdriftWarning, stacklevel=3)
+    else:
+        rec = load(path, **load_kwargs)
     _one_declared(rec.declared_units, rec.source)
 
     def chunks(chunk):
