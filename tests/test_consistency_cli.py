@@ -135,3 +135,12 @@ def test_summary_cell_follows_the_verdict_rule():
 
     assert summary_cell(res((1.3, 0.9, 1.8)), "gx") == "none (largest 1.3)"
     assert summary_cell(res((1.2, 1.05, 1.4), (1.6, 0.9, 2.5)), "gx") == "1.6 [0.9, 2.5]"
+
+
+def test_model_text_in_the_channel_units():
+    from fogdrift.cli.consistency import _model_text
+
+    comps = [{"kind": "white", "arw_dprh": 1e-4}, {"kind": "gauss_markov", "tc_s": 10.0, "sigma_dph": 0.002}]
+    assert _model_text(comps) == "N 0.0001 deg/√h, GM σ 0.002 deg/h T_c 10 s"
+    # m/s^2 in place of deg/h: (m/s^2) sqrt(h) = 3600 m/s/sqrt(h)
+    assert _model_text(comps, "accel") == "VRW 0.36 m/s/√h, GM σ 0.002 m/s² T_c 10 s"

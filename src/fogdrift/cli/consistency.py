@@ -151,20 +151,22 @@ def print_result(res, label: str, kinds=None) -> None:
         say("  " + verdict_line(res, axis))
 
 
-def _model_text(comps) -> str:
+def _model_text(comps, kind: str = "gyro") -> str:
+    """The components in words, in the channel's units (an accelerometer's hold m/s^2 in place of deg/h)."""
+    accel = kind == "accel"
     parts = []
     for c in comps:
         k = c["kind"]
         if k == "white":
-            parts.append(f"N {c['arw_dprh']:.3g} deg/√h")
+            parts.append(f"VRW {3600 * c['arw_dprh']:.3g} m/s/√h" if accel else f"N {c['arw_dprh']:.3g} deg/√h")
         elif k == "random_walk":
-            parts.append(f"K {c['rrw_dphrh']:.3g} deg/h^1.5")
+            parts.append(f"K {c['rrw_dphrh']:.3g} (m/s²)/√h" if accel else f"K {c['rrw_dphrh']:.3g} deg/h^1.5")
         elif k == "gauss_markov":
-            parts.append(f"GM σ {c['sigma_dph']:.3g} deg/h T_c {c['tc_s']:.3g} s")
+            parts.append(f"GM σ {c['sigma_dph']:.3g} {'m/s²' if accel else 'deg/h'} T_c {c['tc_s']:.3g} s")
         elif k == "quantization":
-            parts.append(f"Q {c['q_urad']:.3g} µrad")
+            parts.append(f"Q {c['q_urad'] / 4.8481368:.3g} m/s" if accel else f"Q {c['q_urad']:.3g} µrad")
         else:
-            parts.append(f"R {c['ramp_dph2']:.3g} deg/h²")
+            parts.append(f"R {c['ramp_dph2']:.3g} {'(m/s²)/h' if accel else 'deg/h²'}")
     return ", ".join(parts) or "(none)"
 
 
@@ -243,8 +245,11 @@ def consistency(
                                   f"(has {', '.join(given)})")
             full = {a: given[a] for a in record.axis_names}
             source = f"{components.name}"
+        from .noise import channel_kinds
+
+        kinds = channel_kinds(record)  # gyro: angle error [deg]; accel: velocity error [m/s]
         for axis, comps in full.items():
-            say(f"{axis}: full model from {source}: {_model_text(comps)}"
+            say(f"{axis}: full model from {source}: {_model_text(comps, kinds.get(axis, 'gyro'))}"
                 + ("" if not notes.get(axis) else f" ({'; '.join(notes[axis])})"))
         train_sha = file_sha256(load.file)
         logs = []
@@ -260,9 +265,6 @@ def consistency(
         say(f"held out: {', '.join(p.name for p in held_out)}; calibration {calibration:g} s, horizons "
             f"{', '.join(f'{x:g}' for x in h)} s; origins {'calibration + horizon' if origin_step is None else f'{origin_step:g} s'} "
             "apart (non-overlapping windows), pooled over the held-out logs")
-        from .noise import channel_kinds
-
-        kinds = channel_kinds(record)  # gyro: angle error [deg]; accel: velocity error [m/s]
         covering = {a: random_walk_covering(c, cover, calibration, k_bound_dphrh=k_bounds.get(a),
                                             quantity=kinds.get(a, "gyro")) for a, c in full.items()}
         cov_models = {a: [c for c in reduced_model(full[a]) if c["kind"] == "white"]
