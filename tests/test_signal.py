@@ -283,3 +283,14 @@ def test_models_have_one_validation_hook():
     for cls in classes:
         assert callable(cls._validate)
         assert not hasattr(cls, "_validate_params") and not hasattr(cls, "_check_params"), cls
+
+
+@pytest.mark.parametrize("args, flag", [(["--gm-window", "2"], "--gm-window"), (["--fit-taus", "10:1"], "--fit-taus"),
+                                        (["--taus", "weekly"], "--taus"), (["--wavelet", "db99"], "db99")])
+def test_cli_analyze_refuses_a_bad_setting_in_one_line_before_reading(tmp_path, args, flag):
+    from fogdrift.cli import app
+
+    missing = tmp_path / "never_read.csv"  # the settings are refused before the file is opened
+    missing.write_text("t_s,gz[deg/h]\n0,1\n")
+    res = runner.invoke(app, ["analyze", str(missing), *args, "--out", str(tmp_path / "o")])
+    assert res.exit_code == 1 and len(res.output.strip().splitlines()) == 1 and flag in res.output, res.output

@@ -72,7 +72,8 @@ FLAGS = {
     "model": "--model", "chunk_samples": "--chunk", "out": "--out", "pdf": "--pdf",
     "method": "--method", "noise_method": "--noise-method", "scales": "--scales", "levels": "--scales",
     "curve": "--curve", "sensor": "--sensor", "robust": "--robust", "train_fraction": "--train-fraction",
-    "val_fraction": "--val-fraction", "causal_window_s": "--causal-window",
+    "val_fraction": "--val-fraction", "causal_window_s": "--causal-window", "gm_window": "--gm-window",
+    "fit_tau_s": "--fit-taus",
     # reader options (fogdrift.io.registry.READERS) and the temperature column
     "temperature": "--temperature", "topic": "--topic", "stamp": "--stamp", "dataset": "--dataset",
     "variable": "--variable", "gain": "--gain", "layout": "--layout", "scale": "--scale",
