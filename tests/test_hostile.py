@@ -523,3 +523,19 @@ def test_allan_under_a_memory_cap_ends_in_one_line_or_succeeds(tmp_path, cap_mb)
         err = [ln for ln in lines(proc.stderr) if ln.strip()]
         assert len(err) == 1 and err[0].startswith("error: ") and ("memory" in err[0]), proc.stderr
         assert [q for q in (os.listdir(out) if out.exists() else []) if q.startswith(TMP_PREFIX)] == []
+
+
+def test_a_dependency_that_cannot_be_mapped_for_memory_is_not_called_missing(monkeypatch):
+    import importlib
+
+    from fogdrift.io.readers.base import MissingDependencyError, require
+
+    def fail(name):
+        raise ImportError("libarrow_substrait.so.2600: failed to map segment from shared object")
+
+    monkeypatch.setattr(importlib, "import_module", fail)
+    with pytest.raises(ResourceError) as ei:
+        require("pyarrow", "fleet", "writing the batch summary (Parquet)")
+    assert not isinstance(ei.value, MissingDependencyError)
+    assert "'pyarrow', which is installed but could not be loaded: out of memory" in str(ei.value)
+    assert "pip install" not in str(ei.value)

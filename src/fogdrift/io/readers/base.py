@@ -64,6 +64,13 @@ def require(module: str, extra: str, what: str):
     try:
         return importlib.import_module(module)
     except ImportError as exc:
+        if "failed to map segment" in str(exc) or isinstance(exc.__cause__ or exc.__context__, MemoryError):
+            from ...errors import ResourceError
+
+            raise ResourceError(  # installed, but its shared library does not fit under a memory limit
+                f"{what} needs the Python package {module.split('.')[0]!r}, which is installed but could not be "
+                f"loaded: out of memory ({describe_exception(exc)}); run it with more memory (a process limit: "
+                "ulimit -v)") from exc
         raise MissingDependencyError(
             f"{what} needs the Python package {module.split('.')[0]!r}, which is not installed; "
             f"install it with: pip install 'fogdrift[{extra}]'"
