@@ -294,3 +294,12 @@ def test_cli_analyze_refuses_a_bad_setting_in_one_line_before_reading(tmp_path, 
     missing.write_text("t_s,gz[deg/h]\n0,1\n")
     res = runner.invoke(app, ["analyze", str(missing), *args, "--out", str(tmp_path / "o")])
     assert res.exit_code == 1 and len(res.output.strip().splitlines()) == 1 and flag in res.output, res.output
+
+
+def test_separation_axis_is_complete_when_built():
+    from fogdrift.pipeline import run_separation
+
+    x = simulate(2000, 1.0, arw_dprh=0.05, rrw_dphrh=0.5, bias_dph=3.0, seed=1)
+    (sep,) = run_separation(from_array(x, dt_s=1.0), AnalysisConfig(model_rate_hz=None, level=2))
+    assert sep.mean_removed_dph == pytest.approx(float(np.mean(x)), rel=1e-12) and sep.level == 2
+    assert abs(float(np.mean(sep.rate_dph))) < 1e-9  # the mean stored is the one removed

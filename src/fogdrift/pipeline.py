@@ -310,7 +310,7 @@ def library_versions() -> dict:
 
 
 def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False,
-                  spectrum="auto", outliers=None) -> AllanAxis:
+                  spectrum="auto", outliers=None, quantity="angular_rate") -> AllanAxis:
     """Allan-family variance and noise identification of one 1-D rate series.
 
     The curve is computed on the configured grid (``cfg.taus``) for display; the noise fit always uses an octave
@@ -322,6 +322,10 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     the fit; the fit curve then also holds the taus at whole multiples of each period (a sinusoid vanishes there,
     so quantization and a periodic error are told apart), and no tau gets a phase-noise (white-PM) EDF
     (:func:`fogdrift.allan.ci.periodic_alpha`).
+
+    ``quantity``: the channel's quantity (:attr:`fogdrift.signal.Channel.quantity`); an accelerometer's
+    (``"specific_force"``, the series in m/s^2) fit is reported in the accelerometer term table
+    (:func:`fogdrift.noise.quantity.express`: velocity random walk in m/s/sqrt(h), bias instability in ug ...).
 
     ``outliers``: the OutlierReport of a rate already treated by the caller (stored in the result as if
     ``check_outliers`` had found it); the results are complete when built, nothing is patched afterwards.
@@ -362,6 +366,10 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     tau_range = None if lo is None and hi is None else (lo, hi)
     noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range,
                       spectrum=spectrum, markov=True)
+    if quantity != "angular_rate":
+        from .noise.quantity import express
+
+        noise = express(noise, quantity)
     if outliers is not None:  # a new, complete NoiseFit carrying the report (the fit's own object is not edited)
         noise = dataclasses.replace(noise, outliers=outliers.to_dict())
     return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers)
@@ -462,7 +470,8 @@ def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | No
     out = []
     for name in record.axis_names:
         checkpoint("Allan variance", axis=name)
-        out.append(analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True))
+        out.append(analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True,
+                                 quantity=record.signal.channel(name).quantity))
     return out
 
 
@@ -478,19 +487,19 @@ def run_separation(record, cfg: AnalysisConfig | None = None, *, factor: int | N
         checkpoint("separation", axis=name)
         x = np.asarray(rec.axis(name), dtype=np.float64)
         # A constant goes wholly into the drift; remove it so the drift shows the variation only.
-        sep = _separation_axis(name, x - x.mean(), rec.dt_s, cfg)
-        sep.mean_removed_dph = float(x.mean())
+        sep = _separation_axis(name, x - x.mean(), rec.dt_s, cfg, mean_removed_dph=float(x.mean()))
         out.append(sep)
     return out
 
 
-def _separation_axis(name, x, dt_s, cfg: AnalysisConfig) -> SeparationAxis:
-    """Separate one whole series and analyse original, drift and noise."""
+def _separation_axis(name, x, dt_s, cfg: AnalysisConfig, mean_removed_dph: float | None = None) -> SeparationAxis:
+    """Separate one whole series and analyse original, drift and noise (``mean_removed_dph``: the mean the caller
+    subtracted from ``x``, stored in the result)."""
     level, scan = _resolved_level(x, cfg, dt_s)
     drift, noise = _separate(x, _with_level(cfg, level), dt_s)
     rows = [(label, analyse_allan(label, sig, dt_s, cfg)) for label, sig in
             (("original", x), ("drift", drift), ("noise", noise))]
-    return SeparationAxis(name, dt_s, level, x, drift, noise, rows, scan)
+    return SeparationAxis(name, dt_s, level, x, drift, noise, rows, scan, mean_removed_dph)
 
 
 def _with_level(cfg: AnalysisConfig, level: int) -> AnalysisConfig:
