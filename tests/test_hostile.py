@@ -539,3 +539,16 @@ def test_a_dependency_that_cannot_be_mapped_for_memory_is_not_called_missing(mon
     assert not isinstance(ei.value, MissingDependencyError)
     assert "'pyarrow', which is installed but could not be loaded: out of memory" in str(ei.value)
     assert "pip install" not in str(ei.value)
+
+
+def test_a_write_refused_for_another_reason_is_a_config_error_naming_the_file(tmp_path):
+    out = tmp_path / "o"
+    with pytest.raises(ConfigError) as ei:
+        with OutputDir(out, command="noise") as od:
+            with od.file("sub/noise.json") as tmp:
+                tmp.write_text("{}")
+                raise PermissionError(errno.EACCES, "Permission denied")
+    assert not isinstance(ei.value, ResourceError)
+    assert str(ei.value).startswith(f"out= {out}: cannot write sub/noise.json: Permission denied (EACCES); "
+                                     f"nothing was written to {out}")
+    assert not [p for p in out.rglob("*") if p.name.startswith(TMP_PREFIX)]
