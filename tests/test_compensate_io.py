@@ -250,3 +250,20 @@ def test_cli_gaps_longest_compensates_the_longest_segment(bundle, tmp_path):
     b = load_bundle(bundle).axis("gz").bias_dph
     np.testing.assert_allclose(got["t_s"], 310.0 + np.arange(500.0))
     np.testing.assert_allclose(got["compensated"][:, 0], v[300:] - b, atol=1e-9)
+
+
+def test_relative_out_folder_holds_the_files_itself(bundle, tmp_path, monkeypatch):
+    """--out o (relative): the files are o/compensated.csv ..., not o/o/... (an OutputDir takes a relative path as
+    one inside its folder, so compensate writes through absolute paths)."""
+    from fogdrift.cli import app
+
+    _csv(tmp_path / "r.csv", "t_s,gz[deg/h]", 45.0 + np.sin(np.arange(300) * 0.9))
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(app, ["compensate", str(bundle), "r.csv", "--model", "bias", "--no-heading",
+                                 "--no-artefacts", "--out", "o"])
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == sorted(
+        [MANIFEST, "compensated.csv", "compensated.npz", "compensation.json", "compensation_allan.png"])
+    assert "wrote o/compensated.csv, o/compensated.npz" in r.output
+    doc = json.loads((tmp_path / "o" / "compensation.json").read_text())
+    assert doc["files"]["csv"] == "o/compensated.csv"

@@ -186,7 +186,8 @@ def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_ra
                                bias=bias_mode, segment=segment,
                                keep_model_rate=(heading or artefacts)
                                and source.n_samples // match.factor <= max_model_rate_samples)
-    out = Path(out_dir)
+    out = Path(out_dir)  # as the caller named it (the paths in the summary and the result)
+    out_abs = out.absolute()  # written through: an OutputDir takes a relative path as one inside its folder
     names = [a for a, _ in match.axes]
     scale = match.scale_to_dph  # the reader's own factor (file unit -> deg/h), carried: outputs divide by it once
     writers, files = [], {}
@@ -203,12 +204,12 @@ def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_ra
     with contextlib.ExitStack() as stack:  # the final names appear (renamed) only when every row is written
         if "csv" in formats:
             files["csv"] = out / "compensated.csv"
-            writers.append(CsvWriter(stack.enter_context(atomic_path(files["csv"])), names, match.unit,
+            writers.append(CsvWriter(stack.enter_context(atomic_path(out_abs / "compensated.csv")), names, match.unit,
                                      engine.has_sigma))
         if "npz" in formats:
             files["npz"] = out / "compensated.npz"
-            writers.append(NpzWriter(stack.enter_context(atomic_path(files["npz"])), source.n_samples, names,
-                                     match.unit, scale, engine.has_sigma))
+            writers.append(NpzWriter(stack.enter_context(atomic_path(out_abs / "compensated.npz")), source.n_samples,
+                                     names, match.unit, scale, engine.has_sigma))
         try:
             for t, x in source.chunks(chunk_samples):
                 emit(engine.push(t, x))
@@ -267,8 +268,8 @@ def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_ra
     caveats = _caveats(result, name, plans, curves, why_not)
     messages.extend(caveats.values())
     if figures and curves:
-        files["figure"] = plot_before_after(curves, out / "compensation_allan.png", "ADEV before / after",
-                                            caveats=caveats)
+        files["figure"] = out / "compensation_allan.png"
+        plot_before_after(curves, out_abs / "compensation_allan.png", "ADEV before / after", caveats=caveats)
     messages[:] = [render_options(m, flags) for m in messages]
     result.summary = {
         "fogdrift_result": "compensation",
@@ -285,7 +286,8 @@ def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_ra
         "heading": [h.to_dict() for h in result.heading], "artefacts": [a.to_dict() for a in result.artefacts],
         "verdicts": [v.to_dict() for v in result.verdicts], "wall_s": time.perf_counter() - t_start,
     }
-    files["json"] = _write_json(result.summary, out / "compensation.json")
+    files["json"] = out / "compensation.json"
+    _write_json(result.summary, out_abs / "compensation.json")
     result.summary["files"]["json"] = str(files["json"])
     return result
 
