@@ -347,7 +347,7 @@ def check_dt_s(dt_s, name: str = "dt_s") -> float:
     except (TypeError, ValueError, OverflowError):
         raise ConfigError(f"{name} must be a number of seconds > 0, got {dt_s!r}") from None
     if not (dt > 0 and math.isfinite(dt)):
-        raise ConfigError(f"{name} must be a finite number of seconds > 0, got {dt_s!r}")
+        raise ConfigError(f"{name} must be a finite number > 0 (seconds); got {dt_s!r}")
     if not DT_MIN_S <= dt <= DT_MAX_S:
         raise ConfigError(f"{name} must be a sample interval between {DT_MIN_S:g} s and {DT_MAX_S:g} s, got {dt_s!r}")
     return dt

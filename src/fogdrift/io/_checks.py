@@ -6,7 +6,6 @@ Private: the public entry points (:func:`~fogdrift.io.load`, :func:`~fogdrift.io
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -28,19 +27,6 @@ def check_path(path, *, allow_dir: bool = False) -> Path:
     if not p.is_file() and not (allow_dir and p.is_dir()):
         raise DataFormatError("not a regular file; expected a data file, got a directory or device", path=p)
     return p
-
-
-def positive_float(value, name: str) -> float:
-    """``value`` as a finite float > 0, or ConfigError naming ``name``."""
-    if isinstance(value, bool):
-        raise ConfigError(f"{name} must be a number > 0; got {value!r}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{name} must be a number > 0; got {value!r}") from None
-    if not math.isfinite(v) or v <= 0:
-        raise ConfigError(f"{name} must be a finite number > 0; got {value!r}")
-    return v
 
 
 def int_arg(value, name: str) -> int:

@@ -21,7 +21,6 @@ from ..signal import Channel, Sampling, SignalDescription
 from ._checks import (
     check_path,
     first_nonfinite,
-    positive_float,
     split_keys,
     take_columns,
     to_dph,
@@ -284,7 +283,7 @@ def _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, ga
 
 
 def _interval_option(dt_s, rate_hz):
-    dt = None if dt_s is None else units.check_dt_s(positive_float(dt_s, "dt_s"), "dt_s")
+    dt = None if dt_s is None else units.check_dt_s(dt_s, "dt_s")
     fs = None if rate_hz is None else units.check_rate_hz(rate_hz, "{opt:rate_hz}")
     if dt is not None and fs is not None and abs(dt * fs - 1.0) > 1e-6:
         raise ConfigError(

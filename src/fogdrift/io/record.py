@@ -17,7 +17,7 @@ from .. import units
 from .._util import check_distinct_names
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
 from ..signal import Channel, Sampling, SignalDescription
-from ._checks import first_nonfinite, int_arg, positive_float, split_keys, take_columns, to_dph
+from ._checks import first_nonfinite, int_arg, split_keys, take_columns, to_dph
 
 __all__ = ["GyroRecord", "block_average", "from_array", "decimation_factor"]
 
@@ -112,7 +112,7 @@ class GyroRecord:
         if len(declared) != len(names):
             raise ConfigError(f"declared_units must give one unit (or None) per axis {names!r}; got {declared!r}")
         object.__setattr__(self, "declared_units", declared)
-        object.__setattr__(self, "dt_s", positive_float(self.dt_s, "dt_s"))
+        object.__setattr__(self, "dt_s", units.check_dt_s(self.dt_s, "dt_s"))
         object.__setattr__(self, "t0_s", float(self.t0_s))
         object.__setattr__(self, "scale_to_dph", float(self.scale_to_dph))
         object.__setattr__(self, "source", str(self.source))
@@ -264,9 +264,16 @@ class GyroRecord:
         idx = [self._axis_index(k) for k in split_keys(keys, "keys")]
         if len(set(idx)) != len(idx):
             raise ConfigError(f"keys select an axis twice; expected distinct axes, got {keys!r}")
+        signal = self.signal.select(idx)
+        chans = signal.channels
+        if len({(c.unit_as_read, c.scale_to_internal) for c in chans}) == 1:  # one unit again: its legacy fields
+            unit, scale = chans[0].unit_as_read, chans[0].scale_to_internal
+        else:
+            unit, scale = ",".join(f"{c.name}={c.unit_as_read}" for c in chans), 1.0
         return dataclasses.replace(
             self, rate_dph=take_columns(self.rate_dph, idx), axis_names=tuple(self.axis_names[i] for i in idx),
-            declared_units=tuple(self.declared_units[i] for i in idx), signal=self.signal.select(idx),
+            declared_units=tuple(self.declared_units[i] for i in idx), signal=signal, input_unit=unit,
+            scale_to_dph=scale,
         )
 
     def slice(self, start: int, stop: int) -> "GyroRecord":
@@ -322,7 +329,7 @@ class GyroRecord:
         interval (integrating gyros, angle increments) this is exactly the average rate over
         the longer interval, so ``t0_s`` is unchanged.
         """
-        target = positive_float(dt_s, "dt_s")
+        target = units.check_dt_s(dt_s, "dt_s")
         ratio = target / self.dt_s
         m = int(round(ratio))
         if m < 1 or abs(m * self.dt_s - target) > _MULTIPLE_RTOL * target:
@@ -537,7 +544,7 @@ def decimation_factor(native_dt_s: float, rate_hz: float) -> int:
     ...
     fogdrift.errors.ConfigError: model rate 3 Hz does not divide the native 100 Hz by an integer; nearest valid rates: 3.03 Hz (/33), 2.941 Hz (/34); pass model_rate_hz=
     """
-    dt = positive_float(native_dt_s, "native_dt_s")
+    dt = units.check_dt_s(native_dt_s, "native_dt_s")
     try:
         fs = float(rate_hz)
     except (TypeError, ValueError):
@@ -613,7 +620,7 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
     >>> rec.rate_dph[:, 0]
     array([10., 10., 20.])
     """
-    dt = positive_float(dt_s, "dt_s")
+    dt = units.check_dt_s(dt_s, "dt_s")
     spec = units.parse_unit(unit, None)  # any quantity: a gyro's deg/h or an accelerometer's m/s^2, g ...
     sampling = Sampling(dt_s=dt, dt_source="argument")
     try:
