@@ -62,7 +62,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ConfigError, FogdriftWarning, render_options
-from .units import EARTH_RATE_DPH, parse_unit
+from .units import EARTH_RATE_DPH, STANDARD_GRAVITY_MPS2, parse_unit
 
 __all__ = [
     "Finding",
@@ -255,10 +255,20 @@ def check_record(record) -> list[Finding]:
     >>> [(f.rule, f.likely_units) for f in check_record(from_array(numbers, dt_s=0.01, unit="deg/s"))]
     [('white-noise', ('deg/h',))]
     """
+    quantities = record.quantities
+    if "specific_force" in quantities:  # the gyro rules for the gyro channels, the accelerometer rules for the rest
+        gyro = [n for n, q in zip(record.axis_names, quantities) if q == "angular_rate"]
+        accel = [n for n, q in zip(record.axis_names, quantities) if q == "specific_force"]
+        findings = [f for f in check_record(record.select(gyro)) if f.rule != "sample-rate"] if gyro else []
+        return findings + accel_findings(record.select(accel)) + _rate_findings(record)
+    return _gyro_findings(record) + gravity_like_findings(record) + _rate_findings(record)
+
+
+def _gyro_findings(record) -> list[Finding]:
     names = tuple(record.axis_names)
     floors = [noise_floor(record.axis(n), record.dt_s) for n in names]
     rates = [np.asarray(record.axis(n), dtype=np.float64) for n in names]
-    peaks = [float(np.max(np.abs(r))) if r.size else 0.0 for r in rates]
+    peaks = [float(max(r.max(), -r.min())) if r.size else 0.0 for r in rates]  # max |rate|, no |r| copy
     means = [float(np.mean(r)) if r.size else 0.0 for r in rates]
     unit = record.input_unit
     broken = _violations(floors, peaks, means)
@@ -300,6 +310,11 @@ def check_record(record) -> list[Finding]:
                 f"N <= {_fmt(worst)} deg/√h) yet their mean vector is {norm:.3g} deg/h; a static "
                 f"gyro of that grade shows the Earth rate, {EARTH_RATE_DPH:.2f} deg/h (unless bias and Earth rate were "
                 f"removed before, or the base moved); {hint}", likely))
+    return findings
+
+
+def _rate_findings(record) -> list[Finding]:
+    findings = []
     fs = record.fs_hz
     if fs <= RATE_MIN_HZ or fs > RATE_MAX_HZ:
         slow = fs <= RATE_MIN_HZ
@@ -309,6 +324,73 @@ def check_record(record) -> list[Finding]:
             f"gyro log; check {{opt:time_unit}} ({'a time column in ms read as s gives a 1000 times longer step' if slow else 'a time column in s read as ms gives a 1000 times shorter step'}) "
             "and {opt:rate_hz}"))
     return findings
+
+
+#: Relative tolerance of "the mean vector of a static accelerometer triad is 1 g".
+GRAVITY_RTOL = 0.1
+#: Specific-force units tried, in order, when a static triad's mean is not 1 g.
+ACCEL_CANDIDATES = ("g", "m/s^2", "mg", "ug")
+
+
+def accel_findings(record) -> list[Finding]:
+    """The accelerometer twin of the Earth-rate rule: a static triad reads gravity, ``|mean| = 1 g``.
+
+    Applies to a record of three accelerometer channels (m/s^2 inside); a mean vector whose length is not
+    within :data:`GRAVITY_RTOL` of standard gravity (9.80665 m/s^2) says the numbers are read in the wrong unit
+    (mg read as g: 1000 g) or the base moved or was not level-free (the checks warn, never change data).  With
+    fewer than three accelerometer channels gravity's direction is unknown: nothing is checked (the gyro rules,
+    white-noise class and Earth rate, have no accelerometer twin here).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fogdrift.io import from_array
+    >>> x = np.tile([0.0, 0.0, -1.0], (2000, 1)) + np.random.default_rng(0).normal(0, 1e-3, (2000, 3))
+    >>> accel_findings(from_array(x, dt_s=0.01, unit="g", axis_names=["ax", "ay", "az"]))
+    []
+    >>> [f.likely_units for f in accel_findings(from_array(x, dt_s=0.01, unit="mg", axis_names=["ax", "ay", "az"]))]
+    [('g',)]
+    """
+    if record.n_axes != 3:
+        return []
+    means = [float(np.mean(record.axis(n))) for n in record.axis_names]
+    norm = float(np.linalg.norm(means))
+    g0 = STANDARD_GRAVITY_MPS2
+    if abs(norm / g0 - 1.0) <= GRAVITY_RTOL:
+        return []
+    unit = record.input_unit
+    scale = record.signal.channels[0].scale_to_internal
+    raw = norm / scale  # the mean vector's length in the numbers as read
+    likely = tuple(u for u in ACCEL_CANDIDATES if u != unit
+                   and abs(raw * parse_unit(u, "specific_force").scale_to_internal() / g0 - 1.0) <= GRAVITY_RTOL)
+    hint = f"the numbers fit {' or '.join(likely)}: check {{opt:unit}}" if likely else         "check {opt:unit} (or the triad was not static)"
+    return [Finding("gravity", tuple(record.axis_names),
+                    f"with the specific force read as {unit} the mean vector of these 3 accelerometer axes is "
+                    f"{norm / g0:.4g} g ({norm:.4g} m/s^2); a static triad reads 1 g; {hint}", likely)]
+
+
+def gravity_like_findings(record) -> list[Finding]:
+    """A "gyro" triad whose mean vector is 1 g in m/s^2 or in g (one axis along it) is likely an accelerometer.
+
+    Applies to three angular-rate channels: when the mean vector's length in the numbers as read is within 2 % of
+    9.80665 or of 1 and one axis holds over 90 % of it (gravity along one axis of a levelled triad), the
+    channels are likely accelerometers read with an angular-rate unit.
+    """
+    if record.n_axes != 3:
+        return []
+    scale = record.signal.channels[0].scale_to_internal
+    means = np.array([float(np.mean(record.axis(n))) for n in record.axis_names]) / scale
+    norm = float(np.linalg.norm(means))
+    if norm <= 0 or float(np.max(means**2)) / norm**2 < 0.9:
+        return []
+    for level, unit in ((STANDARD_GRAVITY_MPS2, "m/s^2"), (1.0, "g")):
+        if abs(norm / level - 1.0) <= 0.02:
+            return [Finding("gravity", tuple(record.axis_names),
+                            f"read as {record.input_unit}, the mean vector of these 3 axes is {norm:.4g} with one "
+                            f"axis along it: gravity in {unit} (1 g = 9.80665 m/s^2), so these are likely "
+                            f"accelerometers; give their unit as {{opt:unit}} {unit} (or gyro=...,accel={unit})",
+                            (unit,))]
+    return []
 
 
 def _hint(likely, floors, record) -> str:

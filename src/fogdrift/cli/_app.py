@@ -427,7 +427,16 @@ def echo_record(load: "LoadOptions", record, path=None) -> None:
         units += f", time {smp.time_unit} ({_SOURCE_WORDS['time_unit'].get(smp.time_unit_source, smp.time_unit_source)})"
     say(f"{path.name}: {record.n_samples} samples x {record.n_axes} {'axis' if record.n_axes == 1 else 'axes'} ({', '.join(record.axis_names)}), "
         f"{record.duration_s:.6g} s at {record.fs_hz:.6g} Hz (dt {record.dt_s:.6g} s {rate_src}); units: {units}; "
-        "rates converted to deg/h")
+        + _converted_words(record))
+
+
+def _converted_words(record) -> str:
+    """"rates converted to deg/h", or what each quantity was converted to (accelerometers: m/s^2)."""
+    qs = list(dict.fromkeys(record.quantities))
+    if qs == ["angular_rate"]:
+        return "rates converted to deg/h"
+    words = {"angular_rate": "rates (gyro) to deg/h", "specific_force": "specific force (accelerometer) to m/s^2"}
+    return "converted: " + ", ".join(words[q] for q in qs)
 
 
 #: How :func:`echo_record` words a unit's source (:data:`fogdrift.signal.UNIT_SOURCES`).

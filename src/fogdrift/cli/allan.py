@@ -7,7 +7,7 @@ from pathlib import Path
 from ._app import (EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, StatisticOpt, TausOpt, TermsOpt, app,
                    check_plausible, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck,
                    progress, run, with_load_options)
-from ._tables import noise_table, print_noise_notes
+from ._tables import noise_table, print_noise_notes, relabel_note
 
 DEFAULT_OUT = Path("out/allan")
 
@@ -42,12 +42,18 @@ def allan(
         with progress("allan", record.axis_names) as (allan_cb, _):
             results = run_allan(record, cfg, progress=allan_cb)
         name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}[statistic]
-        console.print(noise_table(f"{load.file.name}: {estimator} {name}, 95 % intervals in brackets "
-                                  "(– (< x): not in the selected model, x its upper bound; [0, x]: in the "
-                                  "model but not resolved from zero; B: the flicker floor when fitted, else the "
-                                  "IEEE reading min ADEV/0.664; every cell a bound when no model fits)",
-                                  [[a.name] + noise_row(a.noise) + [shaped_cell(a.noise), fit_cell(a.noise)]
-                                   for a in results], fit=True, extra=("periodic / Markov",)))
+        by_quantity = {}
+        for a in results:  # one table per quantity: gyro terms, then accelerometer terms (their own units)
+            by_quantity.setdefault(getattr(a.noise, "quantity", "angular_rate"), []).append(a)
+        for quantity, group in by_quantity.items():
+            what = "" if quantity == "angular_rate" else "accelerometer (velocity random walk N, bias instability B) "
+            console.print(noise_table(f"{load.file.name}: {what}{estimator} {name}, 95 % intervals in brackets "
+                                      "(– (< x): not in the selected model, x its upper bound; [0, x]: in the "
+                                      "model but not resolved from zero; B: the flicker floor when fitted, else the "
+                                      "IEEE reading min ADEV/0.664; every cell a bound when no model fits)",
+                                      [[a.name] + noise_row(a.noise) + [relabel_note(shaped_cell(a.noise), quantity),
+                                                                        fit_cell(a.noise)]
+                                       for a in group], fit=True, extra=("periodic / Markov",), quantity=quantity))
         for a in results:
             print_noise_notes(a.name, a.noise, a.outliers, record.dt_s)
         temp = record.metadata()["temperature"]

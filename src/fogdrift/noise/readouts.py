@@ -51,7 +51,8 @@ class Readout:
         if self.value is None:
             return f"{self.term}: no {self.term}-slope in the curve"
         where = "its term dominates" if self.dominated else "another term dominates"
-        out = f"{self.term} {self.value:.3g} {DISPLAY_UNITS.get(self.term, self.unit)} (read at tau = {self.tau_s:.3g} s, {where})"
+        unit = DISPLAY_UNITS.get(self.term, self.unit) if self.unit == TERM_UNITS.get(self.term) else self.unit
+        out = f"{self.term} {self.value:.3g} {unit} (read at tau = {self.tau_s:.3g} s, {where})"
         return out + (f"; {self.note}" if self.note else "")
 
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .terms import TERM_TABLE, TERMS, laws_of, markov_shape, periodic_shape
+from .terms import TERMS, laws_of, markov_shape, periodic_shape, term_table
 
 __all__ = ["NoiseTerm", "NoiseFit", "TERM_STATUSES"]
 
@@ -60,8 +60,14 @@ class NoiseTerm:
         return self.status == "resolved"
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "value": _f(self.value), "unit": self.unit, "lo95": _f(self.lo95),
-                "hi95": _f(self.hi95), "status": self.status, "estimable": self.estimable, "reason": self.reason}
+        out = {"name": self.name, "value": _f(self.value), "unit": self.unit, "lo95": _f(self.lo95),
+               "hi95": _f(self.hi95), "status": self.status, "estimable": self.estimable, "reason": self.reason}
+        if self.unit == "ug":  # an accelerometer's bias instability: also in m/s^2 (1 ug = 9.80665e-6 m/s^2)
+            g = 9.80665e-6
+            out["si"] = {"unit": "m/s^2", "value": None if self.value is None else self.value * g,
+                         "lo95": None if self.lo95 is None else self.lo95 * g,
+                         "hi95": None if self.hi95 is None else self.hi95 * g}
+        return out
 
 
 @dataclass
@@ -142,6 +148,7 @@ class NoiseFit:
     outliers: dict | None = None
     shaped: dict = field(default_factory=dict)
     no_fit: dict | None = None
+    quantity: str = "angular_rate"
 
     # -- the fitted curve ------------------------------------------------------------------------------------
     @property
@@ -201,7 +208,7 @@ class NoiseFit:
 
     def coefficient(self, name) -> float:
         """The term's coefficient in its reported unit from ``A`` (0 when absent)."""
-        return TERM_TABLE[name].to_unit * math.sqrt(self._x2(name))
+        return term_table(self.quantity)[name].to_unit * math.sqrt(self._x2(name))
 
     # -- serialisation ------------------------------------------------------------------------------------------
     def to_dict(self) -> dict:
@@ -231,4 +238,5 @@ class NoiseFit:
             "shaped": {k: {kk: vv for kk, vv in v.items() if not isinstance(vv, np.ndarray)}
                        for k, v in self.shaped.items()},
             "no_fit": self.no_fit,
+            **({"quantity": self.quantity} if self.quantity != "angular_rate" else {}),
         }

@@ -25,12 +25,17 @@ from types import MappingProxyType
 import numpy as np
 
 from ..errors import ConfigError
-from ..units import B_FACTOR, URAD_PER_ARCSEC
+from ..units import B_FACTOR, STANDARD_GRAVITY_MPS2, URAD_PER_ARCSEC
 from .covariance import expected_variance
 
 __all__ = [
     "TermSpec",
     "TERM_TABLE",
+    "ACCEL_TERM_TABLE",
+    "TERM_TABLES",
+    "term_table",
+    "display_units",
+    "SHAPED_UNITS",
     "TERMS",
     "TERM_UNITS",
     "TERM_HEADERS",
@@ -125,6 +130,54 @@ TERM_TABLE = MappingProxyType({
     "R": TermSpec("R", "rate ramp", 2, 0.5, "(deg/h)/s", "deg/h^2", "_dph2", "R [deg/h²]",
                   3600.0, None, _IEEE + "; 1/s = 3600/h"),
 })
+
+_IEEE_ACCEL = ("IEEE Std 1293-2018 (accelerometers) Annex on the Allan variance: the same laws as IEEE Std 952-1997 "
+               "Annex C with specific force [m/s^2] in place of rate; term names per IEEE Std 528-2019")
+
+#: The accelerometer twins of the five terms (the Allan laws are the same; the rate is specific force in m/s^2, so
+#: the law units are (m/s^2) s = m/s, (m/s^2) sqrt(s), m/s^2, (m/s^2)/sqrt(s), (m/s^2)/s).  B is reported in ug
+#: (1 ug = 9.80665e-6 m/s^2, standard gravity, CGPM 1901); the JSON also gives it in m/s^2.
+ACCEL_TERM_TABLE = MappingProxyType({
+    "Q": TermSpec("Q", "velocity quantization", -2, 3.0, "(m/s^2) s = m/s", "m/s", "_mps", "Q [m/s]",
+                  1.0, 2, _IEEE_ACCEL + "; (m/s^2) s = m/s"),
+    "N": TermSpec("N", "velocity random walk", -1, 1.0, "(m/s^2) sqrt(s)", "m/s/sqrt(h)", "_mps_rh",
+                  "N [m/s/√h]", 60.0, 0, _IEEE_ACCEL + "; m/s/sqrt(s) = 60 m/s/sqrt(h) (sqrt(h) = 60 sqrt(s))"),
+    "B": TermSpec("B", "bias instability", 0, B_FACTOR**2, "m/s^2", "ug", "_ug", "B [µg]",
+                  1.0 / (STANDARD_GRAVITY_MPS2 * 1e-6), -1,
+                  _IEEE_ACCEL + "; 1 ug = 9.80665e-6 m/s^2; flat level (2 ln2/pi) B^2, sigma_min = 0.6643 B"),
+    "K": TermSpec("K", "acceleration random walk", 1, 1.0 / 3.0, "(m/s^2)/sqrt(s)", "m/s^2/sqrt(h)", "_mps2_rh",
+                  "K [m/s²/√h]", 60.0, -2, _IEEE_ACCEL + "; 1/sqrt(s) = 60/sqrt(h) (= 1/3600 of the m/s/h^1.5 figure)"),
+    "R": TermSpec("R", "acceleration ramp", 2, 0.5, "(m/s^2)/s", "m/s^2/h", "_mps2_ph", "R [m/s²/h]",
+                  3600.0, None, _IEEE_ACCEL + "; 1/s = 3600/h"),
+})
+
+#: The term table of each quantity (:data:`fogdrift.units.QUANTITIES`): the gyro's IEEE-952 table and the
+#: accelerometer's.  The Allan laws (powers, coefficients, alphas) are the same; units and names differ.
+TERM_TABLES = MappingProxyType({"angular_rate": TERM_TABLE, "specific_force": ACCEL_TERM_TABLE})
+
+#: Units of the shaped terms per quantity: S amplitude and M driving density (rate unit, rate unit/sqrt(s)).
+SHAPED_UNITS = MappingProxyType({"angular_rate": ("deg/h", "deg/h/sqrt(s)"),
+                                 "specific_force": ("m/s^2", "m/s^2/sqrt(s)")})
+
+
+def term_table(quantity="angular_rate"):
+    """The term table of a channel's quantity (``"angular_rate"``: gyro, ``"specific_force"``: accelerometer).
+
+    Examples
+    --------
+    >>> term_table("specific_force")["N"].long_name, term_table("specific_force")["N"].unit
+    ('velocity random walk', 'm/s/sqrt(h)')
+    """
+    try:
+        return TERM_TABLES[quantity or "angular_rate"]
+    except (KeyError, TypeError):
+        raise ConfigError(f"no term table for quantity {quantity!r}; expected one of {list(TERM_TABLES)}") from None
+
+
+def display_units(quantity="angular_rate") -> dict:
+    """The units as printed for people for a quantity (``DISPLAY_UNITS`` for a gyro)."""
+    return {k: v.header.split("[", 1)[1].rstrip("]") for k, v in term_table(quantity).items()}
+
 
 #: Noise terms in order of the power of tau in the Allan variance: Q, N, B, K, R.
 TERMS = tuple(TERM_TABLE)
