@@ -290,3 +290,15 @@ def test_accelerometer_velocity_error_by_hand_and_by_simulation():
 def test_random_walk_covering_white_only_model_says_nothing_to_cover():
     d = random_walk_covering([{"kind": "white", "arw_dprh": 0.1}], 60.0, 60.0, k_bound_dphrh=3.0)
     assert d["k_eff_dphrh"] == 0.0 and "no drift beyond its white noise" in d["sentence"]
+
+
+def test_short_log_gives_no_origins_at_long_horizons_and_none_reaching_is_an_error():
+    comps = {"x": [{"kind": "white", "arw_dprh": 0.2}]}
+    long = ({"x": _simulate(1, 2000, DT, 0.2)}, DT)  # 200 s
+    short = ({"x": _simulate(2, 400, DT, 0.2)}, DT)  # 40 s: reaches h = 5 s after 20 s, not h = 30 s
+    res = check_consistency("t", comps, [long, short], t_cal_s=20.0, horizons_s=[5.0, 30.0])
+    n5, n30 = (r.n_origins for r in res.axes["x"]["rows"])
+    assert n5 == 8 + 1 and n30 == 4  # floor((N - k - m)/s) + 1 per log; the short log adds 1 at 5 s, 0 at 30 s
+    with pytest.raises(InsufficientDataError,
+                       match=r"horizon\(s\) 300 s after a 20 s calibration \(the longest is 200 s\)"):
+        check_consistency("t", comps, [long, short], t_cal_s=20.0, horizons_s=[5.0, 300.0])

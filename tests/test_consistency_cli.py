@@ -170,3 +170,12 @@ def test_consistency_on_accelerometer_logs_is_velocity(tmp_path):
     for r in rows:
         assert abs(r["coverage"]["68 %"] - 0.6827) < 4 * math.sqrt(0.68 * 0.32 / r["n_origins"])
     assert "velocity error" in res.output and "accelerometer_random_walk" in res.output
+
+
+def test_horizon_no_log_reaches_is_one_line_with_flags(logs, tmp_path):
+    res = runner.invoke(app, ["consistency", str(logs[0]), "--unit", "deg/h", "--held-out", str(logs[1]),
+                              "--calibration", "20", "--horizons", "5,5000", "--out", str(tmp_path / "q")])
+    assert res.exit_code == 1
+    lines = [l for l in res.output.splitlines() if l.strip() and not l.startswith(("consistency", "gz:", "held"))]
+    assert any("horizon(s) 5000 s" in l and "shorten --horizons or --calibration" in l for l in lines), res.output
+    assert "Traceback" not in res.output

@@ -378,7 +378,8 @@ def readings_from_gmwm(axis, kind: str = "gyro") -> dict:
         at = f" at τ = {b.tau_s:.4g} s" if b.tau_s else ""
         out["bias_instability"] = Reading(b.value_dph, b.lo95_dph, b.hi95_dph, "deg/h", None, f"B_min{at} (GMWM)")
     elif b.bound_dph is not None:
-        out["bias_instability"] = Reading(b.bound_dph, None, None, "deg/h", "upper", f"B_min, an upper bound ({b.reason})")
+        out["bias_instability"] = Reading(b.bound_dph, None, None, "deg/h", "upper",
+                                          f"B_min, an upper bound ({b.reason})")
     return _accel_in_place_of_deg_h(out) if kind == "accel" else out
 
 

@@ -20,14 +20,19 @@ from typing import Annotated, List, Optional
 import typer
 
 from ..errors import ConfigError
-from ._app import JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run, say, warn
-from ._app import with_load_options
+from ._app import (FLAGS, JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run,
+                   say, warn, with_load_options)
 
 DEFAULT_OUT = Path("out/consistency")
 
+# the flags of this command's library settings, for {opt:NAME} in fogdrift.evaluation.consistency's messages
+# (registered here until cli/_app.FLAGS lists them; setdefault never overrides an entry there)
+for _name, _flag in (("horizons", "--horizons"), ("calibration", "--calibration"), ("origin_step", "--origin-step")):
+    FLAGS.setdefault(_name, _flag)
+
 HeldOutOpt = Annotated[Optional[List[Path]], typer.Option(
-    "--held-out", metavar="<path>", help="A held-out static log of the same sensor (repeat the option for several); read with the "
-                       "same reading options as FILE.")]
+    "--held-out", metavar="<path>", help="A held-out static log of the same sensor (repeat the option for "
+                                         "several); read with the same reading options as FILE.")]
 CalOpt = Annotated[float, typer.Option("--calibration", help="Static calibration window [s] before each origin; "
                                                              "the bias is its mean.")]
 HorizonsOpt = Annotated[str, typer.Option("--horizons", help="Comma-separated horizons [s] after the calibration.")]
@@ -263,7 +268,8 @@ def consistency(
                                   "held-out logs need the training log's axes")
             logs.append(({a: rec.axis(a) for a in record.axis_names}, rec.dt_s))
         say(f"held out: {', '.join(p.name for p in held_out)}; calibration {calibration:g} s, horizons "
-            f"{', '.join(f'{x:g}' for x in h)} s; origins {'calibration + horizon' if origin_step is None else f'{origin_step:g} s'} "
+            f"{', '.join(f'{x:g}' for x in h)} s; origins "
+            f"{'calibration + horizon' if origin_step is None else f'{origin_step:g} s'} "
             "apart (non-overlapping windows), pooled over the held-out logs")
         covering = {a: random_walk_covering(c, cover, calibration, k_bound_dphrh=k_bounds.get(a),
                                             quantity=kinds.get(a, "gyro")) for a, c in full.items()}

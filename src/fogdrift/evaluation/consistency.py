@@ -464,7 +464,8 @@ def components_from_gmwm(ieee) -> tuple[list[dict], list[str]]:
     if "K_dphrh" in t:
         comps.append({"kind": "random_walk", "rrw_dphrh": float(t["K_dphrh"].value)})
     for g in ie.gm:
-        comps.append({"kind": "gauss_markov", "tc_s": float(g["tc_s"].value), "sigma_dph": float(g["sigma_gm_dph"].value)})
+        comps.append({"kind": "gauss_markov", "tc_s": float(g["tc_s"].value),
+                      "sigma_dph": float(g["sigma_gm_dph"].value)})
     if "R_dph2" in t:
         comps.append({"kind": "ramp", "ramp_dph2": float(t["R_dph2"].value)})
     if "B_dph" in t:
@@ -526,7 +527,8 @@ def check_consistency(target: str, components_by_axis: dict, held_out: list, *, 
         Each held-out log: ``{axis: rate [deg/h]}`` and its sample interval [s]; origins of all logs are pooled
         per axis.
     t_cal_s, horizons_s
-        See :func:`observed_angle_errors_deg`.
+        See :func:`observed_angle_errors_deg`.  A log shorter than ``t_cal_s + h`` gives no origin at horizon h;
+        a horizon no log reaches is an :class:`~fogdrift.errors.InsufficientDataError`.
     step_s : float or None
         Origin spacing [s]; default ``t_cal_s + h`` for each horizon (non-overlapping windows, so more origins
         count at short horizons).
@@ -548,9 +550,18 @@ def check_consistency(target: str, components_by_axis: dict, held_out: list, *, 
             if axis not in rates:
                 raise ConfigError(f"the held-out log has no axis {axis!r} (has {', '.join(rates)})")
             for j, hj in enumerate(h):  # per horizon: origins T_cal + h apart (independent windows)
-                errs[j].append(observed_angle_errors_deg(rates[axis], dt, T, [hj], step_s=step_s,
-                                                         quantity=q)[1][:, 0])
+                try:
+                    errs[j].append(observed_angle_errors_deg(rates[axis], dt, T, [hj], step_s=step_s,
+                                                             quantity=q)[1][:, 0])
+                except InsufficientDataError:  # this log is shorter than T_cal + h: no origin at this horizon
+                    errs[j].append(np.empty(0))
         e = [np.concatenate(x) for x in errs]
+        empty = [f"{hj:g}" for hj, x in zip(h, e) if x.size == 0]
+        if empty:
+            longest = max(len(rates[axis]) * dt for rates, dt in held_out)
+            raise InsufficientDataError(
+                f"no held-out log is long enough for the horizon(s) {', '.join(empty)} s after a {T:g} s calibration "
+                f"(the longest is {longest:g} s); shorten {{opt:horizons}} or {{opt:calibration}}")
         axes[axis] = {"components": comps, "rows": coverage_rows(e, sigma, h, unit="m/s" if q == "accel" else "deg"),
                       "n_logs": len(held_out), "quantity": q}
     return ConsistencyResult(target=target, axes=axes, t_cal_s=T, horizons_s=tuple(float(x) for x in h))
