@@ -179,3 +179,10 @@ def test_horizon_no_log_reaches_is_one_line_with_flags(logs, tmp_path):
     lines = [l for l in res.output.splitlines() if l.strip() and not l.startswith(("consistency", "gz:", "held"))]
     assert any("horizon(s) 5000 s" in l and "shorten --horizons or --calibration" in l for l in lines), res.output
     assert "Traceback" not in res.output
+
+
+def test_training_log_as_held_out_is_warned(logs, tmp_path):
+    res = runner.invoke(app, ["consistency", str(logs[0]), "--unit", "deg/h", "--held-out", str(logs[0]),
+                              "--calibration", "20", "--horizons", "20", "--out", str(tmp_path / "w")])
+    assert res.exit_code == 0, res.output
+    assert "is the training log itself (same SHA-256): its coverage is no held-out evidence" in res.output
