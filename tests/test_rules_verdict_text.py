@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 from fogdrift.evaluation.heading import heading_row
-from fogdrift.evaluation.verdicts import (Verdict, adev_caveat, artefact_table, artefact_verdict, heading_table,
+from fogdrift.evaluation.verdicts import (Verdict, adev_caveat, artefact_table, artefact_verdict, causal_verdict,
+                                          compensation_verdicts, heading_table, paper_measure_verdict,
                                           heading_verdict, headline_verdict, judge, table2_marks, table2_verdict)
 from fogdrift.evaluation.verdicts import _f, _pct
 
@@ -237,3 +238,41 @@ def test_judgement_texts_and_number_formats():
     assert [_f(x) for x in (None, math.inf, 0, 1e4, 1e-3, 9.99e-4, 0.1234, -2e-5)] == [
         "n/a", "n/a", "0", "1.00e+04", "0.001", "9.99e-04", "0.123", "-2.00e-05"]
     assert _f(0.123456, 2) == "0.12" and _f(12345.0, 2) == "1.2e+04"
+
+
+def _metrics(skill, rmse, rmse_p):
+    return NS(skill=skill, rmse_dph=rmse, rmse_persistence_dph=rmse_p, to_dict=lambda: {"rmse_dph": rmse})
+
+
+def test_causal_and_paper_measure_sentences():
+    """Skill > 0 beats persistence (NaN skill does not); the paper's measure is labelled as such and says n/a
+    where persistence's RMSE is 0."""
+    ma = NS(name="gz", causal_metrics={"persistence": _metrics(0.0, 1.0, 1.0), "AR(p)": _metrics(0.12, 0.88, 1.0),
+                                       "Kalman": _metrics(-0.05, 1.05, 1.0),
+                                       "GM(1,1)": _metrics(math.nan, math.nan, 1.0)},
+            metrics={"persistence": _metrics(0.0, 1.0, 1.0), "AR(p)": _metrics(0.3, 0.7, 1.0),
+                     "Kalman": _metrics(0.1, 0.9, 0.0)})
+    c = causal_verdict(ma)
+    assert c.lines == ["gz: against the causal drift (what a real-time compensator sees), one-step skill vs "
+                       "persistence: AR(p) 0.12; Kalman -0.05; GM(1,1) n/a.",
+                       "gz: AR(p) beat persistence on the causal target."]
+    assert c.data["AR(p)"] == {"skill": 0.12, "rmse_dph": 0.88, "rmse_persistence_dph": 1.0}
+    assert "persistence" not in c.data
+    p = paper_measure_verdict(ma)
+    assert p.to_dict() == {"kind": "paper", "lines": [
+        "gz: paper's measure (one step ahead, target = non-causal wavelet drift; not a compensation result): AR(p) "
+        "RMSE -30 % vs persistence; Kalman RMSE n/a vs persistence."],
+        "data": {"AR(p)": {"rmse_dph": 0.7}, "Kalman": {"rmse_dph": 0.9}}}
+    none = NS(name="gz", causal_metrics={"persistence": _metrics(0.0, 1.0, 1.0), "Kalman": _metrics(-0.05, 1.05, 1.0)},
+              metrics={"persistence": _metrics(0.0, 1.0, 1.0)})
+    assert causal_verdict(none).lines[1] == "gz: no model beats persistence on the causal target."
+    assert paper_measure_verdict(none).lines == ["gz: paper's measure (one step ahead, target = non-causal wavelet "
+                                                 "drift; not a compensation result): persistence only."]
+    only = NS(name="gz", causal_metrics={"persistence": _metrics(0.0, 1.0, 1.0)}, metrics={})
+    assert causal_verdict(only).to_dict() == {"kind": "causal", "lines": ["Only persistence was run."], "data": {}}
+    assert compensation_verdicts() == []
+    assert [v.kind for v in compensation_verdicts(model_axis=ma)] == ["causal", "paper"]
+    h = _heading(TWO, (60.0, 600.0))
+    vs = compensation_verdicts(heading=h, artefacts=ART, model_axis=ma)
+    assert [v.kind for v in vs] == ["heading", "artefacts", "causal", "paper"]
+    assert vs[0].lines == heading_verdict(h).lines and vs[1].lines == artefact_verdict(ART).lines
