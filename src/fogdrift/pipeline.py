@@ -332,7 +332,7 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     """
     from .allan import allan_variance
     from .allan.ci import periodic_alpha
-    from .noise import fit_noise
+    from .noise import express_quantity, fit_noise
     from .noise.periodic import null_taus, periodic_content
 
     if check_outliers:
@@ -367,9 +367,7 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range,
                       spectrum=spectrum, markov=True)
     if quantity != "angular_rate":
-        from .noise.quantity import express
-
-        noise = express(noise, quantity)
+        noise = express_quantity(noise, quantity)
     if outliers is not None:  # a new, complete NoiseFit carrying the report (the fit's own object is not edited)
         noise = dataclasses.replace(noise, outliers=outliers.to_dict())
     return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers)

@@ -83,7 +83,7 @@ def take_columns(a: np.ndarray, idx) -> np.ndarray:
 
 def to_dph(a: np.ndarray, scale: float) -> np.ndarray:
     """float64 rates in deg/h: no copy when ``a`` is float64 already and ``scale == 1``."""
-    if scale == 1.0 and a.dtype == np.float64:
+    if np.ndim(scale) == 0 and scale == 1.0 and a.dtype == np.float64:  # scale: one factor, or one per column
         return a
     with np.errstate(over="ignore"):  # an overflow becomes inf, which the callers locate
         return np.multiply(a, scale, dtype=np.float64)

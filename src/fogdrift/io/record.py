@@ -17,6 +17,7 @@ from .. import units
 from .._util import check_distinct_names
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
 from ..signal import Channel, Sampling, SignalDescription
+from .channel_quantity import check_name
 from ._checks import first_nonfinite, int_arg, split_keys, take_columns, to_dph
 
 __all__ = ["GyroRecord", "block_average", "from_array", "decimation_factor"]
@@ -645,8 +646,6 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
             raise ConfigError(
                 f"axis_names must be {arr.shape[1]} unique names (one per column); got {axis_names!r}"
             )
-    from .channel_quantity import check_name
-
     for name in names:
         check_name(name, spec, f"unit {unit!r}", str(source))
     n = arr.shape[0]

@@ -24,6 +24,7 @@ import numpy as np
 from ..errors import ConfigError
 from .convert import coefficients_from_A, paper_table1_from_A
 from .identify import POOR_CHI2_RED, identify, thin_taus
+from .quantity import express as express_quantity
 from .readouts import Readout, slope_readouts
 from .result import TERM_STATUSES, NoiseFit, NoiseTerm
 from .terms import (
@@ -43,6 +44,7 @@ from .terms import (
 from ..units import B_FACTOR
 
 __all__ = [
+    "express_quantity",
     "fit_noise",
     "identify",
     "NoiseFit",
