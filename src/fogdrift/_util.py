@@ -1,12 +1,17 @@
-"""Small validation and serialisation helpers shared across layers (imports only numpy and errors)."""
+"""Small validation and serialisation helpers shared across layers (imports only numpy, errors and the atomic
+output edge :mod:`fogdrift.output`)."""
 
 from __future__ import annotations
 
+import json
+import math
 import re
+from pathlib import Path
 
 import numpy as np
 
 from .errors import ConfigError, DataFormatError, InsufficientDataError
+from .output import atomic_path
 
 
 def check_series(y, name: str = "y", *, min_length: int = 1, allow_2d: bool = False, needed_by: str = "",
@@ -103,6 +108,45 @@ def json_default(obj):
     if hasattr(obj, "to_dict"):
         return obj.to_dict()
     raise TypeError(f"not JSON-serialisable: {type(obj).__name__}")
+
+
+def finite_or_null(obj):
+    """``obj`` (nested dicts, lists, tuples) with every NaN and infinity replaced by None, so the JSON is strict.
+
+    >>> finite_or_null({"a": float("nan"), "b": [1.0, float("inf")], "c": "x"})
+    {'a': None, 'b': [1.0, None], 'c': 'x'}
+    """
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: finite_or_null(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [finite_or_null(v) for v in obj]
+    return obj
+
+
+def strict_json(obj, *, indent: int | None = 2, sort_keys: bool = False) -> str:
+    """``obj`` as strict JSON text (RFC 8259): numpy values and ``to_dict()`` objects converted
+    (:func:`json_default`), NaN and infinity written as ``null``, never as the non-standard ``NaN``/``Infinity``.
+
+    The one strict-JSON serialiser; :func:`write_json` writes its text atomically.
+
+    >>> import numpy as np
+    >>> strict_json({"tau_s": np.float64(2.0), "edf": float("nan"), "m": np.arange(2)}, indent=None)
+    '{"tau_s": 2.0, "edf": null, "m": [0, 1]}'
+    """
+    data = finite_or_null(json.loads(json.dumps(obj, default=json_default)))
+    return json.dumps(data, indent=indent, sort_keys=sort_keys, allow_nan=False)
+
+
+def write_json(obj, path, *, indent: int | None = 2, sort_keys: bool = False):
+    """Write :func:`strict_json` of ``obj`` to ``path`` atomically (complete or absent,
+    :func:`fogdrift.output.atomic_path`); returns the path as :class:`pathlib.Path`."""
+    path = Path(path)
+    text = strict_json(obj, indent=indent, sort_keys=sort_keys)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path
 
 
 def safe_name(name) -> str:

@@ -22,12 +22,14 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import ConfigError
+from ..noise.terms import TERM_TABLE
 
 __all__ = ["CommandSpec", "COMMANDS", "command_spec", "noise_columns", "record_columns", "run_allan_command",
            "run_analyze_command", "TERMS"]
 
-#: IEEE-952 coefficients in the summary, with the unit suffix of their columns.
-TERMS = (("Q", "urad"), ("N", "dprh"), ("B", "dph"), ("K", "dphrh"), ("R", "dph2"))
+#: IEEE-952 coefficients in the summary, with the unit suffix of their columns, read from the term table
+#: (``("Q", "urad"), ("N", "dprh"), ("B", "dph"), ("K", "dphrh"), ("R", "dph2")``).
+TERMS = tuple((name, spec.suffix.lstrip("_")) for name, spec in TERM_TABLE.items())
 
 
 @dataclass(frozen=True)
@@ -68,6 +70,38 @@ def record_columns(record) -> dict:
     return row
 
 
+def ieee_columns(terms, b_min: dict) -> dict:
+    """The one column mapper of the IEEE-952 coefficients, for the Allan fit and GMWM alike.
+
+    Parameters
+    ----------
+    terms : mapping
+        Term name (``Q``, ``N``, ``B``, ``K``, ``R``) -> an object with ``value``, ``lo95``, ``hi95`` (in the
+        units of :data:`fogdrift.noise.TERM_UNITS`) and ``status``: a :class:`fogdrift.noise.NoiseTerm` or a
+        :class:`fogdrift.gmwm.analysis.GmwmTerm`.
+    b_min : dict
+        The IEEE reading min ADEV / 0.664 in the shape of ``NoiseFit.b_min`` (``value`` [deg/h], ``tau_s`` [s],
+        ``bound_only``); GMWM's through :meth:`fogdrift.gmwm.ieee.BiasInstability.as_b_min`.  ``{}``: none.
+
+    Returns
+    -------
+    dict
+        ``{name}_{unit}``, ``{name}_lo95_{unit}``, ``{name}_hi95_{unit}``, ``{name}_status`` per term, then
+        ``b_min_dph``, ``b_min_tau_s``, ``b_min_bound_only``.
+    """
+    row = {}
+    for name, unit in TERMS:
+        term = terms[name]
+        row[f"{name}_{unit}"] = _f(term.value)
+        row[f"{name}_lo95_{unit}"] = _f(term.lo95)
+        row[f"{name}_hi95_{unit}"] = _f(term.hi95)
+        row[f"{name}_status"] = str(term.status)
+    b = b_min or {}
+    row.update(b_min_dph=_f(b.get("value")), b_min_tau_s=_f(b.get("tau_s")),
+               b_min_bound_only=None if b.get("value") is None else bool(b.get("bound_only")))
+    return row
+
+
 def noise_columns(noise) -> dict:
     """Summary columns of one noise fit (:class:`fogdrift.noise.NoiseFit`).
 
@@ -76,20 +110,12 @@ def noise_columns(noise) -> dict:
     and the plausible ones; the fit's quality, chi-squared, dof, p-value and tau range; the IEEE reading of
     the bias instability at the curve's minimum.
     """
-    row = {}
-    for name, unit in TERMS:
-        term = noise.terms[name]
-        row[f"{name}_{unit}"] = _f(term.value)
-        row[f"{name}_lo95_{unit}"] = _f(term.lo95)
-        row[f"{name}_hi95_{unit}"] = _f(term.hi95)
-        row[f"{name}_status"] = str(term.status)
-    b = noise.b_min or {}
+    row = ieee_columns(noise.terms, noise.b_min)
     row.update(statistic=str(noise.statistic), noise_model="+".join(noise.selected) or "none",
                plausible_models="; ".join(noise.plausible) or None, fit_quality=str(noise.quality),
                fit_chi2_red=_f(noise.chi2_red), fit_dof=int(noise.dof), fit_p_value=_f(noise.p_value),
                fit_n_points=int(len(noise.fit_tau_s)), fit_tau_min_s=_f(noise.tau_min_s),
-               fit_tau_max_s=_f(noise.tau_max_s), b_min_dph=_f(b.get("value")), b_min_tau_s=_f(b.get("tau_s")),
-               b_min_bound_only=None if b.get("value") is None else bool(b.get("bound_only")),
+               fit_tau_max_s=_f(noise.tau_max_s),
                outliers=None if not noise.outliers else int(noise.outliers.get("count") or 0))
     return row
 
@@ -171,22 +197,12 @@ def gmwm_columns(axis) -> dict:
     """Summary columns of one GMWM axis (:class:`fogdrift.gmwm.analysis.GmwmAxis`)."""
     sel = axis.selection
     ie = sel.ieee
-    row = {"statistic": "wvar"}
-    terms = axis.ieee_terms()
-    for name, unit in TERMS:
-        t = terms[name]
-        row[f"{name}_{unit}"] = _f(t.value)
-        row[f"{name}_lo95_{unit}"] = _f(t.lo95)
-        row[f"{name}_hi95_{unit}"] = _f(t.hi95)
-        row[f"{name}_status"] = t.status
-    b = ie.b_min
+    # the model's ADEV minimum, or its 95 % bound where it lies beyond the scales used (gmwm.ieee)
+    row = {"statistic": "wvar", **ieee_columns(axis.ieee_terms(), ie.b_min.as_b_min())}
     fit = sel.fit
     row.update(noise_model=str(sel.selected), fit_quality="good" if sel.passed_checks else "poor",
                fit_dof=int(fit.df), fit_p_value=_f(fit.j_pvalue),
-               fit_n_points=int(len(axis.wvar.scale_s) - len(sel.excluded)),
-               # the model's ADEV minimum, or its 95 % bound where it lies beyond the scales used (gmwm.ieee)
-               b_min_dph=_f(b.value_dph if b.value_dph is not None else b.bound_dph), b_min_tau_s=_f(b.tau_s),
-               b_min_bound_only=None if b.value_dph is None and b.bound_dph is None else b.value_dph is None)
+               fit_n_points=int(len(axis.wvar.scale_s) - len(sel.excluded)))
     return row
 
 

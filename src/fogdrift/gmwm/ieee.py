@@ -49,12 +49,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..units import B_FACTOR
 from .processes import PROCESSES, parse_model
 
 __all__ = ["IEEEValue", "BiasInstability", "IEEEResult", "to_ieee", "B_ADEV_FACTOR"]
 
-#: Flat Allan deviation of flicker noise in units of B: sqrt(2 ln2 / pi).
-B_ADEV_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)
+#: Flat Allan deviation of flicker noise in units of B: sqrt(2 ln2 / pi) (:data:`fogdrift.units.B_FACTOR`).
+B_ADEV_FACTOR = B_FACTOR
 _Z95 = 1.959963984540054
 _STEP = 1e-5
 
@@ -141,6 +142,22 @@ class BiasInstability:
 
     def to_dict(self) -> dict:
         return {k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in self.__dict__.items()}
+
+    def as_b_min(self) -> dict:
+        """This reading in the shape of the Allan fit's ``NoiseFit.b_min`` (one shape for both methods).
+
+        ``{"value", "unit", "tau_s", "bound_only", "lo95", "hi95", "rule"}``, B in deg/h: ``value`` is the reading,
+        or its 95 % upper bound with ``bound_only`` True; ``{}`` when nothing is read (as the Allan fit's empty
+        ``b_min``).
+        """
+        if self.value_dph is None and self.bound_dph is None:
+            return {}
+        bound = self.value_dph is None
+        return {"value": float(self.bound_dph if bound else self.value_dph), "unit": "deg/h",
+                "tau_s": None if self.tau_s is None else float(self.tau_s), "bound_only": bound,
+                "lo95": None if bound or self.lo95_dph is None else float(self.lo95_dph),
+                "hi95": float(self.bound_dph) if bound else (None if self.hi95_dph is None else float(self.hi95_dph)),
+                "rule": self.label}
 
 
 @dataclass(frozen=True)

@@ -10,11 +10,13 @@ metric scores, and scale their y axis on the scored part only.
 from __future__ import annotations
 
 import functools
+import itertools
 import re
 from pathlib import Path
 
 import numpy as np
 
+from ..noise.terms import ALL_TERMS
 from ..output import atomic_path
 
 #: Width [in] of every report figure; with :data:`DPI` about 1200 px.
@@ -54,11 +56,16 @@ def _styled(fn):
     return wrapper
 
 
-def _save(fig, path) -> Path:
+def _save(fig, path, **savefig) -> Path:
+    """Write ``fig`` to ``path`` atomically (complete or absent) and close it, whatever happens.
+
+    ``savefig`` keywords go to :meth:`matplotlib.figure.Figure.savefig` (default ``dpi=DPI``); every figure of
+    the package is saved here.
+    """
     path = Path(path)
     try:
         with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=DPI)
+            fig.savefig(tmp, **{"dpi": DPI, **savefig})
     finally:
         _plt().close(fig)
     return path
@@ -148,7 +155,7 @@ def plot_allan(axes_list, path, title=None) -> Path:
         ax.loglog(tau, fit.model_dev_dph(tau), "r--" if no_fit else "r-", lw=2.0,
                   label=literal(f"best candidate {'+'.join(fit.selected)} (no model fits)" if no_fit else
                                 f"fit {'+'.join(fit.selected)}"))
-        for name, style in zip(("Q", "N", "B", "K", "R", "S", "M"), ("--", "-.", ":", "--", "-.", ":", "--")):
+        for name, style in zip(ALL_TERMS, itertools.cycle(("--", "-.", ":"))):
             t = fit.terms.get(name)
             if name in fit.selected and t is not None and t.value:
                 ax.loglog(tau, fit.term_dev_dph(name, tau), style, lw=1.2, label=name)

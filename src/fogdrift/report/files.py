@@ -2,40 +2,21 @@
 
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
 
 import numpy as np
 
-from .._util import json_default
+from .._util import write_json
 from ..noise import TERM_TABLE
 from ..output import atomic_path
 from .figures import _safe, plot_allan, plot_models, plot_residuals, plot_separation, plot_separation_allan
 
-def _clean(obj):
-    """Replace NaN/inf by None so the JSON is strict."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    return obj
-
-
-def write_json(obj, path) -> Path:
-    path = Path(path)
-    data = json.loads(json.dumps(obj, default=json_default))
-    with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(_clean(data), indent=2, allow_nan=False))
-    return path
-
+__all__ = ["write_json", "write_allan_outputs", "write_separation_outputs", "write_model_outputs"]
 
 
 def _noise_csv_rows(label, aa):
     cells = []
-    for name in ("Q", "N", "B", "K", "R"):
+    for name in TERM_TABLE:
         t = aa.noise.terms[name]
         cells += [t.value, t.lo95, t.hi95]
     return [label] + ["" if c is None else repr(float(c)) for c in cells]

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
 from ..output import atomic_path
-from .figures import literal
+from .figures import _save, literal
 from .files import write_json
 
 __all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
@@ -62,13 +62,7 @@ def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
                              f"J = {fit.q:.3g}, df {fit.df}, p = {fit.j_pvalue:.2g}"), fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    path = Path(path)
-    try:
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    finally:
-        plt.close(fig)
-    return path
+    return _save(fig, path, dpi=110, bbox_inches="tight")
 
 
 def write_gmwm_outputs(axes: list[GmwmAxis], out_dir, *, source: str, record: dict | None = None) -> dict:
@@ -119,3 +113,10 @@ def gmwm_noise_html(axis: GmwmAxis) -> str:
             + (f"<ul class='note'>{excl}</ul>" if excl else "")
             + "<table class='gmwm-candidates'><tr><th>candidate</th><th>WIC</th><th>passed</th><th>why rejected</th>"
               f"</tr>{cands}</table>")
+
+
+def gmwm_axis_block(ax, result, fig_dir, pre, fig_offset, evaluated) -> str:
+    """Report section ``gmwm`` (:mod:`fogdrift.report.sections`): the GMWM noise table of an axis analysed with
+    ``--noise-method gmwm``, first in the axis's noise identification; ``""`` for an Allan-only axis."""
+    gm = getattr(ax, "gmwm", None)
+    return "" if gm is None else gmwm_noise_html(gm)

@@ -16,7 +16,8 @@ import struct
 from datetime import datetime, timezone
 from pathlib import Path
 
-from ..evaluation.verdicts import judge, table2_marks
+from ..evaluation.verdicts import CONSTANT_BIAS_LABEL, judge, table2_marks
+from ..models.registry import MODELS
 from ..output import atomic_path
 from ..temperature import summary_line, temperature_summary
 from .figures import (_safe, plot_allan, plot_models, plot_residuals, plot_separation, plot_separation_allan,
@@ -27,14 +28,16 @@ from .settings import settings_rows
 from .summary import OUTCOME_LABELS, cannot_support, noise_headline, recording_rows, summary_dict, verdict_items
 from .tables import (METRICS_HEADERS, NOISE_HEADERS, _fmt, causal_metrics_rows, fit_cell, metrics_rows, noise_notes, noise_row,
                      readout_text, verdict)
-from .gmwm import gmwm_noise_html
 from .pdf import write_pdf
+from .sections import sections
 from .temperature import plot_rate_and_temperature
 
 __all__ = ["write_report", "render_report"]
 
-#: Order of the compensators in the heading-error and artefact tables (others follow, persistence last).
-MODEL_ORDER = ("constant bias", "AR", "GM(1,1)", "Elman", "grey-Elman", "Kalman")
+#: Order of the compensators in the heading-error and artefact tables: the constant-bias baseline, then the
+#: model registry's labels in its (report) order, persistence (the registry's last row) last; others follow the
+#: registry's models.  ``"AR(p)"`` stands for every ``"AR(4)"``...
+MODEL_ORDER = (CONSTANT_BIAS_LABEL,) + tuple(spec.label for spec in MODELS if spec.name != "persistence")
 
 _CSS = """
 *{box-sizing:border-box}
@@ -135,8 +138,8 @@ def _order(labels) -> list:
     def key(label):
         if label == "persistence":
             return (len(MODEL_ORDER) + 1, label)
-        for i, prefix in enumerate(MODEL_ORDER):
-            if label == prefix or label.startswith(prefix + "("):  # "AR(p)"
+        for i, name in enumerate(MODEL_ORDER):
+            if label == name or (name.endswith("(p)") and label.startswith(name[:-2])):  # "AR(p)": "AR(4)"
                 return (i, label)
         return (len(MODEL_ORDER), label)
 
@@ -314,23 +317,38 @@ def _table_note_heading() -> str:
 
 
 def _axis_section(ax, result, fig_dir, pre, fig_offset, evaluated) -> str:
+    """One axis: its heading, then every ``axis`` row of :data:`fogdrift.report.sections.SECTIONS` in order."""
     name = _safe(ax.name)
     parts = [f'<section id="{_e(pre)}axis-{_e(name)}"><h2>{"Applied: " if pre else ""}Axis {_e(ax.name)}</h2>',
-             "<h3>Noise identification (whole record, native rate)</h3>",
-             _table(("signal",) + NOISE_HEADERS, [["original"] + noise_row(ax.original.noise)], "allan"),
-             _ul(noise_notes(ax.original.noise)),
-             '<p class="note">Slope read-outs (cross-check): ' + _e(readout_text(ax.original.noise)) + "</p>",
-             _img(plot_allan([ax.original], fig_dir / f"{pre}fig3_allan_{name}.png", "Allan deviation (Fig. 3)")),
-             "<h3>Drift / noise separation</h3>",
-             _img(plot_separation(ax.separation, fig_dir / f"{pre}fig5_drift_noise_{name}.png", ax.models.split),
-                  "The models separate inside each block (no test information reaches training); this figure "
-                  "separates the whole record for display."),
-             _img(plot_separation_allan(ax.separation, fig_dir / f"{pre}fig6_allan_{name}.png")),
-             _compensation_section(ax, fig_dir, pre, fig_offset, evaluated), "</section>"]
-    if getattr(ax, "gmwm", None) is not None:  # analyze --noise-method gmwm: the GMWM table first
+             "<h3>Noise identification (whole record, native rate)</h3>"]
+    parts += [s.render(ax, result, fig_dir, pre, fig_offset, evaluated) for s in sections("axis")]
+    return "\n".join([p for p in parts if p] + ["</section>"])
 
-        parts.insert(2, gmwm_noise_html(ax.gmwm))
-    return "\n".join(parts)
+
+def noise_block(ax, result, fig_dir, pre, fig_offset, evaluated) -> str:
+    """Section ``noise``: the Allan-fit noise table of the whole record, its notes, slope read-outs, Fig. 3."""
+    name = _safe(ax.name)
+    return "\n".join([
+        _table(("signal",) + NOISE_HEADERS, [["original"] + noise_row(ax.original.noise)], "allan"),
+        _ul(noise_notes(ax.original.noise)),
+        '<p class="note">Slope read-outs (cross-check): ' + _e(readout_text(ax.original.noise)) + "</p>",
+        _img(plot_allan([ax.original], fig_dir / f"{pre}fig3_allan_{name}.png", "Allan deviation (Fig. 3)"))])
+
+
+def separation_block(ax, result, fig_dir, pre, fig_offset, evaluated) -> str:
+    """Section ``separation``: drift and white noise of the whole record (Fig. 5) and their ADEV (Fig. 6)."""
+    name = _safe(ax.name)
+    return "\n".join([
+        "<h3>Drift / noise separation</h3>",
+        _img(plot_separation(ax.separation, fig_dir / f"{pre}fig5_drift_noise_{name}.png", ax.models.split),
+             "The models separate inside each block (no test information reaches training); this figure "
+             "separates the whole record for display."),
+        _img(plot_separation_allan(ax.separation, fig_dir / f"{pre}fig6_allan_{name}.png"))])
+
+
+def compensation_block(ax, result, fig_dir, pre, fig_offset, evaluated) -> str:
+    """Section ``compensation`` (:func:`_compensation_section`)."""
+    return _compensation_section(ax, fig_dir, pre, fig_offset, evaluated)
 
 
 def _split_seconds(result) -> dict | None:
@@ -346,8 +364,19 @@ def _glossary_section() -> str:
     return f'<section id="glossary"><h2>Glossary</h2><dl class="glossary">{items}</dl></section>'
 
 
-def _temperature_block(record, fig_dir) -> str:
-    """Rate and temperature against time, with the temperature's range and drift, when the log carries one."""
+def signal_block(result, record, fig_dir) -> str:
+    """Section ``signal``: Fig. 1, the output of every axis with the chronological split."""
+    return _img(plot_signal(record, fig_dir / "fig1_signal.png", _split_seconds(result)))
+
+
+def spectrum_block(result, record, fig_dir) -> str:
+    """Section ``spectrum``: Fig. 2, the output's spectrum."""
+    return _img(plot_spectrum(record, fig_dir / "fig2_spectrum.png"))
+
+
+def temperature_block(result, record, fig_dir) -> str:
+    """Section ``temperature``: rate and temperature against time, with the temperature's range and drift, when
+    the log carries one (``""`` otherwise)."""
     temp = getattr(record, "temperature_c", None)
     if temp is None:
         return ""
@@ -378,8 +407,7 @@ def render_report(result, record, fig_dir, *, sensor=None, evaluated=True, gener
             '<p class="note">Method: Tang et al., Chinese J. Lasers 39(10) 2012, with the corrected IEEE-952 '
             "quantization relation (the paper's Table 1 Q formula is 3·3600² too large). The drift is separated "
             "inside each block, so no test information leaks into training.</p>",
-            _img(plot_signal(record, fig_dir / "fig1_signal.png", _split_seconds(result))),
-            _img(plot_spectrum(record, fig_dir / "fig2_spectrum.png")), _temperature_block(record, fig_dir), "</section>"]
+            *[s.render(result, record, fig_dir) for s in sections("recording")], "</section>"]
     body += [_axis_section(ax, result, fig_dir, "", 0, evaluated) for ax in result.axes]
     if result.apply_to is not None:
         body.append(f'<section id="applied"><h2>Generalisation: fitted models applied unchanged to '

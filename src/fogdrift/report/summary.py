@@ -14,7 +14,7 @@ import numpy as np
 from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
 from ..gmwm.compare import compare_with_allan
 from ..noise import TERM_TABLE
-from ..noise.terms import DISPLAY_UNITS
+from ..noise.terms import DISPLAY_UNITS, TERMS
 from .tables import _fmt, noise_row, shaped_cell, term_text
 
 __all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "recording_rows", "noise_headline", "verdict_items",
@@ -84,7 +84,7 @@ def noise_headline(result) -> tuple:
         return _gmwm_headline(axes)
     headers = ["whole record, native rate (Allan fit)"] + [f"axis {ax.name}" for ax in axes]
     fits = [ax.original.noise for ax in axes]
-    cells = [dict(zip(("Q", "N", "B", "K", "R"), noise_row(f))) for f in fits]
+    cells = [dict(zip(TERMS, noise_row(f))) for f in fits]
     rows = []
     for name in HEADLINE_TERMS:
         label = ("B bias instability: the flicker floor when fitted, else the IEEE reading min ADEV/0.664 [deg/h]"

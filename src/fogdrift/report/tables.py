@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import math
 
-NOISE_HEADERS = ("Q [µrad]", "N [deg/√h]", "B [deg/h]", "K [deg/h^1.5]", "R [deg/h²]")
+from ..noise.terms import TERM_HEADERS, TERMS
+
+NOISE_HEADERS = tuple(TERM_HEADERS[name] for name in TERMS)
 
 METRICS_HEADERS = (
     "model",
@@ -56,7 +58,7 @@ def noise_row(noise) -> list[str]:
     (:func:`b_headline`).  When no model fits (``noise.no_fit``) every cell is an upper bound or "–": the
     coefficients of a model that misses the curve are no result."""
     cells = []
-    for name in ("Q", "N", "B", "K", "R"):
+    for name in TERMS:
         t = noise.terms[name]
         if getattr(noise, "no_fit", None):
             cells.append("–" if t.hi95 is None else f"– (< {_fmt(t.hi95, 3)})")

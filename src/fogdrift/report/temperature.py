@@ -12,9 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError
-from ..output import atomic_path
 from ..temperature import summary_line, temperature_summary
-from .figures import literal
+from .figures import _save, literal
 
 __all__ = ["plot_rate_and_temperature", "MAX_POINTS"]
 
@@ -84,9 +83,4 @@ def plot_rate_and_temperature(record, path) -> Path:
         fig.suptitle(f"Rate and temperature (block means of {k} samples)", fontsize=9)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    try:
-        with atomic_path(path) as tmp:  # complete or absent (fogdrift.output)
-            fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
-    finally:
-        plt.close(fig)
-    return path
+    return _save(fig, path, dpi=110, bbox_inches="tight", format="png")  # complete or absent (fogdrift.output)

@@ -1,0 +1,94 @@
+"""One IEEE-term shape for the Allan fit and GMWM (issue 21): fleet's one column mapper, GMWM's B_min in the Allan
+fit's ``b_min`` shape, the term list and the report's model order read from their tables."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import pytest
+
+from fogdrift.fleet.commands import TERMS, ieee_columns
+from fogdrift.gmwm.ieee import BiasInstability
+from fogdrift.models.registry import MODELS
+from fogdrift.noise.terms import TERM_TABLE
+from fogdrift.report.html import MODEL_ORDER, _order
+from fogdrift.report.tables import NOISE_HEADERS
+
+
+def _b(value=None, lo=None, hi=None, tau=None, bound=None):
+    return BiasInstability("min-avar", value, lo, hi, tau, bound, "" if value else "still falling",
+                           "min of the model's ADEV / 0.664")
+
+
+def test_gmwm_b_min_in_the_allan_shape():
+    got = _b(2.0, 1.5, 2.5, 117.0).as_b_min()
+    assert got == {"value": 2.0, "unit": "deg/h", "tau_s": 117.0, "bound_only": False, "lo95": 1.5, "hi95": 2.5,
+                   "rule": "min of the model's ADEV / 0.664"}
+    bound = _b(tau=900.0, bound=7.06).as_b_min()     # beyond the scales used: the 95 % bound, flagged
+    assert bound["value"] == 7.06 and bound["bound_only"] is True and bound["lo95"] is None
+    assert bound["hi95"] == 7.06 and bound["tau_s"] == 900.0
+    assert _b().as_b_min() == {}
+    # the Allan fit's b_min has these keys (noise/checks.py _classical_b)
+    assert set(got) == {"value", "unit", "tau_s", "bound_only", "lo95", "hi95", "rule"}
+
+
+def test_one_column_mapper_for_both_methods():
+    t = SimpleNamespace
+    terms = {n: t(value=None, lo95=None, hi95=0.5, status="absent") for n in TERM_TABLE}
+    terms["N"] = t(value=0.01, lo95=0.009, hi95=0.011, status="resolved")
+    allan = ieee_columns(terms, {"value": 2.0, "tau_s": 117.0, "bound_only": False})
+    gmwm = ieee_columns(terms, _b(2.0, 1.5, 2.5, 117.0).as_b_min())
+    assert allan == gmwm
+    assert allan["N_dprh"] == 0.01 and allan["N_lo95_dprh"] == 0.009 and allan["N_hi95_dprh"] == 0.011
+    assert allan["Q_urad"] is None and allan["Q_hi95_urad"] == 0.5 and allan["Q_status"] == "absent"
+    assert allan["b_min_dph"] == 2.0 and allan["b_min_tau_s"] == 117.0 and allan["b_min_bound_only"] is False
+    bound = ieee_columns(terms, _b(tau=900.0, bound=7.06).as_b_min())
+    assert bound["b_min_dph"] == 7.06 and bound["b_min_bound_only"] is True
+    none = ieee_columns(terms, _b().as_b_min())
+    assert none["b_min_dph"] is None and none["b_min_tau_s"] is None and none["b_min_bound_only"] is None
+
+
+def test_term_lists_come_from_the_term_table():
+    assert TERMS == (("Q", "urad"), ("N", "dprh"), ("B", "dph"), ("K", "dphrh"), ("R", "dph2"))
+    assert [n for n, _ in TERMS] == list(TERM_TABLE)
+    assert NOISE_HEADERS == ("Q [µrad]", "N [deg/√h]", "B [deg/h]", "K [deg/h^1.5]", "R [deg/h²]")
+
+
+def test_report_model_order_is_the_registry_order():
+    labels = [s.label for s in MODELS]
+    assert MODEL_ORDER == ("constant bias", *labels[:-1]) and labels[-1] == "persistence"
+    got = _order(["persistence", "AR(4)", "Kalman", "constant bias", "GM(1,1)", "Elman", "grey-Elman", "other"])
+    assert got == ["constant bias", "grey-Elman", "Elman", "GM(1,1)", "AR(4)", "Kalman", "other", "persistence"]
+
+
+@pytest.mark.parametrize("label", ["ARX", "AR"])
+def test_ar_template_matches_only_ar_with_an_order(label):
+    assert _order([label, "AR(2)"])[0] == "AR(2)"
+
+
+def test_one_strict_json_writer(tmp_path):
+    import json
+
+    import numpy as np
+
+    from fogdrift import _util, report
+    from fogdrift.report import files
+
+    assert report.write_json is _util.write_json and files.write_json is _util.write_json
+    doc = {"edf": np.array([1.5, np.nan]), "tau_s": np.float32(2.0), "hi": float("inf"), "n": np.int64(3),
+           "nested": [{"x": float("-inf")}]}
+    p = _util.write_json(doc, tmp_path / "a.json")
+    text = p.read_text()
+    assert "NaN" not in text and "Infinity" not in text
+    assert json.loads(text) == {"edf": [1.5, None], "tau_s": 2.0, "hi": None, "n": 3, "nested": [{"x": None}]}
+    assert [f.name for f in tmp_path.iterdir()] == ["a.json"]        # no temporary left beside it
+    assert _util.strict_json({"b": 1, "a": 2}, indent=None, sort_keys=True) == '{"a": 2, "b": 1}'
+
+
+def test_flicker_constant_has_one_home():
+    import math
+
+    from fogdrift.gmwm.ieee import B_ADEV_FACTOR
+    from fogdrift.units import B_FACTOR
+
+    assert B_ADEV_FACTOR is B_FACTOR and math.isclose(B_FACTOR, 0.664282, rel_tol=1e-6)
