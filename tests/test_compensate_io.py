@@ -267,3 +267,55 @@ def test_relative_out_folder_holds_the_files_itself(bundle, tmp_path, monkeypatc
     assert "wrote o/compensated.csv, o/compensated.npz" in r.output
     doc = json.loads((tmp_path / "o" / "compensation.json").read_text())
     assert doc["files"]["csv"] == "o/compensated.csv"
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the .npy stream's time base (io.chunked.open_rows), each rule on a case where only it applies
+
+
+def _stream(tmp_path, t, *, chunk=64, **kw):
+    from fogdrift.io.chunked import open_rows
+
+    x = np.full(t.size, 45.0)
+    np.save(tmp_path / "s.npy", np.column_stack([t, x]))
+    src = open_rows(tmp_path / "s.npy", time_column="col0", unit="deg/h", **kw)
+    return src, [c for c in src.chunks(chunk)]
+
+
+def test_stream_time_rules_each_on_its_own_case(tmp_path):
+    # uniform 10-ms grid in ms with time_unit="ms": dt 0.01 s, t in s
+    src, chunks = _stream(tmp_path, 10.0 * np.arange(200) + 5.0, time_unit="ms")
+    assert src.dt_s == pytest.approx(0.01, rel=1e-12) and src.t0_s == pytest.approx(0.005)
+    np.testing.assert_allclose(np.concatenate([t for t, _ in chunks]), 0.005 + 0.01 * np.arange(200), rtol=1e-12)
+    assert src.signal.sampling.dt_source == "time column" and src.signal.sampling.time_unit == "ms"
+    # one step of 0.5 s among steps of 1 s (no scatter, no gap): a short step (a rate change), in the FIRST chunk
+    t = np.cumsum(np.r_[0.0, np.ones(4), 0.5, np.ones(194)])
+    with pytest.raises(DataFormatError, match=r"time step at sample 5 is 0.5 s"):
+        _stream(tmp_path, t)
+    # steps alternating 0.5 / 1.5 s (the median hides it): refused at opening, as scattered steps
+    t = np.cumsum(np.r_[0.0, np.tile([0.5, 1.5], 100)])
+    with pytest.raises(DataFormatError, match=r"scatter by 50 %"):
+        _stream(tmp_path, t)
+    # steps 0.9 / 1.1 s: each within the step limits, but they scatter by 10 % (median absolute deviation)
+    t = np.cumsum(np.r_[0.0, np.tile([0.9, 1.1], 100)])
+    with pytest.raises(DataFormatError, match=r"scatter by 10 %"):
+        _stream(tmp_path, t)
+    # 300 steps of 1 s then 199 of 1.4 s: median 1, no scatter (most steps are exact), no gap (1.4 < 1.5), but the
+    # span 300 + 199 x 1.4 = 578.6 s against (500 - 1) x 1 = 499 s: refused when the stream reaches the end
+    t = np.cumsum(np.r_[0.0, np.ones(300), np.full(199, 1.4)])
+    with pytest.raises(DataFormatError, match=r"spans 578.6 s, but its 500 samples at 1 s span 499 s"):
+        _stream(tmp_path, t)
+    # a rate given that disagrees with the time column by more than 1 %
+    with pytest.raises(DataFormatError, match="disagrees with the given sample interval"):
+        _stream(tmp_path, np.arange(100.0), rate_hz=1.05)
+
+
+def test_a_non_unit_configuration_error_is_not_turned_into_the_unit_refusal(bundle, tmp_path):
+    # a .npy without a time column and without --rate: the interval is what is missing, not the unit
+    np.save(tmp_path / "r.npy", np.full(100, 45.0))
+    with pytest.raises(ConfigError) as info:
+        compensate_file(bundle, tmp_path / "r.npy", tmp_path / "o", **_kw(unit="deg/h", axis_map="col0=gz"))
+    assert "cannot tell the sample interval" in str(info.value)
+    with pytest.raises(ConfigError) as info:  # both missing: the unit is asked for first, suggesting the bundle's
+        compensate_file(bundle, tmp_path / "r.npy", tmp_path / "o", **_kw(axis_map="col0=gz"))
+    assert "pass unit= deg/h (the bundle was trained on deg/h)" in str(info.value)
