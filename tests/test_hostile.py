@@ -552,3 +552,20 @@ def test_a_write_refused_for_another_reason_is_a_config_error_naming_the_file(tm
     assert str(ei.value).startswith(f"out= {out}: cannot write sub/noise.json: Permission denied (EACCES); "
                                      f"nothing was written to {out}")
     assert not [p for p in out.rglob("*") if p.name.startswith(TMP_PREFIX)]
+
+
+def test_raw_binary_records_are_held_to_the_row_limit_and_memory_budget(tmp_path, monkeypatch):
+    p = tmp_path / "imu.bin"
+    rec = np.zeros(100_000, dtype=[("seq", "<u2"), ("gx", "<i4"), ("gy", "<i4")])
+    rec["seq"] = np.arange(100_000) % 65536
+    p.write_bytes(rec.tobytes())
+    opts = {"reader_options": {"layout": "<u2 seq, <i4 gx, <i4 gy"}, "unit": "deg/h", "rate_hz": 100.0}
+    monkeypatch.setenv(limits.ENV_ROWS, "99999")
+    with pytest.raises(ResourceLimitError, match=r"imu\.bin: 100000 records; expected at most 99999"):
+        load(p, **opts)
+    monkeypatch.setenv(limits.ENV_ROWS, "100000")
+    monkeypatch.setenv(limits.ENV_MEMORY, "1M")    # gx, gy used (the counter is time): 100 000 x 2 x 8 = 1.53 MiB
+    with pytest.raises(ResourceLimitError, match=r"100000 records x 2 used field\(s\) as float64 needs 1\.53 MiB"):
+        load(p, **opts)
+    monkeypatch.setenv(limits.ENV_MEMORY, "2M")
+    assert load(p, **opts).n_samples == 100_000

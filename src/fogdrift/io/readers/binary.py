@@ -38,6 +38,7 @@ import numpy as np
 
 from ...errors import ConfigError, DataFormatError
 from ..hashing import file_sha256
+from .limits import check_memory, check_rows
 from .base import Table
 
 __all__ = ["open_table", "BinaryTable", "parse_layout", "parse_scale", "SEQUENCE_NAMES"]
@@ -164,6 +165,9 @@ class BinaryTable(Table):
     def read(self, used) -> np.ndarray:
         if self.data is None:
             n = self.records.shape[0]
+            check_rows(n, self.path, "records")
+            check_memory(n * 8.0 * max(len(set(used)), 1), self.path,
+                         f"{n} records x {len(set(used))} used field(s) as float64")
             data = np.zeros((n, len(self.names)), dtype=np.float64, order="F")   # unused columns cost nothing
             for j in sorted(set(used)):
                 name = self.names[j]
