@@ -156,7 +156,7 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", unit=None
                       stacklevel=2)
         unit = apply_unit
     edge = contextlib.nullcontext() if active(Path(out_dir) / "compensation.json") is not None else \
-        OutputDir(out_dir, command="compensate", protect=[path])
+        OutputDir(out_dir, command="compensate", create_parents=True, protect=[path])  # parents: as mkdir -p before
     with edge:
         return _compensate(bundle, path, out_dir, model=model, bias=bias,
                            unit=unit, axis_map=axis_map, accept_rate=accept_rate,

@@ -1,11 +1,17 @@
-"""Windows of one axis of a large file, in deg/h, for out-of-core analysis (:mod:`fogdrift.allan.chunked`).
+"""Large files read in pieces: windows of one axis for out-of-core analysis (:mod:`fogdrift.allan.chunked`), and
+row chunks of several axes for ``fogdrift compensate``.
 
 :func:`open_source` opens ``.npy``, raw binary or HDF5 without loading it: :meth:`ChunkSource.read` returns
 samples ``[start, stop)`` of one column as float64 deg/h, read with plain file reads (``np.fromfile`` at an
 offset) or an h5py hyperslab, so memory is bounded by the window asked for, never by the file (a memory
 map would count every page it ever touched in the process's resident set).
 
-This path takes the sample rate as given (``rate_hz``/``dt_s``): it has no time column and no gap
+:func:`open_rows` streams the rate columns of a ``.npy`` in row chunks, each converted once to deg/h by the
+factor it records in its :class:`~fogdrift.signal.SignalDescription` (``fogdrift compensate`` reads ``.npy`` logs
+through it); a named time column's steps, scatter and span are checked as the rows stream, by the rules of
+:func:`fogdrift.io.load`.
+
+:func:`open_source` takes the sample rate as given (``rate_hz``/``dt_s``): it has no time column and no gap
 splitting.  A raw binary sequence counter is checked for gaps while the first pass streams the file (an
 error names the record).  Load smaller files with :func:`fogdrift.io.load`, which checks everything.
 """
