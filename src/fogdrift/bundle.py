@@ -494,7 +494,7 @@ def load_bundle(path) -> Bundle:
                              "or damaged after the bundle was written; re-create the bundle")
     unit = d.get(raw, "input_unit", str, "")
     try:
-        unit_spec = parse_unit(unit)
+        unit_spec = parse_unit(unit, None)  # a unit of any quantity (gyro deg/s, accelerometer g ...)
     except ConfigError:
         d.fail("input_unit", f"unknown unit {unit!r}")
     native = d.get(raw, "native_dt_s", "positive", "")
