@@ -303,3 +303,21 @@ def test_separation_axis_is_complete_when_built():
     (sep,) = run_separation(from_array(x, dt_s=1.0), AnalysisConfig(model_rate_hz=None, level=2))
     assert sep.mean_removed_dph == pytest.approx(float(np.mean(x)), rel=1e-12) and sep.level == 2
     assert abs(float(np.mean(sep.rate_dph))) < 1e-9  # the mean stored is the one removed
+
+
+def test_cli_analyze_decides_the_factor_once_and_echoes_the_sources(tmp_path, monkeypatch):
+    from fogdrift.cli import app
+
+    calls = []
+    real = io_record.decimation_factor
+    monkeypatch.setattr(io_record, "decimation_factor", lambda *a: calls.append(a) or real(*a))
+    x = simulate(4000, 0.5, arw_dprh=0.05, rrw_dphrh=0.5, bias_dph=2.0, seed=6)
+    p = tmp_path / "g.csv"
+    p.write_text("t_s,gz\n" + "".join(f"{k * 0.5:.3f},{v / 3600.0:.12f}\n" for k, v in enumerate(x)))
+    res = runner.invoke(app, ["analyze", str(p), "--unit", "deg/s", "--models", "persistence", "--level", "2",
+                              "--no-heading", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    assert calls == [(0.5, 1.0)]
+    assert "(dt 0.5 s from time column 't_s'); units: rate deg/s (--unit), time s (declared in the header)" in res.output
+    doc = json.loads((tmp_path / "o" / "bundle" / "manifest.json").read_text())
+    assert doc["block_average_factor"] == 2 and doc["signal"]["channels"][0]["unit_source"] == "option"
