@@ -321,3 +321,13 @@ def test_cli_analyze_decides_the_factor_once_and_echoes_the_sources(tmp_path, mo
     assert "(dt 0.5 s from time column 't_s'); units: rate deg/s (--unit), time s (declared in the header)" in res.output
     doc = json.loads((tmp_path / "o" / "bundle" / "manifest.json").read_text())
     assert doc["block_average_factor"] == 2 and doc["signal"]["channels"][0]["unit_source"] == "option"
+
+
+@pytest.mark.parametrize("field, value", [("scale_to_internal", "big"), ("scale_to_internal", None),
+                                          ("scale_to_internal", -1.0), ("quantity", "pressure"),
+                                          ("unit_as_read", 5), ("unit_source", ["x"])])
+def test_a_damaged_channel_is_one_config_error(field, value):
+    d = from_array([1.0, 2.0], dt_s=0.01, unit="deg/s").signal.to_dict()
+    d["channels"][0][field] = value
+    with pytest.raises(ConfigError):
+        SignalDescription.from_dict(d)

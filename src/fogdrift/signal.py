@@ -164,7 +164,10 @@ class Channel:
         if not isinstance(self.unit, units.UnitSpec):
             raise ConfigError(f"unit must be a fogdrift.units.UnitSpec (from units.parse_unit); got {self.unit!r}")
         _choice(self.unit_source, UNIT_SOURCES, "unit_source")
-        scale = float(self.scale_to_internal)
+        try:
+            scale = math.nan if isinstance(self.scale_to_internal, bool) else float(self.scale_to_internal)
+        except (TypeError, ValueError, OverflowError):
+            scale = math.nan
         if not (math.isfinite(scale) and scale > 0):
             raise ConfigError(f"scale_to_internal must be a finite number > 0; got {self.scale_to_internal!r}")
         object.__setattr__(self, "scale_to_internal", scale)
