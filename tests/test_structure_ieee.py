@@ -92,3 +92,54 @@ def test_flicker_constant_has_one_home():
     from fogdrift.units import B_FACTOR
 
     assert B_ADEV_FACTOR is B_FACTOR and math.isclose(B_FACTOR, 0.664282, rel_tol=1e-6)
+
+
+def _old_table(x, digits=4):  # report/tables._fmt before the one formatter (oracle)
+    import math
+    if x is None:
+        return "–"
+    x = float(x)
+    if not math.isfinite(x):
+        return "NaN"
+    if x == 0:
+        return "0"
+    if abs(x) >= 1e4 or abs(x) < 1e-3:
+        return f"{x:.{digits - 1}e}"
+    return f"{x:.{digits}g}"
+
+
+def _old_gmwm(x, digits=4):  # report/gmwm.fmt before
+    import math
+    if isinstance(x, str):
+        return x
+    if x is None or not math.isfinite(float(x)):
+        return "–"
+    return f"{float(x):.{digits}g}"
+
+
+def _old_page(x):  # fleet/page._fmt before
+    if x is None:
+        return "–"
+    if isinstance(x, float):
+        return f"{x:.0f}" if 1e4 <= abs(x) < 1e9 and x == round(x) else f"{x:.4g}"
+    return str(x)
+
+
+VALUES = [None, 0.0, -0.0, 1.0, -2.5, 2.41234e-4, 9.99949e-4, 1e-3, 0.012345678, 123.456, 9999.4, 9999.96, 1e4,
+          12345.0, -12345.678, 3.6e5, 1e9, 2.5e12, float("nan"), float("inf"), float("-inf"), 7, 0]
+
+
+@pytest.mark.parametrize("x", VALUES)
+def test_one_formatter_prints_what_each_old_one_printed(x):
+    from fogdrift.fleet.page import _fmt as page
+    from fogdrift.gmwm.compare import _g
+    from fogdrift.report.gmwm import fmt as gmwm
+    from fogdrift.report.tables import _fmt as table
+
+    for d in (2, 3, 4):
+        assert table(x, d) == _old_table(x, d)
+        assert gmwm(x, d) == _old_gmwm(x, d)
+        if x is not None:
+            assert _g(x, d) == f"{x:.{d}g}"
+    assert page(x) == _old_page(x)
+    assert gmwm("< 7.06") == "< 7.06"

@@ -110,6 +110,52 @@ def json_default(obj):
     raise TypeError(f"not JSON-serialisable: {type(obj).__name__}")
 
 
+def fmt_number(x, digits: int = 4, *, missing: str = "–", nonfinite: str | None = "–", sci_outside=None,
+               whole_below: float | None = None) -> str:
+    """A number as a table or text cell: the one number formatter of the reports, the console and the fleet page.
+
+    Parameters
+    ----------
+    x : float, int, str or None
+        The number (a text cell, such as a bound ``"< 7.06"``, comes back as it is).
+    digits : int
+        Significant digits (``f"{x:.{digits}g}"``).
+    missing : str
+        Cell of None.
+    nonfinite : str or None
+        Cell of NaN and infinity; None formats them as Python does (``nan``, ``inf``).
+    sci_outside : (float, float), optional
+        ``(lo, hi)``: values with ``|x| < lo`` or ``|x| >= hi`` (except 0) in scientific notation with ``digits``
+        significant digits, ``0`` as ``"0"``.
+    whole_below : float, optional
+        Whole numbers with ``1e4 <= |x| < whole_below`` written without decimals (counts, sample numbers).
+
+    Examples
+    --------
+    >>> fmt_number(2.41234), fmt_number(None), fmt_number(float("nan")), fmt_number("< 7.1")
+    ('2.412', '–', '–', '< 7.1')
+    >>> fmt_number(12345.0, sci_outside=(1e-3, 1e4)), fmt_number(0.0, sci_outside=(1e-3, 1e4))
+    ('1.234e+04', '0')
+    >>> fmt_number(360000.0, whole_below=1e9), fmt_number(0.5, 3)
+    ('360000', '0.5')
+    """
+    if x is None:
+        return missing
+    if isinstance(x, str):
+        return x
+    x = float(x)
+    if not math.isfinite(x) and nonfinite is not None:
+        return nonfinite
+    if sci_outside is not None and math.isfinite(x):
+        if x == 0:
+            return "0"
+        if abs(x) < sci_outside[0] or abs(x) >= sci_outside[1]:
+            return f"{x:.{digits - 1}e}"
+    if whole_below is not None and 1e4 <= abs(x) < whole_below and x == round(x):
+        return f"{x:.0f}"
+    return f"{x:.{digits}g}"
+
+
 def finite_or_null(obj):
     """``obj`` (nested dicts, lists, tuples) with every NaN and infinity replaced by None, so the JSON is strict.
 

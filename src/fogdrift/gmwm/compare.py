@@ -19,6 +19,7 @@ Units: N in deg/sqrt(h), B in deg/h, tau in s.
 
 from __future__ import annotations
 
+from .._util import fmt_number
 from ..errors import InsufficientDataError
 from ..pipeline import AnalysisConfig, run_allan
 
@@ -26,7 +27,7 @@ __all__ = ["compare_with_allan", "attach_allan_checks"]
 
 
 def _g(x, d=3):
-    return f"{x:.{d}g}"
+    return fmt_number(x, d, nonfinite=None)
 
 
 def _t(tau):

@@ -10,11 +10,11 @@ It uses only public names of :mod:`fogdrift.report` (``write_json``).
 from __future__ import annotations
 
 import html
-import math
 from pathlib import Path
 
 import numpy as np
 
+from .._util import fmt_number
 from ..gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
 from ..output import atomic_path
 from .figures import _save, literal
@@ -24,12 +24,9 @@ __all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
 
 
 def fmt(x, digits=4) -> str:
-    """A number with ``digits`` significant digits ('–' for None/NaN; a text cell such as a bound as it is)."""
-    if isinstance(x, str):
-        return x
-    if x is None or not math.isfinite(float(x)):
-        return "–"
-    return f"{float(x):.{digits}g}"
+    """A number with ``digits`` significant digits ('–' for None/NaN; a text cell such as a bound as it is):
+    :func:`fogdrift._util.fmt_number`."""
+    return fmt_number(x, digits)
 
 
 def plot_gmwm(axes: list[GmwmAxis], path) -> Path:

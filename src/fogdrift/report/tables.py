@@ -5,8 +5,7 @@ Nothing here prints or writes; the console (:mod:`fogdrift.cli`) and the HTML re
 
 from __future__ import annotations
 
-import math
-
+from .._util import fmt_number
 from ..noise.terms import TERM_HEADERS, TERMS
 
 NOISE_HEADERS = tuple(TERM_HEADERS[name] for name in TERMS)
@@ -25,16 +24,8 @@ METRICS_HEADERS = (
 
 
 def _fmt(x, digits=4) -> str:
-    if x is None:
-        return "–"
-    x = float(x)
-    if not math.isfinite(x):
-        return "NaN"
-    if x == 0:
-        return "0"
-    if abs(x) >= 1e4 or abs(x) < 1e-3:
-        return f"{x:.{digits - 1}e}"
-    return f"{x:.{digits}g}"
+    """A table cell: :func:`fogdrift._util.fmt_number`, scientific below 1e-3 and from 1e4, NaN as ``NaN``."""
+    return fmt_number(x, digits, nonfinite="NaN", sci_outside=(1e-3, 1e4))
 
 
 def term_text(term) -> str:
