@@ -36,24 +36,9 @@ def int_arg(value, name: str) -> int:
     return int(value)
 
 
-def parse_unit(unit):
-    """``("rate", name)`` or ``("inc", angle unit)`` for an angular-rate unit string.
-
-    A thin view of :func:`fogdrift.units.parse_unit` (the one unit parser) kept for the readers;
-    new code calls that and keeps the :class:`~fogdrift.units.UnitSpec`.
-    """
-    spec = units.parse_unit(unit)
-    return ("rate" if spec.kind == "rate" else "inc"), spec.base
-
-
 def valid_units() -> list[str]:
-    """Every angular-rate unit string :func:`fogdrift.units.parse_unit` accepts."""
+    """Every angular-rate unit string :func:`fogdrift.units.parse_unit` (the one unit parser) accepts."""
     return units.valid_units("angular_rate")
-
-
-def unit_scale(kind: str, base: str, dt_s: float) -> float:
-    """Factor to deg/h for a parsed unit (see :func:`parse_unit`) at sample interval ``dt_s`` [s]."""
-    return units.parse_unit(base if kind == "rate" else f"inc:{base}").scale_to_internal(dt_s)
 
 
 def split_keys(keys, name: str) -> list:
