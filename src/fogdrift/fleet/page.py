@@ -26,14 +26,15 @@ from .._util import fmt_number
 from ..output import atomic_path
 from ..report.figures import literal
 from .commands import TERMS
-from .summary import UNITS
+from .summary import ACCEL_TERMS, UNITS
 
 __all__ = ["write_fleet_page", "control_limits", "outliers", "SIGMA"]
 
 #: Control-limit width in standard deviations.
 SIGMA = 3.0
 
-_UNIT_TEXT = {"urad": "µrad", "dprh": "deg/√h", "dph": "deg/h", "dphrh": "deg/h^1.5", "dph2": "deg/h²"}
+_UNIT_TEXT = {"urad": "µrad", "dprh": "deg/√h", "dph": "deg/h", "dphrh": "deg/h^1.5", "dph2": "deg/h²",
+              "mps": "m/s", "mps_rh": "m/s/√h", "ug": "µg", "mps2_rh": "m/s²/√h", "mps2_ph": "m/s²/h"}
 
 
 def control_limits(values) -> tuple[float, float, float] | None:
@@ -113,7 +114,8 @@ def _chart(rows, name, unit, axes_names):
         for k, r in enumerate(sel):
             v = r.get(col)
             if v is not None:
-                yerr = [[v - (r.get(lo) if r.get(lo) is not None else v)], [(r.get(hi) or v) - v]]
+                # a value at its data bound can sit an ulp above its hi95 (rounding): no negative bar
+                yerr = [[max(0.0, v - (r.get(lo) if r.get(lo) is not None else v))], [max(0.0, (r.get(hi) or v) - v)]]
                 ax.errorbar([k], [v], yerr=yerr, fmt="o", ms=4, color="k", lw=0.8, capsize=2)
             elif r.get(hi) is not None:
                 ax.plot([k], [r[hi]], "v", mfc="none", color="0.4", ms=6)
@@ -188,7 +190,7 @@ def write_fleet_page(rows: list[dict], path, *, command: str = "", settings: dic
              "Open triangles: not in that file's selected noise model (or not estimable), drawn at the 95 % upper "
              "bound.</p>"]
     flagged_all = []
-    for name, unit in TERMS:
+    for name, unit in TERMS + ACCEL_TERMS:  # gyro axes' charts, then accelerometer axes' (their own columns)
         chart = _chart(good, name, unit, axes_names) if axes_names else None
         if chart is None:
             continue

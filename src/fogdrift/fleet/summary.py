@@ -15,9 +15,15 @@ from pathlib import Path
 
 from ..io.readers.base import require
 from ..output import atomic_path
+from ..noise.terms import ACCEL_TERM_TABLE
 from .commands import TERMS
 
-__all__ = ["COLUMNS", "UNITS", "write_summary", "read_summary", "schema"]
+#: The accelerometer's coefficients, with the unit suffix of their columns (``("Q", "mps"), ("N", "mps_rh"),
+#: ("B", "ug"), ("K", "mps2_rh"), ("R", "mps2_ph")``): an accelerometer row fills these, a gyro row the
+#: :data:`TERMS` columns; the ``{name}_status`` column is shared (:func:`fogdrift.fleet.tasks.split_by_quantity`).
+ACCEL_TERMS = tuple((name, spec.suffix.lstrip("_")) for name, spec in ACCEL_TERM_TABLE.items())
+
+__all__ = ["ACCEL_TERMS", "COLUMNS", "UNITS", "write_summary", "read_summary", "schema"]
 
 #: (column, type, unit or meaning).  Types: str, int, float, bool.
 COLUMNS: tuple = (
@@ -40,12 +46,20 @@ COLUMNS: tuple = (
     ("temperature_range_c", "float", "deg C"),
     ("temperature_change_c", "float", "deg C, end minus start of the log"),
     ("temperature_slope_c_per_h", "float", "deg C/h, least-squares slope"),
+    ("quantity", "str", "what the axis measures, from its unit: angular_rate (gyro: the deg/h-based columns) or "
+                        "specific_force (accelerometer: the m/s-based columns)"),
     ("statistic", "str", "Allan-family statistic of the noise fit: adev, hdev or mdev"),
     *[c for name, unit in TERMS for c in (
         (f"{name}_{unit}", "float", f"{name} estimate (null when not in the selected model)"),
         (f"{name}_lo95_{unit}", "float", f"{name} 95 % lower bound"),
         (f"{name}_hi95_{unit}", "float", f"{name} 95 % upper bound (for an absent term: its upper bound)"),
         (f"{name}_status", "str", f"{name}: resolved, unresolved, absent or not_estimable"),
+    )],
+    *[c for name, unit in ACCEL_TERMS for c in (
+        (f"{name}_{unit}", "float", f"accelerometer {ACCEL_TERM_TABLE[name].long_name} {name} "
+                                    f"[{ACCEL_TERM_TABLE[name].unit}] (null when not in the selected model)"),
+        (f"{name}_lo95_{unit}", "float", f"accelerometer {name} 95 % lower bound [{ACCEL_TERM_TABLE[name].unit}]"),
+        (f"{name}_hi95_{unit}", "float", f"accelerometer {name} 95 % upper bound [{ACCEL_TERM_TABLE[name].unit}]"),
     )],
     ("noise_model", "str", "selected noise model, e.g. N+B+K"),
     ("plausible_models", "str", "models within the selection window of the best, '; '-separated"),
@@ -57,6 +71,7 @@ COLUMNS: tuple = (
     ("fit_tau_min_s", "float", "s"),
     ("fit_tau_max_s", "float", "s"),
     ("b_min_dph", "float", "deg/h, bias instability read at the minimum of the fitted ADEV (IEEE-952 practice)"),
+    ("b_min_ug", "float", "ug, an accelerometer's bias instability read at the minimum of the fitted ADEV"),
     ("b_min_tau_s", "float", "s, tau of that minimum"),
     ("b_min_bound_only", "bool", "true when the fitted ADEV still falls at the longest tau (b_min is a bound)"),
     ("outliers", "int", "samples beyond the outlier threshold"),

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from ..errors import FogdriftError, ResourceError
 
-__all__ = ["FileTask", "run_file", "load_record", "MANIFEST"]
+__all__ = ["FileTask", "run_file", "load_record", "split_by_quantity", "MANIFEST"]
 
 #: Name of the per-file manifest, written last.
 MANIFEST = "batch.json"
@@ -76,6 +76,34 @@ def cached_rows(task: FileTask, sha256: str):
     return rows
 
 
+def split_by_quantity(record, rows: list[dict]) -> list[dict]:
+    """Each row in the columns of its axis's quantity: an accelerometer axis's coefficients (already in the
+    accelerometer's units, :func:`fogdrift.noise.quantity.express`) move from the gyro-named columns (``N_dprh``
+    ...) to the accelerometer's (``N_mps_rh`` ...), ``b_min_dph`` to ``b_min_ug``; every row gets ``quantity``.
+    A gyro row is unchanged but for ``quantity``.  So no accelerometer figure sits in a deg/h column."""
+    from .commands import TERMS
+    from .summary import ACCEL_TERMS
+
+    out = []
+    for row in rows:
+        name = row.get("axis")
+        try:
+            quantity = record.signal.channel(name).quantity if name is not None else None
+        except FogdriftError:
+            quantity = None
+        row = dict(row, quantity=quantity)
+        if quantity == "specific_force":
+            for (term, g), (_, a) in zip(TERMS, ACCEL_TERMS):
+                for kind in ("", "lo95_", "hi95_"):
+                    key = f"{term}_{kind}{g}"
+                    if key in row:
+                        row[f"{term}_{kind}{a}"] = row.pop(key)
+            if "b_min_dph" in row:
+                row["b_min_ug"] = row.pop("b_min_dph")
+        out.append(row)
+    return out
+
+
 def _plausibility(record, flags) -> list[str]:
     """The plausibility findings the single commands print as warnings (a likely wrong unit or time unit)."""
     from ..plausibility import check_record
@@ -119,7 +147,7 @@ def run_file(task: FileTask) -> list[dict]:
                 warnings.simplefilter("always")
                 record = load_record(task.path, task.settings)
                 notes = _plausibility(record, task.flags)
-                rows = command_spec(task.command).run(record, task.settings, od.path)
+                rows = split_by_quantity(record, command_spec(task.command).run(record, task.settings, od.path))
             status, error, cache = "ok", None, True
         except ResourceError as exc:         # out of memory / disk space: the machine's state, never cached
             rows, status, error, cache = [{}], "error", f"{type(exc).__name__}: {exc.render(task.flags)}", False
