@@ -74,10 +74,10 @@ def test_one_strict_json_writer(tmp_path):
     from fogdrift import _util, report
     from fogdrift.report import files
 
-    assert report.write_json is _util.write_json and files.write_json is _util.write_json
+    assert report.write_json is files.write_json
     doc = {"edf": np.array([1.5, np.nan]), "tau_s": np.float32(2.0), "hi": float("inf"), "n": np.int64(3),
            "nested": [{"x": float("-inf")}]}
-    p = _util.write_json(doc, tmp_path / "a.json")
+    p = files.write_json(doc, tmp_path / "a.json")
     text = p.read_text()
     assert "NaN" not in text and "Infinity" not in text
     assert json.loads(text) == {"edf": [1.5, None], "tau_s": 2.0, "hi": None, "n": 3, "nested": [{"x": None}]}

@@ -1,17 +1,15 @@
-"""Small validation and serialisation helpers shared across layers (imports only numpy, errors and the atomic
-output edge :mod:`fogdrift.output`)."""
+"""Small validation and serialisation helpers shared across layers (imports only numpy and errors, so that every
+module, :mod:`fogdrift.output` included, can use them)."""
 
 from __future__ import annotations
 
 import json
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 
 from .errors import ConfigError, DataFormatError, InsufficientDataError
-from .output import atomic_path
 
 
 def check_series(y, name: str = "y", *, min_length: int = 1, allow_2d: bool = False, needed_by: str = "",
@@ -175,7 +173,8 @@ def strict_json(obj, *, indent: int | None = 2, sort_keys: bool = False) -> str:
     """``obj`` as strict JSON text (RFC 8259): numpy values and ``to_dict()`` objects converted
     (:func:`json_default`), NaN and infinity written as ``null``, never as the non-standard ``NaN``/``Infinity``.
 
-    The one strict-JSON serialiser; :func:`write_json` writes its text atomically.
+    The one strict-JSON serialiser: :func:`fogdrift.report.files.write_json` writes its text atomically (every
+    result file), :mod:`fogdrift.output` its manifest.
 
     >>> import numpy as np
     >>> strict_json({"tau_s": np.float64(2.0), "edf": float("nan"), "m": np.arange(2)}, indent=None)
@@ -183,16 +182,6 @@ def strict_json(obj, *, indent: int | None = 2, sort_keys: bool = False) -> str:
     """
     data = finite_or_null(json.loads(json.dumps(obj, default=json_default)))
     return json.dumps(data, indent=indent, sort_keys=sort_keys, allow_nan=False)
-
-
-def write_json(obj, path, *, indent: int | None = 2, sort_keys: bool = False):
-    """Write :func:`strict_json` of ``obj`` to ``path`` atomically (complete or absent,
-    :func:`fogdrift.output.atomic_path`); returns the path as :class:`pathlib.Path`."""
-    path = Path(path)
-    text = strict_json(obj, indent=indent, sort_keys=sort_keys)
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-    return path
 
 
 def safe_name(name) -> str:

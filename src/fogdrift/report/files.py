@@ -6,12 +6,22 @@ from pathlib import Path
 
 import numpy as np
 
-from .._util import write_json
+from .._util import strict_json
 from ..noise import TERM_TABLE
 from ..output import atomic_path
 from .figures import _safe, plot_allan, plot_models, plot_residuals, plot_separation, plot_separation_allan
 
 __all__ = ["write_json", "write_allan_outputs", "write_separation_outputs", "write_model_outputs"]
+
+
+def write_json(obj, path, *, indent: int | None = 2, sort_keys: bool = False) -> Path:
+    """Write :func:`fogdrift._util.strict_json` of ``obj`` (NaN and infinity as null) to ``path`` atomically
+    (complete or absent, :func:`fogdrift.output.atomic_path`): the one JSON writer of the result files."""
+    path = Path(path)
+    text = strict_json(obj, indent=indent, sort_keys=sort_keys)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path
 
 
 def _noise_csv_rows(label, aa):
