@@ -244,6 +244,8 @@ def test_validate_checks_without_mutating():
     (dict(gm_window=2), "gm_window"), (dict(model_rate_hz=float("inf")), "model_rate_hz"),
     (dict(model_rate_hz=1e300), "model_rate_hz"), (dict(causal_window_s=float("nan")), "causal_window_s"),
     (dict(latitude_deg=10.0, earth_axes={"gz": "sideways"}), "axis orientation"), (dict(seed=1.5), "seed"),
+    (dict(train_fraction="most"), "train_fraction"), (dict(val_fraction=None), "val_fraction"),
+    (dict(lags="4"), "lags"), (dict(latitude_deg="north"), "latitude"),
 ])
 def test_validate_checks_every_setting(bad, opt):
     with pytest.raises(ConfigError, match=opt):

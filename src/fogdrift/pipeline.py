@@ -158,7 +158,8 @@ class AnalysisConfig:
         ConfigError
             The first invalid setting, named as ``{opt:NAME}``, with the rule and the value.
         """
-        if not 0 < self.train_fraction < 1 or not 0 <= self.val_fraction < 1:
+        if not (_finite_number(self.train_fraction) and _finite_number(self.val_fraction)) \
+                or not 0 < self.train_fraction < 1 or not 0 <= self.val_fraction < 1:
             raise ConfigError(
                 f"the training share ({{opt:train_fraction}}) must be in (0, 1) and the validation share "
                 f"({{opt:val_fraction}}) in [0, 1); got {self.train_fraction}, {self.val_fraction}"
