@@ -20,7 +20,8 @@ import pytest
 from fogdrift.evaluation.heading import heading_row
 from fogdrift.evaluation.verdicts import (Verdict, adev_caveat, artefact_table, artefact_verdict, causal_verdict,
                                           compensation_verdicts, heading_table, paper_measure_verdict,
-                                          heading_verdict, headline_verdict, judge, table2_marks, table2_verdict)
+                                          heading_verdict, headline_verdict, independent_origins, judge, table2_marks,
+                                          table2_verdict)
 from fogdrift.evaluation.verdicts import _f, _pct
 
 
@@ -276,3 +277,62 @@ def test_causal_and_paper_measure_sentences():
     vs = compensation_verdicts(heading=h, artefacts=ART, model_axis=ma)
     assert [v.kind for v in vs] == ["heading", "artefacts", "causal", "paper"]
     assert vs[0].lines == heading_verdict(h).lines and vs[1].lines == artefact_verdict(ART).lines
+
+
+def test_headline_without_counts_uses_the_origin_step_and_the_given_thresholds():
+    """Rows without counts (a bundle written before them): 30 origins 60 s apart at 600 s are 3 independent ones,
+    so nothing is judged, and the ADEV caveat says so; ``material`` and ``min_origins`` reach every judgement."""
+    rows = [NS(model="constant bias", horizon_s=600.0, n_origins=30, rms_deg=8.0, ratio_to_bias=1.0),
+            NS(model="Kalman", horizon_s=600.0, n_origins=30, rms_deg=4.0, ratio_to_bias=0.5)]
+    h = _heading(rows, (600.0,), step=60.0)
+    v = headline_verdict(h)
+    assert v.kind == "headline" and v.data["outcome"] == "undetermined"
+    assert "gives 30 calibration origin(s), 3 of them with non-overlapping horizons, at 600 s" in v.lines[0]
+    assert adev_caveat("Kalman", None, heading=h).endswith("heading error at 600 s 0.5 x constant bias's (3 "
+                                                           "non-overlapping origins: too few to judge).")
+    six = [_row("constant bias", 60.0, 1.0, 1.0, n=6), _row("Kalman", 60.0, 0.8, 0.8, 5, 1, n=6)]
+    assert headline_verdict(_heading(six, (60.0,)), min_origins=5).data["outcome"] == "reduces"
+    assert headline_verdict(_heading(six, (60.0,))).data["outcome"] == "undetermined"
+    v = headline_verdict(_heading(six, (60.0,)), material=0.6, min_origins=5)
+    assert v.kind == "headline" and v.data["outcome"] == "none" and v.lines == [
+        "gx: no model reduces the heading error by 60 % or more at most non-overlapping origins at 60 s after a "
+        "300-s calibration (constant bias leaves 1 deg RMS)."]
+
+
+def test_headline_of_a_model_worse_at_two_horizons_and_flagged_lists_everything():
+    rows = [_row("constant bias", 60.0, 1.0, 1.0), _row("Kalman", 60.0, 0.45, 0.45, 20, 10),
+            _row("AR(p)", 60.0, 1.1, 1.1, 5, 25), _row("GM(1,1)", 60.0, 1.2, 1.2, 5, 25),
+            _row("constant bias", 600.0, 8.0, 1.0), _row("Kalman", 600.0, 9.6, 1.2, 10, 20),
+            _row("AR(p)", 600.0, 8.0, 1.0, 15, 15), _row("GM(1,1)", 600.0, 8.0, 1.0, 15, 15),
+            _row("constant bias", 3600.0, 20.0, 1.0), _row("Kalman", 3600.0, math.inf, math.inf, 0, 30),
+            _row("AR(p)", 3600.0, 20.0, 1.0, 15, 15), _row("GM(1,1)", 3600.0, 20.0, 1.0, 15, 15)]
+    h = _heading(rows, (60.0, 600.0, 3600.0))
+    v = headline_verdict(h, NS(rows=[NS(model="Kalman", flagged_hz=(0.001,))]))
+    assert v.kind == "headline" and v.data["outcome"] == "mixed"
+    assert v.lines == ["gx: Kalman reduces the heading error by 55 % at 60 s after a 300-s calibration (0.45 vs 1 "
+                       "deg RMS, better at 20 of 30 non-overlapping origins) but worsens it by +20 % at 600 s (worse "
+                       "at 20 of 30 non-overlapping origins), diverges at 3600 s and removes real rate near 0.001 Hz "
+                       "(artefact check)."]
+    only = headline_verdict(_heading([rows[0], rows[1]], (60.0,)))
+    assert only.kind == "headline" and only.lines == [
+        "gx: Kalman reduces the heading error by 55 % at 60 s after a 300-s calibration (0.45 vs 1 deg RMS, better "
+        "at 20 of 30 non-overlapping origins) and worsens it at no judged horizon (60 s); artefact check not run."]
+    none = headline_verdict(_heading([rows[0], rows[2], rows[3]], (60.0,)))
+    assert none.kind == "headline" and none.lines[0].endswith("(constant bias leaves 1 deg RMS; worse: AR(p), "
+                                                              "GM(1,1)).")
+    assert headline_verdict(None).lines == [": heading error not evaluated (not run); no compensation verdict."]
+    assert headline_verdict(NS(axis="gq", calib_s=300.0, step_s=300.0, horizons_s=(60.0,),
+                               rows=[rows[1]])).lines[0].startswith("gq: cannot judge")
+    nobase = headline_verdict(NS(axis="gq", calib_s=300.0, step_s=300.0, horizons_s=(60.0,), rows=[rows[1]]))
+    assert "gives 0 calibration origin(s) at 60 s" in nobase.lines[0] and nobase.kind == "headline"
+
+
+def test_independent_origins_of_no_origins_and_table_cells_with_more_digits():
+    assert independent_origins(0, 60.0, 600.0) == 0 and independent_origins(-1, 600.0, 60.0) == 0
+    r = NS(model="m", gains={0.001: 0.8537}, step_survival={10.0: 0.1234}, ramp_survival=0.9876,
+           flagged_hz=(0.001, 0.002))
+    assert artefact_table(NS(frequencies_hz=[0.001], step_delays_s=(10.0,), rows=[r]))[1] == [
+        ["m", "0.85", "0.12", "0.99", "0.001, 0.002"]]
+    # a row without a kind is not a practical row
+    rows = [NS(label="Kalman row", model="Kalman")]
+    assert table2_marks(rows, NS(rows=[NS(model="Kalman", flagged_hz=(0.001,))])) == {}
