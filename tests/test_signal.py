@@ -246,6 +246,7 @@ def test_validate_checks_without_mutating():
     (dict(latitude_deg=10.0, earth_axes={"gz": "sideways"}), "axis orientation"), (dict(seed=1.5), "seed"),
     (dict(train_fraction="most"), "train_fraction"), (dict(val_fraction=None), "val_fraction"),
     (dict(lags="4"), "lags"), (dict(latitude_deg="north"), "latitude"),
+    (dict(earth_axes={"gz": "up"}), "without a latitude; pass latitude_deg="),
 ])
 def test_validate_checks_every_setting(bad, opt):
     with pytest.raises(ConfigError, match=opt):

@@ -214,6 +214,9 @@ class AnalysisConfig:
                               "north|south|east|west (the Earth-rate component depends on the axis orientation)")
         if not isinstance(self.earth_axes, dict):
             raise ConfigError(f"{{opt:earth_axes}} must map axis names to orientations; got {self.earth_axes!r}")
+        if self.earth_axes and self.latitude_deg is None:
+            raise ConfigError("an Earth-rate axis orientation ({opt:earth_axes}) was given without a latitude; pass "
+                              "{opt:latitude_deg} DEG")
         if self.latitude_deg is not None:
             from .units import earth_rate_projection_dph
 
@@ -455,8 +458,6 @@ def _check_earth_axes(record, cfg: AnalysisConfig) -> None:
     unknown = [k for k in cfg.earth_axes if k not in record.axis_names]
     if unknown:
         raise ConfigError(f"Earth-rate axis {unknown} not in the record; its axes are {list(record.axis_names)}")
-    if cfg.earth_axes and cfg.latitude_deg is None:
-        raise ConfigError("an Earth-rate axis orientation was given without a latitude (--latitude DEG)")
 
 
 # ---------------------------------------------------------------------------------------------------------
