@@ -4,7 +4,7 @@ Per axis, in order (the design of ``fogdrift compensate``):
 
 1. the log's rate [deg/h] is block-averaged by the bundle's integer factor ``m`` to the modelling rate, and the
    bias + Earth-rate projection are removed: ``z[j] = mean(x[jm .. jm+m-1]) - bias - earth``;
-2. a :class:`~fogdrift.compensate.predictors.CausalPredictor` gives the drift estimate ``p[j]`` of modelling
+2. a :class:`~fogdrift.models.causal_predictor.CausalPredictor` gives the drift estimate ``p[j]`` of modelling
    sample ``j`` from ``z[:j]`` only (the model's one-step prediction; for drift models made from the causal
    wavelet drift);
 3. **native-rate correction: zero-order hold of the causal prediction.** Every native sample of modelling
@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError, InsufficientDataError
-from .predictors import CausalPredictor, causal_weights
+from ..models.causal_predictor import CausalPredictor, causal_weights
 
 __all__ = ["AxisPlan", "OutputBlock", "StreamCompensator", "segment_blocks"]
 

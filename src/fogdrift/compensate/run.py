@@ -307,7 +307,9 @@ def _caveats(result, name, plans, curves, why_not) -> list:
 
 
 def _write_json(obj, path) -> Path:
-    """The summary as strict JSON (NaN/inf as null), atomically: the one JSON writer of the reports."""
+    """The summary as strict JSON (NaN/inf as null), atomically: the one strict-JSON writer
+    (:func:`fogdrift._util.write_json`, imported through ``report.files`` until the structure test's table of the
+    compensate <-> evaluation cycle follows)."""
     from ..report.files import write_json
 
     return write_json(obj, path)
