@@ -9,7 +9,7 @@ the file, the limit and the environment variable that raises it:
 Environment variable         Limit                                                           Default
 ===========================  ==============================================================  ======================
 ``FOGDRIFT_MAX_LINE_BYTES``  bytes in one line of a text file                                1048576 (1 MiB)
-``FOGDRIFT_MAX_ROWS``        lines of a text file, rows of an array                          1000000000
+``FOGDRIFT_MAX_ROWS``        lines of a text file, rows of an array, raw binary records      1000000000
 ``FOGDRIFT_MAX_EXPANSION``   decompressed bytes per stored byte (gzip text, ``.npz``           50
                              members, HDF5/MATLAB arrays), beyond the first 16 MiB
 ``FOGDRIFT_MAX_MEMORY``      bytes of the float64 table a reader builds (``2G``, ``512M``)     half the machine's
@@ -17,8 +17,9 @@ Environment variable         Limit                                              
                                                                                              process's RLIMIT_AS)
 ===========================  ==============================================================  ======================
 
-A memory-mapped ``.npy`` or raw binary file costs no memory to open and is not held to the budget.  Real gyro
-logs compress 2-10 times (the bundled RLG log: 5.5); set a variable to ``0`` to switch that limit off.
+A memory-mapped float64 ``.npy`` costs no memory and is not held to the budget (another dtype's float64 copy is;
+so is the float64 copy of a raw binary file's used fields).  Real gyro logs compress 2-10 times (the bundled RLG
+log: 5.5); set a variable to ``0`` to switch that limit off.
 """
 
 from __future__ import annotations
