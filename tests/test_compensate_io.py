@@ -319,3 +319,13 @@ def test_a_non_unit_configuration_error_is_not_turned_into_the_unit_refusal(bund
     with pytest.raises(ConfigError) as info:  # both missing: the unit is asked for first, suggesting the bundle's
         compensate_file(bundle, tmp_path / "r.npy", tmp_path / "o", **_kw(axis_map="col0=gz"))
     assert "pass unit= deg/h (the bundle was trained on deg/h)" in str(info.value)
+
+
+def test_a_constant_log_gets_its_figure_without_a_warning(bundle, tmp_path):
+    import warnings
+
+    log = _csv(tmp_path / "c.csv", "t_s,gz[deg/h]", np.full(300, 45.0))  # ADEV 0 at every tau
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # matplotlib's "no positive values ... log-scaled" would be one
+        res = compensate_file(bundle, log, tmp_path / "o", heading=False, artefacts=False, model="bias")
+    assert (tmp_path / "o" / "compensation_allan.png").stat().st_size > 5_000 and "figure" in res.files

@@ -158,11 +158,14 @@ def plot_before_after(curves, path, title, caveats: dict | None = None) -> Path:
     n = len(curves)
     fig, axs = plt.subplots(1, n, figsize=(5.2 * n, 4.2), squeeze=False)
     for ax, (name, before, after, label) in zip(axs[0], curves):
+        positive = False
         for r, color, text in ((before, "k", "log (bias removed)"), (after, "C3", f"compensated: {label}")):
-            yerr = np.vstack([r.adev_dph - r.adev_lo68_dph, r.adev_hi68_dph - r.adev_dph])
-            ax.errorbar(r.tau_s, r.adev_dph, yerr=yerr, fmt="o-", ms=3, lw=0.8, color=color, label=text)
+            ok = np.asarray(r.adev_dph) > 0  # a log scale shows positive ADEVs only (a constant log has none)
+            positive = positive or bool(ok.any())
+            yerr = np.vstack([r.adev_dph - r.adev_lo68_dph, r.adev_hi68_dph - r.adev_dph])[:, ok]
+            ax.errorbar(r.tau_s[ok], r.adev_dph[ok], yerr=yerr, fmt="o-", ms=3, lw=0.8, color=color, label=text)
         ax.set_xscale("log")
-        ax.set_yscale("log")
+        ax.set_yscale("log" if positive else "linear")
         ax.set_xlabel("τ [s]")
         ax.set_ylabel("σ(τ) [deg/h]")
         ax.set_title(f"{title}: {name}")
