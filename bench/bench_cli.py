@@ -101,7 +101,7 @@ def main(argv=None) -> list[dict]:
                               tmp / "a1"), env)
         at = _timed([sys.executable, "-c", ALLANTOOLS_CHILD, str(tmp / "y.npy"), str(tmp / "taus.npy")], env)
         call = json.loads(at["stdout_last"]) if at["stdout_last"].startswith("{") else {}
-        rows.append(dict(case=f"allan {n:.0e} .npy, {m.size} tau (whole command)", fogdrift_s=fd["wall_s"],
+        rows.append(dict(case=f"allan {n:.0e} .npy, {m.size} tau (whole command)", fogdrift_s=fd["wall_s"], rc=fd["rc"] or at["rc"],
                          rss_mb=fd["peak_rss_mb"], peer="allantools oadev (process: import, load, call)",
                          peer_s=at["wall_s"], ratio=at["wall_s"] / fd["wall_s"], target="ratio >= 5",
                          met=at["wall_s"] / fd["wall_s"] >= 5,
@@ -114,26 +114,28 @@ def main(argv=None) -> list[dict]:
                              target=f"<= {TARGETS['csv.gz read']} s", met=read_s <= TARGETS["csv.gz read"]))
             for name in ("allan", "noise"):
                 r = _timed(_fogdrift(name, imu1, "--unit", "deg/s", "--out", tmp / name), env)
-                rows.append(dict(case=f"{name}, ADIS imu1 (3 x 10^6)", fogdrift_s=r["wall_s"], rss_mb=r["peak_rss_mb"],
+                rows.append(dict(case=f"{name}, ADIS imu1 (3 x 10^6)", fogdrift_s=r["wall_s"], rss_mb=r["peak_rss_mb"], rc=r["rc"],
                                  target=f"<= {TARGETS[name]} s", met=r["rc"] == 0 and r["wall_s"] <= TARGETS[name]))
             if not args.quick:
                 r = _timed(_fogdrift("analyze", imu1, "--unit", "deg/s", "--out", tmp / "an"), env)
-                rows.append(dict(case="analyze, ADIS imu1 (3 x 10^6)", fogdrift_s=r["wall_s"], rss_mb=r["peak_rss_mb"],
+                rows.append(dict(case="analyze, ADIS imu1 (3 x 10^6)", fogdrift_s=r["wall_s"], rss_mb=r["peak_rss_mb"], rc=r["rc"],
                                  target=f"<= {TARGETS['analyze']} s", met=r["rc"] == 0 and r["wall_s"] <= 60))
                 if imu2.exists() and (tmp / "an" / "bundle").exists():
-                    r = _timed(_fogdrift("compensate", tmp / "an" / "bundle", imu2, "--out", tmp / "comp"), env)
-                    rows.append(dict(case="compensate, ADIS imu2 with imu1's bundle", fogdrift_s=r["wall_s"],
+                    r = _timed(_fogdrift("compensate", tmp / "an" / "bundle", imu2, "--unit", "deg/s", "--out", tmp / "comp"), env)
+                    rows.append(dict(case="compensate, ADIS imu2 with imu1's bundle", fogdrift_s=r["wall_s"], rc=r["rc"],
                                      rss_mb=r["peak_rss_mb"], target=f"<= {TARGETS['compensate']} s",
                                      met=r["rc"] == 0 and r["wall_s"] <= TARGETS["compensate"]))
         if not args.quick and RLG.exists():
             r = _timed(_fogdrift("analyze", RLG, *DEMO_ARGS, "--out", tmp / "demo"), env)
-            rows.append(dict(case="make demo (analyze, bundled RLG)", fogdrift_s=r["wall_s"], rss_mb=r["peak_rss_mb"],
+            rows.append(dict(case="make demo (analyze, bundled RLG)", fogdrift_s=r["wall_s"], rss_mb=r["peak_rss_mb"], rc=r["rc"],
                              target=f"<= {TARGETS['demo']} s", met=r["rc"] == 0 and r["wall_s"] <= TARGETS["demo"]))
     load = os.getloadavg()
     print(f"load average after: {load[0]:.1f} {load[1]:.1f} {load[2]:.1f}; {os.cpu_count()} cores\n")
     print("| case | fogdrift wall s | peak RSS MB | peer | peer s | ratio | target | met | note |")
     print("|---|---:|---:|---|---:|---:|---|---|---|")
     for r in rows:
+        if r.get("rc"):
+            r["note"] = (r.get("note", "") + f" FAILED: exit {r['rc']}").strip()
         ratio = f"{r['ratio']:.1f}x" if r.get("ratio") else "-"
         peer_s = f"{r['peer_s']:.2f}" if r.get("peer_s") else "-"
         print(f"| {r['case']} | {r['fogdrift_s']:.2f} | {r['rss_mb']:.0f} | {r.get('peer', '-')} | {peer_s} | "

@@ -110,7 +110,8 @@ def summary_rows() -> list[dict]:
     d = _read("cli.json")
     for r in (d or {}).get("rows", []):
         rows.append(_row("command", r["case"], r["fogdrift_s"], r.get("peer", ""), r.get("peer_s"), r.get("ratio"),
-                         r["target"] + (" (met)" if r["met"] else " (NOT met)"),
+                         r["target"] + (" (met)" if r["met"] else " (NOT met)")
+                         + (f"; FAILED: exit {r['rc']}" if r.get("rc") else ""),
                          f"peak RSS {r['rss_mb']:.0f} MB" + (f"; {r['note']}" if r.get("note") else "")))
     return rows
 
