@@ -464,14 +464,19 @@ def _check_earth_axes(record, cfg: AnalysisConfig) -> None:
 # entry points
 
 
-def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | None = None) -> list[AllanAxis]:
-    """Allan variance and noise identification of every axis of a record at its native rate."""
+def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | None = None, *,
+              own_units: bool = True) -> list[AllanAxis]:
+    """Allan variance and noise identification of every axis of a record at its native rate.
+
+    ``own_units`` (default True): each axis's fit in its quantity's term table (an accelerometer's velocity random
+    walk in m/s/sqrt(h), B in ug, :func:`fogdrift.noise.quantity.express`); False keeps every fit in the gyro
+    table's units of the internal unit (for a comparison with a reading made the same way, the GMWM's)."""
     cfg = (cfg or AnalysisConfig()).validate()
     out = []
     for name in record.axis_names:
         checkpoint("Allan variance", axis=name)
         out.append(analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True,
-                                 quantity=record.signal.channel(name).quantity))
+                                 quantity=record.signal.channel(name).quantity if own_units else "angular_rate"))
     return out
 
 

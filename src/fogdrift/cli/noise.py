@@ -107,21 +107,29 @@ def print_spec_for_allan(limits: dict, results, record, out_dir, source: str) ->
                                           for a in results}, out_dir, source=source)
 
 
-def print_gmwm(title, axes):
+def print_gmwm(title, axes, quantities=None):
     """Per axis: IEEE table (one B, by its rule), the other B readings as details, the comparison with the Allan
-    fit when one was made, candidates (WIC, why rejected), excluded scales, J with its caveat."""
+    fit when one was made, candidates (WIC, why rejected), excluded scales, J with its caveat.  ``quantities``:
+    axis name -> quantity; an accelerometer's reading (:func:`fogdrift.gmwm.quantity.express_gmwm`) shows B in
+    ug and its rate levels in m/s^2."""
     from ..gmwm.analysis import J_CAVEAT, b_detail_lines, ieee_rows
+    from ..gmwm.quantity import accel_rows
+    from ..noise.quantity import restate_text
 
+    quantities = quantities or {}
     for a in axes:
         sel = a.selection
-        console.print(fitted_table(f"{title} axis {a.name}: GMWM {sel.selected}"
+        q = quantities.get(a.name, "angular_rate")
+        rows = accel_rows(ieee_rows(a)) if q == "specific_force" else ieee_rows(a)
+        what = " (accelerometer: velocity random walk N, bias instability B)" if q == "specific_force" else ""
+        console.print(fitted_table(f"{title} axis {a.name}{what}: GMWM {sel.selected}"
                                    f"{'' if sel.passed_checks else ' (no candidate passed every check)'}, "
                                    "95 % intervals",
                                    ["quantity", "value", "95 % interval", "unit", "from"],
                                    [[r[0], _fmt(r[1]), _interval(r[2], r[3]), r[4], r[5]]
-                                    for r in ieee_rows(a)]))
+                                    for r in rows]))
         for line in b_detail_lines(a):
-            say(f"  {a.name}: {line}")
+            say(f"  {a.name}: {restate_text(line, q)}")
         if a.allan_check is not None:
             for line in a.allan_check["lines"]:
                 say(f"  {a.name}: GMWM vs Allan fit: {line}",
@@ -207,9 +215,13 @@ def noise(
                 axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=model, levels=scales, robust=robust)
                         for name in record.axis_names]
                 attach_allan_checks(record, axes)
+            from ..gmwm.quantity import express_gmwm
+
+            quantities = {c.name: c.quantity for c in record.signal.channels}
+            axes = [express_gmwm(a, quantities[a.name]) for a in axes]  # an accelerometer's terms in its units
             source, meta = str(record.source), record.metadata()
             kinds = channel_kinds(record)
-        print_gmwm((curve or load.file).name, axes)
+        print_gmwm((curve or load.file).name, axes, None if curve else quantities)
         if limits is not None:
             from ..spec import readings_from_gmwm
 

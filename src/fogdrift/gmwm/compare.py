@@ -181,7 +181,8 @@ def attach_allan_checks(record, axes) -> list:
     ``fogdrift batch --command noise`` alike; returns ``axes``."""
 
     try:
-        fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate())}
+        # both readings in the units of the internal unit (the GMWM's are re-stated per quantity afterwards)
+        fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate(), own_units=False)}
     except InsufficientDataError as exc:  # too short for the Allan fit: the GMWM result stands, and says so
         for a in axes:
             a.allan_check = {"agree": None, "n_agree": None, "b_agree": None,

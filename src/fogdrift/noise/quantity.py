@@ -63,16 +63,19 @@ def restate_text(text: str, quantity: str) -> str:
     alts = "|".join(re.escape(s) for s, _ in _SPELLINGS)
 
     def sub(m):
-        spelled = m.group(2)
+        spelled = m.group(4)
         term = dict(_SPELLINGS)[spelled]
         if term is None:
-            return f"{m.group(1)} {q_unit}"
+            return f"{m.group(0)[:m.start(4) - m.start(0)]}{q_unit}"
         if term == "":
-            return f"{m.group(1)} {rate_unit}"
-        value = float(m.group(1)) * unit_factor(term, quantity)
-        return f"{value:.3g} {disp[term]}"
+            return f"{m.group(0)[:m.start(4) - m.start(0)]}{rate_unit}"
+        f = unit_factor(term, quantity)
+        value = f"{float(m.group(1)) * f:.4g}"
+        iv = "" if m.group(2) is None else f" [{float(m.group(2)) * f:.3g}, {float(m.group(3)) * f:.3g}]"
+        return f"{value}{iv} {disp[term]}"
 
-    out = re.sub(_NUM + r" ?(" + alts + r")(?![\w^²/])", sub, text)
+    # "x unit" and "x [lo, hi] unit": every number re-scaled
+    out = re.sub(_NUM + r"(?: \[" + _NUM + r", " + _NUM + r"\])? ?(" + alts + r")(?![\w^²/])", sub, text)
     for spelled, term in _SPELLINGS:  # units without a number in front ("[0.1, 0.2] deg/√h" is rare; label only)
         if term:
             out = out.replace(spelled, disp[term])
