@@ -35,6 +35,7 @@ import threading
 import time
 from pathlib import Path
 
+from ._util import strict_json
 from .errors import ConfigError, FogdriftError, ResourceError
 from .interrupt import check, critical
 from .interrupt import requested as check_requested
@@ -474,7 +475,7 @@ class OutputDir:
         target = self.path / MANIFEST
         tmp = target.with_name(f"{TMP_PREFIX}{os.getpid()}-{MANIFEST}")
         try:
-            tmp.write_text(json.dumps(doc, indent=1, allow_nan=False), encoding="utf-8")
+            tmp.write_text(strict_json(doc, indent=1), encoding="utf-8")
             os.replace(tmp, target)
         except BaseException:  # disk full: no 0-byte temporary manifest left behind
             with contextlib.suppress(OSError):
