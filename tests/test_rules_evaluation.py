@@ -180,3 +180,33 @@ def test_artefact_adev_ratio_is_read_at_0371_over_f_with_the_sample_interval():
     for f, w in zip(freqs, want):
         assert_allclose(got[f], w, rtol=1e-9)
     assert res.row("constant bias").adev_ratio == {f: 1.0 for f in freqs}
+
+
+@pytest.mark.parametrize("dt, duration, want", [
+    (0.5, 3600.0, [0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0]),  # Nyquist 1 Hz, kept (edge)
+    (0.01, 1000.0, [0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0]),  # 2 periods
+    (2.0, 10000.0, [0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2]),  # Nyquist 0.25 Hz
+])
+def test_default_frequencies_are_the_1_2_5_series_between_two_periods_and_nyquist(dt, duration, want):
+    """Written out by hand: 1-2-5 x 10^k Hz with f <= 0.5 / dt (Nyquist, inclusive) and f x duration >= 2.
+    Catches Nyquist as 0.5 dt (invisible at dt = 1 s) or 1.5 / dt, and a strict edge at either end."""
+    from fogdrift.evaluation.artefacts import default_frequencies
+
+    assert default_frequencies(dt, duration) == want
+
+
+def test_artefact_result_to_dict_turns_non_finite_values_into_null():
+    from fogdrift.evaluation.artefacts import ArtefactResult, ArtefactRow
+
+    r = ArtefactRow("m", {0.001: 0.5, 0.01: math.nan}, {10.0: 0.9, 100.0: None}, math.inf, {0.001: 0.8, 0.01: None},
+                    (0.001,))
+    row = {"model": "m", "gain_vs_frequency": {"0.001": 0.5, "0.01": None},
+           "step_survival": {"10.0": 0.9, "100.0": None},
+           "ramp_survival": None, "adev_ratio_at_0.371_over_f": {"0.001": 0.8, "0.01": None}, "flagged_hz": [0.001]}
+    assert r.to_dict() == row
+    res = ArtefactResult("gz", 0.5, 3.0, [0.001], (10.0,), [r], ["n"])
+    assert res.to_dict() == {"axis": "gz", "dt_s": 0.5, "amplitude_dph": 3.0, "frequencies_hz": [0.001],
+                             "step_delays_s": [10.0], "rows": [row], "notes": ["n"]}
+    assert res.row("m") is r and ArtefactRow("k", {}, {}, 0.25, {}, ()).to_dict()["ramp_survival"] == 0.25
+    with pytest.raises(KeyError):
+        res.row("other")
