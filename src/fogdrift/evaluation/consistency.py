@@ -53,7 +53,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError, InsufficientDataError
-from ..models.statespace import check_components, components_from_allan, flicker_as_gauss_markov
+from ..models.components import components_from_gmwm, components_from_noise_fit  # re-exported
+from ..models.statespace import check_components
 
 __all__ = [
     "BANDS",
@@ -417,64 +418,6 @@ def random_walk_covering(components, horizon_s: float, t_cal_s: float, *, k_boun
     return {"k_eff_dphrh": k_eff, "k_alone_dphrh": k_alone, "ratio": ratio, "ratio_to_bound": to_bound,
             "k_bound_dphrh": kb, "horizon_s": h, "t_cal_s": T,
             "k_eff_si": si, "sentence": sentence}
-
-
-def components_from_noise_fit(noise) -> tuple[list[dict], list[str]]:
-    """Noise components of an Allan noise fit (:class:`fogdrift.noise.NoiseFit`), and notes on what was left out.
-
-    The power-law terms go through :func:`fogdrift.models.statespace.components_from_allan` (B as Gauss-Markov
-    terms over the fitted tau range, a ramp as the random walk with its Allan variance at the longest tau); the
-    Markov term M (when selected, with a correlation time) is one Gauss-Markov component; a periodic term S is
-    left out (it integrates to a bounded angle Omega0 / (2 pi f), negligible beside the noise).
-
-    Raises
-    ------
-    ConfigError
-        The fit is not of the Allan variance (the coefficients are then no Allan-law A).
-    """
-    notes = []
-    if noise.statistic != "adev":
-        raise ConfigError(f"the consistency check needs an Allan-variance fit; this one is of {noise.statistic!r}")
-    A = np.clip(np.asarray(noise.A, dtype=np.float64)[:5], 0.0, None)
-    comps = components_from_allan(A, tau_range_s=(noise.tau_min_s, noise.tau_max_s))
-    m = (noise.shaped or {}).get("M") or {}
-    if "M" in noise.selected and m.get("tc_s") and m.get("sigma_dph"):
-        comps.append({"kind": "gauss_markov", "tc_s": float(m["tc_s"]), "sigma_dph": float(m["sigma_dph"])})
-    if "S" in noise.selected:
-        notes.append("periodic term S left out (it integrates to a bounded angle)")
-    if noise.no_fit:
-        notes.append("no model fits this record's Allan curve: the components are the best candidate's")
-    return check_components(comps), notes
-
-
-def components_from_gmwm(ieee) -> tuple[list[dict], list[str]]:
-    """Noise components of a GMWM model's IEEE reading (:class:`fogdrift.gmwm.ieee.IEEEResult`, or a GMWM axis).
-
-    WN -> white (N), QN -> quantization (Q), RW -> random walk (K), each GM -> a Gauss-Markov component (T_c,
-    sigma), DR -> a ramp with a random slope of 1-sigma R, FLICKER -> Gauss-Markov terms over the fitted tau range
-    (:func:`fogdrift.models.statespace.flicker_as_gauss_markov`).
-    """
-    ie = getattr(getattr(ieee, "selection", None), "ieee", ieee)
-    t = ie.terms
-    comps, notes = [], []
-    if "N_dprh" in t:
-        comps.append({"kind": "white", "arw_dprh": float(t["N_dprh"].value)})
-    if "Q_urad" in t:
-        comps.append({"kind": "quantization", "q_urad": float(t["Q_urad"].value)})
-    if "K_dphrh" in t:
-        comps.append({"kind": "random_walk", "rrw_dphrh": float(t["K_dphrh"].value)})
-    for g in ie.gm:
-        comps.append({"kind": "gauss_markov", "tc_s": float(g["tc_s"].value),
-                      "sigma_dph": float(g["sigma_gm_dph"].value)})
-    if "R_dph2" in t:
-        comps.append({"kind": "ramp", "ramp_dph2": float(t["R_dph2"].value)})
-    if "B_dph" in t:
-        lo, hi = (float(x) for x in ie.tau_range_s)
-        if not (0 < lo < hi and math.isfinite(hi)):
-            raise ConfigError("the GMWM fit has a flicker term but no fitted tau range to replace it over")
-        comps.extend(flicker_as_gauss_markov(float(t["B_dph"].value), lo, hi))
-        notes.append("flicker B replaced by Gauss-Markov terms over the fitted tau range")
-    return check_components(comps), notes
 
 
 @dataclass
