@@ -181,7 +181,7 @@ def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
     passed, else ``poor``) and the bias instability at the AVAR minimum implied by the model.
     """
     from ..gmwm.analysis import analyse_gmwm
-    from ..gmwm.compare import attach_allan_checks
+    from ..gmwm.compare import attach_allan_checks, express_gmwm
     from ..report.gmwm import write_gmwm_outputs
 
     opts = settings.get("gmwm", {})
@@ -189,6 +189,8 @@ def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
                          levels=opts.get("levels"), robust=bool(opts.get("robust", False)))
             for name in record.axis_names]
     attach_allan_checks(record, axes)  # as 'fogdrift noise': N and B against the Allan fit, in noise.json
+    # an accelerometer axis's reading in its units (B stays m/s^2 here; the batch row shows it in ug)
+    axes = [express_gmwm(a, record.signal.channel(a.name).quantity) for a in axes]
     write_gmwm_outputs(axes, out_dir, source=str(record.source), record=record.metadata())
     return [{"axis": a.name, **record_columns(record), **gmwm_columns(a)} for a in axes]
 

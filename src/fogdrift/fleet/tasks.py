@@ -76,11 +76,13 @@ def cached_rows(task: FileTask, sha256: str):
     return rows
 
 
-def split_by_quantity(record, rows: list[dict]) -> list[dict]:
+def split_by_quantity(record, rows: list[dict], b_in_mps2: bool = False) -> list[dict]:
     """Each row in the columns of its axis's quantity: an accelerometer axis's coefficients (already in the
     accelerometer's units, :func:`fogdrift.noise.quantity.express`) move from the gyro-named columns (``N_dprh``
     ...) to the accelerometer's (``N_mps_rh`` ...), ``b_min_dph`` to ``b_min_ug``; every row gets ``quantity``.
-    A gyro row is unchanged but for ``quantity``.  So no accelerometer figure sits in a deg/h column."""
+    A gyro row is unchanged but for ``quantity``.  So no accelerometer figure sits in a deg/h column.
+    ``b_in_mps2``: the rows' B figures are in m/s^2 (a GMWM reading, :mod:`fogdrift.gmwm.quantity`), converted
+    to ug here (1 ug = 9.80665e-6 m/s^2)."""
     from .commands import TERMS
     from .summary import ACCEL_TERMS
 
@@ -100,6 +102,10 @@ def split_by_quantity(record, rows: list[dict]) -> list[dict]:
                         row[f"{term}_{kind}{a}"] = row.pop(key)
             if "b_min_dph" in row:
                 row["b_min_ug"] = row.pop("b_min_dph")
+            if b_in_mps2:
+                for key in ("B_ug", "B_lo95_ug", "B_hi95_ug", "b_min_ug"):
+                    if row.get(key) is not None:
+                        row[key] = row[key] / 9.80665e-6
         out.append(row)
     return out
 
@@ -147,7 +153,8 @@ def run_file(task: FileTask) -> list[dict]:
                 warnings.simplefilter("always")
                 record = load_record(task.path, task.settings)
                 notes = _plausibility(record, task.flags)
-                rows = split_by_quantity(record, command_spec(task.command).run(record, task.settings, od.path))
+                rows = split_by_quantity(record, command_spec(task.command).run(record, task.settings, od.path),
+                                         b_in_mps2=task.command == "noise")
             status, error, cache = "ok", None, True
         except ResourceError as exc:         # out of memory / disk space: the machine's state, never cached
             rows, status, error, cache = [{}], "error", f"{type(exc).__name__}: {exc.render(task.flags)}", False

@@ -22,6 +22,7 @@ from __future__ import annotations
 from .._util import fmt_number
 from ..errors import InsufficientDataError
 from ..pipeline import AnalysisConfig, run_allan
+from .quantity import express_gmwm  # noqa: F401 -- re-exported for the batch worker (one allowed import edge)
 
 __all__ = ["compare_with_allan", "attach_allan_checks"]
 
