@@ -329,3 +329,18 @@ def test_a_constant_log_gets_its_figure_without_a_warning(bundle, tmp_path):
         warnings.simplefilter("error")  # matplotlib's "no positive values ... log-scaled" would be one
         res = compensate_file(bundle, log, tmp_path / "o", heading=False, artefacts=False, model="bias")
     assert (tmp_path / "o" / "compensation_allan.png").stat().st_size > 5_000 and "figure" in res.files
+
+
+def test_bad_chunk_is_refused_before_anything_is_touched(bundle, tmp_path):
+    from fogdrift.cli import app
+
+    log = _csv(tmp_path / "r.csv", "t_s,gz[deg/h]", 45.0 + np.sin(np.arange(300) * 0.9))
+    base = ["compensate", str(bundle), str(log), "--model", "bias", "--no-heading", "--no-artefacts", "--out",
+            str(tmp_path / "o")]
+    assert CliRunner().invoke(app, base).exit_code == 0
+    before = sorted(p.name for p in (tmp_path / "o").iterdir())
+    r = CliRunner().invoke(app, base + ["--chunk", "0"])
+    assert r.exit_code == 1 and "Traceback" not in r.output
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert lines == ["error: --chunk must be an integer >= 1 (rows read at a time); got 0"]
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == before  # the earlier run's files are still there

@@ -9,6 +9,8 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from ..allan import allan_variance
 from ..bundle import Bundle, load_bundle
 from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
@@ -179,6 +181,8 @@ def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_ra
         raise ConfigError(f"formats must be a non-empty subset of {list(FORMATS)}; got {list(formats)!r}")
     bias_mode = parse_bias(bias)
     name = _model_name(b, model)
+    if isinstance(chunk_samples, bool) or not isinstance(chunk_samples, (int, np.integer)) or chunk_samples < 1:
+        raise ConfigError(f"{{opt:chunk_samples}} must be an integer >= 1 (rows read at a time); got {chunk_samples!r}")
     source = open_log(path, unit=unit, bundle_unit=b.input_unit, **load_kwargs)
     match = match_log(source, b, axis_map=axis_map, accept_rate=accept_rate)
     plans = [AxisPlan(log_ax, b.axis(b_ax), name) for log_ax, b_ax in match.axes]

@@ -344,7 +344,7 @@ class RowSource:
         stream: an error names the sample.
         """
         if isinstance(chunk_samples, bool) or not isinstance(chunk_samples, (int, np.integer)) or chunk_samples < 1:
-            raise ConfigError(f"chunk_samples must be an integer >= 1; got {chunk_samples!r}")
+            raise ConfigError(f"{{opt:chunk_samples}} must be an integer >= 1 (rows read at a time); got {chunk_samples!r}")
         yield from self._reader(int(chunk_samples))
 
 
