@@ -569,3 +569,22 @@ def test_raw_binary_records_are_held_to_the_row_limit_and_memory_budget(tmp_path
         load(p, **opts)
     monkeypatch.setenv(limits.ENV_MEMORY, "2M")
     assert load(p, **opts).n_samples == 100_000
+
+
+def test_a_batch_file_whose_workers_died_is_an_error_row_in_words():
+    from fogdrift.fleet import runner
+    from fogdrift.fleet.tasks import FileTask
+
+    class KilledWorker(Exception):  # distributed's exception, by name (the fleet extra may be absent)
+        pass
+
+    task = FileTask(path="/d/u0.npy", file="u0.npy", out_dir="/o/u0.npy", rel_out="u0.npy", command="allan",
+                    settings={}, settings_sha256="0" * 64)
+    exc = KilledWorker("Attempted to run task 'fogdrift-0-abc' on 4 different workers, but all those workers died "
+                       "while running it.")
+    (row,) = runner._error_rows(task, exc)
+    assert row["status"] == "error" and row["error"] == (
+        "KilledWorker: the worker process running u0.npy died, on 4 workers in turn (out of memory is the usual "
+        "cause: run it alone, or with fewer --workers)")
+    (row,) = runner._error_rows(task, ValueError("x"))
+    assert row["error"] == "ValueError: x (the task or its worker failed)"

@@ -203,9 +203,18 @@ def _worker_env(n_workers: int) -> dict:
 
 
 def _error_rows(task: FileTask, exc: BaseException) -> list[dict]:
+    if type(exc).__name__ == "KilledWorker":  # distributed: every worker that ran it died (memory, most often)
+        error = (f"KilledWorker: the worker process running {task.file} died, {_retries(exc)}(out of memory is the "
+                 "usual cause: run it alone, or with fewer --workers)")
+    else:
+        error = f"{type(exc).__name__}: {exc} (the task or its worker failed)"
     return [{"file": task.file, "path": task.path, "command": task.command, "out_dir": task.rel_out,
-             "settings_sha256": task.settings_sha256, "status": "error",
-             "error": f"{type(exc).__name__}: {exc} (the task or its worker failed)", "wall_s": 0.0}]
+             "settings_sha256": task.settings_sha256, "status": "error", "error": error, "wall_s": 0.0}]
+
+
+def _retries(exc: BaseException) -> str:
+    m = re.search(r"on (\d+) different workers", str(exc))
+    return f"on {m.group(1)} workers in turn " if m else ""
 
 
 def run_batch(inputs, out_dir, *, command: str = "allan", settings: dict | None = None, pattern: str | None = None,
