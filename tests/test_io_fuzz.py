@@ -63,9 +63,10 @@ def check_load(path, options, segments=False):
 # ------------------------------------------------------------------------------------------
 @FUZZ
 @given(prefix=st.sampled_from([b"", b"\x93NUMPY", b"\x93NUMPY\x01\x00v\x00", b"PK\x03\x04", b"PK\x05\x06",
-                               b"\x1f\x8b", b"\x1f\x8b\x08\x00", b"\xef\xbb\xbf", b"\xff\xfe"]),
+                               b"\x1f\x8b", b"\x1f\x8b\x08\x00", b"\xef\xbb\xbf", b"\xff\xfe",
+                               b"MATLAB", b"MATLAB 5.0 MAT-file"]),   # issue 23: scipy's IndexError under 128 B
        body=st.binary(max_size=400),
-       ext=st.sampled_from([".csv", ".txt", ".gz", ".npy", ".npz", ".bin", ""]),
+       ext=st.sampled_from([".csv", ".txt", ".gz", ".npy", ".npz", ".bin", ".mat", ".zip", ""]),
        options=OPTIONS)
 def test_random_bytes(tmp_path_factory, prefix, body, ext, options):
     p = tmp_path_factory.mktemp("bytes") / f"f{ext}"
