@@ -198,3 +198,22 @@ def test_a_gyro_reading_gravity_is_flagged():
     y = _triad(2000, level=(0.40, -0.42, -0.29), noise=0.04)
     assert [f for f in check_record(from_array(y, dt_s=0.01, unit="deg/s", axis_names=["gx", "gy", "gz"]))
             if f.rule == "gravity"] == []
+
+
+def test_gmwm_reading_restated_for_an_accelerometer():
+    """White noise of sigma [m/s^2] per sample at dt: N = sigma sqrt(dt) (m/s^2) sqrt(s) = 60 sigma sqrt(dt) m/s/sqrt(h)."""
+    from fogdrift.gmwm.analysis import analyse_gmwm
+    from fogdrift.gmwm.quantity import accel_rows, express_gmwm
+    from fogdrift.gmwm.analysis import ieee_rows
+
+    dt, sigma = 0.01, 0.0333
+    y = sigma * np.random.default_rng(3).standard_normal(2**15)
+    gyro = analyse_gmwm("az", y, dt, model="WN")
+    acc = express_gmwm(gyro, "specific_force")
+    n_g, n_a = gyro.selection.ieee.terms["N_dprh"], acc.selection.ieee.terms["N_dprh"]
+    assert n_a.unit == "m/s/sqrt(h)" and n_a.value == pytest.approx(3600.0 * n_g.value, rel=1e-12)
+    assert n_a.lo95 <= 60.0 * sigma * math.sqrt(dt) <= n_a.hi95
+    assert "Q_arcsec" not in acc.selection.ieee.terms
+    assert express_gmwm(gyro, "angular_rate") is gyro
+    b = [r for r in accel_rows(ieee_rows(acc)) if r[0] == "B"][0]
+    assert b[4] == "µg"

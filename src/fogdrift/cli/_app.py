@@ -185,7 +185,10 @@ LOAD_PARAMS = (
     ("rate", Annotated[Optional[float], typer.Option("--rate", help="Sample rate [Hz] (if the file has no time column).")], None),
     ("unit", Annotated[Optional[str], typer.Option(
         "--unit", help="Input unit: deg/h, deg/s, rad/s, rad/h, arcsec/s, or angle increments inc:deg, inc:rad, "
-                       "inc:arcsec.  Required unless the header declares it (e.g. 'gz[deg/s]'): never guessed.")],
+                       "inc:arcsec; accelerometers: g, mg, ug, m/s^2, inc:m/s.  A gyro+accelerometer log or folder: "
+                       "gyro=deg/s,accel=g (channels assigned by name: gx, gyro*, w*, omega* gyro; ax, acc*, a_x "
+                       "accelerometer; or NAME=UNIT per column; docs/accelerometers.md).  Required unless the "
+                       "header declares it (e.g. 'gz[deg/s]', 'ax[g]'): never guessed.")],
      None),
     ("time_unit", Annotated[Optional[str], typer.Option(
         "--time-unit", help="Unit of the time column: s, ms, us or ns.  Required for a time column unless the header "
@@ -444,6 +447,17 @@ _SOURCE_WORDS = {
     "unit": {"option": "--unit", "header": "declared in the header"},
     "time_unit": {"option": "--time-unit", "header": "declared in the header"},
 }
+
+
+def gyro_only(record, command: str) -> None:
+    """Refuse accelerometer channels in a command whose models and evaluation are the gyro's (drift modelling,
+    heading error): one line naming them and the commands that do take them (docs/accelerometers.md)."""
+    acc = [n for n, q in zip(record.axis_names, record.quantities) if q == "specific_force"]
+    if acc:
+        raise ConfigError(f"{Path(str(record.source)).name}: fogdrift {command} models gyro drift and its heading "
+                          f"error; {', '.join(acc)} {'is an accelerometer channel' if len(acc) == 1 else 'are accelerometer channels'} "
+                          "(specific force, from its unit); analyse them with allan, noise, batch or export, or "
+                          "leave them out with {opt:columns}")
 
 
 def check_plausible(record) -> None:

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from ._app import (JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app, check_model_rate,
+from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app, check_model_rate,
                    check_plausible, console, csv_list, echo_record, parse_level, progress, run, say,
                    with_load_options)
 from ._tables import metrics_table
@@ -68,6 +68,7 @@ def model(
                              training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
                              model_rate_hz=model_rate or None).validate()
         record = load.load()
+        gyro_only(record, "model")
         factor = check_model_rate(record, cfg)
         echo_record(load, record)
         check_plausible(record)

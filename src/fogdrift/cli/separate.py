@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._app import (JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, check_model_rate,
+from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, check_model_rate,
                    check_plausible, console, echo_record, parse_level, parse_taus, progress, run, say,
                    with_load_options)
 from ._tables import noise_table
@@ -45,6 +45,7 @@ def separate(
         cfg = AnalysisConfig(wavelet=wavelet, level=parse_level(level), mode=mode,
                              model_rate_hz=model_rate or None, taus=parse_taus(taus)).validate()
         record = load.load()
+        gyro_only(record, "separate")
         factor = check_model_rate(record, cfg)
         echo_record(load, record)
         check_plausible(record)
