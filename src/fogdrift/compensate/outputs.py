@@ -65,7 +65,9 @@ class NpzWriter:
         shapes = {"t_s": (n_samples,), "compensated": (n_samples, k), "drift_estimate": (n_samples, k)}
         if with_sigma:
             shapes["drift_sigma"] = (n_samples, k)
-        stem = self.path.name if self.path.name.startswith(TMP_PREFIX) else f"{TMP_PREFIX}{os.getpid()}-{self.path.name}"
+        stem = self.path.name
+        if not stem.startswith(TMP_PREFIX):
+            stem = f"{TMP_PREFIX}{os.getpid()}-{stem}"
         self._paths = {name: self.path.with_name(f"{stem}.{name}.npy") for name in shapes}
         self._files = {}
         try:

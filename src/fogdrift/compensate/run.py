@@ -94,7 +94,8 @@ def _allan_rows(before, after, dt):
 
 def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", unit=None, axis_map=None,
                     accept_rate=False, columns=None, time_column="auto", rate_hz=None, time_unit=None, format=None,
-                    reader_options=None, temperature=None, gaps="error", apply_unit=None, chunk_samples=DEFAULT_CHUNK, formats=FORMATS, figures=True, heading=True, artefacts=True,
+                    reader_options=None, temperature=None, gaps="error", apply_unit=None, chunk_samples=DEFAULT_CHUNK,
+                    formats=FORMATS, figures=True, heading=True, artefacts=True,
                     calib_s=300.0, step_s=300.0, horizons_s=(60.0, 600.0, 3600.0), max_model_rate_samples=1 << 23,
                     segment=None, progress=None, flags=None) -> CompensationResult:
     """Compensate the log ``path`` with ``bundle`` and write the results to ``out_dir``.
@@ -182,7 +183,8 @@ def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_ra
     bias_mode = parse_bias(bias)
     name = _model_name(b, model)
     if isinstance(chunk_samples, bool) or not isinstance(chunk_samples, (int, np.integer)) or chunk_samples < 1:
-        raise ConfigError(f"{{opt:chunk_samples}} must be an integer >= 1 (rows read at a time); got {chunk_samples!r}")
+        raise ConfigError(f"{{opt:chunk_samples}} must be an integer >= 1 (rows read at a time); got "
+                          f"{chunk_samples!r}")
     source = open_log(path, unit=unit, bundle_unit=b.input_unit, **load_kwargs)
     match = match_log(source, b, axis_map=axis_map, accept_rate=accept_rate)
     plans = [AxisPlan(log_ax, b.axis(b_ax), name) for log_ax, b_ax in match.axes]
@@ -281,7 +283,8 @@ def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_ra
         "log": str(source.path), "log_sha256": source.sha256, "held_out": held_out, "model": name,
         "model_label": "constant bias" if name == BIAS_ONLY else plans[0].model.label,
         "bias_mode": "keep" if bias_mode == "keep" else {"re_estimate_s": bias_mode},
-        "unit": match.unit, "scale_to_dph": scale, "signal": source.signal.to_dict(), "native_dt_s": source.dt_s, "model_dt_s": b.model_dt_s,
+        "unit": match.unit, "scale_to_dph": scale, "signal": source.signal.to_dict(), "native_dt_s": source.dt_s,
+        "model_dt_s": b.model_dt_s,
         "block_average_factor": match.factor, "n_samples": source.n_samples, "chunk_samples": int(chunk_samples),
         "design": "drift estimate of modelling interval j = the model's one-step prediction from modelling samples "
                   "< j, held over the interval's native samples (zero-order hold); compensated = rate - bias - "

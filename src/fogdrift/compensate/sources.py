@@ -102,7 +102,8 @@ class LogSource:
     def chunks(self, chunk_samples: int = DEFAULT_CHUNK):
         """Yield ``(t_s (n,), rate_dph (n, n_axes))`` in order, ``chunk_samples`` rows at a time."""
         if isinstance(chunk_samples, bool) or not isinstance(chunk_samples, (int, np.integer)) or chunk_samples < 1:
-            raise ConfigError(f"{{opt:chunk_samples}} must be an integer >= 1 (rows read at a time); got {chunk_samples!r}")
+            raise ConfigError(f"{{opt:chunk_samples}} must be an integer >= 1 (rows read at a time); got "
+                              f"{chunk_samples!r}")
         yield from self._chunks(int(chunk_samples))
 
 

@@ -344,7 +344,8 @@ class RowSource:
         stream: an error names the sample.
         """
         if isinstance(chunk_samples, bool) or not isinstance(chunk_samples, (int, np.integer)) or chunk_samples < 1:
-            raise ConfigError(f"{{opt:chunk_samples}} must be an integer >= 1 (rows read at a time); got {chunk_samples!r}")
+            raise ConfigError(f"{{opt:chunk_samples}} must be an integer >= 1 (rows read at a time); got "
+                              f"{chunk_samples!r}")
         yield from self._reader(int(chunk_samples))
 
 
@@ -531,7 +532,8 @@ def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None
 
     names = tuple(f"col{j}" for j in r_idx)
     sampling = Sampling(dt_s=dt, dt_source="rate option" if t_idx is None else "time column",
-                        time_column=None if t_idx is None else tcol, time_unit=None if t_idx is None else (time_unit or "s"),
+                        time_column=None if t_idx is None else tcol,
+                        time_unit=None if t_idx is None else (time_unit or "s"),
                         time_unit_source=None if t_idx is None else ("option" if time_unit else None))
     signal = SignalDescription(sampling=sampling, channels=tuple(
         Channel(name=n, unit=spec, unit_source="option", declared_unit=None, scale_to_internal=scale) for n in names))
