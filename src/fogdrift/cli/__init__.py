@@ -22,10 +22,61 @@ import sys
 __all__ = ["app", "main"]
 
 
+#: Command name -> the module that declares it, in the order ``fogdrift --help`` lists them.  :func:`main` imports a
+#: command's module only when that command runs (or when the top-level help lists them all): ``fogdrift allan``
+#: no longer imports ``batch`` (and with it fleet, noise and scipy), ``compensate``, ``model`` ...
+COMMAND_MODULES = {
+    "allan": "allan", "model": "model", "analyze": "analyze", "noise": "noise", "batch": "batch",
+    "compensate": "compensate", "consistency": "consistency", "export": "export", "separate": "separate",
+}
+
+
 def _commands():
-    from . import allan, analyze, batch, compensate, consistency, export, model, noise, separate  # noqa: F401  (register the commands)
+    """The typer application with every command registered (imports every command module)."""
+    import importlib
+
+    for module in dict.fromkeys(COMMAND_MODULES.values()):
+        importlib.import_module(f"{__name__}.{module}")
     from ._app import app
 
+    return app
+
+
+def _lazy_app():
+    """The typer application whose click group imports a command's module when the command is looked up.
+
+    The group class (``app.info.cls``) lists :data:`COMMAND_MODULES` (then any other registered command) and, for
+    a name not registered yet, imports its module (``@app.command()`` registers it) and builds that command as
+    typer would.  Everything else (the callback's options, help, errors, typer's exception hook) is typer's own.
+    """
+    import importlib
+
+    import typer.core
+    import typer.main
+
+    from ._app import app
+
+    built = set()
+
+    class LazyGroup(typer.core.TyperGroup):
+        def list_commands(self, ctx):
+            return list(dict.fromkeys([*COMMAND_MODULES, *self.commands]))
+
+        def get_command(self, ctx, name):
+            if name not in self.commands and name in COMMAND_MODULES:
+                importlib.import_module(f"{__name__}.{COMMAND_MODULES[name]}")
+                for info in app.registered_commands:  # the module's commands (and those of modules it imports)
+                    if id(info) in built:
+                        continue
+                    built.add(id(info))
+                    cmd = typer.main.get_command_from_info(
+                        info, pretty_exceptions_short=app.pretty_exceptions_short,
+                        rich_markup_mode=app.rich_markup_mode)
+                    if cmd.name and cmd.name not in self.commands:
+                        self.add_command(cmd)
+            return super().get_command(ctx, name)
+
+    app.info.cls = LazyGroup
     return app
 
 
@@ -84,7 +135,7 @@ def main():  # console-script entry point
     try:  # outside the guard too: a Ctrl-C while the guard itself starts or stops
         with interrupt.SigintGuard(on_timeout=_on_timeout, grace_s=0.6):
             try:
-                _commands()(prog_name="fogdrift")
+                _lazy_app()(prog_name="fogdrift")
             except SystemExit as exc:
                 code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
             except KeyboardInterrupt:  # before a command's frame took over (imports, option parsing)
