@@ -32,7 +32,7 @@ import resource, sys, time, json
 from fogdrift.compensate import compensate_file
 t0 = time.perf_counter()
 res = compensate_file(sys.argv[1], sys.argv[2], sys.argv[3], model=sys.argv[4], formats=("npz",), heading=False,
-                      rate_hz=100.0)
+                      rate_hz=100.0, unit="deg/h")
 wall = time.perf_counter() - t0
 print(json.dumps({"wall_s": wall, "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
                   "n": res.summary["n_samples"]}))

@@ -244,7 +244,8 @@ def _compensate(bundle, log, out, *extra):
     from fogdrift.cli import app
 
     res = CliRunner().invoke(app, ["compensate", str(bundle), str(log), "--model", "ar", "--calibration", "200",
-                                   "--origin-step", "200", "--horizons", "60", "--out", str(out), *extra],
+                                   "--origin-step", "200", "--horizons", "60", "--unit", "deg/s", "--out", str(out),
+                                   *extra],
                              env={"COLUMNS": "200"})
     assert res.exit_code == 0, res.output
     return res.output, json.loads((out / "compensation.json").read_text())
@@ -272,7 +273,7 @@ def test_compensate_artefact_switches_and_rendered_json(trained, tmp_path):
     assert doc["artefacts"]
     text = (tmp_path / "on" / "compensation.json").read_text()
     assert "{opt:" not in text
-    assert "pass --apply-unit to override" in text  # the CSV declares no unit: the note names the CLI flag
+    assert "read as deg/s (--unit)" in text  # the CSV declares no unit: the note says where the unit came from
 
 
 # ---------------------------------------------------------------------------------------------------------------
