@@ -8,10 +8,18 @@ prediction H x_{k|k-1}.  This is the field's standard way to use a noise model; 
 models are judged beside it.
 
 The noise model is either given (``components``, e.g. from a GMWM fit: white noise, random walk,
-Gauss-Markov (T_c, sigma)) or identified in :meth:`Kalman.fit` from the Allan variance of the
-training block (:func:`fogdrift.allan.allan_variance` + :func:`fogdrift.noise.fit_noise`, then
-:func:`~fogdrift.models.statespace.components_from_allan`), so it never sees validation or test
-data (method notes §5.1).
+Gauss-Markov (T_c, sigma)) or identified in :meth:`Kalman.fit` from the **training block only**, so it
+never sees validation or test data (method notes §5.1), by one of two methods (``noise_method``):
+
+* ``"allan"`` (default): the Allan variance of the training block (:func:`fogdrift.allan.allan_variance` +
+  :func:`fogdrift.noise.fit_noise`, then :func:`~fogdrift.models.statespace.components_from_allan`);
+  :func:`identify_components`;
+* ``"gmwm"``: the GMWM model selection on the Haar wavelet variance of the training block
+  (:func:`fogdrift.gmwm.analysis.analyse_gmwm`, default candidates), its processes mapped to components by
+  :func:`fogdrift.models.components.components_from_gmwm` (WN, QN, RW, each GM, flicker as GM terms; a
+  drift DR as the random walk with its Allan variance at the longest scale, as the Allan route does);
+  :func:`identify_components_gmwm`.  A block of fewer than :data:`GMWM_MIN_SAMPLES` samples is refused
+  with one line.
 """
 
 from __future__ import annotations
@@ -22,8 +30,10 @@ import warnings
 import numpy as np
 
 from .._util import check_series
-from ..errors import ConfigError, FogdriftError, FogdriftWarning
+from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError
+from ..gmwm.analysis import analyse_gmwm
 from .base import DriftModel
+from .components import components_from_gmwm
 from .statespace import (
     check_components,
     components_from_allan,
@@ -32,7 +42,14 @@ from .statespace import (
     state_space,
 )
 
-__all__ = ["Kalman", "identify_components"]
+__all__ = ["Kalman", "identify_components", "identify_components_gmwm", "NOISE_METHODS", "GMWM_MIN_SAMPLES"]
+
+#: How :class:`Kalman` identifies its noise model from the training block when no ``components`` are given.
+NOISE_METHODS = ("allan", "gmwm")
+
+#: Fewest training samples a GMWM identification takes: 2^7, i.e. J = 6 Haar scales (a white + Gauss-Markov
+#: model, 3 parameters, keeps 3 degrees of freedom for the WIC and the sanity checks).
+GMWM_MIN_SAMPLES = 128
 
 
 def identify_components(y, dt_s: float, *, terms=("Q", "N", "B", "K", "R")) -> tuple[list[dict], dict]:
@@ -81,6 +98,74 @@ def identify_components(y, dt_s: float, *, terms=("Q", "N", "B", "K", "R")) -> t
     return comps, info
 
 
+def identify_components_gmwm(y, dt_s: float) -> tuple[list[dict], dict]:
+    """Noise components of a rate series [deg/h] from a GMWM fit of it (training block only).
+
+    The GMWM model selection (:func:`fogdrift.gmwm.analysis.analyse_gmwm`: Haar wavelet variance, default
+    candidates, WIC, sanity checks, short-scale exclusion) on ``y`` as given, then
+    :func:`fogdrift.models.components.components_from_gmwm` with a drift DR folded into the random walk.
+
+    Parameters
+    ----------
+    y : ndarray, shape (n,)
+        Rate [deg/h] (the caller validates it: finite, 1-D).
+    dt_s : float
+        Sample interval [s].
+
+    Returns
+    -------
+    components : list of dict
+    info : dict
+        ``method`` ("gmwm"), ``selected`` (the GMWM model, e.g. ``"WN+RW+GM"``), ``passed_checks``,
+        ``n_samples``, ``tau_range_s`` (Allan times the fit covers [s]), ``notes`` and ``reason`` (why the
+        selection is a fallback, empty otherwise).  JSON-ready (it is saved in the model file).
+
+    Raises
+    ------
+    InsufficientDataError
+        ``y`` has fewer than :data:`GMWM_MIN_SAMPLES` samples (one line, naming the alternative).
+
+    Warns
+    -----
+    FogdriftWarning
+        No GMWM candidate passed every sanity check: the components are those of the best candidate
+        without a hard failure, and ``reason`` says why it was still taken.
+
+    Examples
+    --------
+    White noise of 6 deg/h per 1-s sample is identified as WN alone, N = 6/60 deg/sqrt(h):
+
+    >>> y = np.random.default_rng(0).normal(0.0, 6.0, 4096)
+    >>> comps, info = identify_components_gmwm(y, 1.0)
+    >>> info["selected"], [c["kind"] for c in comps], abs(comps[0]["arw_dprh"] / 0.1 - 1) < 0.05
+    ('WN', ['white'], True)
+    """
+    n = int(np.asarray(y).size)
+    if n < GMWM_MIN_SAMPLES:
+        raise InsufficientDataError(
+            f"Kalman noise_method 'gmwm': the training block has {n} samples at {1.0 / dt_s:.4g} Hz; a GMWM fit "
+            f"needs at least {GMWM_MIN_SAMPLES} (use noise_method 'allan', a longer record or a higher model rate)",
+            needed=GMWM_MIN_SAMPLES, got=n)
+    with warnings.catch_warnings(record=True) as log:
+        warnings.simplefilter("always", FogdriftWarning)
+        axis = analyse_gmwm("train", y, dt_s)
+    sel = axis.selection
+    comps, notes = components_from_gmwm(axis, ramp="random_walk")
+    reason = ""
+    if not sel.passed_checks:
+        failed = next((c for c in sel.candidates if c.model == sel.selected), None)
+        why = "; ".join(failed.reasons) if failed is not None and failed.reasons else "see the GMWM candidates"
+        reason = f"no GMWM candidate passed every sanity check; {sel.selected} has the smallest WIC ({why})"
+        warnings.warn(f"Kalman noise model (GMWM): {reason}", FogdriftWarning, stacklevel=3)
+    for w in log:  # anything else the GMWM said, passed on once
+        if not (issubclass(w.category, FogdriftWarning) and "no candidate passed" in str(w.message)):
+            warnings.warn(w.message, w.category, stacklevel=3)
+    lo, hi = (float(v) for v in sel.ieee.tau_range_s)
+    info = {"method": "gmwm", "selected": sel.selected, "passed_checks": bool(sel.passed_checks), "n_samples": n,
+            "tau_range_s": [lo, hi], "notes": list(notes), "reason": reason}
+    return comps, info
+
+
 class Kalman(DriftModel):
     """Kalman-filter drift estimate from a noise model; runs on the (bias-removed) rate.
 
@@ -96,13 +181,21 @@ class Kalman(DriftModel):
         the white-noise 1-sigma), i.e. nearly diffuse.
     terms : sequence of str or None
         Allan terms turned into components when identifying (subset of Q, N, B, K, R); None: all.
+        Used by ``noise_method="allan"`` only.
+    noise_method : {"allan", "gmwm"}
+        How the noise model is identified from ``y_train`` when ``components`` is None: the Allan fit
+        (:func:`identify_components`, default) or the GMWM model selection
+        (:func:`identify_components_gmwm`; at least :data:`GMWM_MIN_SAMPLES` training samples).  Ignored
+        when ``components`` are given.
 
     Attributes
     ----------
     components_ : list of dict
         The noise model used.
     identification_ : dict
-        How it was obtained (``method``, Allan ``A``, tau range), or ``{"method": "given"}``.
+        How it was obtained: ``method`` (``"allan"``, ``"difference-variance"``, ``"allan+difference-variance"``,
+        ``"gmwm"`` or ``"given"``) and its details (Allan ``A`` and tau range; the GMWM ``selected`` model,
+        ``passed_checks``, ``n_samples``, tau range).  Saved in the model file.
     bias_prior_dph_ : float
     state_names_ : tuple of str
     x_end_, P_end_ : ndarray
@@ -129,11 +222,12 @@ class Kalman(DriftModel):
     label = "Kalman"
     input_kind = "rate"
 
-    def __init__(self, *, components=None, dt_s=1.0, bias_prior_dph=None, terms=None):
+    def __init__(self, *, components=None, dt_s=1.0, bias_prior_dph=None, terms=None, noise_method="allan"):
         self.components = components
         self.dt_s = dt_s
         self.bias_prior_dph = bias_prior_dph
         self.terms = terms
+        self.noise_method = noise_method
 
     # -- fit ------------------------------------------------------------------------------------
     def _validate(self) -> float:
@@ -145,10 +239,13 @@ class Kalman(DriftModel):
             raise ConfigError(f"Kalman dt_s must be a finite number > 0 s; got {self.dt_s!r}")
         if self.terms is not None and (isinstance(self.terms, str) or set(self.terms) - set("QNBKR")):
             raise ConfigError(f"Kalman terms must be None or a subset of Q, N, B, K, R; got {self.terms!r}")
+        if not isinstance(self.noise_method, str) or self.noise_method not in NOISE_METHODS:
+            raise ConfigError(f"Kalman noise_method must be one of {', '.join(NOISE_METHODS)}; "
+                              f"got {self.noise_method!r}")
         return dt
 
     def fit(self, y_train, y_val=None):
-        """Identify (or take) the noise model and filter ``y_train``; ``y_val`` is ignored.
+        """Identify (or take) the noise model and filter ``y_train``; ``y_val`` is ignored (never seen).
 
         Raises
         ------
@@ -156,10 +253,14 @@ class Kalman(DriftModel):
             Bad parameter or component list.
         DataFormatError
             ``y_train`` not 1-D or not finite.
+        InsufficientDataError
+            ``noise_method="gmwm"`` and fewer than :data:`GMWM_MIN_SAMPLES` training samples.
         """
         dt = self._validate()
         y = check_series(y_train, "y_train", min_length=2)
-        if self.components is None:
+        if self.components is None and self.noise_method == "gmwm":
+            comps, info = identify_components_gmwm(y, dt)  # the training block only, never y_val
+        elif self.components is None:
             comps, info = identify_components(y, dt, terms=tuple(self.terms or "QNBKR"))
         else:
             comps, info = check_components(self.components), {"method": "given"}
