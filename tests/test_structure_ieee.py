@@ -143,3 +143,18 @@ def test_one_formatter_prints_what_each_old_one_printed(x):
             assert _g(x, d) == f"{x:.{d}g}"
     assert page(x) == _old_page(x)
     assert gmwm("< 7.06") == "< 7.06"
+
+
+def test_no_copies_in_the_report_and_fleet_packages():
+    # a ratchet on the places this issue cleaned: the term list, JSON serialisation, the flicker constant
+    import re
+    from pathlib import Path
+
+    src = Path(__file__).resolve().parents[1] / "src" / "fogdrift"
+    files = [*sorted((src / "report").glob("*.py")), src / "fleet" / "commands.py", src / "fleet" / "page.py",
+             src / "fleet" / "summary.py", src / "gmwm" / "ieee.py", src / "gmwm" / "compare.py"]
+    for f in files:
+        text = f.read_text(encoding="utf-8")
+        assert '"Q", "N", "B", "K", "R"' not in text, f"{f.name}: read the term list from noise.terms.TERMS"
+        assert not re.search(r"json\.dumps?\(", text), f"{f.name}: JSON through _util.strict_json / report write_json"
+        assert not re.search(r"log\(2(\.0)?\) / (math|np)\.pi", text), f"{f.name}: the flicker constant is units.B_FACTOR"
