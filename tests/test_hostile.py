@@ -588,3 +588,32 @@ def test_a_batch_file_whose_workers_died_is_an_error_row_in_words():
         "cause: run it alone, or with fewer --workers)")
     (row,) = runner._error_rows(task, ValueError("x"))
     assert row["error"] == "ValueError: x (the task or its worker failed)"
+
+
+def test_batch_json_is_strict_json(tmp_path, monkeypatch):
+    pytest.importorskip("pyarrow")
+    from fogdrift.fleet import commands, run_batch
+    from fogdrift.fleet.tasks import MANIFEST as BATCH_JSON
+
+    real = commands.command_spec
+
+    class Spec:
+        def __init__(self, spec):
+            self._spec = spec
+            self.name = spec.name
+
+        def run(self, record, settings, out):
+            rows = self._spec.run(record, settings, out)
+            return [dict(r, N_lo95_dprh=float("nan")) for r in rows]   # an interval the fit could not bound
+
+        def __getattr__(self, name):
+            return getattr(self._spec, name)
+
+    monkeypatch.setattr("fogdrift.fleet.tasks.command_spec", lambda name: Spec(real(name)), raising=False)
+    monkeypatch.setattr(commands, "command_spec", lambda name: Spec(real(name)))
+    p = tmp_path / "u.npy"
+    np.save(p, np.random.default_rng(4).normal(size=4000))
+    run_batch([p], tmp_path / "o", settings={"load": {"unit": "deg/h", "rate_hz": 100.0}}, scheduler="serial")
+    text = (tmp_path / "o" / "u.npy" / BATCH_JSON).read_text()
+    doc = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-standard JSON constant {c}"))
+    assert doc["rows"][0]["N_lo95_dprh"] is None

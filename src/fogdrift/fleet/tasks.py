@@ -20,6 +20,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
+from .._util import strict_json
 from ..errors import FogdriftError, ResourceError
 
 __all__ = ["FileTask", "run_file", "load_record", "split_by_quantity", "MANIFEST"]
@@ -172,5 +173,6 @@ def run_file(task: FileTask) -> list[dict]:
             doc = {"sha256": sha256, "settings_sha256": task.settings_sha256, "command": task.command,
                    "settings": task.settings, "rows": rows}
             with atomic_path(od.path / MANIFEST) as tmp:
-                tmp.write_text(json.dumps(doc, indent=1, default=str))
+                # strict JSON (NaN/inf as null: a row's unfitted interval); default=str keeps any odd cell a string
+                tmp.write_text(strict_json(json.loads(json.dumps(doc, default=str)), indent=1))
     return rows
