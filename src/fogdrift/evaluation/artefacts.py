@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError
+from ..models.causal_predictor import CausalPredictor, causal_weights
 
 __all__ = ["ArtefactRow", "ArtefactResult", "artefact_check", "default_frequencies", "ALLAN_PEAK"]
 
@@ -103,7 +104,6 @@ class ArtefactResult:
 
 def _one_step(z, model, g):
     """Compensated series z - p (p = causal one-step drift estimate, 0 before the model has one)."""
-    from ..compensate.predictors import CausalPredictor
 
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
@@ -180,7 +180,6 @@ def artefact_check(rate_dph, dt_s, models, *, causal_window: int, wavelet="db2",
     >>> g[0.002] < 0.3, g[0.2] > 0.9
     (True, True)
     """
-    from ..compensate.predictors import causal_weights
 
     z = np.asarray(rate_dph, dtype=np.float64)
     if z.ndim != 1 or z.size < 4 * int(causal_window) or not np.all(np.isfinite(z)):

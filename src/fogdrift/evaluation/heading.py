@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError, FogdriftError, InsufficientDataError
+from ..models.causal_predictor import causal_weights
 
 __all__ = ["HORIZONS_S", "CONSTANT_BIAS", "HeadingRow", "HeadingResult", "heading_errors", "heading_row",
            "angle_error_deg"]
@@ -219,7 +220,6 @@ def heading_errors(rate_dph, dt_s, models, *, causal_window: int, wavelet="db2",
     >>> row.n_origins, 0.008 < row.rms_deg < 0.018
     (66, True)
     """
-    from ..compensate.predictors import causal_weights
 
     r = np.asarray(rate_dph, dtype=np.float64)
     if r.ndim != 1 or not np.all(np.isfinite(r)):
