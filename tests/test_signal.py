@@ -334,3 +334,18 @@ def test_a_damaged_channel_is_one_config_error(field, value):
     d["channels"][0][field] = value
     with pytest.raises(ConfigError):
         SignalDescription.from_dict(d)
+
+
+def test_cli_apply_to_echo_names_the_flag_that_gave_the_unit(tmp_path):
+    from fogdrift.cli import app
+
+    for name, seed, scale, header in (("a.csv", 7, 1.0 / 3600.0, "t_s,gz[deg/s]"), ("b.csv", 8, 1.0, "t_s,gz")):
+        x = simulate(4000, 0.5, arw_dprh=0.05, rrw_dphrh=0.5, bias_dph=2.0, seed=seed)
+        (tmp_path / name).write_text(header + "\n" + "".join(f"{k * 0.5:.3f},{v * scale:.12f}\n"
+                                                             for k, v in enumerate(x)))
+    res = runner.invoke(app, ["analyze", str(tmp_path / "a.csv"), "--apply-to", str(tmp_path / "b.csv"),
+                              "--apply-unit", "deg/h", "--models", "persistence", "--level", "2", "--no-heading",
+                              "--out", str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    assert "a.csv: 4000 samples" in res.output and "units: rate deg/s (declared in the header)" in res.output
+    assert "b.csv: 4000 samples" in res.output and "units: rate deg/h (--apply-unit)" in res.output

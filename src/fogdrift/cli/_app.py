@@ -410,11 +410,13 @@ def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool
 
 
 # -- what was read --------------------------------------------------------------------------------------------
-def echo_record(load: "LoadOptions", record, path=None) -> None:
+def echo_record(load: "LoadOptions", record, path=None, *, unit_flag: str = "--unit",
+                time_unit_flag: str = "--time-unit") -> None:
     """One line: the file, samples, axes, duration, the sample rate and where it came from, the units and theirs.
 
     Where the rate and the units came from is read from the record's signal description
-    (:attr:`fogdrift.io.GyroRecord.signal`), made by :func:`fogdrift.io.load` while reading.
+    (:attr:`fogdrift.io.GyroRecord.signal`), made by :func:`fogdrift.io.load` while reading; a unit given as
+    an option is named by ``unit_flag`` / ``time_unit_flag`` (``--apply-unit`` for a second recording).
     """
     path = Path(path or load.file)
     smp = record.signal.sampling
@@ -425,9 +427,11 @@ def echo_record(load: "LoadOptions", record, path=None) -> None:
         rate_src = f"from time column '{smp.time_column}'"
     else:
         rate_src = "from the file's time stamps"
-    units = f"rate {record.input_unit} ({_SOURCE_WORDS['unit'].get(chan.unit_source, chan.unit_source)})"
+    words = {"option": unit_flag, "header": "declared in the header"}
+    units = f"rate {record.input_unit} ({words.get(chan.unit_source, chan.unit_source)})"
     if smp.time_unit is not None:
-        units += f", time {smp.time_unit} ({_SOURCE_WORDS['time_unit'].get(smp.time_unit_source, smp.time_unit_source)})"
+        words = {"option": time_unit_flag, "header": "declared in the header"}
+        units += f", time {smp.time_unit} ({words.get(smp.time_unit_source, smp.time_unit_source)})"
     say(f"{path.name}: {record.n_samples} samples x {record.n_axes} {'axis' if record.n_axes == 1 else 'axes'} ({', '.join(record.axis_names)}), "
         f"{record.duration_s:.6g} s at {record.fs_hz:.6g} Hz (dt {record.dt_s:.6g} s {rate_src}); units: {units}; "
         + _converted_words(record))
@@ -440,13 +444,6 @@ def _converted_words(record) -> str:
         return "rates converted to deg/h"
     words = {"angular_rate": "rates (gyro) to deg/h", "specific_force": "specific force (accelerometer) to m/s^2"}
     return "converted: " + ", ".join(words[q] for q in qs)
-
-
-#: How :func:`echo_record` words a unit's source (:data:`fogdrift.signal.UNIT_SOURCES`).
-_SOURCE_WORDS = {
-    "unit": {"option": "--unit", "header": "declared in the header"},
-    "time_unit": {"option": "--time-unit", "header": "declared in the header"},
-}
 
 
 def gyro_only(record, command: str) -> None:

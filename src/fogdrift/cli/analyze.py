@@ -121,7 +121,8 @@ def analyze(
             other = load.load(apply_to, unit=apply_unit, time_unit=apply_time_unit)
             other = _match_axes(record, other, apply_to)
             other_factor = check_model_rate(other, cfg)
-            echo_record(load, other, apply_to)
+            echo_record(load, other, apply_to, unit_flag="--apply-unit" if apply_unit else "--unit",
+                        time_unit_flag="--apply-time-unit" if apply_time_unit else "--time-unit")
             check_plausible(other)
         elif apply_unit or apply_time_unit:
             raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
