@@ -212,3 +212,27 @@ def test_gmwm_ramp_folds_into_the_random_walk_like_the_allan_route():
     assert [c["kind"] for c in components_from_gmwm(ie)[0]] == ["white", "random_walk", "ramp"]
     with pytest.raises(ConfigError, match="ramp must be"):
         components_from_gmwm(ie, ramp="drop")
+
+
+def test_a_fallback_gmwm_selection_is_used_with_one_warning_saying_why(monkeypatch):
+    """No candidate passed the checks: the best one is used, one FogdriftWarning names it and its failed check
+    (the selection's own warning is not repeated), and identification_ records it."""
+    from fogdrift.errors import FogdriftWarning
+
+    v = lambda x: SimpleNamespace(value=x)  # noqa: E731
+
+    def fake(name, x, dt_s, **kw):
+        warnings.warn("no candidate passed every sanity check; WN (smallest WIC ...)", FogdriftWarning)
+        ie = SimpleNamespace(terms={"N_dprh": v(0.1)}, gm=[], tau_range_s=(1.0, 64.0))
+        sel = SimpleNamespace(selected="WN", passed_checks=False, ieee=ie,
+                              candidates=[SimpleNamespace(model="WN", reasons=("soft: residual z = 4.2 at scale 8 s",))])
+        return SimpleNamespace(selection=sel)
+
+    monkeypatch.setattr(kalman_module, "analyse_gmwm", fake)
+    with warnings.catch_warnings(record=True) as log:
+        warnings.simplefilter("always")
+        model = Kalman(noise_method="gmwm").fit(np.zeros(GMWM_MIN_SAMPLES))
+    msgs = [str(w.message) for w in log if issubclass(w.category, FogdriftWarning)]
+    assert len(msgs) == 1 and "WN has the smallest WIC (soft: residual z = 4.2 at scale 8 s)" in msgs[0]
+    assert model.identification_["passed_checks"] is False and "residual z" in model.identification_["reason"]
+    assert model.components_ == [{"kind": "white", "arw_dprh": 0.1}]
