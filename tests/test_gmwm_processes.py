@@ -206,3 +206,47 @@ def test_ieee_mapping_worked_example_of_the_notes():
     gm = PROCESSES["GM"].ieee(np.array([-math.log(0.9999), 1e-12 * f2]), dt)
     assert_allclose(gm["tc_s"], 99.995, rtol=1e-5)
     assert_allclose(gm["sigma_gm_dph"], 14.59, rtol=1e-3)
+
+
+def _reference_wv_and_jacobian(mdl, th, tau):
+    """The model WV and Jacobian composed from the registry's NumPy ``wv`` and :func:`ar1_wv` (the compiled
+    kernel of LatentModel must give the same values)."""
+    comps, cols = [], []
+    for key, sl in zip(mdl.components, mdl.slices):
+        p = th[sl]
+        comps.append(PROCESSES[key].wv(p, tau))
+        if key == "GM":
+            h = 1e-3
+            cols += [(ar1_wv(p[0] * math.exp(h), p[1], tau) - ar1_wv(p[0] * math.exp(-h), p[1], tau)) / (2 * h),
+                     ar1_wv(p[0], p[1], tau)]
+        else:
+            cols.append((2.0 if key == "DR" else 1.0) * PROCESSES[key].wv(p, tau))
+    comps = np.array(comps)
+    return comps, comps.sum(axis=0), np.column_stack(cols)
+
+
+@pytest.mark.parametrize("model", ["WN+RW+GM", "QN+WN+RW+2GM", "WN+DR+3GM", "QN+WN+RW+DR+FLICKER+2GM", "WN+GM"])
+def test_compiled_wv_and_jacobian_equal_the_numpy_composition(model):
+    """Issue 25: LatentModel.wv / wv_components / wv_jacobian run one compiled kernel (the GMWM optimiser's inner
+    loop); same values as the NumPy path, with GMs of different beta (a row mix-up between GMs would show), the
+    small-(m beta) series and the closed form both exercised, and a drift (factor 2 in its Jacobian column)."""
+    mdl = parse_model(model)
+    rng = np.random.default_rng(25)
+    tau = 2.0 ** np.arange(1, 22)
+    for _ in range(40):
+        th = np.exp(rng.uniform(-16, 2, mdl.n_params))
+        for j, name in enumerate(mdl.param_names):
+            if name.endswith(".beta"):
+                th[j] = 10 ** rng.uniform(-8, 1.5)
+        comps, total, jac = _reference_wv_and_jacobian(mdl, th, tau)
+        assert_allclose(mdl.wv_components(th, tau), comps, rtol=1e-14, atol=0)
+        assert_allclose(mdl.wv(th, tau), total, rtol=1e-14, atol=0)
+        assert_allclose(mdl.wv_jacobian(th, tau), jac, rtol=1e-12, atol=1e-14 * np.abs(jac).max())
+    # one scale, a 0-d tau and a GM whose m beta straddles the 1e-3 series switch
+    th = np.array([1.0, 2e-4, 0.5])[: mdl.n_params] if model == "WN+GM" else None
+    if th is not None:
+        for t in (np.array([8.0]), 8.0):
+            assert_allclose(mdl.wv(th, t), _reference_wv_and_jacobian(mdl, th, np.atleast_1d(t))[1].reshape(np.shape(t)),
+                            rtol=1e-14)
+        t = np.array([8.0, 10.0, 12.0])  # m beta = 8e-4, 1.0e-3, 1.2e-3
+        assert_allclose(mdl.wv(th, t), _reference_wv_and_jacobian(mdl, th, t)[1], rtol=1e-14)

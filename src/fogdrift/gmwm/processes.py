@@ -160,6 +160,88 @@ def _ar1_series(m, beta):
 
 
 # ----------------------------------------------------------------------------------------
+# Compiled WV and Jacobian of a composite model (the optimiser's inner loop)
+# ----------------------------------------------------------------------------------------
+# least_squares evaluates the model WV and its Jacobian a few hundred thousand times per
+# ``fogdrift noise`` run on ~20 scales each: the NumPy path spends almost all of that in
+# per-call overhead (one ufunc per operation, one lambda per component).  The kernel below
+# evaluates every component at every scale, and the Jacobian, in one compiled call, with the
+# same operations in the same order as :func:`ar1_wv` and the registry's ``wv`` (so the same
+# values: tested against them).
+_CODE = {"QN": 0, "WN": 1, "RW": 2, "DR": 3, "FLICKER": 4, "GM": 5}
+_JAC_H = 1e-3  # central-difference step in log beta (see LatentModel.wv_jacobian)
+_EXP_H, _EXP_MH = math.exp(_JAC_H), math.exp(-_JAC_H)
+
+
+def _ar1_unit_py(b, m, v):
+    """AR(1) Haar WV per unit innovation variance at one half-width ``m`` (as :func:`ar1_wv`), given
+    ``v = -expm1(-m b)`` (computed by NumPy, as in :func:`ar1_wv`: its vectorised ``expm1`` may differ from
+    libm's in the last bit, and the values are to be the same)."""
+    mb = m * b
+    if mb < 1e-3:
+        return ((2.0 * m * m + 1.0) / (12.0 * m)
+                - b * (3.0 * math.pow(m, 3.0) - 4.0 * m * m - 2.0) / (24.0 * m)
+                + b * b * (m - 1.0) * (7.0 * math.pow(m, 3.0) - 8.0 * m * m - 3.0 * m - 3.0) / (120.0 * m))
+    u = -math.expm1(-b)
+    return (m * u * (2.0 - u) - (1.0 - u) * v * (2.0 + v)) / (2.0 * m * m * math.pow(u, 3.0) * (2.0 - u))
+
+
+def _wv_kernel_py(codes, starts, theta, t, flick, vv, dr_p2, comps, total, jac, eh, emh, want_jac, h):
+    """Fill ``comps`` (n_comp, n_tau), ``total`` (n_tau) and, if ``want_jac``, ``jac`` (n_tau, n_params)."""
+    n_tau = t.shape[0]
+    g = 0  # GM counter: rows of vv (3 per GM with the Jacobian: beta, beta e^h, beta e^-h)
+    for c in range(codes.shape[0]):
+        code = codes[c]
+        i = starts[c]
+        p = theta[i]
+        for k in range(n_tau):
+            tk = t[k]
+            if code == 0:
+                val = 6.0 * p / (tk * tk)
+            elif code == 1:
+                val = p / tk
+            elif code == 2:
+                val = p * (tk * tk + 2.0) / (12.0 * tk)
+            elif code == 3:
+                val = dr_p2 * (tk * tk) / 16.0  # dr_p2 = omega ** 2 by libm pow, as the registry
+            elif code == 4:
+                val = p * flick[k]
+            else:
+                m = tk / 2.0
+                s2 = theta[i + 1]
+                r = 3 * g if want_jac else g
+                val = s2 * _ar1_unit(p, m, vv[r, k])
+                if want_jac:
+                    up = s2 * _ar1_unit(p * eh, m, vv[r + 1, k])
+                    dn = s2 * _ar1_unit(p * emh, m, vv[r + 2, k])
+                    jac[k, i] = (up - dn) / (2.0 * h)
+                    jac[k, i + 1] = val
+            comps[c, k] = val
+            if c == 0:
+                total[k] = val
+            else:
+                total[k] = total[k] + val
+            if want_jac and code != 5:
+                jac[k, i] = 2.0 * val if code == 3 else val
+        if code == 5:
+            g += 1
+
+
+_WV_KERNEL = []
+
+
+def _wv_kernel():
+    """The compiled kernel (numba, cached on disk), compiled on first use."""
+    if not _WV_KERNEL:
+        import numba
+
+        unit = numba.njit(cache=True, error_model="numpy")(_ar1_unit_py)
+        globals()["_ar1_unit"] = unit
+        _WV_KERNEL.append(numba.njit(cache=True, error_model="numpy")(_wv_kernel_py))
+    return _WV_KERNEL[0]
+
+
+# ----------------------------------------------------------------------------------------
 # Flicker (1/f) WV factor
 # ----------------------------------------------------------------------------------------
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
@@ -412,6 +494,12 @@ class LatentModel:
         self.param_names = tuple(names)
         self.slices = tuple(slices)
         self.n_params = i
+        self._codes = np.array([_CODE[k] for k in comps], dtype=np.int64)
+        self._starts = np.array([sl.start for sl in slices], dtype=np.int64)
+        self._has_flicker = "FLICKER" in comps
+        self._dr = slices[comps.index("DR")].start if "DR" in comps else -1
+        self._gm_beta = np.array([sl.start for k, sl in zip(comps, slices) if k == "GM"], dtype=np.int64)
+        self._flick = {}
 
     def __repr__(self) -> str:
         return f"LatentModel({self.name!r})"
@@ -432,15 +520,46 @@ class LatentModel:
             raise ConfigError(f"{self.name} has {self.n_params} parameters {self.param_names}; got shape {th.shape}")
         return th
 
-    def wv_components(self, theta, tau) -> np.ndarray:
-        """WV of each component, shape ``(n_components, n_tau)`` in rate^2."""
+    def _compiled(self, theta, tau, want_jac):
+        """Components, total and (if ``want_jac``) Jacobian in one compiled call (see :func:`_wv_kernel`)."""
         th = self._theta(theta)
         t = np.asarray(tau, dtype=np.float64)
-        return np.array([PROCESSES[k].wv(th[s], t) for k, s in zip(self.components, self.slices)])
+        shape = t.shape
+        t = np.ascontiguousarray(t.ravel())
+        if self._has_flicker:
+            key = t.tobytes()
+            flick = self._flick.get(key)
+            if flick is None:
+                flick = np.ascontiguousarray(flicker_wv_factor(t), dtype=np.float64)
+                if len(self._flick) > 64:
+                    self._flick.clear()
+                self._flick[key] = flick
+        else:
+            flick = t
+        if self.n_gm:
+            beta = th[self._gm_beta]
+            if want_jac:
+                beta = np.stack([beta, beta * _EXP_H, beta * _EXP_MH], axis=1).ravel()
+            with np.errstate(over="ignore", invalid="ignore"):
+                vv = -np.expm1(-np.multiply.outer(beta, t / 2.0))
+        else:
+            vv = np.empty((0, 0))
+        dr_p2 = float(th[self._dr]) ** 2 if self._dr >= 0 else 0.0
+        n = t.size
+        comps = np.empty((len(self.components), n))
+        total = np.empty(n)
+        jac = np.empty((n, self.n_params)) if want_jac else np.empty((0, 0))
+        _wv_kernel()(self._codes, self._starts, np.ascontiguousarray(th), t, flick, vv, dr_p2, comps, total, jac,
+                     _EXP_H, _EXP_MH, want_jac, _JAC_H)
+        return comps.reshape((comps.shape[0],) + shape), total.reshape(shape), jac
+
+    def wv_components(self, theta, tau) -> np.ndarray:
+        """WV of each component, shape ``(n_components, n_tau)`` in rate^2."""
+        return self._compiled(theta, tau, False)[0]
 
     def wv(self, theta, tau) -> np.ndarray:
         """Theoretical Haar WV ``sum_k nu2_k(tau; theta_k)`` in rate^2 at scales ``tau`` (samples)."""
-        return self.wv_components(theta, tau).sum(axis=0)
+        return self._compiled(theta, tau, False)[1]
 
     def wv_jacobian(self, theta, tau) -> np.ndarray:
         """``d nu2(tau) / d log theta``, shape ``(n_tau, n_params)``.
@@ -450,10 +569,13 @@ class LatentModel:
         difference in ``log beta`` with step 1e-3 (truncation error about 1e-7; where
         ``m beta`` is small the WV hardly depends on ``beta`` and the column's relative
         error can reach about 1e-4, which only affects the optimiser's path and the SEs at that
-        level).
+        level).  For 1-D ``tau`` the values come from one compiled call (:func:`_wv_kernel`), equal to
+        this NumPy composition (tested).
         """
-        th = self._theta(theta)
         t = np.asarray(tau, dtype=np.float64)
+        if t.ndim == 1:
+            return self._compiled(theta, t, True)[2]
+        th = self._theta(theta)
         cols = []
         for key, sl in zip(self.components, self.slices):
             p = th[sl]
