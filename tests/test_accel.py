@@ -217,3 +217,17 @@ def test_gmwm_reading_restated_for_an_accelerometer():
     assert express_gmwm(gyro, "angular_rate") is gyro
     b = [r for r in accel_rows(ieee_rows(acc)) if r[0] == "B"][0]
     assert b[4] == "µg"
+
+
+def test_allan_outputs_of_an_accelerometer_say_m_s2(tmp_path):
+    from fogdrift.pipeline import AnalysisConfig, run_allan
+    from fogdrift.report import write_allan_outputs
+
+    y = 0.01 * np.random.default_rng(2).standard_normal((4096, 2))
+    acc = from_array(y, dt_s=0.01, unit="m/s^2", axis_names=["ax", "ay"])
+    write_allan_outputs(run_allan(acc, AnalysisConfig(terms=["N"]).validate()), acc, tmp_path)
+    head = (tmp_path / "allan.csv").read_text().splitlines()[0]
+    assert head.startswith("axis,tau_s,m,adev_mps2,avar_m2ps4,") and "dph" not in head
+    gyro = from_array(y, dt_s=0.01, unit="deg/h", axis_names=["gx", "gy"])
+    write_allan_outputs(run_allan(gyro, AnalysisConfig(terms=["N"]).validate()), gyro, tmp_path)
+    assert (tmp_path / "allan.csv").read_text().splitlines()[0].startswith("axis,tau_s,m,adev_dph,avar_dph2,")

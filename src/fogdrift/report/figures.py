@@ -165,7 +165,8 @@ def plot_allan(axes_list, path, title=None) -> Path:
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("τ [s]")
-        ax.set_ylabel(f"{label} σ(τ) [deg/h]")
+        unit = "m/s²" if getattr(fit, "quantity", "angular_rate") == "specific_force" else "deg/h"
+        ax.set_ylabel(f"{label} σ(τ) [{unit}]")
         ax.set_title(literal(f"{title or label}: {aa.name}   χ²_red {fit.chi2_red:.3g}, p = {fit.p_value:.2g} "
                      f"({'no model fits' if no_fit else fit.quality})"))
         ax.grid(True, which="both", alpha=0.3)

@@ -64,9 +64,19 @@ def write_allan_outputs(allan_axes, record, out_dir) -> dict:
                          repr(float(r.dev_lo95_dph[i])), repr(float(r.dev_hi95_dph[i]))])
     dev = {"adev": "adev", "hdev": "hdev", "mdev": "mdev"}.get(getattr(allan_axes[0].allan, "statistic", "adev"), "dev")
     var = {"adev": "avar", "hdev": "hvar", "mdev": "mvar"}.get(dev, "var")
+    quantities = set(getattr(record, "quantities", ("angular_rate",)))
+    if quantities == {"angular_rate"}:
+        u, u2 = "dph", "dph2"
+    elif quantities == {"specific_force"}:  # accelerometer axes: the curve is in m/s^2 (the internal unit)
+        u, u2 = "mps2", "m2ps4"
+    else:  # gyro and accelerometer axes: each row says its unit
+        u, u2 = "internal", "internal2"
+        units = {n: ("deg/h" if q == "angular_rate" else "m/s^2") for n, q in zip(record.axis_names, record.quantities)}
+        rows = [row + [units[row[0]]] for row in rows]
     _write_rows_csv(out / "allan.csv",
-                    ["axis", "tau_s", "m", f"{dev}_dph", f"{var}_dph2", "n_terms", "edf", f"{dev}_lo68_dph",
-                     f"{dev}_hi68_dph", f"{dev}_lo95_dph", f"{dev}_hi95_dph"], rows)
+                    ["axis", "tau_s", "m", f"{dev}_{u}", f"{var}_{u2}", "n_terms", "edf", f"{dev}_lo68_{u}",
+                     f"{dev}_hi68_{u}", f"{dev}_lo95_{u}", f"{dev}_hi95_{u}"] + (["unit"] if u == "internal" else []),
+                    rows)
     plot_allan(allan_axes, out / "allan.png")
     return {"json": out / "allan.json", "csv": out / "allan.csv", "png": out / "allan.png"}
 
