@@ -303,3 +303,54 @@ def test_overflowing_time_response_warns():
     with pytest.warns(FogdriftWarning, match="overflows"):
         out = gm11_predict(fit, 3000)
     assert np.isfinite(out[:100]).all() and np.isinf(out[-1])
+
+
+def _free_run_reference(model, hist, h):
+    """Rolling free run written out step by step: each next value is GM(1,1) fitted by gm11_fit (least squares
+    with lstsq, an estimator independent of the batched kernel) on the last ``window`` values, then fed back."""
+    w = model.window
+    buf = list(np.asarray(hist[-w:], dtype=np.float64) + model.shift_)
+    out = []
+    for _ in range(h):
+        fit = gm11_fit(np.array(buf[-w:]))
+        nxt = float(gm11_predict(fit, w + 1)[-1])
+        out.append(nxt)
+        buf.append(nxt)
+    return np.array(out) - model.shift_
+
+
+@pytest.mark.parametrize("window", [4, 8, 13])
+def test_forecast_many_equals_forecast_per_origin(window):
+    """Issue 25: the heading evaluation's rolling origins in one call; every row equals the per-origin forecast
+    (same operations per row) and an independent step-by-step lstsq free run."""
+    rng = np.random.default_rng(25)
+    y = 3.0 + np.cumsum(rng.normal(0, 0.02, 900)) + rng.normal(0, 0.05, 900)
+    model = GM11(mode="rolling", window=window).fit(y[:400])
+    origins = np.arange(100, 880, 61)
+    hists = np.array([y[t - 100:t] for t in origins])
+    many = model.forecast_many(25, hists)
+    assert many.shape == (origins.size, 25)
+    for row, hist in zip(many, hists):
+        assert_allclose(row, model.forecast(25, history=hist), rtol=1e-12, atol=0)
+        assert_allclose(row[:5], _free_run_reference(model, hist, 5), rtol=1e-8)
+    # shifted windows: a row-offset bug (window taken one sample late) would show against the reference
+    assert_allclose(model.forecast_many(1, hists)[:, 0], [_free_run_reference(model, h_, 1)[0] for h_ in hists],
+                    rtol=1e-8)
+    assert model.forecast_many(0, hists).shape == (origins.size, 0)
+
+
+def test_forecast_many_whole_mode_and_bad_input():
+    rng = np.random.default_rng(5)
+    y = 2.0 + np.cumsum(rng.normal(0, 0.05, 60))
+    whole = GM11(mode="whole").fit(y)
+    hists = np.stack([y[:40], y[10:50]])
+    assert_allclose(whole.forecast_many(4, hists), np.tile(whole.forecast(4, history=y[:40]), (2, 1)), rtol=1e-12)
+    rolling = GM11(mode="rolling", window=6).fit(y)
+    with pytest.raises(InsufficientDataError):
+        rolling.forecast_many(2, y[None, :5])
+    with pytest.raises(DataFormatError):
+        rolling.forecast_many(2, y[:10])
+    with pytest.raises(DataFormatError):
+        rolling.forecast_many(2, np.full((2, 8), np.nan))
+    with pytest.raises(NotFittedError):
+        GM11().forecast_many(2, hists)

@@ -725,13 +725,51 @@ class GM11(DriftModel):
                     got=int(hist.size),
                 )
             buf = hist[-w:].copy()
-        buf = buf + self.shift_
-        out = np.empty(h)
+        return self._free_run(buf[None, :], h)[0]
+
+    def forecast_many(self, h: int, histories):
+        """Free-run forecasts of ``h`` samples after each row of ``histories`` [deg/h], all origins at once.
+
+        Row ``i`` of the result equals ``forecast(h, history=histories[i])`` (same operations on each row, so the
+        same values: tested), but each forecast step is one NumPy call over every origin instead of one per
+        origin: the heading evaluation's rolling origins in one call (issue 25).
+
+        Parameters
+        ----------
+        h : int
+            Forecast length [samples].
+        histories : array_like, shape (n_origins, n_hist)
+            One history per row [deg/h, unshifted], ``n_hist >= window`` in rolling mode; in whole mode only
+            its length matters (as in :meth:`forecast`).
+
+        Returns
+        -------
+        ndarray, shape (n_origins, h)
+        """
+        self._check_fitted()
+        h = _check_count(h, "h")
+        hist = np.asarray(histories, dtype=np.float64)
+        if hist.ndim != 2 or not np.all(np.isfinite(hist)):
+            raise DataFormatError(f"histories must be a finite 2-D array (origins x samples); got shape {hist.shape}")
+        if self.mode == "whole":
+            return np.tile(self._whole_at(hist.shape[1], h), (hist.shape[0], 1))
+        w = int(self.window)
+        if hist.shape[1] < w:
+            raise InsufficientDataError(
+                f"GM11 forecast needs a history of at least window={w} samples; got {hist.shape[1]}",
+                needed=w,
+                got=int(hist.shape[1]),
+            )
+        return self._free_run(hist[:, -w:], h)
+
+    def _free_run(self, last, h: int) -> np.ndarray:
+        """Rolling free run from the windows ``last`` (rows, unshifted): each forecast is fed back."""
+        w = last.shape[1]
+        buf = np.empty((last.shape[0], w + h))
+        buf[:, :w] = last + self.shift_
         for i in range(h):
-            nxt = float(_gm11_next_batch(buf[None, :])[0])
-            out[i] = nxt
-            buf = np.append(buf[1:], nxt)
-        return out - self.shift_
+            buf[:, w + i] = _gm11_next_batch(buf[:, i:i + w])
+        return buf[:, w:] - self.shift_
 
     # -- persistence ----------------------------------------------------------------------------
     def _get_state(self):
