@@ -8,6 +8,7 @@ from ._app import (EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, StatisticOp
                    check_plausible, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck,
                    progress, run, with_load_options)
 from ._tables import noise_table, print_noise_notes, relabel_note
+from .noise import SpecOpt
 
 DEFAULT_OUT = Path("out/allan")
 
@@ -24,6 +25,7 @@ def allan(
     fit_taus: FitTausOpt = ":",
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
+    spec: SpecOpt = None,
 ):
     """Allan variance and IEEE-952 noise coefficients Q, N, B, K, R of every axis: the terms are selected from
     the data, with 95 % intervals, the fit's chi-squared and p-value, and what was left out and why."""
@@ -36,6 +38,11 @@ def allan(
         precheck(estimator=estimator, terms=term_list)
         cfg = AnalysisConfig(taus=parse_taus(taus), estimator=estimator, fit_tau_s=parse_fit_taus(fit_taus),
                              terms=term_list, statistic=statistic, outliers=outliers).validate()
+        limits = None
+        if spec is not None:  # read before the work: a bad spec file is one line, nothing computed
+            from ..spec import read_spec
+
+            limits = read_spec(spec)
         record = load.load()
         echo_record(load, record)
         check_plausible(record)
@@ -61,6 +68,10 @@ def allan(
             from ..temperature import summary_line
 
             console.print("  " + summary_line(temp), highlight=False)
+        if limits is not None:
+            from .noise import print_spec_for_allan
+
+            print_spec_for_allan(limits, results, record, r.out.path, spec.name)
         files = write_allan_outputs(results, record, r.out.path)
         r.wrote()
         r.print_json(files["json"])
