@@ -55,3 +55,18 @@ def test_batch_with_a_rate_unit_refuses_the_accelerometer_file(folder, tmp_path)
     assert [r["file"] for r in bad] == ["imu_accel.csv"]
     assert "channel 'ax' is named as a specific-force (accelerometer) channel" in bad[0]["error"]
     assert res.n_ok == 1
+
+
+def test_split_by_quantity_moves_and_converts_by_hand():
+    from fogdrift.fleet.tasks import split_by_quantity
+    from fogdrift.io import from_array
+
+    rec = from_array(np.zeros((10, 2)), dt_s=0.01, unit="g",
+                     axis_names=["ax", "ay"])
+    rows = [{"axis": "ax", "N_dprh": 0.2, "N_lo95_dprh": 0.1, "N_hi95_dprh": 0.3, "B_dph": 1e-3, "b_min_dph": 2e-3}]
+    (r,) = split_by_quantity(rec, rows)
+    assert r["quantity"] == "specific_force" and "N_dprh" not in r and r["N_mps_rh"] == 0.2 and r["N_hi95_mps_rh"] == 0.3
+    assert r["B_ug"] == 1e-3 and r["b_min_ug"] == 2e-3          # an Allan row is in ug already
+    (r,) = split_by_quantity(rec, rows, b_in_mps2=True)          # a GMWM row: m/s^2 -> ug, 1 ug = 9.80665e-6 m/s^2
+    assert r["B_ug"] == pytest.approx(101.97162, rel=1e-6) and r["b_min_ug"] == pytest.approx(203.94324, rel=1e-6)
+    assert r["N_mps_rh"] == 0.2
