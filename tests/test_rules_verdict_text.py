@@ -336,3 +336,55 @@ def test_independent_origins_of_no_origins_and_table_cells_with_more_digits():
     # a row without a kind is not a practical row
     rows = [NS(label="Kalman row", model="Kalman")]
     assert table2_marks(rows, NS(rows=[NS(model="Kalman", flagged_hz=(0.001,))])) == {}
+
+
+def test_judged_horizon_sentence_lists_reductions_by_size_the_unsure_and_the_worse():
+    """One judged horizon (10 independent origins, exactly the minimum), every outcome of judge at once."""
+    rows = [_row("constant bias", 60.0, 1.0, 1.0, n=10), _row("A", 60.0, 0.8, 0.8, 6, 4, n=10),
+            _row("B", 60.0, 0.5, 0.5, 8, 2, n=10), _row("C", 60.0, 0.9, 0.9, 4, 6, n=10),
+            _row("D", 60.0, 1.1, 1.1, 6, 4, n=10), _row("E", 60.0, 1.3, 1.3, 2, 8, n=10),
+            _row("F", 60.0, 1.2, 1.2, 3, 7, n=10), _row("G", 60.0, math.nan, math.nan, 0, 10, n=10),
+            _row("H", 60.0, 1.0, 1.0, 5, 5, n=10)]
+    v = heading_verdict(_heading(rows, (60.0,), step=None, axis="gz"))
+    assert v.kind == "heading" and v.lines[-1] == (
+        "gz, 60 s: reduces the heading error: B by 50 % (better at 8 of 10 non-overlapping origins), A by 20 % (better "
+        "at 6 of 10 non-overlapping origins); C -10 % but better at only 4 of 10 non-overlapping origins; D +10 % but "
+        "worse at only 4 of 10 non-overlapping origins; worse: E (+30 %, worse at 8 of 10 non-overlapping origins), F "
+        "(+20 %, worse at 7 of 10 non-overlapping origins), G diverges.")
+    assert v.data["60.0"]["reduces"] == ["B", "A"] and v.data["60.0"]["worsens"] == ["E", "F", "G"]
+    assert v.data["60.0"]["counts"]["D"] == {"better": 6, "worse": 4, "n_independent": 10,
+                                             "outcome": "not at most origins"}
+    v = heading_verdict(_heading(rows[:4], (60.0,), step=None, axis="gz"), material=0.3)
+    assert v.lines[-1] == "gz, 60 s: reduces the heading error: B by 50 % (better at 8 of 10 non-overlapping origins)."
+    v = heading_verdict(_heading(rows[:2], (60.0,), step=None, axis="gz"), material=0.6)
+    assert v.lines[-1] == ("gz, 60 s: no model reduces the heading error (60 % or more lower RMS and better at most "
+                           "non-overlapping origins).")
+    assert heading_verdict(_heading(rows[:2], (60.0,), step=None), min_origins=11).data["60.0"]["too_few_origins"]
+
+
+def test_rows_without_counts_in_the_per_horizon_sentences_and_table():
+    rows = [NS(model="constant bias", horizon_s=600.0, n_origins=30, rms_deg=8.0, ratio_to_bias=1.0,
+               predicted_sigma_deg=None),
+            NS(model="K", horizon_s=600.0, n_origins=30, rms_deg=4.0, ratio_to_bias=0.5, predicted_sigma_deg=None)]
+    h = _heading(rows, (600.0,), step=60.0, axis="gz")
+    v = heading_verdict(h)
+    assert v.lines == ["gz, 600 s after a 300-s calibration (30 origins): constant bias leaves 8 deg RMS; K 4 deg "
+                       "(-50 %, better at ? of 3 non-overlapping origins (not counted)).",
+                       "gz, 600 s: 30 origin(s), 3 of them with non-overlapping horizons, are too few to judge "
+                       "(need 10; use a longer held-out record)."]
+    assert heading_table(h)[1] == [["constant bias", "8", "1", "30", "–", "–"],
+                                   ["K", "4", "0.5", "30", "?/3", "–"]]
+    nan = NS(horizon_s=60.0, n_origins=12, rms_deg=0.0, ratio_to_bias=None, n_independent=12, better_independent=0,
+             worse_independent=0)
+    assert judge(nan).outcome == "n/a" and judge(nan).counts() == "better at 0 of 12 non-overlapping origins"
+    assert judge(NS(horizon_s=60.0, n_origins=12, rms_deg=0.0)).outcome == "n/a"
+
+
+def test_artefact_sentence_counts_only_gains_below_09_and_missing_gains_as_kept():
+    art = NS(axis="gz", frequencies_hz=[0.001, 0.01], rows=[NS(model="A", gains={0.001: 0.9}, flagged_hz=()),
+                                                             NS(model="B", gains={0.01: 0.89}, flagged_hz=())])
+    v = artefact_verdict(art)
+    assert v.kind == "artefacts" and v.lines == [
+        "gz: B removes > 10 % of injected rate at 0.01 Hz (no Allan improvement claimed there)."]
+    assert v.data == {"A": {"flagged_hz": [], "removes_over_10pct_hz": []},
+                      "B": {"flagged_hz": [], "removes_over_10pct_hz": [0.01]}}
