@@ -189,18 +189,20 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.pipeline": (DEBT("H-signal"), ("fogdrift.allan", "fogdrift.allan.ci", "fogdrift.gmwm.analysis",
         "fogdrift.lifting", "fogdrift.metrics", "fogdrift.models", "fogdrift.noise", "fogdrift.noise.periodic",
         "fogdrift.noise.spectral", "fogdrift.outliers", "fogdrift.units", "fogdrift.io.record",
-        "fogdrift.allan.grid", "fogdrift.models.grey", "fogdrift.noise.terms")),
+        "fogdrift.allan.grid", "fogdrift.models.grey", "fogdrift.noise.terms", "fogdrift._util",
+        "fogdrift.allan._kernels", "fogdrift.allan.chunked", "fogdrift.allan.core", "fogdrift.allan.statistics",
+        "fogdrift.io.chunked")),
     "fogdrift.io.record": (DEBT("H-signal"), ("fogdrift.temperature",)),
     "fogdrift.evaluation.analysis": (DEBT("H-signal") + " (private bundle helpers: H-signal gives a public function)", (
         "fogdrift.bundle",)),
     "fogdrift.plausibility": (DEBT("H-speed"), ("fogdrift.allan",)),
-    "fogdrift.compensate.run": (DEBT("H-compensate") + " (part of the compensate <-> evaluation cycle)", (
+    "fogdrift.compensate.run": (DEBT("H-compensate"), (
         "fogdrift.evaluation.artefacts", "fogdrift.evaluation.heading", "fogdrift.evaluation.verdicts",
         "fogdrift.report.files")),
-    "fogdrift.evaluation.artefacts": (DEBT("unowned") + " (part of the compensate <-> evaluation cycle)", (
-        "fogdrift.allan", "fogdrift.compensate.predictors")),
-    "fogdrift.evaluation.heading": (DEBT("unowned") + " (part of the compensate <-> evaluation cycle)", (
-        "fogdrift.compensate.predictors", "fogdrift.evaluation.verdicts")),
+    "fogdrift.evaluation.artefacts": (DEBT("unowned"), (
+        "fogdrift.allan",)),
+    "fogdrift.evaluation.heading": (DEBT("unowned"), (
+        "fogdrift.evaluation.verdicts",)),
     "fogdrift.export": (DEBT("H-export"), ("fogdrift.export.conversions",)),
     "fogdrift.export.targets": (DEBT("H-export"), ("fogdrift.errors",)),
     "fogdrift.io.readers._columns": (DEBT("H-hostile"), ("fogdrift.io.readers.limits",)),
@@ -221,12 +223,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
 #: Cycles known today -> the plan that removes them.  A key is the set of modules that identifies the cycle: a
 #: found cycle holding all of them is this one (its other members may change while it is worked on).  Keep it
 #: empty; an entry is a debt, and an entry no found cycle matches must be removed.
-KNOWN_CYCLES: dict[frozenset, str] = {
-    frozenset({"fogdrift.compensate", "fogdrift.compensate.run", "fogdrift.evaluation.heading"}):
-        "evaluation.heading/artefacts import compensate.predictors (deferred), which runs compensate/__init__ -> "
-        "compensate.run -> evaluation and report; H-compensate: the predictors move below both packages "
-        "(models.causal_predictor), or compensate/__init__ imports run lazily",
-}
+KNOWN_CYCLES: dict[frozenset, str] = {}
 
 
 def _known(cycle) -> bool:
