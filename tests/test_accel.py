@@ -231,3 +231,16 @@ def test_allan_outputs_of_an_accelerometer_say_m_s2(tmp_path):
     gyro = from_array(y, dt_s=0.01, unit="deg/h", axis_names=["gx", "gy"])
     write_allan_outputs(run_allan(gyro, AnalysisConfig(terms=["N"]).validate()), gyro, tmp_path)
     assert (tmp_path / "allan.csv").read_text().splitlines()[0].startswith("axis,tau_s,m,adev_dph,avar_dph2,")
+
+
+def test_gyro_only_commands_refuse_accelerometer_channels(tmp_path):
+    from fogdrift.cli._app import gyro_only
+    from fogdrift.compensate.sources import open_log
+
+    p = _csv(tmp_path, "a.csv", "t_s,ax,ay,az", [[0.01 * i, *r] for i, r in enumerate(_triad(300))])
+    with pytest.raises(ConfigError, match="compensate applies a gyro drift model; ax, ay, az are accelerometer"):
+        open_log(p, unit="g")
+    with pytest.raises(ConfigError, match="fogdrift analyze models gyro drift and its heading error; ax, ay, az are "
+                                          "accelerometer channels"):
+        gyro_only(load(p, unit="g"), "analyze")
+    gyro_only(from_array(np.zeros((4, 1)), dt_s=0.01, unit="deg/s", axis_names=["gz"]), "analyze")  # a gyro passes

@@ -115,6 +115,16 @@ def _one_declared(units, path) -> str | None:
     return next(iter(declared), None)
 
 
+def _gyro_only(src: LogSource) -> LogSource:
+    """Refuse accelerometer channels (a bundle models gyro drift; docs/accelerometers.md): one line naming them."""
+    acc = [c.name for c in src.signal.channels if c.quantity == "specific_force"]
+    if acc:
+        raise ConfigError(f"{src.path}: compensate applies a gyro drift model; {', '.join(acc)} "
+                          f"{'is an accelerometer channel' if len(acc) == 1 else 'are accelerometer channels'} "
+                          "(specific force, from its unit): leave them out with {opt:columns}")
+    return src
+
+
 def _streamed(path, load_kwargs) -> LogSource:
     src = open_rows(path, columns=load_kwargs.get("columns"), time_column=load_kwargs.get("time_column", "auto"),
                     rate_hz=load_kwargs.get("rate_hz"), time_unit=load_kwargs.get("time_unit"),
@@ -177,8 +187,8 @@ def open_log(path, *, unit=None, columns=None, time_column="auto", rate_hz=None,
         and gaps == "error"
     try:
         if stream:
-            return _streamed(p, {k: kwargs[k] for k in _STREAM_OPTIONS})
-        return _loaded(p, {k: v for k, v in kwargs.items() if v is not None})
+            return _gyro_only(_streamed(p, {k: kwargs[k] for k in _STREAM_OPTIONS}))
+        return _gyro_only(_loaded(p, {k: v for k, v in kwargs.items() if v is not None}))
     except ConfigError as exc:
         if unit is not None or bundle_unit is None or "{opt:unit}" not in str(exc.args[0] if exc.args else ""):
             raise
