@@ -170,7 +170,8 @@ def _ar1_series(m, beta):
 # values: tested against them).
 _CODE = {"QN": 0, "WN": 1, "RW": 2, "DR": 3, "FLICKER": 4, "GM": 5}
 _JAC_H = 1e-3  # central-difference step in log beta (see LatentModel.wv_jacobian)
-_EXP_H, _EXP_MH = math.exp(_JAC_H), math.exp(-_JAC_H)
+_EXP_H, _EXP_MH = math.exp(_JAC_H), math.exp(-_JAC_H)  # numba freezes these module constants into the kernel
+_BETA3 = np.array([1.0, _EXP_H, _EXP_MH])  # beta, beta e^h, beta e^-h (x 1.0 is exact)
 
 
 def _ar1_unit_py(b, m, v):
@@ -186,7 +187,7 @@ def _ar1_unit_py(b, m, v):
     return (m * u * (2.0 - u) - (1.0 - u) * v * (2.0 + v)) / (2.0 * m * m * math.pow(u, 3.0) * (2.0 - u))
 
 
-def _wv_kernel_py(codes, starts, theta, t, flick, vv, dr_p2, comps, total, jac, eh, emh, want_jac, h):
+def _wv_kernel_py(codes, starts, theta, t, flick, vv, dr_p2, comps, total, jac, want_jac):
     """Fill ``comps`` (n_comp, n_tau), ``total`` (n_tau) and, if ``want_jac``, ``jac`` (n_tau, n_params)."""
     n_tau = t.shape[0]
     g = 0  # GM counter: rows of vv (3 per GM with the Jacobian: beta, beta e^h, beta e^-h)
@@ -212,9 +213,9 @@ def _wv_kernel_py(codes, starts, theta, t, flick, vv, dr_p2, comps, total, jac, 
                 r = 3 * g if want_jac else g
                 val = s2 * _ar1_unit(p, m, vv[r, k])
                 if want_jac:
-                    up = s2 * _ar1_unit(p * eh, m, vv[r + 1, k])
-                    dn = s2 * _ar1_unit(p * emh, m, vv[r + 2, k])
-                    jac[k, i] = (up - dn) / (2.0 * h)
+                    up = s2 * _ar1_unit(p * _EXP_H, m, vv[r + 1, k])
+                    dn = s2 * _ar1_unit(p * _EXP_MH, m, vv[r + 2, k])
+                    jac[k, i] = (up - dn) / (2.0 * _JAC_H)
                     jac[k, i + 1] = val
             comps[c, k] = val
             if c == 0:
@@ -539,7 +540,7 @@ class LatentModel:
         if self.n_gm:
             beta = th[self._gm_beta]
             if want_jac:
-                beta = np.stack([beta, beta * _EXP_H, beta * _EXP_MH], axis=1).ravel()
+                beta = np.multiply.outer(beta, _BETA3).ravel()
             with np.errstate(over="ignore", invalid="ignore"):
                 vv = -np.expm1(-np.multiply.outer(beta, t / 2.0))
         else:
@@ -549,8 +550,7 @@ class LatentModel:
         comps = np.empty((len(self.components), n))
         total = np.empty(n)
         jac = np.empty((n, self.n_params)) if want_jac else np.empty((0, 0))
-        _wv_kernel()(self._codes, self._starts, np.ascontiguousarray(th), t, flick, vv, dr_p2, comps, total, jac,
-                     _EXP_H, _EXP_MH, want_jac, _JAC_H)
+        _wv_kernel()(self._codes, self._starts, np.ascontiguousarray(th), t, flick, vv, dr_p2, comps, total, jac, want_jac)
         return comps.reshape((comps.shape[0],) + shape), total.reshape(shape), jac
 
     def wv_components(self, theta, tau) -> np.ndarray:
