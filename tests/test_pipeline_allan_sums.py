@@ -12,7 +12,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from fogdrift import pipeline
+from fogdrift import pipeline, pipeline_sums
 from fogdrift.allan import allan_variance
 from fogdrift.allan.ci import periodic_alpha
 from fogdrift.noise.periodic import null_taus, periodic_content
@@ -126,7 +126,7 @@ def test_long_series_take_the_out_of_core_sums_with_the_same_result(monkeypatch,
     cfg = AnalysisConfig(taus=25, estimator=estimator)
     spectrum = analyse_spectrum(rate, DT)
     ref_res, ref_fit = _reference_curves(rate, DT, cfg, spectrum)
-    monkeypatch.setattr(pipeline, "CHUNKED_MIN_SAMPLES", 100_000)
+    monkeypatch.setattr(pipeline_sums, "CHUNKED_MIN_SAMPLES", 100_000)
 
     def no_phase(y):
         raise AssertionError("the in-memory angle array was built")
@@ -145,3 +145,44 @@ def test_errors_are_those_of_allan_variance():
     with pytest.raises(ConfigError, match="statistic='mdev'"):
         analyse_allan("x", _series(1000, False), DT, AnalysisConfig(statistic="mdev", estimator="fast"),
                       spectrum=None)
+
+
+def test_plausibility_sums_are_handed_on_and_reused(monkeypatch):
+    """check_record(sums=) keeps the noise floor's octave ADEV sums; run_allan reuses them: one angle array per
+    axis for the check and the analysis together, and the same results as without them."""
+    from fogdrift.allan import _kernels
+    from fogdrift.io import from_array
+    from fogdrift.plausibility import check_record
+    from fogdrift.pipeline import run_allan
+
+    rate = np.column_stack([_series(30_000, True), _series(30_000, False, seed=9)])
+    record = from_array(rate, dt_s=DT, unit="deg/h")
+    want = run_allan(record, AnalysisConfig())
+    calls = []
+    real = _kernels.operator_sums
+    monkeypatch.setattr(_kernels, "operator_sums", lambda p, m, *a: calls.append(m.tolist()) or real(p, m, *a))
+    sums = {}
+    check_record(record, sums=sums)
+    assert sorted(sums) == sorted(record.axis_names)
+    octave = [2**k for k in range(13)]           # m <= 30 000 / 4
+    assert calls == [octave, octave]
+    got = run_allan(record, AnalysisConfig(), sums=sums)
+    # the analysis adds only the null taus of the periodic axis (period 0.37 s: 37 samples and multiples), no
+    # octave m again; the aperiodic axis needs no pass at all
+    assert len(calls) == 3 and not set(calls[2]) & set(octave) and 37 in calls[2]
+    for a, b in zip(got, want):
+        _same(a.allan, b.allan)
+        assert a.noise.to_dict() == b.noise.to_dict()
+
+
+def test_sums_of_another_array_are_not_reused():
+    from fogdrift.pipeline_sums import AllanSums
+
+    x = _series(5000, False)
+    s = AllanSums(x, DT)
+    assert s.holds(x, DT, "adev", "overlapping")
+    assert s.holds(x[:], DT, "adev", "overlapping")          # the same memory through another view
+    assert not s.holds(x.copy(), DT, "adev", "overlapping")
+    assert not s.holds(x[:-1], DT, "adev", "overlapping")
+    assert not s.holds(x, 2 * DT, "adev", "overlapping")
+    assert not s.holds(x, DT, "hdev", "overlapping")

@@ -39,6 +39,7 @@ from .interrupt import checkpoint  # a stop point between stages/axes/models; re
 from .io import file_sha256
 from .models import MODEL_NAMES  # registry order = report order
 from .models import build_model as make_model  # make_model(name, cfg, progress=None), old name kept for now
+from .pipeline_sums import CHUNKED_MIN_SAMPLES, AllanSums  # noqa: F401 (re-exported)
 from .pipeline_results import (
     AllanAxis,
     AnalysisAxis,
@@ -314,7 +315,7 @@ def library_versions() -> dict:
 
 
 def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False,
-                  spectrum="auto", outliers=None, quantity="angular_rate") -> AllanAxis:
+                  spectrum="auto", outliers=None, quantity="angular_rate", sums=None) -> AllanAxis:
     """Allan-family variance and noise identification of one 1-D rate series.
 
     The curve is computed on the configured grid (``cfg.taus``) for display; the noise fit always uses an octave
@@ -333,6 +334,11 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
 
     ``outliers``: the OutlierReport of a rate already treated by the caller (stored in the result as if
     ``check_outliers`` had found it); the results are complete when built, nothing is patched afterwards.
+
+    ``sums``: an :class:`~fogdrift.pipeline_sums.AllanSums` another stage already took of this very array (the
+    plausibility check's octave ADEV, :func:`fogdrift.plausibility.check_record`); its sums are reused and only the
+    missing cluster sizes are computed.  Ignored unless it holds the same array (after outlier treatment), interval,
+    statistic and estimator.
     """
     from .allan.ci import periodic_alpha
     from .noise import express_quantity, fit_noise
@@ -350,7 +356,8 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     # Every grid this analysis may need (display, octave, octave + the null taus of the periodic content) is known
     # before the data are touched: one pass of operator sums serves them all, and each result is rebuilt from the
     # sums (result_from_sums, the function allan_variance ends in: identical field by field).
-    sums = _AllanSums(rate_dph, dt_s, cfg)
+    if sums is None or not sums.holds(rate_dph, dt_s, cfg.statistic, cfg.estimator):
+        sums = AllanSums(rate_dph, dt_s, cfg.statistic, cfg.estimator)
     m_disp = sums.grid(cfg.taus)
     m_oct = m_disp if cfg.taus == "octave" else sums.grid("octave")
     taus = m_fit = None
@@ -382,100 +389,6 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     if outliers is not None:  # a new, complete NoiseFit carrying the report (the fit's own object is not edited)
         noise = dataclasses.replace(noise, outliers=outliers.to_dict())
     return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers)
-
-
-#: From this many samples on, the Allan operator sums are taken out of core (:mod:`fogdrift.allan.chunked`, the
-#: same terms added in another order: equal to 1e-12 relative, 7e-15 measured) instead of through a float64 angle array of N + 1 points: 8 N bytes (0.8 GB at 10^8)
-#: against a few windows of :data:`fogdrift.allan.chunked.DEFAULT_CHUNK` samples.
-CHUNKED_MIN_SAMPLES = 1 << 24
-
-
-class _AllanSums:
-    """The operator sums of one rate series [(deg/h)^2 samples^2], computed once for every cluster size an analysis
-    needs, and the :class:`~fogdrift.allan.AllanResult` of any subset of them for any EDF alpha.
-
-    The checks and the order of operations are those of :func:`fogdrift.allan.allan_variance` (same errors, same
-    sums: the compiled kernel sums each m on its own, so the sums do not depend on which m share a pass); the
-    result is built by :func:`fogdrift.allan.core.result_from_sums`, where ``allan_variance`` ends.  Long series
-    (:data:`CHUNKED_MIN_SAMPLES`, overlapping or non-overlapping ADEV) take the out-of-core pass over the array
-    already in memory, which gives the same sums to 1e-12 relative without the 8 N-byte angle array.
-    """
-
-    def __init__(self, rate_dph, dt_s, cfg: AnalysisConfig):
-        from ._util import check_series
-        from .allan.statistics import get_statistic
-        from .units import check_dt_s
-
-        self.stat = get_statistic(cfg.statistic)
-        self.y = np.ascontiguousarray(check_series(rate_dph, "rate_dph"))
-        self.dt = check_dt_s(dt_s)
-        self.stat.check_sampling(cfg.estimator)
-        self.estimator = cfg.estimator
-        self.n = n = self.y.size
-        if n < 2:
-            raise InsufficientDataError(f"an Allan variance needs at least 2 rate samples, got {n}", needed=2, got=n)
-        self.m = np.empty(0, dtype=np.int64)
-        self.sums = np.empty(0)
-
-    def grid(self, taus) -> np.ndarray:
-        """Cluster sizes m of a tau specification (:func:`fogdrift.allan.tau_grid`, default max_fraction)."""
-        from .allan.grid import tau_grid
-
-        return tau_grid(self.n, self.dt, taus, statistic=self.stat.name)
-
-    def strides(self, m: np.ndarray) -> np.ndarray:
-        from .allan.core import _fast_strides
-
-        if self.estimator == "fast":
-            return _fast_strides(m)
-        return m.copy() if self.estimator == "non-overlapping" else np.ones_like(m)
-
-    @property
-    def chunked(self) -> bool:
-        return (self.n >= CHUNKED_MIN_SAMPLES and self.stat.name == "adev"
-                and self.estimator in ("overlapping", "non-overlapping"))
-
-    def compute(self, grids, progress=None) -> None:
-        """The sums at every m of ``grids`` (one pass); ``progress(done, total)`` counts taus."""
-        from .allan import _kernels
-
-        if progress is not None and not callable(progress):
-            raise ConfigError(f"progress must be a callable(done, total) or None, got {progress!r}")
-        m = np.unique(np.concatenate([np.asarray(g, dtype=np.int64) for g in grids]))
-        strides = self.strides(m)
-        sums = np.empty(m.size)
-        if self.chunked:
-            from .allan import chunked
-            from .io.chunked import ChunkSource
-
-            y = self.y
-            source = ChunkSource(path=Path("<memory>"), n_samples=self.n, dt_s=self.dt, name="rate",
-                                 scale_to_dph=1.0, describe="in-memory float64", _read=lambda a, b: y[a:b])
-            chunk = chunked.DEFAULT_CHUNK
-            mu, offsets = chunked._mean_and_offsets(source, chunk, None)
-            sums[:] = chunked._second_difference_sums(chunked._Phase(source, mu, offsets), m, strides, chunk, None)
-            if progress is not None:
-                progress(m.size, m.size)
-        else:
-            p = _kernels.phase_dph_samples(self.y)
-            groups = [np.arange(m.size)] if progress is None else \
-                np.array_split(np.arange(m.size), max(1, -(-m.size // 8)))
-            done = 0
-            for g in groups:
-                sums[g] = _kernels.operator_sums(p, m[g], strides[g], self.stat.coefficients, self.stat.windowed)
-                done += g.size
-                if progress is not None:
-                    progress(done, m.size)
-            del p
-        self.m, self.sums = m, sums
-
-    def result(self, m: np.ndarray, noise_alpha):
-        """The AllanResult at cluster sizes ``m`` (all computed) with ``noise_alpha`` as for ``allan_variance``."""
-        from .allan.core import result_from_sums
-
-        idx = np.searchsorted(self.m, m)
-        return result_from_sums(self.sums[idx], self.n, m, self.strides(m), self.dt, statistic=self.stat.name,
-                                estimator=self.estimator, noise_alpha=noise_alpha)
 
 
 def _treated_record(record, cfg: AnalysisConfig):
@@ -566,18 +479,22 @@ def _check_earth_axes(record, cfg: AnalysisConfig) -> None:
 
 
 def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | None = None, *,
-              own_units: bool = True) -> list[AllanAxis]:
+              own_units: bool = True, sums: dict | None = None) -> list[AllanAxis]:
     """Allan variance and noise identification of every axis of a record at its native rate.
 
     ``own_units`` (default True): each axis's fit in its quantity's term table (an accelerometer's velocity random
     walk in m/s/sqrt(h), B in ug, :func:`fogdrift.noise.quantity.express`); False keeps every fit in the gyro
-    table's units of the internal unit (for a comparison with a reading made the same way, the GMWM's)."""
+    table's units of the internal unit (for a comparison with a reading made the same way, the GMWM's).
+
+    ``sums``: axis name -> :class:`~fogdrift.pipeline_sums.AllanSums` already taken of that axis (the plausibility
+    check's, :func:`fogdrift.plausibility.check_record` ``sums=``), reused where they hold the analysed array."""
     cfg = (cfg or AnalysisConfig()).validate()
     out = []
     for name in record.axis_names:
         checkpoint("Allan variance", axis=name)
         out.append(analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True,
-                                 quantity=record.signal.channel(name).quantity if own_units else "angular_rate"))
+                                 quantity=record.signal.channel(name).quantity if own_units else "angular_rate",
+                                 sums=(sums or {}).get(name)))
     return out
 
 

@@ -159,12 +159,15 @@ class Finding:
         return render_options(self.message, flags)
 
 
-def noise_floor(rate_dph, dt_s) -> NoiseFloor:
+def noise_floor(rate_dph, dt_s, *, keep: list | None = None) -> NoiseFloor:
     """White-noise floor ``min over tau of sigma(tau) sqrt(tau_s) / 60`` [deg/sqrt(h)] of one rate series.
 
     Uses the overlapping Allan deviation on the octave grid of :func:`fogdrift.allan.allan_variance`, the taus
     up to 1/:data:`MIN_CLUSTERS` of the record, and at most :data:`MAX_CHECK_SAMPLES` samples.
     ``lo68``/``hi68`` take the same minimum over the 68 % bounds.
+
+    ``keep``: a list to which the :class:`~fogdrift.pipeline_sums.AllanSums` behind the floor is appended when
+    it covers the whole series (at most :data:`MAX_CHECK_SAMPLES` samples), for the Allan analysis to reuse.
 
     Examples
     --------
@@ -175,12 +178,20 @@ def noise_floor(rate_dph, dt_s) -> NoiseFloor:
     >>> round(noise_floor(x, 0.01).estimate, 1)
     0.5
     """
-    from .allan import allan_variance
+    from .pipeline_sums import AllanSums
 
-    x = np.asarray(rate_dph, dtype=np.float64)[:MAX_CHECK_SAMPLES]
+    whole = np.asarray(rate_dph, dtype=np.float64)
+    x = whole[:MAX_CHECK_SAMPLES]
     if x.size < 8:
         return NoiseFloor(math.nan, math.nan, math.nan)
-    res = allan_variance(x, dt_s, taus="octave", estimator="overlapping")
+    # the octave overlapping ADEV (allan_variance's result, field by field), through sums the analysis can reuse
+    sums = AllanSums(x, dt_s, "adev", "overlapping")
+    octave = sums.grid("octave")
+    sums.compute((octave,))
+    res = sums.result(octave, "auto")
+    if keep is not None and x.size == whole.size:
+        sums.source = rate_dph
+        keep.append(sums)
     keep = x.size / np.asarray(res.m, dtype=np.float64) >= MIN_CLUSTERS
     if not keep.any():
         keep = np.ones(np.asarray(res.m).shape, dtype=bool)
@@ -236,8 +247,12 @@ def _violations(floors, peaks, means, factor: float = 1.0) -> set:
     return broken
 
 
-def check_record(record) -> list[Finding]:
+def check_record(record, *, sums: dict | None = None) -> list[Finding]:
     """Findings for a :class:`~fogdrift.io.GyroRecord` that no gyro would produce (see the module docstring).
+
+    ``sums``: a dict that receives, per gyro axis checked on its whole series, the Allan operator sums of its
+    noise floor (:class:`~fogdrift.pipeline_sums.AllanSums`), for :func:`fogdrift.pipeline.run_allan` (``sums=``)
+    to reuse instead of computing the octave ADEV again.
 
     Returns
     -------
@@ -259,14 +274,19 @@ def check_record(record) -> list[Finding]:
     if "specific_force" in quantities:  # the gyro rules for the gyro channels, the accelerometer rules for the rest
         gyro = [n for n, q in zip(record.axis_names, quantities) if q == "angular_rate"]
         accel = [n for n, q in zip(record.axis_names, quantities) if q == "specific_force"]
-        findings = [f for f in check_record(record.select(gyro)) if f.rule != "sample-rate"] if gyro else []
+        findings = [f for f in check_record(record.select(gyro), sums=sums) if f.rule != "sample-rate"] if gyro else []
         return findings + accel_findings(record.select(accel)) + _rate_findings(record)
-    return _gyro_findings(record) + gravity_like_findings(record) + _rate_findings(record)
+    return _gyro_findings(record, sums) + gravity_like_findings(record) + _rate_findings(record)
 
 
-def _gyro_findings(record) -> list[Finding]:
+def _gyro_findings(record, sums: dict | None = None) -> list[Finding]:
     names = tuple(record.axis_names)
-    floors = [noise_floor(record.axis(n), record.dt_s) for n in names]
+    floors = []
+    for n in names:
+        keep = []
+        floors.append(noise_floor(record.axis(n), record.dt_s, keep=keep))
+        if sums is not None and keep:
+            sums[n] = keep[0]
     rates = [np.asarray(record.axis(n), dtype=np.float64) for n in names]
     peaks = [float(max(r.max(), -r.min())) if r.size else 0.0 for r in rates]  # max |rate|, no |r| copy
     means = [float(np.mean(r)) if r.size else 0.0 for r in rates]

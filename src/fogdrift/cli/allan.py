@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._app import (EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, StatisticOpt, TausOpt, TermsOpt, app,
-                   check_plausible, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck,
-                   progress, run, with_load_options)
+from ._app import (FLAGS, EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, StatisticOpt, TausOpt, TermsOpt, app,
+                   console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, progress, run, warn,
+                   with_load_options)
 from ._tables import noise_table, print_noise_notes, relabel_note
 from .noise import SpecOpt
 
@@ -45,9 +45,16 @@ def allan(
             limits = read_spec(spec)
         record = load.load()
         echo_record(load, record)
-        check_plausible(record)
+        # the plausibility check (as _app.check_plausible) keeps the octave ADEV sums of its noise floors: the
+        # Allan analysis reuses them instead of computing that pass again
+        from ..plausibility import check_record
+
+        sums = {}
+        for finding in check_record(record, sums=sums):
+            warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
         with progress("allan", record.axis_names) as (allan_cb, _):
-            results = run_allan(record, cfg, progress=allan_cb)
+            results = run_allan(record, cfg, progress=allan_cb, sums=sums)
+        del sums
         name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}[statistic]
         by_quantity = {}
         for a in results:  # one table per quantity: gyro terms, then accelerometer terms (their own units)
