@@ -210,3 +210,30 @@ def test_artefact_result_to_dict_turns_non_finite_values_into_null():
     assert res.row("m") is r and ArtefactRow("k", {}, {}, 0.25, {}, ()).to_dict()["ramp_survival"] == 0.25
     with pytest.raises(KeyError):
         res.row("other")
+
+
+def test_step_survival_of_persistence_is_its_analytic_step_response():
+    """Persistence of the causal drift (window W = 128, dt = 1 s): d samples after a step the compensated output
+    keeps 1 - sum_{i >= W - d} g_i of it (g the causal-drift weights); the check averages that over +-w samples,
+    w = max(1, round(0.05 d / dt)).  At 2, 4 and 30 s the step is partly absorbed (survival not 0 or 1), so a survival
+    scaled by A (or A^2), a wrong averaging window or a wrong delay is visible; the delays that do not fit after the
+    step are dropped, and the result lists its frequencies, delays and notes.
+    Catches: survival x A instead of / A, window 0.05 / d, delays kept beyond the block, dropped notes/frequencies."""
+    W, n = 128, 6000
+    z = np.random.default_rng(3).normal(0.0, 5.0, n)
+    res = artefact_check(z, 1.0, {"persistence": Persistence().fit([0.0])}, causal_window=W, frequencies_hz=[0.01],
+                         step_delays_s=(2.0, 4.0, 30.0, 1000.0, 5000.0))
+    g = causal_drift(np.eye(W), W, "db2", level=4, mode="symmetric")[-1]
+
+    def surv(d):
+        return 1.0 if d <= 0 else 1.0 - float(np.sum(g[max(W - d, 0):]))
+
+    for delay in (2.0, 4.0, 30.0):
+        d, w = int(delay), max(1, int(round(0.05 * delay)))
+        want = np.mean([surv(k) for k in range(max(0, d - w), d + w + 1)])
+        assert 0.02 < abs(want) < 0.95  # measured: 0.70, 0.46 and -0.078 (an overshoot; w = 2 at 30 s)
+        assert_allclose(res.row("persistence").step_survival[delay], want, rtol=1e-9, atol=1e-12)
+    k_step = W + (n - W) // 4  # 1596: 5000 s after it is beyond the block
+    assert res.step_delays_s == (2.0, 4.0, 30.0, 1000.0) and k_step + 1000 < n <= k_step + 5000
+    assert res.frequencies_hz == [0.01] and res.notes[0].startswith("amplitude ")
+    assert res.row("constant bias").step_survival == {2.0: 1.0, 4.0: 1.0, 30.0: 1.0, 1000.0: 1.0}
