@@ -186,3 +186,31 @@ def test_sums_of_another_array_are_not_reused():
     assert not s.holds(x[:-1], DT, "adev", "overlapping")
     assert not s.holds(x, 2 * DT, "adev", "overlapping")
     assert not s.holds(x, DT, "hdev", "overlapping")
+
+
+def test_run_analysis_reuses_the_sums_for_the_native_rate_row(monkeypatch):
+    """run_analysis(sums=) hands each axis' sums to its native-rate analysis only (the other rows are other
+    series); the result is the same as without them."""
+    from fogdrift.io import from_array
+    from fogdrift.plausibility import check_record
+    from fogdrift.pipeline import run_analysis
+
+    record = from_array(_series(3000, False, seed=4), dt_s=1.0, unit="deg/h")
+    cfg = AnalysisConfig(models=("ar",), level=2, causal_window_s=64.0)
+    want = run_analysis(record, cfg)
+    sums = {}
+    check_record(record, sums=sums)
+    seen = []
+    real = pipeline.analyse_allan
+
+    def spy(*a, **k):
+        seen.append(k.get("sums"))
+        return real(*a, **k)
+
+    monkeypatch.setattr(pipeline, "analyse_allan", spy)
+    got = run_analysis(record, cfg, sums=sums)
+    assert seen[0] is sums[record.axis_names[0]] and all(s is None for s in seen[1:])
+    x = np.asarray(record.axis(record.axis_names[0]), dtype=np.float64)
+    assert sums[record.axis_names[0]].holds(x, 1.0, "adev", "overlapping")   # reused, not recomputed
+    _same(got.axes[0].original.allan, want.axes[0].original.allan)
+    assert got.axes[0].original.noise.to_dict() == want.axes[0].original.noise.to_dict()

@@ -670,14 +670,17 @@ def _table2(ma: ModelAxis, cfg: AnalysisConfig) -> list[CompensatedSignal]:
 
 def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | None = None, sha256: str | None = None,
                  apply_to=None, progress=None, fitted_from: "AnalysisResult | list | None" = None,
-                 factor: int | None = None, apply_to_factor: int | None = None) -> AnalysisResult:
+                 factor: int | None = None, apply_to_factor: int | None = None,
+                 sums: dict | None = None) -> AnalysisResult:
     """The whole method on one record (see the module docstring); ``apply_to`` is a second GyroRecord.
 
     ``progress(epoch, n_epochs, train_loss, val_loss)`` is passed to the neural models.
     With ``fitted_from`` (used for ``apply_to``), no model is fitted: the models of that analysis are applied
     unchanged to the axes of the same name.  ``factor`` / ``apply_to_factor``: the block-average factors to
     the modelling rate of ``record`` / ``apply_to`` when already decided (:func:`model_factor`); decided here
-    otherwise, once.
+    otherwise, once.  ``sums``: axis name -> :class:`~fogdrift.pipeline_sums.AllanSums` of ``record``'s axes
+    already taken (the plausibility check's, :func:`fogdrift.plausibility.check_record` ``sums=``), reused by the
+    native-rate Allan analysis where they hold the analysed array (not after outliers were clipped or replaced).
     """
     t_start = time.perf_counter()
     cfg = (cfg or AnalysisConfig()).validate()
@@ -689,7 +692,7 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
     for name in record.axis_names:
         checkpoint("Allan variance (native rate)", axis=name)
         original = analyse_allan(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s, cfg,
-                                 outliers=outlier_reports[name])
+                                 outliers=outlier_reports[name], sums=(sums or {}).get(name))
         gmwm = None
         if cfg.noise_method == "gmwm":
             from .gmwm.analysis import analyse_gmwm
