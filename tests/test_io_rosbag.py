@@ -25,7 +25,7 @@ RAD = 180.0 / math.pi * 3600.0
 T0_NS = 1_700_000_000_123_456_789
 
 
-def _imu(ts, i, w, stamp_ns, frame="imu_link"):
+def _imu(ts, i, w, stamp_ns, frame="imu_link", a=(0.0, 0.0, 9.81)):
     T = ts.types
     stamp = T["builtin_interfaces/msg/Time"](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
     kw = {"stamp": stamp, "frame_id": frame}
@@ -35,8 +35,8 @@ def _imu(ts, i, w, stamp_ns, frame="imu_link"):
     return T["sensor_msgs/msg/Imu"](
         header=T["std_msgs/msg/Header"](**kw), orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
         orientation_covariance=np.zeros(9), angular_velocity=V(x=w[0], y=w[1], z=w[2]),
-        angular_velocity_covariance=np.full(9, 0.5), linear_acceleration=V(x=0.0, y=0.0, z=9.81),
-        linear_acceleration_covariance=np.zeros(9))
+        angular_velocity_covariance=np.full(9, 0.5), linear_acceleration=V(x=a[0], y=a[1], z=a[2]),
+        linear_acceleration_covariance=np.full(9, 0.25))
 
 
 def _temp(ts, i, stamp_ns, value):
@@ -49,8 +49,11 @@ def _temp(ts, i, stamp_ns, value):
 
 
 def write_bag(path, ros, w, stamps_ns, *, receive_ns=None, frames=None, extra_imu=False, temps=None,
-              storage=None):
-    """A bag with /imu/data (and optionally a second Imu topic and /imu/temperature)."""
+              storage=None, a=None):
+    """A bag with /imu/data (and optionally a second Imu topic and /imu/temperature).
+
+    ``w``: angular velocity [rad/s] per message; ``a``: linear acceleration [m/s^2] per message (default
+    (0, 0, 9.81) in every message)."""
     if ros == 1:
         ts = get_typestore(Stores.ROS1_NOETIC)
         writer, ser = Writer1(path), ts.serialize_ros1
@@ -71,7 +74,8 @@ def write_bag(path, ros, w, stamps_ns, *, receive_ns=None, frames=None, extra_im
                 writer.write(ct, t, ser(_temp(ts, i, temps[i][0], temps[i][1]), "sensor_msgs/msg/Temperature"))
                 continue
             frame = frames[i] if frames else "imu_link"
-            raw = ser(_imu(ts, i, w[i], int(stamps_ns[i]), frame), "sensor_msgs/msg/Imu")
+            acc = (0.0, 0.0, 9.81) if a is None else tuple(float(v) for v in a[i])
+            raw = ser(_imu(ts, i, w[i], int(stamps_ns[i]), frame, acc), "sensor_msgs/msg/Imu")
             writer.write(c, t, raw)
             if c2 is not None:
                 writer.write(c2, t, raw)

@@ -1,8 +1,9 @@
-"""ROS 1 and ROS 2 bag reader (rosbags, pure Python; extra ``[ros]``): ``sensor_msgs/Imu`` angular velocity.
+"""ROS 1 and ROS 2 bag reader (rosbags, pure Python; extra ``[ros]``): ``sensor_msgs/Imu`` angular velocity and
+linear acceleration.
 
 A ROS 1 bag is one ``.bag`` file; a ROS 2 bag is a directory holding ``metadata.yaml`` and its
 ``.db3`` (SQLite) or ``.mcap`` storage files (a storage file inside such a directory opens the
-directory).  Options (CLI ``--topic``, ``--stamp``, ``--temperature``):
+directory).  Options (CLI ``--topic``, ``--stamp``, ``--temperature``; ``fields``):
 
 ``topic``
     The ``sensor_msgs/Imu`` topic.  Default: the only Imu topic of the bag; with none or several
@@ -15,8 +16,18 @@ directory).  Options (CLI ``--topic``, ``--stamp``, ``--temperature``):
 ``temperature``
     A ``sensor_msgs/Temperature`` topic, interpolated linearly onto the Imu times (held at its
     first/last value outside its span); it becomes a column of that name.
+``fields``
+    Which channels are analysed when no columns are chosen: ``"gyro"`` (default, what fogdrift
+    read before linear acceleration was read: a bag's commands print what they printed),
+    ``"accel"`` or ``"both"`` (a six-channel record, each channel with its own quantity).
 
-Columns ``gx, gy, gz`` are ``angular_velocity.x/.y/.z`` and declare rad/s (REP 103/145).  Time
+Columns ``gx, gy, gz`` are ``angular_velocity.x/.y/.z`` and declare rad/s (REP 103/145: an
+angular rate); columns ``ax, ay, az`` are ``linear_acceleration.x/.y/.z`` and declare m/s^2 (the
+message definition: a specific force).  Every Imu topic has all six, so all six are columns of
+the table; ``fields`` only decides the default selection (the others are ``non_rate``), and
+choosing columns by name (CLI ``--columns gx,gy,gz,ax,ay,az``) reads any of them whatever
+``fields`` is.  No unit option is needed: each channel's quantity follows from its declared
+unit (:mod:`fogdrift.io.channel_quantity`).  Time
 is relative to the first message; the absolute start (UTC) is in the notes.  The Imu fields
 are decoded in bulk from the serialised bytes (fixed offsets after the variable-length
 ``frame_id``), and the first and last messages are checked against rosbags' own deserialiser.
@@ -37,23 +48,46 @@ from ...errors import ConfigError, DataFormatError
 from ..hashing import path_sha256
 from .base import PARSER_ERRORS, Table, describe_exception, require
 
-__all__ = ["open_table", "BagTable", "IMU_TYPE", "TEMPERATURE_TYPE", "STAMPS"]
+__all__ = ["open_table", "BagTable", "IMU_TYPE", "TEMPERATURE_TYPE", "STAMPS", "FIELDS", "GYRO_COLUMNS",
+           "ACCEL_COLUMNS"]
 
 IMU_TYPE = "sensor_msgs/msg/Imu"
 TEMPERATURE_TYPE = "sensor_msgs/msg/Temperature"
 #: Values of the ``stamp`` option.
 STAMPS = ("header", "receive")
+#: Values of the ``fields`` option: the channels analysed by default.
+FIELDS = ("gyro", "accel", "both")
+#: ``angular_velocity.x/.y/.z`` [rad/s] and ``linear_acceleration.x/.y/.z`` [m/s^2] (sensor_msgs/Imu).
+GYRO_COLUMNS = ("gx", "gy", "gz")
+ACCEL_COLUMNS = ("ax", "ay", "az")
 
 
 class BagTable(Table):
-    """Angular velocity of one Imu topic; ``time_s`` from the chosen stamps."""
+    """Angular velocity and linear acceleration of one Imu topic; ``time_s`` from the chosen stamps."""
 
     format = "bag"
     row_kind = "message"
 
-    def __init__(self, path, *, names, units, data, time_s, sha256, what):
+    def __init__(self, path, *, names, units, data, time_s, sha256, what, no_accel=None):
         super().__init__(path, names=names, named=True, units=units, data=data, time_s=time_s, sha256=sha256)
         self.what = what
+        #: Index of the first message whose linear_acceleration_covariance[0] is -1 (None: none is).
+        self.no_accel = no_accel
+
+    def read(self, used) -> np.ndarray:
+        """The numbers; DataFormatError when an accelerometer column is used from a bag that says it has none.
+
+        sensor_msgs/Imu: "If you have no estimate for one of the data elements ... set element 0 of the
+        associated covariance matrix to -1"; a gyro-only driver does so for linear_acceleration, whose
+        values are then not measurements (often zeros).
+        """
+        acc = [self.names[j] for j in used if self.names[j] in ACCEL_COLUMNS]
+        if acc and self.no_accel is not None:
+            raise DataFormatError(
+                f"message {self.no_accel} has linear_acceleration_covariance[0] = -1 (sensor_msgs/Imu: the driver "
+                f"has no linear acceleration estimate); expected measured values for {', '.join(acc)} (leave them "
+                "out: select the gyro channels with {opt:columns} gx,gy,gz)", path=self.path, column=acc[0])
+        return self.data
 
     def describe(self, n_rows: int) -> str:
         return f"{self.what}, {n_rows} messages"
@@ -113,13 +147,15 @@ _BATCH = 1 << 16
 
 
 def _decode_imu(raws: list, is_ros2: bool, p: Path, first: int = 0):
-    """(stamp ns int64, angular velocity (n, 3) float64) from serialised Imu messages, vectorised.
+    """(stamp ns int64, [angular velocity, linear acceleration] (n, 6) float64) from serialised Imu messages.
 
-    ROS 2 (CDR): 4-byte encapsulation header, then stamp (int32 sec, uint32 nanosec), frame_id
-    (uint32 length incl. NUL + bytes), padding to 8 (relative to the payload), orientation (4
-    doubles), its covariance (9), angular_velocity (3): ``4 + align8(12 + L) + 104``.
+    Vectorised.  ROS 2 (CDR): 4-byte encapsulation header, then stamp (int32 sec, uint32 nanosec),
+    frame_id (uint32 length incl. NUL + bytes), padding to 8 (relative to the payload), orientation
+    (4 doubles), its covariance (9), angular_velocity (3): ``4 + align8(12 + L) + 104``; then its
+    covariance (9 doubles) and linear_acceleration (3) at ``+ 24 + 72``, then that one's covariance.
     ROS 1: seq (uint32), stamp (uint32 secs, uint32 nsecs), frame_id (uint32 length + bytes),
-    then the same doubles unaligned: ``16 + L + 104``.
+    then the same doubles unaligned: ``16 + L + 104``.  Fixed-size arrays carry no length in
+    either encoding, so all 37 doubles are contiguous.
     """
     n = len(raws)
     lengths = np.fromiter((len(r) for r in raws), dtype=np.int64, count=n)
@@ -162,18 +198,28 @@ def _decode_imu(raws: list, is_ros2: bool, p: Path, first: int = 0):
             f"{int(flen[i])}-byte frame_id, got {int(lengths[i])}", path=p,
         )
     av = gather(starts + av_off, 24, "f8").astype(np.float64)
-    return sec * 1_000_000_000 + nsec, av
+    la = gather(starts + av_off + _LA_AFTER_AV, 24, "f8").astype(np.float64)
+    la_cov0 = gather(starts + av_off + _LA_AFTER_AV + 24, 8, "f8")[:, 0]
+    return sec * 1_000_000_000 + nsec, np.hstack([av, la]), la_cov0 == -1.0
 
 
-def _check_against_deserializer(reader, conn, raws: dict, av, stamps, p):
-    """The first and last messages through rosbags' deserialiser must equal the bulk decoding."""
+#: Bytes from angular_velocity to linear_acceleration: the 3 doubles and the 9 of their covariance
+#: (linear_acceleration_covariance follows linear_acceleration's 3 doubles).
+_LA_AFTER_AV = 8 * (3 + 9)
+
+
+def _check_against_deserializer(reader, conn, raws: dict, av, stamps, p, no_acc=None):
+    """The first and last messages through rosbags' deserialiser must equal the bulk decoding (all six values)."""
     for i in sorted(raws):
         msg = reader.deserialize(raws[i], conn.msgtype)
-        ref = (msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z)
+        w, f = msg.angular_velocity, msg.linear_acceleration
+        ref = (w.x, w.y, w.z, f.x, f.y, f.z)
         st = msg.header.stamp
         ns = int(getattr(st, "sec", getattr(st, "secs", 0))) * 1_000_000_000 + int(
             getattr(st, "nanosec", getattr(st, "nsecs", 0)))
-        if not np.array_equal(np.asarray(ref), av[i]) or ns != stamps[i]:
+        flag = bool(msg.linear_acceleration_covariance[0] == -1.0)
+        if not np.array_equal(np.asarray(ref), av[i]) or ns != stamps[i] or (no_acc is not None
+                                                                               and flag != bool(no_acc[i])):
             raise DataFormatError(f"Imu message {i} decodes differently in bulk than through rosbags; expected "
                                   f"{ref} at {ns} ns, got {tuple(av[i])} at {int(stamps[i])} ns", path=p)
 
@@ -202,13 +248,33 @@ def _temperature(reader, conns, topic, stamp, p):
     return np.asarray(t, dtype=np.int64)[order], np.asarray(v)[order]
 
 
-def open_table(path: Path, *, topic=None, stamp="header", temperature=None) -> Table:
-    """Read the angular velocity of one Imu topic (see the module docstring).
+def open_table(path: Path, *, topic=None, stamp="header", temperature=None, fields=None) -> Table:
+    """Read the angular velocity [rad/s] and linear acceleration [m/s^2] of one Imu topic (see the module docstring).
+
+    Parameters
+    ----------
+    path : Path
+        A ROS 1 ``.bag`` file, a ROS 2 bag directory, or a storage file inside one.
+    topic : str, optional
+        The ``sensor_msgs/Imu`` topic (default: the only one).
+    stamp : {"header", "receive"}
+        Time from the messages' header stamps or the recorder's receive time.
+    temperature : str, optional
+        A ``sensor_msgs/Temperature`` topic [deg C] brought onto the Imu times.
+    fields : {"gyro", "accel", "both"}, optional
+        The channels selected when no columns are given (default ``"gyro"``: ``gx, gy, gz`` in
+        rad/s); the others stay columns of the table, selectable by name.
+
+    Returns
+    -------
+    BagTable
+        Columns ``gx, gy, gz`` [rad/s], ``ax, ay, az`` [m/s^2] (and the temperature topic
+        [degC]), time from the chosen stamps [s].
 
     Raises
     ------
     ConfigError
-        ``stamp`` not header/receive.
+        ``stamp`` not header/receive, ``fields`` not gyro/accel/both.
     DataFormatError
         Unreadable or corrupt bag (the message locates the message where the bag's own reader
         says), unknown or wrong-type topic, no or several Imu topics without ``topic``, a
@@ -220,6 +286,10 @@ def open_table(path: Path, *, topic=None, stamp="header", temperature=None) -> T
     typesys = require("rosbags.typesys", "ros", "reading ROS bags")
     if stamp not in STAMPS:
         raise ConfigError(f"stamp must be one of {STAMPS}; got {stamp!r} in {{opt:stamp}}")
+    chosen_fields = "gyro" if fields is None else str(fields).strip().lower()
+    if chosen_fields not in FIELDS:
+        raise ConfigError(f"fields must be one of {FIELDS} (gyro: angular_velocity, accel: linear_acceleration, "
+                          f"both: the six channels); got {fields!r} in {{opt:fields}}")
     p = _bag_path(Path(path))
     errors = _errors()
     raws, bag_ns, n_read = [], [], 0
@@ -245,8 +315,10 @@ def open_table(path: Path, *, topic=None, stamp="header", temperature=None) -> T
                                       column=name)
             stamps = np.concatenate([q[0] for q in parts])
             av = np.concatenate([q[1] for q in parts])
+            no_acc = np.concatenate([q[2] for q in parts])
             del parts
-            _check_against_deserializer(reader, conns[0], {0: first_raw, n_read - 1: last_raw}, av, stamps, p)
+            _check_against_deserializer(reader, conns[0], {0: first_raw, n_read - 1: last_raw}, av, stamps, p,
+                                        no_acc)
             temp = None
             if temperature is not None:
                 temp = _temperature(reader, list(reader.connections), str(temperature).strip(), stamp, p)
@@ -267,7 +339,7 @@ def open_table(path: Path, *, topic=None, stamp="header", temperature=None) -> T
         )
     ns = stamps if stamp == "header" else bag_ns
     t_s = (ns - ns[0]).astype(np.float64) / 1e9   # correctly rounded: 1990000000 ns -> 1.99 s
-    names, units, cols = ["gx", "gy", "gz"], ["rad/s"] * 3, [av]
+    names, units, cols = [*GYRO_COLUMNS, *ACCEL_COLUMNS], ["rad/s"] * 3 + ["m/s^2"] * 3, [av]
     if temp is not None:
         names.append(str(temperature).strip())
         units.append("degC")
@@ -275,7 +347,8 @@ def open_table(path: Path, *, topic=None, stamp="header", temperature=None) -> T
                               (temp[0] - ns[0]).astype(np.float64), temp[1]).reshape(-1, 1))
     what = f"ROS {'2' if is_ros2 else '1'} bag, topic {name!r} (sensor_msgs/Imu, {stamp} stamps)"
     table = BagTable(p, names=names, units=units, data=np.hstack(cols), time_s=t_s, sha256=path_sha256(p),
-                     what=what)
+                     what=what, no_accel=int(np.argmax(no_acc)) if no_acc.any() else None)
+    table.non_rate = {"gyro": set(ACCEL_COLUMNS), "accel": set(GYRO_COLUMNS), "both": set()}[chosen_fields]
     sec, frac = divmod(int(ns[0]), 1_000_000_000)
     start = _dt.datetime.fromtimestamp(sec, tz=_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%S")
     table.extra_notes = [f"time 0 = first {stamp} stamp {int(ns[0])} ns ({start}.{frac:09d}Z)"]
