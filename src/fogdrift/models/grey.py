@@ -294,19 +294,27 @@ def _gm11_next_batch(windows: np.ndarray) -> np.ndarray:
     values are all equal (not identifiable) get a = 0, b = mean(x⁰(2..w)). Private kernel: no
     validation.
     """
+    # Written for few NumPy calls per step (the free run calls it once per forecast sample): the same operations
+    # as mean() (sum, then divide by the count) and _gm11_restored() (expm1(a)/a unless |a| < 1e-8), so the
+    # same values (checked bit for bit against the previous form, issue 25), about 2x faster on one row.
     w = windows.shape[1]
+    n = w - 1
     x1 = np.cumsum(windows, axis=1)
-    z = 0.5 * (x1[:, 1:] + x1[:, :-1])
+    z = x1[:, 1:] + x1[:, :-1]
+    z *= 0.5
     y = windows[:, 1:]
-    zm = z.mean(axis=1, keepdims=True)
-    ym = y.mean(axis=1, keepdims=True)
+    zm = np.add.reduce(z, axis=1, keepdims=True) / n
+    ym = np.add.reduce(y, axis=1, keepdims=True) / n
     zc = z - zm
     szz = np.einsum("ij,ij->i", zc, zc)
     szy = np.einsum("ij,ij->i", zc, y - ym)
     ok = szz > 0.0
-    a = np.where(ok, -szy / np.where(ok, szz, 1.0), 0.0)
+    a = -szy / szz if ok.all() else np.where(ok, -szy / np.where(ok, szz, 1.0), 0.0)
     b = ym[:, 0] + a * zm[:, 0]
-    return _gm11_restored(a, b, windows[:, 0], w)
+    e = np.expm1(a)
+    small = np.abs(a) < 1e-8
+    phi = _expm1_over(a) if small.any() else e / a
+    return (b * phi - e * windows[:, 0]) * np.exp(-a * float(w))
 
 
 # ----------------------------------------------------------------------------------------------
