@@ -64,10 +64,13 @@ def with_fields(monkeypatch):
         monkeypatch.setattr(registry, "READERS", readers)
 
 
+@pytest.mark.parametrize("varied", [True, False], ids=["frame_id-varies", "one-frame_id"])
 @pytest.mark.parametrize("ros, storage", [(1, None), (2, "sqlite3"), (2, "mcap")])
-def test_six_channels_read_back_with_their_quantities(tmp_path, ros, storage, monkeypatch):
+def test_six_channels_read_back_with_their_quantities(tmp_path, ros, storage, varied, monkeypatch):
+    """Both bulk paths: messages of one length (a strided view) and of varying length (every CDR alignment)."""
     monkeypatch.setattr(rosbag_reader, "_BATCH", 64)           # several decoding batches
-    path, w, a = _bag(tmp_path, ros, storage, frames=["imu" + "x" * (i % 9) for i in range(400)])
+    frames = ["imu" + "x" * (i % 9) for i in range(400)] if varied else None
+    path, w, a = _bag(tmp_path, ros, storage, frames=frames)
     rec = load(path, columns=list(SIX))                          # no unit given: each channel declares its own
     assert rec.axis_names == SIX
     assert rec.quantities == ("angular_rate",) * 3 + ("specific_force",) * 3

@@ -177,9 +177,16 @@ def _decode_imu(raws: list, is_ros2: bool, p: Path, first: int = 0):
     else:
         order = "<"
 
+    # messages of one length (one frame_id, the usual case): a (n, length) view, sliced by column
+    rows = buf.reshape(n, int(lengths[0])) if n and np.all(lengths == lengths[0]) else None
+
     def gather(offsets, width, dtype):
-        idx = offsets[:, None] + np.arange(width)
-        return buf[idx].copy().view(np.dtype(dtype).newbyteorder(order)).reshape(n, -1)
+        rel = offsets - starts
+        if rows is not None and np.all(rel == rel[0]):
+            block = rows[:, int(rel[0]):int(rel[0]) + width]
+        else:
+            block = buf[offsets[:, None] + np.arange(width)]
+        return np.ascontiguousarray(block).view(np.dtype(dtype).newbyteorder(order)).reshape(n, -1)
 
     sec = gather(starts + 4, 4, "i4" if is_ros2 else "u4")[:, 0].astype(np.int64)
     nsec = gather(starts + 8, 4, "u4")[:, 0].astype(np.int64)
