@@ -222,3 +222,20 @@ def test_cli_analyze_refuses_accelerometer_channels_and_says_how_to_leave_them_o
     text = " ".join(result.output.split())
     assert "ax, ay are accelerometer channels" in text and "--columns" in text
     assert "Traceback" not in result.output
+
+
+def test_cli_export_kalibr_from_a_six_channel_bag(tmp_path):
+    """What allan_variance_ros does, from the bag directly: Kalibr's noise densities are sigma sqrt(dt) in SI
+    (white noise of sigma per sample at dt = 0.01 s: 1e-5 rad/s/sqrt(Hz) and 2e-4 m/s^2/sqrt(Hz))."""
+    yaml = pytest.importorskip("yaml")
+    from typer.testing import CliRunner
+
+    from fogdrift.cli import app
+
+    path = _long_bag(tmp_path)
+    _ok(CliRunner().invoke(app, ["export", str(path), "--columns", ",".join(SIX), "--target", "kalibr",
+                                 "--out", str(tmp_path / "x")], env={"COLUMNS": "220"}))
+    doc = yaml.safe_load((tmp_path / "x" / "imu.yaml").read_text())
+    assert doc["gyroscope_noise_density"] == pytest.approx(1e-4 * math.sqrt(0.01), rel=0.1)
+    assert doc["accelerometer_noise_density"] == pytest.approx(2e-3 * math.sqrt(0.01), rel=0.1)
+    assert doc["update_rate"] == pytest.approx(100.0)
