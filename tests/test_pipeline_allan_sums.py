@@ -127,6 +127,7 @@ def test_long_series_take_the_out_of_core_sums_with_the_same_result(monkeypatch,
     spectrum = analyse_spectrum(rate, DT)
     ref_res, ref_fit = _reference_curves(rate, DT, cfg, spectrum)
     monkeypatch.setattr(pipeline_sums, "CHUNKED_MIN_SAMPLES", 100_000)
+    monkeypatch.setattr(pipeline_sums, "OUT_OF_CORE_CHUNK", 65536)   # several chunks: the windowed path
 
     def no_phase(y):
         raise AssertionError("the in-memory angle array was built")

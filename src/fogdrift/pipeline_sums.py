@@ -17,12 +17,17 @@ import numpy as np
 
 from .errors import ConfigError, InsufficientDataError
 
-__all__ = ["AllanSums", "CHUNKED_MIN_SAMPLES"]
+__all__ = ["AllanSums", "CHUNKED_MIN_SAMPLES", "OUT_OF_CORE_CHUNK"]
 
 #: From this many samples on, the Allan operator sums are taken out of core (:mod:`fogdrift.allan.chunked`, the
 #: same terms added in another order: equal to 1e-12 relative, 2e-15 measured at 10^8 samples) instead of through a
-#: float64 angle array of N + 1 points: 8 N bytes (0.8 GB at 10^8) against ~0.1 GB of windows.
+#: float64 angle array of N + 1 points: 8 N bytes (0.8 GB at 10^8) against :data:`OUT_OF_CORE_CHUNK` windows.
 CHUNKED_MIN_SAMPLES = 1 << 24
+
+#: Start indices per chunk of the out-of-core sums.  At 10^8 samples (octave grid, load 5-6, same process): 2^21
+#: (the engine's default) 18.6-26.0 s and 100-118 MB above the input, 2^22 10.1 s and 185 MB, 2^23 5.0-8.7 s and
+#: 273 MB; the in-memory kernel 3.7-4.7 s and 800 MB.
+OUT_OF_CORE_CHUNK = 1 << 23
 
 
 class AllanSums:
@@ -109,7 +114,7 @@ class AllanSums:
                 y = self.y
                 source = ChunkSource(path=Path("<memory>"), n_samples=self.n, dt_s=self.dt, name="rate",
                                      scale_to_dph=1.0, describe="in-memory float64", _read=lambda a, b: y[a:b])
-                chunk = chunked.DEFAULT_CHUNK
+                chunk = OUT_OF_CORE_CHUNK
                 mu, offsets = chunked._mean_and_offsets(source, chunk, None)
                 sums[:] = chunked._second_difference_sums(chunked._Phase(source, mu, offsets), m, strides, chunk,
                                                           None)
