@@ -147,7 +147,9 @@ _BATCH = 1 << 16
 
 
 def _decode_imu(raws: list, is_ros2: bool, p: Path, first: int = 0):
-    """(stamp ns int64, [angular velocity, linear acceleration] (n, 6) float64) from serialised Imu messages.
+    """(stamp ns int64, [angular velocity, linear acceleration] (n, 6) float64, no-accel flags (n,) bool).
+
+    From serialised Imu messages; the flag is ``linear_acceleration_covariance[0] == -1``.
 
     Vectorised.  ROS 2 (CDR): 4-byte encapsulation header, then stamp (int32 sec, uint32 nanosec),
     frame_id (uint32 length incl. NUL + bytes), padding to 8 (relative to the payload), orientation
