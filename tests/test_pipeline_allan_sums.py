@@ -67,9 +67,9 @@ def _series(n, periodic: bool, seed=3):
 @pytest.fixture
 def fit_spy(monkeypatch):
     """Capture the curve handed to the noise fit."""
-    seen = []
-    real = pipeline.__dict__.get("fit_noise")
     import fogdrift.noise as noise_pkg
+
+    seen = []
 
     real = noise_pkg.fit_noise
 
