@@ -172,6 +172,58 @@ def _fir(x, g):
     return np.lib.stride_tricks.sliding_window_view(x, W) @ g
 
 
+def _batch_forecaster(model):
+    """The model's ``forecast_many(h, histories)`` when it stands for its ``forecast``, else None.
+
+    Only drift-input models; and only when the class that defines ``forecast_many`` is (a subclass of) the one
+    that defines ``forecast``, so a subclass that overrides ``forecast`` alone keeps its own per-origin forecasts.
+    """
+    if getattr(model, "input_kind", "drift") == "rate":
+        return None
+    method = getattr(model, "forecast_many", None)
+    if not callable(method):
+        return None
+    owner = {}
+    for cls in type(model).__mro__:
+        for name in ("forecast", "forecast_many"):
+            if name not in owner and name in vars(cls):
+                owner[name] = cls
+    if "forecast_many" not in owner:  # set on the instance: trust it
+        return method
+    if "forecast" in owner and not issubclass(owner["forecast_many"], owner["forecast"]):
+        return None
+    return method
+
+
+def _batched_forecasts(models, calib) -> dict:
+    """Label -> (n_origins, max h_max) free-run forecasts [deg/h] from one ``forecast_many`` call per model.
+
+    ``calib`` holds (bias, bias-removed window, causal drift, h_max) per origin.  Models without the method, or
+    whose call raises a :class:`~fogdrift.errors.FogdriftError` or returns the wrong shape, are left out (the
+    per-origin loop handles them).
+    """
+    out = {}
+    if not calib:
+        return out
+    histories = None
+    h_top = max(item[3] for item in calib)
+    for label, model in models.items():
+        method = _batch_forecaster(model)
+        if method is None:
+            continue
+        if histories is None:
+            histories = np.stack([item[2] for item in calib])
+        try:
+            with warnings.catch_warnings(), np.errstate(all="ignore"):
+                warnings.simplefilter("ignore")
+                f = np.asarray(method(h_top, histories), dtype=np.float64)
+        except FogdriftError:
+            continue
+        if f.shape == (len(calib), h_top):
+            out[label] = f
+    return out
+
+
 def heading_errors(rate_dph, dt_s, models, *, causal_window: int, wavelet="db2", level=4, mode="symmetric",
                    calib_s=300.0, step_s=300.0, horizons_s=HORIZONS_S, axis="") -> HeadingResult:
     """Angle error of every compensator over rolling origins (see the module docstring).
@@ -249,16 +301,27 @@ def heading_errors(rate_dph, dt_s, models, *, causal_window: int, wavelet="db2",
     errors = {k: np.full((origins.size, len(horizons)), np.nan) for k in labels}
     sigma = {}
     failed = {}
-    for i, t0 in enumerate(origins):
+    # Calibration of every origin first (bias, bias-removed window, causal drift, longest horizon that fits) ...
+    calib = []
+    for t0 in origins:
         win = r[t0 - w_cal:t0]
         b = float(np.mean(win))
         zc = win - b
-        c = _fir(zc, g)
-        h_max = max(H for _, H in horizons if t0 + H <= r.size)
+        calib.append((b, zc, _fir(zc, g), max(H for _, H in horizons if t0 + H <= r.size)))
+    # ... so that a drift model with a batched free run forecasts all origins in one call (issue 25: the grey
+    # model's per-origin forecasts were 62 % of `compensate`); row i cut to its own h_max equals
+    # forecast(h_max, history=c_i) (same per-row operations; a free run is causal).  On a FogdriftError the
+    # per-origin loop below runs instead and decides, as before, whether the model fails.
+    batched = _batched_forecasts(models, calib)
+    for i, t0 in enumerate(origins):
+        b, zc, c, h_max = calib[i]
         future = r[t0:t0 + h_max]
         forecasts = {CONSTANT_BIAS: (np.zeros(h_max), None)}
         for label, model in models.items():
             if label in failed:
+                continue
+            if label in batched:
+                forecasts[label] = (batched[label][i, :h_max], None)
                 continue
             try:
                 with warnings.catch_warnings(), np.errstate(all="ignore"):
