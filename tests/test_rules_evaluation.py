@@ -237,3 +237,22 @@ def test_step_survival_of_persistence_is_its_analytic_step_response():
     assert res.step_delays_s == (2.0, 4.0, 30.0, 1000.0) and k_step + 1000 < n <= k_step + 5000
     assert res.frequencies_hz == [0.01] and res.notes[0].startswith("amplitude ")
     assert res.row("constant bias").step_survival == {2.0: 1.0, 4.0: 1.0, 30.0: 1.0, 1000.0: 1.0}
+
+
+def test_persistence_gain_at_half_a_second_is_the_transfer_function_in_seconds():
+    """dt = 0.5 s: |H(f)| = |1 - sum_i g_i exp(-2 pi i f dt (W - i))| (lags in samples times dt), up to 0.9 Hz
+    (Nyquist 1 Hz kept); 0.0006 Hz has fewer than 2 periods in the 2936-s block and is dropped with a note; a given
+    amplitude is used and stated.  Catches time in samples / dt, the Nyquist or two-period rule without dt, the
+    amplitude argument ignored."""
+    dt, W, n = 0.5, 128, 6000
+    z = np.random.default_rng(11).normal(0.0, 5.0, n)
+    freqs = [0.0006, 0.002, 0.01, 0.05, 0.2, 0.9]
+    res = artefact_check(z, dt, {"persistence": Persistence().fit([0.0])}, causal_window=W, frequencies_hz=freqs,
+                         amplitude_dph=2.0)
+    assert res.amplitude_dph == 2.0 and res.notes[0] == "amplitude 2 deg/h for every injected signal"
+    assert res.frequencies_hz == freqs[1:] and "[0.0006] Hz dropped" in res.notes[1]
+    g = causal_drift(np.eye(W), W, "db2", level=4, mode="symmetric")[-1]
+    lags = W - np.arange(W)
+    for f in freqs[1:]:
+        H = 1.0 - np.sum(g * np.exp(-2j * np.pi * f * dt * lags))
+        assert_allclose(res.row("persistence").gains[f], abs(H), rtol=1e-6)
