@@ -145,8 +145,8 @@ H_TESTS24 = [
      "and abs(float(np.sum(means))) * factor < EARTH_FRACTION",
      ["tests/test_rules_table_edges.py", "-k", "quiet_triad"]),
     ("GMWM batch row: fit_n_points counts the excluded scales too",
-     "src/fogdrift/fleet/commands.py", "fit_n_points=int(len(axis.wvar.scale_s) - len(sel.excluded)),",
-     "fit_n_points=int(len(axis.wvar.scale_s)),",
+     "src/fogdrift/fleet/commands.py", "fit_n_points=int(len(axis.wvar.scale_s) - len(sel.excluded)))",
+     "fit_n_points=int(len(axis.wvar.scale_s)))",
      ["tests/test_rules_table_edges.py", "-k", "gmwm_batch"]),
 ]
 if __name__ == "__main__":
