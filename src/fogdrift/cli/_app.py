@@ -3,7 +3,10 @@
 Commands live one per module in :mod:`fogdrift.cli` (``allan``, ``separate``, ``model``, ``analyze``, ...); each
 only declares options, calls the library and prints.  Options every command that reads a gyro log shares are
 declared once (:data:`LOAD_PARAMS`) and added to a command by :func:`with_load_options`, which hands the command a
-:class:`LoadOptions` instead of seven loose arguments.
+:class:`LoadOptions` instead of loose arguments.  The reader options among them (``--topic``, ``--dataset``,
+``--layout`` ...) are not written here: each is a :class:`fogdrift.io.registry.ReaderOption` in the ``READERS``
+table (name, type, help, flag), and :data:`LOAD_PARAMS`, :class:`LoadOptions`, :data:`FLAGS` and
+:meth:`LoadOptions.reader_options` are built from it; a reader with options needs no edit here.
 
 A command's body runs inside :func:`run`, which
 
@@ -31,7 +34,7 @@ import threading
 import time
 import typing
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, make_dataclass
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -44,6 +47,8 @@ from rich.text import Text
 from .. import __version__
 from .. import interrupt
 from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
+from ..io import load as _io_load
+from ..io.registry import cli_options
 from ..output import OutputDir
 
 app = typer.Typer(
@@ -73,16 +78,17 @@ FLAGS = {
     "method": "--method", "noise_method": "--noise-method", "scales": "--scales", "levels": "--scales",
     "curve": "--curve", "sensor": "--sensor", "robust": "--robust", "train_fraction": "--train-fraction",
     "val_fraction": "--val-fraction", "causal_window_s": "--causal-window", "gm_window": "--gm-window",
-    "fit_tau_s": "--fit-taus",
-    # reader options (fogdrift.io.registry.READERS) and the temperature column
-    "temperature": "--temperature", "topic": "--topic", "stamp": "--stamp", "dataset": "--dataset",
-    "variable": "--variable", "gain": "--gain", "layout": "--layout", "scale": "--scale",
-    "header_bytes": "--header-bytes", "sequence": "--sequence", "format": "--format",
+    "fit_tau_s": "--fit-taus", "format": "--format", "horizons": "--horizons", "calibration": "--calibration",
+    "origin_step": "--origin-step", "spec": "--spec",
 }
 
-#: LoadOptions field -> reader option of fogdrift.io.load(reader_options=...); set ones are passed on.
-READER_OPTIONS = {"topic": "topic", "stamp": "stamp", "dataset": "dataset", "variable": "variable", "gain": "gain",
-                  "layout": "layout", "scale": "scale", "header_bytes": "header_bytes", "sequence": "sequence"}
+#: The reader options of the ``READERS`` table (fogdrift.io.registry), each once: every one is a flag of every
+#: command that reads a log.  Those that :func:`fogdrift.io.load` takes itself (``temperature``: a column of any
+#: file, handed on to a bag/miniSEED reader by ``load``) come first and are passed as that keyword; the others
+#: go in ``load(..., reader_options=...)`` when set.
+_LOAD_KEYWORDS = frozenset(inspect.signature(_io_load).parameters)
+READER_FLAGS = tuple(sorted(cli_options(), key=lambda o: str(o) not in _LOAD_KEYWORDS))
+FLAGS.update({str(o): o.flag for o in READER_FLAGS})
 
 
 def _version(value: bool):
@@ -126,8 +132,8 @@ OutliersOpt = Annotated[str, typer.Option(
 
 
 @dataclass(frozen=True)
-class LoadOptions:
-    """How to read a gyro log: the options of :func:`fogdrift.io.load` as the CLI spells them."""
+class _LoadOptionsBase:
+    """The options of :func:`fogdrift.io.load` that every format shares, as the CLI spells them."""
 
     file: Path
     rate: Optional[float] = None
@@ -136,27 +142,19 @@ class LoadOptions:
     columns: Optional[str] = None
     time_column: str = "auto"
     gaps: str = "error"
-    temperature: Optional[str] = None
     format: Optional[str] = None
-    topic: Optional[str] = None
-    stamp: Optional[str] = None
-    dataset: Optional[str] = None
-    variable: Optional[str] = None
-    gain: Optional[str] = None
-    layout: Optional[str] = None
-    scale: Optional[str] = None
-    header_bytes: Optional[int] = None
-    sequence: Optional[str] = None
 
     def reader_options(self) -> dict:
-        """The reader options that were set (``--topic``, ``--dataset``, ``--layout`` ...)."""
-        return {opt: getattr(self, f) for f, opt in READER_OPTIONS.items() if getattr(self, f) is not None}
+        """The reader options that were set (``--topic``, ``--dataset``, ``--layout`` ...), by option name."""
+        return {str(o): getattr(self, str(o)) for o in READER_FLAGS
+                if str(o) not in _LOAD_KEYWORDS and getattr(self, str(o)) is not None}
 
     def load_kwargs(self) -> dict:
         """Keyword arguments of :func:`fogdrift.io.load` (without ``gaps``)."""
-        return dict(columns=csv_list(self.columns), rate_hz=self.rate, unit=self.unit, time_unit=self.time_unit,
-                    time_column=None if self.time_column.lower() == "none" else self.time_column,
-                    temperature=self.temperature, format=self.format, reader_options=self.reader_options())
+        kwargs = dict(columns=csv_list(self.columns), rate_hz=self.rate, unit=self.unit, time_unit=self.time_unit,
+                      time_column=None if self.time_column.lower() == "none" else self.time_column)
+        kwargs.update({str(o): getattr(self, str(o)) for o in READER_FLAGS if str(o) in _LOAD_KEYWORDS})
+        return dict(kwargs, format=self.format, reader_options=self.reader_options())
 
     def load(self, path=None, *, unit=None, time_unit=None):
         """Load ``path`` (default: ``file``) with these options; ``--gaps longest`` keeps the longest segment.
@@ -178,6 +176,21 @@ class LoadOptions:
         raise ConfigError(f"--gaps must be 'error' or 'longest', got {self.gaps!r}")
 
 
+#: How to read a gyro log: the options of :func:`fogdrift.io.load` as the CLI spells them, with one field per reader
+#: option of the ``READERS`` table (``topic``, ``dataset``, ``header_bytes`` ..., None when not given).
+LoadOptions = make_dataclass(
+    "LoadOptions", [(str(o), Optional[o.type], None) for o in READER_FLAGS], bases=(_LoadOptionsBase,), frozen=True,
+    namespace={"__module__": __name__,
+               "__doc__": "How to read a gyro log: the options of :func:`fogdrift.io.load` as the CLI spells them.\n\n"
+                          "    The shared ones of :class:`_LoadOptionsBase`, then one field per reader option of "
+                          "fogdrift.io.registry.READERS (None when not given): " + ", ".join(map(str, READER_FLAGS))
+                          + "."})
+
+
+def _reader_param(opt):
+    return (str(opt), Annotated[Optional[opt.type], typer.Option(opt.flag, help=opt.help)], None)
+
+
 #: (name, annotation, default) of the shared load parameters, in the order they appear in --help.
 LOAD_PARAMS = (
     ("file", Annotated[Path, typer.Argument(help="Gyro log: CSV/TXT (optionally .gz), .npy, .npz, HDF5, .mat, ROS bag, "
@@ -196,25 +209,23 @@ LOAD_PARAMS = (
     ("columns", Annotated[Optional[str], typer.Option("--columns", help="Comma-separated column names or 0-based indices.")], None),
     ("time_column", Annotated[str, typer.Option("--time-column", help="Time column name/index, 'auto' or 'none'.")], "auto"),
     ("gaps", Annotated[str, typer.Option("--gaps", help="Time gaps > 1.5 intervals: 'error' or 'longest' segment.")], "error"),
-    ("temperature", Annotated[Optional[str], typer.Option(
-        "--temperature", help="Temperature column [deg C] carried with the log (bag: a sensor_msgs/Temperature topic; "
-                              "miniSEED: a channel).")], None),
+    *(_reader_param(o) for o in READER_FLAGS if str(o) in _LOAD_KEYWORDS),
     ("format", Annotated[Optional[str], typer.Option(
         "--format", help="Force a reader: text, npy, npz, hdf5, mat, rosbag1, rosbag2, mseed, binary.")], None),
-    ("topic", Annotated[Optional[str], typer.Option("--topic", help="Bag: the sensor_msgs/Imu topic.")], None),
-    ("stamp", Annotated[Optional[str], typer.Option("--stamp", help="Bag: time from 'header' stamps or 'receive' time.")], None),
-    ("dataset", Annotated[Optional[str], typer.Option("--dataset", help="HDF5: dataset or group path, e.g. /imu.")], None),
-    ("variable", Annotated[Optional[str], typer.Option("--variable", help="MATLAB .mat: variable name.")], None),
-    ("gain", Annotated[Optional[str], typer.Option(
-        "--gain", help="miniSEED: counts per unit, or a StationXML/dataless/RESP response file.")], None),
-    ("layout", Annotated[Optional[str], typer.Option(
-        "--layout", help="Raw binary record as NumPy dtype items, e.g. '<u4 seq, <i4 gx, <i4 gy, <i4 gz'.")], None),
-    ("scale", Annotated[Optional[str], typer.Option(
-        "--scale", help="Raw binary: LSB factor for every field, or per field 'gx=1e-4,temp=0.01'.")], None),
-    ("header_bytes", Annotated[Optional[int], typer.Option("--header-bytes", help="Raw binary: bytes before the first record.")], None),
-    ("sequence", Annotated[Optional[str], typer.Option(
-        "--sequence", help="Raw binary: sequence-counter field (default seq/counter/...; 'none').")], None),
+    *(_reader_param(o) for o in READER_FLAGS if str(o) not in _LOAD_KEYWORDS),
 )
+
+
+def _clashes(params) -> list[str]:
+    """Names or flags given twice in ``params`` (a reader option named like a load option, e.g. ``unit``)."""
+    keys = [name for name, _, _ in params] + [decl for _, ann, _ in params
+                                              for decl in getattr(ann.__metadata__[0], "param_decls", None) or ()]
+    return sorted({k for k in keys if keys.count(k) > 1})
+
+
+if _clashes(LOAD_PARAMS):
+    raise ConfigError(f"reader option(s) of fogdrift.io.registry.READERS clash with the CLI's load options: "
+                      f"{_clashes(LOAD_PARAMS)}; expected other names and flags")
 
 
 def with_load_options(func):

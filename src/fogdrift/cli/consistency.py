@@ -20,15 +20,10 @@ from typing import Annotated, List, Optional
 import typer
 
 from ..errors import ConfigError
-from ._app import (FLAGS, JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run,
+from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run,
                    say, warn, with_load_options)
 
 DEFAULT_OUT = Path("out/consistency")
-
-# the flags of this command's library settings, for {opt:NAME} in fogdrift.evaluation.consistency's messages
-# (registered here until cli/_app.FLAGS lists them; setdefault never overrides an entry there)
-for _name, _flag in (("horizons", "--horizons"), ("calibration", "--calibration"), ("origin_step", "--origin-step")):
-    FLAGS.setdefault(_name, _flag)
 
 HeldOutOpt = Annotated[Optional[List[Path]], typer.Option(
     "--held-out", metavar="<path>", help="A held-out static log of the same sensor (repeat the option for "

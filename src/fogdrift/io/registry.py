@@ -6,6 +6,12 @@ longest matching extension; failing that, a line whose ``sniff`` accepts the fir
 (plain text has no magic bytes: any file without NUL bytes in its first 8000 bytes is text,
 git's rule).  Directories are accepted only by a format with a ``directory_marker``.
 An unknown format is a DataFormatError that names the file and lists the known formats.
+
+Reader options live here too, each declared once: a :class:`ReaderOption` in a line's ``options``
+gives the option's name, value type, help text and CLI flag.  The command line builds its flags
+from this table (:func:`cli_options`; ``fogdrift.cli._app``), so a reader with options needs one
+module and one line here, and no CLI edit, as ObsPy hands ``**kwargs`` on to its format plugins.
+An option shared by several formats (``temperature``) is one object used in each line, one flag.
 """
 
 from __future__ import annotations
@@ -17,7 +23,7 @@ from typing import Callable
 
 from ..errors import ConfigError, DataFormatError
 
-__all__ = ["ReaderSpec", "READERS", "select_reader", "reader_by_name"]
+__all__ = ["ReaderOption", "ReaderSpec", "READERS", "cli_options", "select_reader", "reader_by_name"]
 
 #: Bytes read from the start of a file to match magic numbers and sniff content.
 HEAD_BYTES = 8000
@@ -26,6 +32,62 @@ HEAD_BYTES = 8000
 def _looks_like_text(head: bytes) -> bool:
     """No NUL byte in the first 8000 bytes (git's binary test); UTF-16 text fails it, on purpose."""
     return b"\x00" not in head
+
+
+class ReaderOption(str):
+    """One reader option, declared once: its name, value type, help text and CLI flag.
+
+    The object *is* the option's name (a ``str``), so ``"topic" in spec.options``,
+    ``reader_options={"topic": ...}`` and error messages read it as the plain name; the
+    declaration rides along as attributes, which are read-only.
+
+    Parameters
+    ----------
+    name : str
+        Keyword of the reader's ``open_table`` (and of ``load(..., reader_options={name: ...})``).
+    type : {str, int, float}
+        Type of the value on the command line (the reader still validates it).
+    help : str
+        Help text of the CLI flag; say which format it is for (``"Bag: ..."``) and give units.
+    flag : str, optional
+        CLI flag; default ``--`` and the name with ``_`` written ``-`` (``header_bytes`` ->
+        ``--header-bytes``).
+
+    Notes
+    -----
+    A plain string in :attr:`ReaderSpec.options` is an option of the library alone (no flag),
+    e.g. the text reader's ``delimiter``, which ``load(..., delimiter=...)`` also takes.
+    """
+
+    type: type
+    help: str
+    flag: str
+
+    def __new__(cls, name: str, type: type = str, help: str = "", flag: str | None = None):  # noqa: A002
+        if not (isinstance(name, str) and name.isidentifier()):
+            raise ConfigError(f"reader option name must be a Python identifier; got {name!r}")
+        if type not in (str, int, float):
+            raise ConfigError(f"reader option {name!r}: type must be str, int or float; got {type!r}")
+        if not (isinstance(help, str) and help.strip()):
+            raise ConfigError(f"reader option {name!r}: a help text is required (it is the CLI flag's help)")
+        flag = "--" + name.replace("_", "-") if flag is None else flag
+        if not (isinstance(flag, str) and flag.startswith("--") and len(flag) > 2):
+            raise ConfigError(f"reader option {name!r}: flag must start with '--'; got {flag!r}")
+        self = super().__new__(cls, name)
+        self.__dict__.update(type=type, help=help, flag=flag)
+        return self
+
+    def __setattr__(self, key, value):
+        raise AttributeError(f"ReaderOption {str(self)!r} is read-only")
+
+    @property
+    def name(self) -> str:
+        """The option's name as a plain ``str``."""
+        return str(self)
+
+    def declaration(self) -> tuple:
+        """(name, type, help, flag): two declarations of one option must agree on all four."""
+        return (str(self), self.type, self.help, self.flag)
 
 
 @dataclass(frozen=True)
@@ -45,8 +107,9 @@ class ReaderSpec:
         The file starts with one of these.
     extensions : tuple of str
         Lower-case name endings (``".csv"``, ``".csv.gz"``).
-    options : tuple of str
-        Reader options ``open_table`` accepts (``load(..., reader_options={...})``).
+    options : tuple of ReaderOption or str
+        Reader options ``open_table`` accepts (``load(..., reader_options={...})``); each
+        :class:`ReaderOption` is also a CLI flag of every command that reads a log.
     sniff : callable, optional
         ``sniff(head_bytes) -> bool``, the last resort for formats without magic bytes.
     directory_marker : str, optional
@@ -60,7 +123,7 @@ class ReaderSpec:
     module: str
     magic: tuple[bytes, ...] = ()
     extensions: tuple[str, ...] = ()
-    options: tuple[str, ...] = ()
+    options: tuple[ReaderOption | str, ...] = ()
     sniff: Callable[[bytes], bool] | None = None
     directory_marker: str | None = None
     description: str = ""
@@ -83,7 +146,16 @@ def _looks_like_mseed(head: bytes) -> bool:
             and head[7:8] in (b" ", b"\x00"))
 
 
-_BAG_OPTIONS = ("topic", "stamp", "temperature")
+#: Shared by the bag and miniSEED lines (one option, one flag); ``load(..., temperature=...)`` takes it for
+#: every format (a column), and passes it on to a reader that declares it.
+TEMPERATURE = ReaderOption("temperature", str, "Temperature column [deg C] carried with the log (bag: a "
+                                               "sensor_msgs/Temperature topic; miniSEED: a channel).")
+
+_BAG_OPTIONS = (
+    ReaderOption("topic", str, "Bag: the sensor_msgs/Imu topic."),
+    ReaderOption("stamp", str, "Bag: time from 'header' stamps or 'receive' time."),
+    TEMPERATURE,
+)
 
 #: The formats fogdrift reads, in the order magic bytes (then sniffers) are tried; text is last.
 READERS: tuple[ReaderSpec, ...] = (
@@ -92,22 +164,65 @@ READERS: tuple[ReaderSpec, ...] = (
     ReaderSpec("npz", "npz", magic=(b"PK\x03\x04", b"PK\x05\x06"), extensions=(".npz",),
                description="NumPy .npz archive"),
     ReaderSpec("hdf5", "hdf5", magic=(b"\x89HDF\r\n\x1a\n",), extensions=(".h5", ".hdf5", ".hdf", ".he5"),
-               options=("dataset",), description="HDF5 file (h5py, extra [hdf5])"),
-    ReaderSpec("mat", "matlab", magic=(b"MATLAB",), extensions=(".mat",), options=("variable",),
+               options=(ReaderOption("dataset", str, "HDF5: dataset or group path, e.g. /imu."),),
+               description="HDF5 file (h5py, extra [hdf5])"),
+    ReaderSpec("mat", "matlab", magic=(b"MATLAB",), extensions=(".mat",),
+               options=(ReaderOption("variable", str, "MATLAB .mat: variable name."),),
                description="MATLAB .mat v4/v5/v7 (scipy) or v7.3 (h5py)"),
     ReaderSpec("rosbag1", "rosbag", magic=(b"#ROSBAG V2.0",), extensions=(".bag",), options=_BAG_OPTIONS,
                description="ROS 1 bag (rosbags, extra [ros])"),
     ReaderSpec("rosbag2", "rosbag", magic=(b"\x89MCAP0\r\n", b"SQLite format 3\x00"), extensions=(".db3", ".mcap"),
                options=_BAG_OPTIONS, directory_marker="metadata.yaml",
                description="ROS 2 bag directory (rosbags, extra [ros])"),
-    ReaderSpec("mseed", "mseed", extensions=(".mseed", ".miniseed", ".msd"), options=("gain", "temperature"),
+    ReaderSpec("mseed", "mseed", extensions=(".mseed", ".miniseed", ".msd"),
+               options=(ReaderOption("gain", str, "miniSEED: counts per unit, or a StationXML/dataless/RESP "
+                                                  "response file."), TEMPERATURE),
                sniff=_looks_like_mseed, description="miniSEED (ObsPy, extra [seismo])"),
-    ReaderSpec("binary", "binary", options=("layout", "scale", "header_bytes", "sequence"),
+    ReaderSpec("binary", "binary",
+               options=(ReaderOption("layout", str, "Raw binary record as NumPy dtype items, e.g. "
+                                                    "'<u4 seq, <i4 gx, <i4 gy, <i4 gz'."),
+                        ReaderOption("scale", str, "Raw binary: LSB factor for every field, or per field "
+                                                   "'gx=1e-4,temp=0.01'."),
+                        ReaderOption("header_bytes", int, "Raw binary: bytes before the first record."),
+                        ReaderOption("sequence", str, "Raw binary: sequence-counter field (default "
+                                                      "seq/counter/...; 'none').")),
                description="raw binary records, chosen by giving their layout= (or format='binary')"),
     ReaderSpec("text", "text", magic=(b"\x1f\x8b",),
                extensions=(".csv", ".txt", ".tsv", ".dat", ".log", ".gz"), options=("delimiter",),
                sniff=_looks_like_text, description="CSV/TXT text, optionally gzip"),
 )
+
+
+def cli_options(readers=None) -> tuple[ReaderOption, ...]:
+    """Every :class:`ReaderOption` of the table, once each, in the order of first appearance.
+
+    Parameters
+    ----------
+    readers : sequence of ReaderSpec, optional
+        Default: :data:`READERS` as it is now (a plugged-in line counts).
+
+    Raises
+    ------
+    ConfigError
+        If two lines declare one option name differently (type, help or flag), or two options
+        share a flag: an option shared by several formats is one declaration, one flag.
+    """
+    seen: dict[str, ReaderOption] = {}
+    flags: dict[str, str] = {}
+    for spec in READERS if readers is None else readers:
+        for opt in spec.options:
+            if not isinstance(opt, ReaderOption):
+                continue  # a library-only option
+            first = seen.setdefault(str(opt), opt)
+            if first.declaration() != opt.declaration():
+                raise ConfigError(f"reader option {str(opt)!r} is declared twice differently ({spec.name}: "
+                                  f"{opt.declaration()[1:]}, before: {first.declaration()[1:]}); expected one "
+                                  f"declaration shared by the formats")
+            owner = flags.setdefault(opt.flag, str(opt))
+            if owner != str(opt):
+                raise ConfigError(f"reader options {owner!r} and {str(opt)!r} share the flag {opt.flag}; expected "
+                                  f"one flag per option")
+    return tuple(seen.values())
 
 
 def reader_by_name(name: str) -> ReaderSpec:
