@@ -12,7 +12,6 @@ deg/sqrt(h) for sigma in deg/h.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import sys
@@ -55,15 +54,6 @@ def _bag(tmp_path, ros, storage=None, n=400, name="six", **kw):
     return path, w, a
 
 
-@pytest.fixture
-def with_fields(monkeypatch):
-    """The bag lines of the READERS table with the ``fields`` option (as fogdrift.io.registry should declare it)."""
-    if "fields" not in registry.READERS[[s.name for s in registry.READERS].index("rosbag1")].options:
-        readers = tuple(dataclasses.replace(s, options=(*s.options, "fields")) if s.module == "rosbag" else s
-                        for s in registry.READERS)
-        monkeypatch.setattr(registry, "READERS", readers)
-
-
 @pytest.mark.parametrize("varied", [True, False], ids=["frame_id-varies", "one-frame_id"])
 @pytest.mark.parametrize("ros, storage", [(1, None), (2, "sqlite3"), (2, "mcap")])
 def test_six_channels_read_back_with_their_quantities(tmp_path, ros, storage, varied, monkeypatch):
@@ -88,7 +78,7 @@ def test_six_channels_read_back_with_their_quantities(tmp_path, ros, storage, va
 
 
 @pytest.mark.parametrize("fields, names", [("gyro", SIX[:3]), ("accel", SIX[3:]), ("both", SIX), (" Both ", SIX)])
-def test_fields_option_decides_the_default_selection(tmp_path, with_fields, fields, names):
+def test_fields_option_decides_the_default_selection(tmp_path, fields, names):
     path, w, a = _bag(tmp_path, 2)
     rec = load(path, reader_options={"fields": fields})
     assert rec.axis_names == names
@@ -196,18 +186,25 @@ def test_cli_allan_prints_gyro_and_accelerometer_tables_without_unit(tmp_path):
     assert "N [deg/√h]" in out and "m/s/√h" not in out
 
 
-def test_cli_fields_flag_when_declared(tmp_path):
+def test_cli_fields_flag(tmp_path):
     from typer.testing import CliRunner
 
     from fogdrift.cli import app
-    from fogdrift.cli._app import LOAD_PARAMS
+    from fogdrift.cli._app import FLAGS
 
-    if "fields" not in {name for name, _, _ in LOAD_PARAMS}:
-        pytest.skip("the CLI has no --fields flag yet (fogdrift.cli._app LOAD_PARAMS / READER_OPTIONS)")
+    assert {"rosbag1", "rosbag2"} <= {s.name for s in registry.READERS if "fields" in s.options}
+    assert FLAGS["fields"] == "--fields"                               # one table row, no CLI edit
     path = _long_bag(tmp_path)
     out = _ok(CliRunner().invoke(app, ["allan", str(path), "--fields", "both", "--out", str(tmp_path / "o")],
                                  env={"COLUMNS": "220"}))
     assert "N [deg/√h]" in out and "N [m/s/√h]" in out
+    out = _ok(CliRunner().invoke(app, ["allan", str(path), "--fields", "accel", "--out", str(tmp_path / "a")],
+                                 env={"COLUMNS": "220"}))
+    assert "N [m/s/√h]" in out and "deg/√h" not in out
+    bad = CliRunner().invoke(app, ["allan", str(path), "--fields", "accels", "--out", str(tmp_path / "b")],
+                             env={"COLUMNS": "220"})
+    assert bad.exit_code == 1 and "Traceback" not in bad.output
+    assert "fields must be one of" in bad.output and "got 'accels' in --fields" in " ".join(bad.output.split())
 
 
 def test_cli_analyze_refuses_accelerometer_channels_and_says_how_to_leave_them_out(tmp_path):

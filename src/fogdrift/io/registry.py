@@ -155,6 +155,7 @@ _BAG_OPTIONS = (
     ReaderOption("topic", str, "Bag: the sensor_msgs/Imu topic."),
     ReaderOption("stamp", str, "Bag: time from 'header' stamps or 'receive' time."),
     TEMPERATURE,
+    ReaderOption("fields", str, "Bag: channels analysed by default: gyro (default), accel or both."),
 )
 
 #: The formats fogdrift reads, in the order magic bytes (then sniffers) are tried; text is last.
