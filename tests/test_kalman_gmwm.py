@@ -139,22 +139,14 @@ def test_the_gmwm_fit_sees_exactly_the_training_samples(monkeypatch):
 
 
 def test_pipeline_gives_the_gmwm_only_the_training_block(monkeypatch, bundled_record):
-    """In run_models the GMWM of a gmwm Kalman is called once per axis with exactly the training block of the rate."""
-    from fogdrift import pipeline
+    """With noise_method 'gmwm' the pipeline's Kalman runs the GMWM once per axis on exactly the training block."""
     from fogdrift.pipeline import AnalysisConfig, run_models
 
     calls = []
     real = kalman_module.analyse_gmwm
     monkeypatch.setattr(kalman_module, "analyse_gmwm",
                         lambda name, x, dt_s, **kw: calls.append(np.array(x, copy=True)) or real(name, x, dt_s, **kw))
-    build = pipeline.make_model
-
-    def make_gmwm(name, cfg, progress=None):  # the analysis setting, whether or not the pipeline passes it yet
-        model = build(name, cfg, progress)
-        return model.set_params(noise_method="gmwm") if isinstance(model, Kalman) else model
-
-    monkeypatch.setattr(pipeline, "make_model", make_gmwm)
-    ma = run_models(bundled_record.select("gz"), AnalysisConfig(models=("kalman", "persistence")))[0]
+    ma = run_models(bundled_record.select("gz"), AnalysisConfig(models=("kalman", "persistence"), noise_method="gmwm"))[0]
     a, b = ma.split["train"]
     assert len(calls) == 1 and len(calls[0]) == b - a
     assert_array_equal(calls[0], ma.rate_dph[a:b])
@@ -236,3 +228,12 @@ def test_a_fallback_gmwm_selection_is_used_with_one_warning_saying_why(monkeypat
     assert len(msgs) == 1 and "WN has the smallest WIC (soft: residual z = 4.2 at scale 8 s)" in msgs[0]
     assert model.identification_["passed_checks"] is False and "residual z" in model.identification_["reason"]
     assert model.components_ == [{"kind": "white", "arw_dprh": 0.1}]
+
+
+def test_pipeline_keeps_the_allan_identification_by_default(bundled_record):
+    """The analysis setting reaches the Kalman: the default 'allan' analysis gives an Allan-identified Kalman."""
+    from fogdrift.pipeline import AnalysisConfig, run_models
+
+    ma = run_models(bundled_record.select("gz"), AnalysisConfig(models=("kalman",)))[0]
+    assert ma.fitted["Kalman"].identification_["method"] != "gmwm"
+    assert ma.fitted["Kalman"].noise_method == "allan"

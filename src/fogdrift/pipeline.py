@@ -114,7 +114,8 @@ class AnalysisConfig:
     noise_method : str
         ``"allan"`` (default): the noise table is the Allan fit (:mod:`fogdrift.noise`); ``"gmwm"``: also the GMWM
         model selection on the Haar wavelet variance of the native-rate record (:mod:`fogdrift.gmwm.analysis`),
-        which the report shows as the noise table.
+        which the report shows as the noise table; the Kalman drift model then identifies its noise components
+        by a GMWM fit of its training block too (:class:`fogdrift.models.kalman.Kalman` ``noise_method``).
     """
 
     model_rate_hz: float | None = 1.0
@@ -572,6 +573,8 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
             model = make_model(model_name, cfg, progress)
             if "dt_s" in model.get_params():  # state-space models (Kalman) work in seconds
                 model.set_params(dt_s=dt_s)
+            if "noise_method" in model.get_params():  # the Kalman identifies its noise model as the analysis does
+                model.set_params(noise_method=cfg.noise_method)
             t0 = time.perf_counter()
             fit_on = blocks if model.input_kind == "rate" else drift  # a Kalman filter sees the rate itself
             model.fit(fit_on["train"], fit_on["val"])

@@ -76,7 +76,8 @@ def analyze(
                                                     "Chromium).")] = False,
     noise_method: Annotated[str, typer.Option(
         "--noise-method", help="Noise model of the original output: allan (the Allan fit) or gmwm (also the GMWM "
-                               "model selection on the wavelet variance; the report shows its table first).")]
+                               "model selection on the wavelet variance; the report shows its table first, and the Kalman model "
+                               "identifies its noise components by GMWM on its training block).")]
     = "allan",
     sensor: Annotated[Optional[str], typer.Option(
         "--sensor", help="Sensor make, model and serial number for the report's first screen and analysis.json "
@@ -152,7 +153,8 @@ def analyze(
         comp = write_compensated_test_block([ax.models for ax in result.axes], r.out.path, t0_s=record.t0_s)
         r.wrote()
         say(f"report: {path.resolve()}{'  (+ report.pdf)' if pdf else ''}  ({result.wall_s:.1f} s)")
-        say(f"bundle: {bundle.path}   (apply it to another log: fogdrift compensate {bundle.path} LOG)")
+        say(f"bundle: {bundle.path}   (apply it to another log: fogdrift compensate {bundle.path} LOG --unit "
+            f"{record.input_unit}, or the unit LOG declares)")
         say(f"compensated test block: {', '.join(p.name for p in comp)} (modelling rate, deg/h)")
         if not details:
             say("every table (Table 2, one-step metrics, heading error, artefacts): the report, analysis.json, "
