@@ -277,10 +277,11 @@ def _nperseg(n: int) -> int:
     return int(min(_NPERSEG_MAX, max(_NPERSEG_MIN, 2**k)))
 
 
-def _welch(x: np.ndarray, fs_hz: float, nperseg: int, chunk_samples: int = 1 << 21):
+def _welch(x: np.ndarray, fs_hz: float, nperseg: int, chunk_samples: int = 1 << 21, offset: float = 0.0):
     """One-sided Welch PSD [(unit)^2/Hz] (Hann, 50 % overlap, mean removed per segment), chunk by chunk.
 
-    Returns (f_hz, psd, n_segments).  Identical to one ``scipy.signal.welch`` call on the whole record; memory is
+    Returns (f_hz, psd, n_segments).  Identical to one ``scipy.signal.welch`` call on the whole record ``x -
+    offset`` (``offset`` [unit] is subtracted chunk by chunk, each element as in ``(x - offset)[a:b]``); memory is
     bounded by the chunk (about ``chunk_samples``), not by ``n``.
     """
     from scipy.signal import welch
@@ -295,11 +296,33 @@ def _welch(x: np.ndarray, fs_hz: float, nperseg: int, chunk_samples: int = 1 << 
         j = min(per_chunk, n_seg - done)
         a = done * step
         b = a + (j - 1) * step + nperseg
-        f, p = welch(x[a:b], fs=fs_hz, window="hann", nperseg=nperseg, noverlap=step, detrend="constant",
+        seg = x[a:b] if offset == 0.0 else x[a:b] - offset
+        f, p = welch(seg, fs=fs_hz, window="hann", nperseg=nperseg, noverlap=step, detrend="constant",
                      scaling="density")
         acc = p * j if acc is None else acc + p * j
         done += j
     return f, acc / n_seg, n_seg
+
+
+#: Samples per block of :func:`_variance`: a record up to this length is one block (the result is then
+#: ``np.var``'s, bit for bit); longer ones hold one block-sized float64 temporary instead of a full-length one.
+VAR_BLOCK = 1 << 20
+
+
+def _variance(x: np.ndarray, mean: float, block: int | None = None) -> float:
+    """Population variance [(unit)^2] of 1-D float64 ``x`` about its ``mean`` [unit], block by block.
+
+    Two-pass like ``np.var(x)`` (``mean`` must be ``x.mean()``): the squared deviations are summed per block
+    (NumPy's pairwise sum) and the block sums added in order, so memory is one block, not ``n`` samples.  Equal
+    to ``np.var(x)`` bit for bit when ``x.size <= block``, else to within summation rounding (~1e-15 relative).
+    """
+    block = VAR_BLOCK if block is None else int(block)
+    total = 0.0
+    for a in range(0, x.size, block):
+        d = x[a: a + block] - mean
+        np.multiply(d, d, out=d)
+        total += float(d.sum())
+    return total / x.size
 
 
 def _window(nperseg: int) -> np.ndarray:
@@ -674,11 +697,12 @@ def analyse_spectrum(rate_dph, dt_s, *, false_alarm=0.01, max_lines=16) -> Spect
     if n < MIN_SAMPLES:
         return SpectrumSummary(dt, n, fa, float("nan"), note=f"no spectrum: the record has {n} samples; the line "
                                                              f"search needs at least {MIN_SAMPLES}")
-    var = float(np.var(x))
+    mean = x.mean()  # a reduction: no full-length temporary
+    var = _variance(x, mean)
     if not np.ptp(x) > 0:
         return SpectrumSummary(dt, n, fa, float("nan"), note="no spectrum: the record is constant")
     nperseg = _nperseg(n)
-    f, p, n_seg = _welch(x - x.mean(), fs, nperseg)
+    f, p, n_seg = _welch(x, fs, nperseg, offset=mean)
     df = fs / nperseg
     nu = welch_edf(nperseg, n_seg)
     r_fine = _fine_bin_r(nperseg)

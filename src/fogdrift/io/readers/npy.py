@@ -1,7 +1,9 @@
 """NumPy ``.npy`` reader: 1-D (one axis) or 2-D (samples x columns), memory-mapped.
 
-The array is opened with ``mmap_mode="r"``: a float64 array is handed on as a view of the
-memory map, never copied (other dtypes are converted to float64).  The file's SHA-256 is
+The array is opened with ``mmap_mode="r"`` and handed on as a view of the memory map, never copied here,
+whatever its numeric dtype: :func:`fogdrift.io.load` converts the rate columns to float64 deg/h in one step
+(``np.multiply(raw, scale, dtype=float64)``, one float64 array and no full-size intermediate), so a float32
+file of n samples costs 8 n bytes beside its mapped pages, not 16 n.  The file's SHA-256 is
 computed by reading it once in chunks (the memory map itself reads nothing up front).
 """
 
@@ -46,7 +48,8 @@ def open_table(path: Path) -> Table:
         )
     if arr.dtype != np.float64 and arr.dtype.kind in "biuf":  # converted in memory: held to the budget
         check_memory(arr.size * 8.0, p, f"the {arr.dtype} array {arr.shape} as float64")
-    arr = numeric_column(arr, p, "array")
+    if arr.dtype.kind not in "biuf":
+        numeric_column(arr, p, "array")  # raises: not a real numeric dtype
     if arr.ndim == 1:
         arr = arr.reshape(-1, 1)
     return Table(p, names=[f"col{j}" for j in range(arr.shape[1])], named=False, data=arr,

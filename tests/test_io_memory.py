@@ -1,0 +1,146 @@
+"""Memory of the load -> spectrum path (issue 23 item 4): no full-length float64 temporaries.
+
+Values are checked bit for bit against the operation they replace (``raw.astype(float64) * scale``,
+``np.var``, ``welch(x - x.mean())``); memory by ``tracemalloc``, which sees NumPy's data buffers: a peak of
+one output array passes, a second full-length array (the old path) fails.
+"""
+
+from __future__ import annotations
+
+import math
+import tracemalloc
+
+import numpy as np
+import pytest
+
+import fogdrift.io as fio
+from fogdrift.errors import DataFormatError
+from fogdrift.io._checks import to_dph
+from fogdrift.io.readers import npy as npy_reader
+from fogdrift.noise import spectral
+
+
+def _peak_bytes(fn, *args, **kwargs):
+    tracemalloc.start()
+    try:
+        tracemalloc.reset_peak()
+        base = tracemalloc.get_traced_memory()[0]
+        out = fn(*args, **kwargs)
+        peak = tracemalloc.get_traced_memory()[1] - base
+    finally:
+        tracemalloc.stop()
+    return out, peak
+
+
+# ---------------------------------------------------------------- io: one float64 array per conversion
+
+def test_to_dph_float32_one_array_bit_identical():
+    n = 1 << 21
+    raw = np.random.default_rng(0).standard_normal((n, 1)).astype(np.float32) * np.float32(0.37)
+    scale = 3600.0  # deg/s -> deg/h
+    out, peak = _peak_bytes(to_dph, raw, scale)
+    ref = raw.astype(np.float64) * scale
+    assert out.dtype == np.float64 and out.shape == (n, 1)
+    assert np.array_equal(out.view(np.uint64), ref.view(np.uint64))  # bit for bit
+    assert 8 * n <= peak < 8 * n * 1.25  # the output only; a float64 copy then a product would be 16 n
+
+
+def test_to_dph_per_column_scale_and_ints():
+    raw = np.array([[1, -2], [3, 2**53 + 1]], dtype=np.int64)
+    scale = np.array([3600.0, 0.5])
+    ref = raw.astype(np.float64) * scale
+    assert np.array_equal(to_dph(raw, scale), ref)
+    assert to_dph(raw, 1.0).tolist() == [[1.0, -2.0], [3.0, float(2**53)]]  # int64 -> float64 rounding kept
+
+
+def test_to_dph_float64_unit_scale_is_the_input():
+    a = np.arange(6.0).reshape(3, 2)
+    assert to_dph(a, 1.0) is a
+
+
+def test_npy_reader_keeps_the_memory_map(tmp_path):
+    p = tmp_path / "x.npy"
+    np.save(p, np.arange(10, dtype=np.float32))
+    table = npy_reader.open_table(p)
+    assert table.data.dtype == np.float32 and table.data.shape == (10, 1)
+    assert isinstance(table.data.base, np.memmap) or isinstance(table.data, np.memmap)
+
+
+@pytest.mark.parametrize("unit, scale", [("deg/h", 1.0), ("deg/s", 3600.0), ("rad/s", 3600.0 * 180.0 / math.pi)])
+def test_load_float32_npy_values(tmp_path, unit, scale):
+    x = (np.random.default_rng(1).standard_normal(5000) * 3.0).astype(np.float32)
+    p = tmp_path / "g.npy"
+    np.save(p, x)
+    rec = fio.load(p, unit=unit, rate_hz=100)
+    ref = x.astype(np.float64) * scale
+    got = rec.rate_dph[:, 0]
+    assert rec.rate_dph.dtype == np.float64
+    assert np.max(np.abs(got - ref) / np.abs(ref)) <= 1e-15  # the unit's own factor, to its last digits
+    if unit == "deg/s":
+        assert np.array_equal(got, x.astype(np.float64) * 3600.0)  # bit for bit
+
+
+def test_load_float32_npy_nonfinite_is_located(tmp_path):
+    x = np.ones(100, dtype=np.float32)
+    x[42] = np.nan  # the reader now hands on float32: the scan must still find it, at the right sample
+    p = tmp_path / "nan.npy"
+    np.save(p, x)
+    with pytest.raises(DataFormatError, match=r"non-finite value at sample 42; .* got nan"):
+        fio.load(p, unit="deg/s", rate_hz=100)
+
+
+def test_load_int16_npy_values(tmp_path):
+    x = np.array([-32768, -1, 0, 1, 32767] * 10, dtype=np.int16)
+    p = tmp_path / "i.npy"
+    np.save(p, x)
+    rec = fio.load(p, unit="deg/s", rate_hz=10)
+    assert rec.rate_dph[:5, 0].tolist() == [-32768 * 3600.0, -3600.0, 0.0, 3600.0, 32767 * 3600.0]
+
+
+# ---------------------------------------------------------------- spectral: blockwise variance, offset Welch
+
+def test_variance_one_block_is_np_var_bit_for_bit():
+    x = np.random.default_rng(2).standard_normal(10_001) * 7.0 + 1e3
+    assert spectral._variance(x, x.mean()) == np.var(x)
+
+
+@pytest.mark.parametrize("block", [1, 7, 4096])
+def test_variance_blockwise_against_exact_sum(block):
+    x = np.random.default_rng(3).standard_normal(20_000) * 0.5 + 123.0
+    mean = x.mean()
+    exact = math.fsum((v - mean) ** 2 for v in x.tolist()) / x.size  # population variance (divisor n)
+    got = spectral._variance(x, mean, block)
+    assert abs(got - exact) <= 1e-12 * exact
+    assert abs(got - np.var(x)) <= 1e-12 * exact
+
+
+def test_variance_hand_value():
+    x = np.array([1.0, 2.0, 3.0, 4.0])  # mean 2.5, squared deviations 2.25 + 0.25 + 0.25 + 2.25 = 5
+    assert spectral._variance(x, 2.5, 3) == 1.25
+
+
+def test_variance_memory_is_one_block():
+    n, block = 1 << 22, 1 << 16
+    x = np.random.default_rng(4).standard_normal(n)
+    _, peak = _peak_bytes(spectral._variance, x, x.mean(), block)
+    assert peak <= 8 * block * 3  # two blocks at most (the next before the last is freed); np.var: 8 n (32 MiB)
+
+
+def test_welch_offset_equals_welch_of_the_centred_record():
+    x = np.random.default_rng(5).standard_normal(50_000) + 40.0
+    mean = x.mean()
+    f0, p0, n0 = spectral._welch(x - mean, 100.0, 1024, chunk_samples=8192)
+    f1, p1, n1 = spectral._welch(x, 100.0, 1024, chunk_samples=8192, offset=mean)
+    assert n0 == n1 and np.array_equal(f0, f1)
+    assert np.array_equal(p0, p1)  # same element-wise subtraction: bit for bit
+
+
+def test_analyse_spectrum_variance_blockwise(monkeypatch):
+    t = np.arange(1 << 16) * 0.01
+    x = np.random.default_rng(6).standard_normal(t.size) + 2.0 * np.sin(2 * np.pi * 7.0 * t) + 50.0
+    one = spectral.analyse_spectrum(x, 0.01)
+    monkeypatch.setattr(spectral, "VAR_BLOCK", 1000)
+    many = spectral.analyse_spectrum(x, 0.01)
+    assert one.variance_dph2 == np.var(x)
+    assert abs(many.variance_dph2 - np.var(x)) <= 1e-12 * np.var(x)
+    assert [ln.freq_hz for ln in many.lines] == [ln.freq_hz for ln in one.lines]
