@@ -8,7 +8,7 @@ from ._app import (FLAGS, EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, Stat
                    console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, progress, run, warn,
                    with_load_options)
 from ._tables import noise_table, print_noise_notes, relabel_note
-from .noise import SpecOpt
+from ._spec import SpecOpt, print_spec_for_allan, read_spec_option
 
 DEFAULT_OUT = Path("out/allan")
 
@@ -38,11 +38,7 @@ def allan(
         precheck(estimator=estimator, terms=term_list)
         cfg = AnalysisConfig(taus=parse_taus(taus), estimator=estimator, fit_tau_s=parse_fit_taus(fit_taus),
                              terms=term_list, statistic=statistic, outliers=outliers).validate()
-        limits = None
-        if spec is not None:  # read before the work: a bad spec file is one line, nothing computed
-            from ..spec import read_spec
-
-            limits = read_spec(spec)
+        limits = read_spec_option(spec)  # read before the work: a bad spec file is one line, nothing computed
         record = load.load()
         echo_record(load, record)
         # the plausibility check (as _app.check_plausible) keeps the octave ADEV sums of its noise floors: the
@@ -76,8 +72,6 @@ def allan(
 
             console.print("  " + summary_line(temp), highlight=False)
         if limits is not None:
-            from .noise import print_spec_for_allan
-
             print_spec_for_allan(limits, results, record, r.out.path, spec.name)
         files = write_allan_outputs(results, record, r.out.path)
         r.wrote()

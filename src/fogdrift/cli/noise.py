@@ -21,6 +21,8 @@ import typer
 from ..errors import ConfigError
 from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run, say,
                    with_load_options)
+# (the --spec helpers live in the light cli._spec; imported here under their old names too)
+from ._spec import SpecOpt, channel_kinds, print_spec_comparison, print_spec_for_allan, read_spec_option  # noqa: F401
 
 DEFAULT_OUT = Path("out/noise")
 
@@ -38,12 +40,6 @@ CurveOpt = Annotated[Optional[Path], typer.Option("--curve", help="Fit a publish
                                                                   "adev, n_samples, sample_rate_hz); the unit comes "
                                                                   "from its 'unit' column or --unit.")]
 SensorOpt = Annotated[Optional[str], typer.Option("--sensor", help="With --curve: the table's sensor_key to fit.")]
-SpecOpt = Annotated[Optional[Path], typer.Option(
-    "--spec", help="Datasheet limits (YAML or JSON, each with its unit, e.g. gyro: {arw: \"2 deg/sqrt(h)\", "
-                   "bias_instability: \"0.007 deg/s\"}): pass / fail / cannot tell per channel, judged with the 95 % "
-                   "interval (data/specs/adis16405.yaml is an example).")]
-
-
 def _optional_file(func):
     """Make the FILE argument optional (``--curve`` replaces it)."""
     sig = inspect.signature(func)
@@ -62,49 +58,6 @@ def _fmt(x, digits=4):
 
 def _interval(lo, hi) -> str:
     return "–" if lo is None or hi is None else f"[{_fmt(lo)}, {_fmt(hi)}]"
-
-
-def channel_kinds(record) -> dict:
-    """Axis name -> ``"gyro"`` or ``"accel"`` from the record's channel quantities (gyro when not stated)."""
-    from ..spec import channel_kind
-
-    sig = getattr(record, "signal", None)
-    chans = {c.name: getattr(c, "quantity", None) for c in getattr(sig, "channels", ())} if sig is not None else {}
-    return {name: channel_kind(chans.get(name)) for name in record.axis_names}
-
-
-def print_spec_comparison(spec: dict, channels: dict, out_dir=None, *, source: str = "") -> list:
-    """Judge ``spec`` (:func:`fogdrift.spec.read_spec`) on ``channels`` (name -> (kind, {item: Reading})), print the
-    table and the line saying which B was compared; write spec.json into ``out_dir`` when given.  Returns the
-    judgements.  (Callable from any command that has Allan or GMWM readings.)"""
-    from ..report import write_json
-    from ..spec import B_COMPARED, compare
-
-    js = compare(spec, channels)
-    title = f"datasheet comparison: {spec['sensor'] or source}" + (f" ({source})" if spec["sensor"] and source else "")
-    if not js:
-        say(f"{title}: no limit applies to these channels (the spec has "
-            f"{', '.join(sorted({l.kind for l in spec['limits']}))} limits only)", style="yellow")
-    else:
-        console.print(fitted_table(title + "; every limit read as an upper limit",
-                                   ["channel", "term", "limit", "estimate, 95 % interval", "verdict", "why"],
-                                   [[j.channel, j.limit.item, j.limit.text, j.estimate, j.verdict, j.reason]
-                                    for j in js]))
-    say(f"  {B_COMPARED}", style="dim")
-    if out_dir is not None:
-        write_json({"fogdrift_result": "spec", "spec": source, "sensor": spec["sensor"],
-                    "b_compared": B_COMPARED, "judgements": [j.to_dict() for j in js]}, out_dir / "spec.json")
-    return js
-
-
-def print_spec_for_allan(limits: dict, results, record, out_dir, source: str) -> list:
-    """``--spec`` after an Allan fit (``fogdrift allan``, ``noise --method allan``): the comparison of every axis of
-    ``results`` (:func:`fogdrift.pipeline.run_allan`), printed and written to ``out_dir/spec.json``."""
-    from ..spec import readings_from_noise_fit
-
-    kinds = channel_kinds(record)
-    return print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_noise_fit(a.noise, kinds[a.name]))
-                                          for a in results}, out_dir, source=source)
 
 
 def print_gmwm(title, axes, quantities=None):
@@ -176,11 +129,7 @@ def noise(
             raise ConfigError(f"{{opt:method}} must be 'gmwm' or 'allan'; got {method!r}")
         if (curve is None) == (load.file is None):
             raise ConfigError("give either a log FILE or {opt:curve} TABLE (one of them)")
-        limits = None
-        if spec is not None:  # refuse a bad spec before any work
-            from ..spec import read_spec
-
-            limits = read_spec(spec)
+        limits = read_spec_option(spec)  # refuse a bad spec before any work
         if method == "allan":
             if curve is not None or model.lower() != "auto" or scales is not None or robust:
                 raise ConfigError("--curve, --model, --scales and --robust belong to --method gmwm; the Allan "

@@ -1,0 +1,90 @@
+"""``--spec FILE`` on the command line: the option, and the datasheet comparison printed on the console.
+
+A light module (typer and the CLI's console only; :mod:`fogdrift.spec` is imported when a comparison runs), so that
+``allan``, ``noise``, ``analyze`` and ``batch`` share the option without importing one another: ``fogdrift allan
+--help`` imports no other command.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ._app import console, fitted_table, say
+
+__all__ = ["SpecOpt", "channel_kinds", "read_spec_option", "print_spec_comparison", "print_spec_for_allan",
+           "spec_settings"]
+
+SpecOpt = Annotated[Optional[Path], typer.Option(
+    "--spec", help="Datasheet limits (YAML or JSON, each with its unit, e.g. gyro: {arw: \"2 deg/sqrt(h)\", "
+                   "bias_instability: \"0.007 deg/s\"}): pass / fail / cannot tell per channel, judged with the 95 % "
+                   "interval (data/specs/adis16405.yaml is an example).")]
+
+
+def read_spec_option(spec: Path | None):
+    """The parsed spec of ``--spec`` (:func:`fogdrift.spec.read_spec`), or None without it.  Called before any work:
+    a bad spec file is one line (:class:`~fogdrift.errors.ConfigError`), nothing computed."""
+    if spec is None:
+        return None
+    from ..spec import read_spec
+
+    return read_spec(spec)
+
+
+def spec_settings(limits: dict, source: str) -> dict:
+    """A parsed spec as plain JSON-able data for a batch's settings (each limit in its item's canonical unit, and as
+    written); :func:`fogdrift.fleet.commands.spec_from_settings` turns it back.  Part of the settings hash: a
+    changed limit recomputes the files."""
+    return {"source": source, "sensor": limits["sensor"],
+            "limits": [{"kind": l.kind, "item": l.item, "value": l.value, "text": l.text} for l in limits["limits"]]}
+
+
+def channel_kinds(record) -> dict:
+    """Axis name -> ``"gyro"`` or ``"accel"`` from the record's channel quantities (gyro when not stated)."""
+    from ..spec import channel_kind
+
+    sig = getattr(record, "signal", None)
+    chans = {c.name: getattr(c, "quantity", None) for c in getattr(sig, "channels", ())} if sig is not None else {}
+    return {name: channel_kind(chans.get(name)) for name in record.axis_names}
+
+
+def print_spec_comparison(spec: dict, channels: dict, out_dir=None, *, source: str = "") -> list:
+    """Judge ``spec`` (:func:`fogdrift.spec.read_spec`) on ``channels`` (name -> (kind, {item: Reading})), print the
+    table and the line saying which B was compared; write spec.json into ``out_dir`` when given.  Returns the
+    judgements.  (Callable from any command that has Allan or GMWM readings.)"""
+    from ..spec import compare
+
+    return print_judgements(spec, compare(spec, channels), out_dir, source=source)
+
+
+def print_judgements(spec: dict, js: list, out_dir=None, *, source: str = "") -> list:
+    """Print judgements made already (:func:`fogdrift.spec.compare`) as :func:`print_spec_comparison` does."""
+    from ..report import write_json
+    from ..spec import B_COMPARED
+
+    title = f"datasheet comparison: {spec['sensor'] or source}" + (f" ({source})" if spec["sensor"] and source else "")
+    if not js:
+        say(f"{title}: no limit applies to these channels (the spec has "
+            f"{', '.join(sorted({l.kind for l in spec['limits']}))} limits only)", style="yellow")
+    else:
+        console.print(fitted_table(title + "; every limit read as an upper limit",
+                                   ["channel", "term", "limit", "estimate, 95 % interval", "verdict", "why"],
+                                   [[j.channel, j.limit.item, j.limit.text, j.estimate, j.verdict, j.reason]
+                                    for j in js]))
+    say(f"  {B_COMPARED}", style="dim")
+    if out_dir is not None:
+        write_json({"fogdrift_result": "spec", "spec": source, "sensor": spec["sensor"],
+                    "b_compared": B_COMPARED, "judgements": [j.to_dict() for j in js]}, Path(out_dir) / "spec.json")
+    return js
+
+
+def print_spec_for_allan(limits: dict, results, record, out_dir, source: str) -> list:
+    """``--spec`` after an Allan fit (``fogdrift allan``, ``noise --method allan``): the comparison of every axis of
+    ``results`` (:func:`fogdrift.pipeline.run_allan`), printed and written to ``out_dir/spec.json``."""
+    from ..spec import readings_from_noise_fit
+
+    kinds = channel_kinds(record)
+    return print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_noise_fit(a.noise, kinds[a.name]))
+                                          for a in results}, out_dir, source=source)
