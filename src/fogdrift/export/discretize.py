@@ -26,12 +26,12 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..models.statespace import check_components, components_from_allan, state_space
+from ..noise.terms import TERM_TABLE, TERMS
 from .conversions import DEG
 from .model import ChannelModel
 
 __all__ = ["van_loan", "channel_components", "continuous_model", "discrete_model", "COMPONENT_RATE_UNIT"]
 
-_B_AVAR = 2.0 * math.log(2.0) / math.pi
 #: Rate unit of a channel's statespace components, and its value in SI.
 COMPONENT_RATE_UNIT = {"gyro": ("deg/h", DEG / 3600.0), "accel": ("m/s^2", 1.0)}
 
@@ -78,13 +78,13 @@ def channel_components(ch: ChannelModel, *, max_flicker_terms: int = 4) -> tuple
     unit, scale = COMPONENT_RATE_UNIT[ch.quantity]
     A = np.zeros(5)
     used, left = [], []
-    for i, name in enumerate(("Q", "N", "B", "K", "R")):
+    for i, name in enumerate(TERMS):
         t = ch.terms.get(name)
         if t is None:
             continue
         if (t.has_estimate or (ch.no_fit and t.value is not None)) and t.si:
             x = t.si / scale
-            A[i] = {"Q": 3.0 * x * x, "N": x * x, "B": _B_AVAR * x * x, "K": x * x / 3.0, "R": x * x / 2.0}[name]
+            A[i] = TERM_TABLE[name].avar_coefficient * x * x     # the Allan law c X^2 of the term table
             used.append(name)
         else:
             left.append({"term": name, "reason": t.reason or "not in the selected model",

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import ConfigError, DataFormatError
+from ..noise.terms import TERMS
 from .conversions import quantity_of_unit, single_gm_from_flicker, to_si
 
 __all__ = ["TermValue", "GaussMarkov", "ChannelModel", "MISSING_POLICIES", "Resolved", "load_result",
@@ -207,7 +208,7 @@ def _allan_channel(ax: dict, record: dict, path: str) -> ChannelModel:
     fit = noise.get("fit") or {}
     no_fit = noise.get("no_fit") is not None
     terms = {}
-    for name in ("Q", "N", "B", "K", "R"):
+    for name in TERMS:
         t = noise["terms"].get(name)
         if t is None:
             continue

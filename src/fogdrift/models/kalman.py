@@ -32,6 +32,7 @@ import numpy as np
 from .._util import check_series
 from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError
 from ..gmwm.analysis import analyse_gmwm
+from ..noise.terms import TERMS
 from .base import DriftModel
 from .components import components_from_gmwm
 from .statespace import (
@@ -52,7 +53,7 @@ NOISE_METHODS = ("allan", "gmwm")
 GMWM_MIN_SAMPLES = 128
 
 
-def identify_components(y, dt_s: float, *, terms=("Q", "N", "B", "K", "R")) -> tuple[list[dict], dict]:
+def identify_components(y, dt_s: float, *, terms=TERMS) -> tuple[list[dict], dict]:
     """Noise components of a rate series [deg/h] from its Allan variance (training block only).
 
     Returns ``(components, info)``; ``info`` holds the Allan coefficients ``A`` ((deg/h)^2, s),

@@ -52,6 +52,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ConfigError
+from ..noise.terms import TERM_TABLE, TERMS
+from ..units import URAD_PER_ARCSEC
 
 __all__ = [
     "COMPONENT_KINDS",
@@ -65,9 +67,8 @@ __all__ = [
     "forecast_uncertainty",
 ]
 
-_URAD_PER_ARCSEC = 1e6 * math.pi / (180.0 * 3600.0)
-#: Flat Allan variance of flicker rate noise in units of B^2: 2 ln 2 / pi.
-_B_AVAR = 2.0 * math.log(2.0) / math.pi
+#: Flat Allan variance of flicker rate noise in units of B^2: 2 ln 2 / pi (the B row of the term table).
+_B_AVAR = TERM_TABLE["B"].avar_coefficient
 
 #: Component kinds -> (parameter keys in order, one-line description with units). Data, not code.
 COMPONENT_KINDS: dict[str, tuple[tuple[str, ...], str]] = {
@@ -199,7 +200,7 @@ def flicker_as_gauss_markov(b_dph: float, tau_min_s: float, tau_max_s: float, *,
             for t, v in zip(tcs, var) if v > 0]
 
 
-def components_from_allan(A, *, tau_range_s, terms=("Q", "N", "B", "K", "R"), ramp="random_walk",
+def components_from_allan(A, *, tau_range_s, terms=TERMS, ramp="random_walk",
                           max_flicker_terms: int = 4) -> list[dict]:
     """Noise components from Allan-law coefficients A_-2..A_2 ((deg/h)^2, tau in s).
 
@@ -248,7 +249,7 @@ def components_from_allan(A, *, tau_range_s, terms=("Q", "N", "B", "K", "R"), ra
     if "N" in terms and a[1] > 0:
         out.append({"kind": "white", "arw_dprh": math.sqrt(a[1]) / 60.0})
     if "Q" in terms and a[0] > 0:
-        out.append({"kind": "quantization", "q_urad": math.sqrt(a[0] / 3.0) * _URAD_PER_ARCSEC})
+        out.append({"kind": "quantization", "q_urad": math.sqrt(a[0] / 3.0) * URAD_PER_ARCSEC})
     if "K" in terms and a[3] > 0:
         out.append({"kind": "random_walk", "rrw_dphrh": 60.0 * math.sqrt(3.0 * a[3])})
     if "B" in terms and a[2] > 0:
@@ -339,7 +340,7 @@ def state_space(components, *, dt_s: float, bias_prior_dph: float) -> StateSpace
         if kind == "white":
             r += (60.0 * c["arw_dprh"]) ** 2 / dt
         elif kind == "quantization":
-            q = c["q_urad"] / _URAD_PER_ARCSEC
+            q = c["q_urad"] / URAD_PER_ARCSEC
             r += 2.0 * q * q / (dt * dt)
         elif kind == "random_walk":
             has_rw = True

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..units import B_FACTOR, URAD_PER_ARCSEC
-from .terms import DISPLAY_UNITS, TERM_UNITS
+from .terms import ALL_TERMS, DISPLAY_UNITS, TERM_UNITS, TERMS
 
 __all__ = ["Readout", "slope_readouts"]
 
@@ -87,13 +87,13 @@ def slope_readouts(tau_s, adev_dph, fit=None) -> dict:
     else:
         out["B"] = Readout("B", None, "deg/h", None, None, None,
                            "the ADEV has no interior minimum (still falling or rising at the record's end)")
-    return {t: out[t] for t in ("Q", "N", "B", "K", "R")}
+    return {t: out[t] for t in TERMS}
 
 
 def _judge(term, value, unit, tau, slope, fit) -> Readout:
     if fit is None or fit.statistic != "adev":
         return Readout(term, value, unit, tau, slope, None, "")
-    parts = {n: float(fit.term_dev_dph(n, [tau])[0]) ** 2 for n in ("Q", "N", "B", "K", "R", "S", "M")}
+    parts = {n: float(fit.term_dev_dph(n, [tau])[0]) ** 2 for n in ALL_TERMS}
     total = sum(parts.values())
     share = parts[term] / total if total > 0 else 0.0
     dominated = share >= 0.5
