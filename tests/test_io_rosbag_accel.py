@@ -198,6 +198,7 @@ def test_cli_fields_flag(tmp_path):
     out = _ok(CliRunner().invoke(app, ["allan", str(path), "--fields", "both", "--out", str(tmp_path / "o")],
                                  env={"COLUMNS": "220"}))
     assert "N [deg/√h]" in out and "N [m/s/√h]" in out
+    assert "(declared by the message definition)" in out and "in the header" not in out
     out = _ok(CliRunner().invoke(app, ["allan", str(path), "--fields", "accel", "--out", str(tmp_path / "a")],
                                  env={"COLUMNS": "220"}))
     assert "N [m/s/√h]" in out and "deg/√h" not in out

@@ -196,3 +196,32 @@ def test_a_plugged_in_reader_with_options_needs_no_cli_edit(tmp_path):
     assert res["got"]["rates"] == pytest.approx([r * 2.5 * 3600.0 for r in rates[3:]], rel=1e-12)
     assert res["flags"]["toy_gain"] == "--toy-gain"
     assert registry.READERS[-1].name == "text"                         # this process's table is untouched
+
+
+def test_console_says_where_a_declared_unit_came_from(tmp_path):
+    """Text: "declared in the header" (as before); HDF5: "declared by the file"; an unknown declared unit in HDF5
+    is named the same way (a bag's "declared by the message definition" is checked in test_io_rosbag_accel)."""
+    h5py = pytest.importorskip("h5py")
+    import numpy as np
+
+    t = np.arange(4000) * 0.01
+    p = tmp_path / "log.h5"
+    with h5py.File(p, "w") as f:
+        g = f.create_group("imu")
+        g.create_dataset("t", data=t).attrs["units"] = "s"
+        g.create_dataset("gz", data=np.random.default_rng(1).normal(size=t.size)).attrs["units"] = "deg/s"
+    res = CliRunner().invoke(app, ["allan", str(p), "--dataset", "/imu", "--out", str(tmp_path / "o")],
+                             env={"COLUMNS": "300"})
+    assert res.exit_code == 0, res.output
+    assert "units: rate deg/s (declared by the file)" in res.output and "in the header" not in res.output
+    q = tmp_path / "log.csv"
+    w = np.random.default_rng(2).normal(size=4000)
+    q.write_text("t_s,gz[deg/s]\n" + "".join(f"{0.01 * i:.2f},{w[i]:.6f}\n" for i in range(4000)))
+    res = CliRunner().invoke(app, ["allan", str(q), "--out", str(tmp_path / "c")], env={"COLUMNS": "300"})
+    assert res.exit_code == 0, res.output
+    assert "units: rate deg/s (declared in the header)" in res.output
+    with h5py.File(p, "a") as f:
+        f["imu/gz"].attrs["units"] = "degC"
+    res = CliRunner().invoke(app, ["allan", str(p), "--dataset", "/imu", "--out", str(tmp_path / "d")],
+                             env={"COLUMNS": "300"})
+    assert res.exit_code == 1 and "unknown unit 'degC' declared by the file" in res.output

@@ -438,14 +438,28 @@ def echo_record(load: "LoadOptions", record, path=None, *, unit_flag: str = "--u
         rate_src = f"from time column '{smp.time_column}'"
     else:
         rate_src = "from the file's time stamps"
-    words = {"option": unit_flag, "header": "declared in the header"}
+    declared = _declared_words(load, path)
+    words = {"option": unit_flag, "header": declared}
     units = f"rate {record.input_unit} ({words.get(chan.unit_source, chan.unit_source)})"
     if smp.time_unit is not None:
-        words = {"option": time_unit_flag, "header": "declared in the header"}
+        words = {"option": time_unit_flag, "header": declared}
         units += f", time {smp.time_unit} ({words.get(smp.time_unit_source, smp.time_unit_source)})"
     say(f"{path.name}: {record.n_samples} samples x {record.n_axes} {'axis' if record.n_axes == 1 else 'axes'} ({', '.join(record.axis_names)}), "
         f"{record.duration_s:.6g} s at {record.fs_hz:.6g} Hz (dt {record.dt_s:.6g} s {rate_src}); units: {units}; "
         + _converted_words(record))
+
+
+def _declared_words(load, path) -> str:
+    """A unit the file states, in words: "declared in the header" (text), "declared by the message definition"
+    (ROS bags), else "declared by the file" (HDF5/.mat attributes, miniSEED ...)."""
+    from ..io.registry import reader_by_name, select_reader
+
+    try:
+        spec = reader_by_name(load.format) if load.format else select_reader(path)
+    except FogdriftError:
+        return "declared by the file"
+    return {"text": "declared in the header", "rosbag": "declared by the message definition"}.get(
+        spec.module, "declared by the file")
 
 
 def _converted_words(record) -> str:

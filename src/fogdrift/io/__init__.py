@@ -12,8 +12,10 @@ no analysis.  Supported inputs:
 * NumPy ``.npz`` (several 1-D arrays = named columns, or a single 2-D array);
 * HDF5 (h5py) and MATLAB ``.mat`` v4/v5/v7 (SciPy) and v7.3 (h5py): a dataset, group,
   variable or struct as named columns, HDF5 ``units`` attributes honoured;
-* ROS 1 bags and ROS 2 bag directories (rosbags): ``sensor_msgs/Imu`` angular velocity in rad/s,
-  time from header stamps or receive time;
+* ROS 1 bags and ROS 2 bag directories (rosbags): ``sensor_msgs/Imu`` angular velocity in rad/s
+  (gx, gy, gz) and linear acceleration in m/s^2 (ax, ay, az), each unit declared by the message
+  definition; the gyro channels by default (reader option ``fields``: gyro, accel or both); time
+  from header stamps or receive time;
 * miniSEED (ObsPy): channels as axes, gain as a number or from a response file;
 * raw binary records declared by a NumPy dtype ``layout``, with scale factors and a wrapping
   sequence counter whose jumps are gaps, read through a memory map.
@@ -76,7 +78,9 @@ How to add a reader
    parser's exceptions, :data:`fogdrift.io.readers.base.PARSER_ERRORS`).  Import heavy
    dependencies inside the module: it is imported only when such a file is read.
 2. Add one line to :data:`fogdrift.io.registry.READERS`: name, module, magic bytes,
-   extensions, accepted reader options (``load(..., reader_options={...})``).
+   extensions, accepted reader options (``load(..., reader_options={...})``), each a
+   :class:`~fogdrift.io.registry.ReaderOption` (name, type, help, flag): every command of the
+   CLI then has its flag, with no edit in :mod:`fogdrift.cli`.
 3. Test it like ``tests/test_io_formats.py``: values against the writer's, located errors,
    the SHA-256 against :func:`hashlib.sha256` of the file.
 
