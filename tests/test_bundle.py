@@ -202,9 +202,9 @@ def test_non_finite_parameters_are_refused_at_load(fitted, tmp_path):
     arrays["coef_"] = np.full_like(arrays["coef_"], np.nan)
     np.savez(npz, **arrays)
     # hashes made consistent, as a careful editor would: the seal passes, the parameters do not
-    from fogdrift.bundle import _sha256
+    from fogdrift.io.hashing import file_sha256
 
-    doc["axes"][0]["models"]["ar"]["sha256"]["npz"] = _sha256(npz)
+    doc["axes"][0]["models"]["ar"]["sha256"]["npz"] = file_sha256(npz)
     _write(dst, doc)
     with pytest.raises(ModelFileError, match="parameter 'coef_' of gx/ar holds NaN or inf"):
         load_bundle(dst)

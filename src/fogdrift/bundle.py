@@ -50,8 +50,9 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from ._util import json_default, safe_name
+from ._util import safe_name, strict_json
 from .errors import ConfigError, FogdriftError, ModelFileError
+from .io.hashing import file_sha256
 from .output import atomic_path
 from .signal import Channel, Sampling, SignalDescription
 
@@ -330,14 +331,6 @@ def bundle_from_model_axes(model_axes, cfg, record) -> Bundle:
     )
 
 
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def save_bundle(bundle: Bundle, out_dir) -> Path:
     """Write ``bundle`` to the directory ``out_dir`` (created; an existing manifest is replaced); returns it."""
     out = Path(out_dir)
@@ -350,7 +343,7 @@ def save_bundle(bundle: Bundle, out_dir) -> Path:
             json_path, npz_path = model.save(out / rel)
             files[name] = {"file": rel, "class": type(model).__name__, "label": model.label,
                            "input": model.input_kind,
-                           "sha256": {"json": _sha256(json_path), "npz": _sha256(npz_path)}}
+                           "sha256": {"json": file_sha256(json_path), "npz": file_sha256(npz_path)}}
         axes_doc.append({
             "name": ax.name, "bias_dph": ax.bias_dph, "bias_method": ax.bias_method,
             "earth_rate_dph": ax.earth_rate_dph, "earth_orientation": ax.earth_orientation, "level": ax.level,
@@ -368,22 +361,12 @@ def save_bundle(bundle: Bundle, out_dir) -> Path:
     }
     if bundle.signal is not None:
         doc["signal"] = bundle.signal.to_dict()
-    text = json.dumps(seal_manifest(_finite(json.loads(json.dumps(doc, default=json_default)))), indent=2,
-                      allow_nan=False)
+    # sealed over the strict (NaN -> null) tree that is written: one serialiser, _util.strict_json
+    text = strict_json(seal_manifest(json.loads(strict_json(doc, indent=None))))
     # the manifest last and whole (temporary name, renamed): a bundle without one is incomplete, never half-read
     with atomic_path(out / MANIFEST) as tmp:
         tmp.write_text(text)
     return out
-
-
-def _finite(obj):
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_finite(v) for v in obj]
-    return obj
 
 
 def write_bundle(out_dir, model_axes, cfg, record) -> Bundle:
@@ -561,7 +544,7 @@ def load_bundle(path) -> Bundle:
             for ext, f in zip(("json", "npz"), model_file_paths(base)):
                 if not f.is_file():
                     raise ModelFileError(f"{f}: model file of {name}/{key} is missing")
-                if sums.get(ext) != _sha256(f):
+                if sums.get(ext) != file_sha256(f):
                     raise ModelFileError(f"{f}: SHA-256 differs from the manifest; the model file was modified "
                                          "after the bundle was written")
             _check_finite_parameters(model_file_paths(base)[1], f"{name}/{key}")

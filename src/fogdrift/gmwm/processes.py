@@ -47,6 +47,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import ConfigError
+from ..units import B_FACTOR
 
 __all__ = [
     "Process",
@@ -60,8 +61,9 @@ __all__ = [
     "B_FLAT_WV",
 ]
 
-#: Flat Haar WV of flicker noise in units of B^2: ln2 / pi = (2 ln2 / pi) B^2 / 2.
-B_FLAT_WV = math.log(2.0) / math.pi
+#: Flat Haar WV of flicker noise in units of B^2: ln2 / pi = (2 ln2 / pi) B^2 / 2 (half the flat Allan variance,
+#: :data:`fogdrift.units.B_FACTOR` squared).
+B_FLAT_WV = B_FACTOR**2 / 2.0
 
 _SQRT_H = 60.0  # sqrt(3600 s / h)
 

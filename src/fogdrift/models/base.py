@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._util import check_series, json_default
+from .._util import check_series, strict_json
 from ..errors import ConfigError, ModelFileError, NotFittedError
 from ..output import atomic_path
 from .registry import class_for_file, file_class_names
@@ -120,7 +120,7 @@ class DriftModel:
         }
         # each file complete or absent (temporary name, renamed when written): fogdrift.output.atomic_path
         with atomic_path(json_path) as tmp:
-            tmp.write_text(json.dumps(doc, indent=2, default=json_default))
+            tmp.write_text(strict_json(doc))
         with atomic_path(npz_path) as tmp:
             np.savez(tmp, **{k: np.asarray(v) for k, v in arrays.items()})
         return json_path, npz_path
