@@ -34,11 +34,14 @@ def read_spec_option(spec: Path | None):
 
 
 def spec_settings(limits: dict, source: str) -> dict:
-    """A parsed spec as plain JSON-able data for a batch's settings (each limit in its item's canonical unit, and as
-    written); :func:`fogdrift.fleet.commands.spec_from_settings` turns it back.  Part of the settings hash: a
-    changed limit recomputes the files."""
-    return {"source": source, "sensor": limits["sensor"],
-            "limits": [{"kind": l.kind, "item": l.item, "value": l.value, "text": l.text} for l in limits["limits"]]}
+    """A parsed spec (:func:`fogdrift.spec.read_spec`) back as the mapping of a spec file, each limit as written
+    (``{"source": "adis16405.yaml", "sensor": ..., "gyro": {"arw": "2 deg/sqrt(h)"}, ...}``): the plain, JSON-able
+    ``settings["spec"]`` of a batch (:func:`fogdrift.fleet.commands.spec_from_settings` parses it in each task).
+    Part of the settings hash: a changed limit recomputes the files."""
+    out = {"source": source, "sensor": limits["sensor"]}
+    for lim in limits["limits"]:
+        out.setdefault(lim.kind, {})[lim.item] = lim.text
+    return out
 
 
 def channel_kinds(record) -> dict:

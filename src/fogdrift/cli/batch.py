@@ -17,6 +17,7 @@ import typer
 from ..errors import ConfigError
 from ._app import (FLAGS, LOAD_PARAMS, EstOpt, FitTausOpt, LoadOptions, OutliersOpt, StatisticOpt, TausOpt, TermsOpt,
                    app, csv_list, parse_fit_taus, parse_taus, parse_terms, precheck, progress_count, run, say)
+from ._spec import SpecOpt, read_spec_option, spec_settings
 from .noise import ModelOpt, RobustOpt, ScalesOpt
 
 FLAGS.update({"glob": "--glob", "command": "--command", "scheduler": "--scheduler", "workers": "--workers"})
@@ -61,6 +62,25 @@ def _set_items(items) -> dict:
 DEFAULT_OUT = Path("out/batch")
 
 
+def _print_spec_counts(rows, limits: dict, source: str) -> None:
+    """The batch's datasheet comparison in counts: one line per judged item (pass / fail / cannot tell), and which B
+    was compared; the verdict and reason of every axis are the summary's ``spec_<item>`` columns."""
+    from ..fleet.summary import spec_count_lines
+    from ..spec import B_COMPARED
+
+    lines = spec_count_lines(rows)
+    title = f"datasheet comparison: {limits['sensor'] or source}" + (f" ({source})" if limits["sensor"] else "")
+    if not lines:
+        say(f"{title}: no axis was judged (the spec has {', '.join(sorted({l.kind for l in limits['limits']}))} "
+            "limits only, or every file failed)", style="yellow")
+    else:
+        say(f"{title}, axes per verdict (each axis judged against its own section, gyro or accel; the reasons are "
+            "the summary's spec_<item>_why columns):")
+        for line in lines:
+            say(f"  {line}")
+    say(f"  {B_COMPARED}", style="dim")
+
+
 def _command_help() -> str:
     from ..fleet.commands import COMMANDS  # light: the table, not the commands' libraries
 
@@ -93,6 +113,7 @@ def batch(
     model: ModelOpt = "auto",
     scales: ScalesOpt = None,
     robust: RobustOpt = False,
+    spec: SpecOpt = None,
     set_: Annotated[Optional[list[str]], typer.Option(
         "--set", help="Any other analysis setting NAME=VALUE (fogdrift.pipeline.AnalysisConfig), repeatable.")] = None,
     fail_on_error: Annotated[bool, typer.Option(
@@ -105,9 +126,10 @@ def batch(
     """Run allan, noise or analyze over many logs x axes on Dask; write summary.parquet and a fleet page."""
     from ..fleet import BatchOutputDir, command_spec, run_batch
 
-    with run("batch", out, default_out=DEFAULT_OUT, inputs=list(inputs), expect=("summary.parquet", "fleet.html"),
-             out_class=BatchOutputDir):
+    with run("batch", out, default_out=DEFAULT_OUT, inputs=list(inputs) + ([spec] if spec else []),
+             expect=("summary.parquet", "fleet.html"), out_class=BatchOutputDir):
         command_spec(command)
+        limits = read_spec_option(spec)  # read once, before any work: a bad spec is one line
         if load.gaps not in ("error", "longest"):
             raise ConfigError(f"{{opt:gaps}} must be 'error' or 'longest' in a batch, got {load.gaps!r}")
         term_list = parse_terms(terms)
@@ -129,6 +151,8 @@ def batch(
         settings = {"load": kwargs, "gaps": load.gaps, "analysis": analysis}
         if command == "noise":  # only what was given: a default run keeps the settings hash of earlier runs
             settings["gmwm"] = {k: v for k, v in gmwm.items() if v not in (None, False, "auto")}
+        if limits is not None:  # only with --spec: a run without one keeps the settings hash of earlier runs
+            settings["spec"] = spec_settings(limits, spec.name)
         with progress_count(f"batch {command}", "files") as update:
             def progress(done, total, name):
                 update(done, total, note=f"last finished: {name}")
@@ -140,6 +164,8 @@ def batch(
         for row in result.rows:
             if row.get("status") == "error":
                 say(f"  {row['file']}: {row.get('error')}", style="red")
+        if limits is not None:
+            _print_spec_counts(result.rows, limits, spec.name)
         say(f"summary: {result.summary_path}")
         if result.page_path is not None:
             say(f"fleet page: {result.page_path}")

@@ -21,11 +21,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from ..errors import ConfigError
+from ..errors import ConfigError, FogdriftError
 from ..noise.terms import TERM_TABLE
 
 __all__ = ["CommandSpec", "COMMANDS", "command_spec", "noise_columns", "record_columns", "run_allan_command",
-           "run_analyze_command", "TERMS"]
+           "run_analyze_command", "TERMS", "spec_from_settings", "axis_kind"]
 
 #: IEEE-952 coefficients in the summary, with the unit suffix of their columns, read from the term table
 #: (``("Q", "urad"), ("N", "dprh"), ("B", "dph"), ("K", "dphrh"), ("R", "dph2")``).
@@ -120,6 +120,49 @@ def noise_columns(noise) -> dict:
     return row
 
 
+def spec_from_settings(settings: dict):
+    """The datasheet limits of a batch (``settings["spec"]``: a spec file's mapping, e.g. ``{"sensor": "ADIS16405",
+    "gyro": {"arw": "2 deg/sqrt(h)"}, "accel": {"vrw": "0.2 m/s/sqrt(h)"}}``), parsed by
+    :func:`fogdrift.spec.parse_spec`; None without one.  ConfigError (one line) for a bad spec."""
+    data = settings.get("spec")
+    if data is None:
+        return None
+    from ..spec import parse_spec
+
+    source = data.get("source") if isinstance(data, dict) else None
+    return parse_spec(data, source=f"spec {source}" if source else "settings spec")
+
+
+def axis_kind(record, name: str) -> str:
+    """``"gyro"`` or ``"accel"``: the spec section an axis is judged against (its channel's quantity)."""
+    from ..spec import channel_kind
+
+    try:
+        quantity = record.signal.channel(name).quantity
+    except (FogdriftError, AttributeError):  # no such channel / no signal description: a gyro, as everywhere else
+        quantity = None
+    return channel_kind(quantity)
+
+
+def _spec_allan(limits, record, name: str, noise) -> dict:
+    """``spec_<item>`` / ``spec_<item>_why`` columns of an Allan fit (none without a spec)."""
+    if limits is None:
+        return {}
+    from ..spec import judge_noise_fit, spec_columns
+
+    return spec_columns(judge_noise_fit(limits, name, noise, axis_kind(record, name)))
+
+
+def _spec_gmwm(limits, record, axis) -> dict:
+    """``spec_<item>`` / ``spec_<item>_why`` columns of a GMWM axis (none without a spec)."""
+    if limits is None:
+        return {}
+    from ..spec import compare, readings_from_gmwm, spec_columns
+
+    kind = axis_kind(record, axis.name)
+    return spec_columns(compare(limits, {axis.name: (kind, readings_from_gmwm(axis, kind))}))
+
+
 def _config(settings: dict):
     from ..pipeline import AnalysisConfig
 
@@ -135,9 +178,11 @@ def run_allan_command(record, settings: dict, out_dir) -> list[dict]:
     from ..pipeline import run_allan
     from ..report import write_allan_outputs
 
+    limits = spec_from_settings(settings)
     results = run_allan(record, _config(settings))
     write_allan_outputs(results, record, out_dir)
-    return [{"axis": a.name, **record_columns(record), **noise_columns(a.noise)} for a in results]
+    return [{"axis": a.name, **record_columns(record), **noise_columns(a.noise),
+             **_spec_allan(limits, record, a.name, a.noise)} for a in results]
 
 
 def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
@@ -152,6 +197,7 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     from ..report import write_report
 
     cfg = _config(settings)
+    limits = spec_from_settings(settings)
     result = run_analysis(record, cfg)
     evaluations = {ev.axis: ev for ev in evaluate_analysis(result)}
     write_report(result, record, out_dir, evaluated=True)
@@ -163,7 +209,8 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
         rows.append({"axis": ax.name, **record_columns(record), **noise_columns(ax.original.noise),
                      "verdict": " ".join(paper_measure_verdict(ax.models).lines),
                      "compensation_outcome": None if ev is None else str(ev.outcome),
-                     "compensation_headline": None if ev is None else " ".join(ev.headline.lines)})
+                     "compensation_headline": None if ev is None else " ".join(ev.headline.lines),
+                     **_spec_allan(limits, record, ax.name, ax.original.noise)})
     return rows
 
 
@@ -185,6 +232,7 @@ def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
     from ..report.gmwm import write_gmwm_outputs
 
     opts = settings.get("gmwm", {})
+    limits = spec_from_settings(settings)
     axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=opts.get("model", "auto"),
                          levels=opts.get("levels"), robust=bool(opts.get("robust", False)))
             for name in record.axis_names]
@@ -192,7 +240,8 @@ def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
     # an accelerometer axis's reading in its units (B stays m/s^2 here; the batch row shows it in ug)
     axes = [express_gmwm(a, record.signal.channel(a.name).quantity) for a in axes]
     write_gmwm_outputs(axes, out_dir, source=str(record.source), record=record.metadata())
-    return [{"axis": a.name, **record_columns(record), **gmwm_columns(a)} for a in axes]
+    return [{"axis": a.name, **record_columns(record), **gmwm_columns(a), **_spec_gmwm(limits, record, a)}
+            for a in axes]
 
 
 def gmwm_columns(axis) -> dict:

@@ -234,7 +234,9 @@ def run_batch(inputs, out_dir, *, command: str = "allan", settings: dict | None 
         A name of :data:`fogdrift.fleet.commands.COMMANDS` (``"allan"``, ``"analyze"``).
     settings : dict, optional
         ``{"load": {...keywords of fogdrift.io.load...}, "gaps": "error"|"longest", "analysis":
-        {...fields of fogdrift.pipeline.AnalysisConfig...}}``; validated before any work.
+        {...fields of fogdrift.pipeline.AnalysisConfig...}}``, optionally ``"spec"`` (datasheet limits as a spec
+        file's mapping, :func:`fogdrift.fleet.commands.spec_from_settings`: each row gets ``spec_<item>`` verdict
+        columns); validated before any work.
     pattern : str, optional
         Glob for the files inside folders (``"*.csv.gz"``); also filters explicit files.
     scheduler : None, "serial" or str
@@ -323,9 +325,12 @@ def _run(od, paths, spec, settings, scheduler, workers, page, progress, flags, t
 
 
 def _validate(settings: dict) -> None:
-    unknown = set(settings) - {"load", "gaps", "analysis", "gmwm"}
+    unknown = set(settings) - {"load", "gaps", "analysis", "gmwm", "spec"}
     if unknown:
-        raise ConfigError(f"unknown batch settings {sorted(unknown)}; expected load, gaps, analysis, gmwm")
+        raise ConfigError(f"unknown batch settings {sorted(unknown)}; expected load, gaps, analysis, gmwm, spec")
+    from .commands import spec_from_settings
+
+    spec_from_settings(settings)  # a bad spec: one line before any work
     gmwm = settings.get("gmwm", {})
     if set(gmwm) - {"model", "levels", "robust"}:
         raise ConfigError(f"unknown gmwm settings {sorted(set(gmwm) - {'model', 'levels', 'robust'})}; "

@@ -23,7 +23,15 @@ from .commands import TERMS
 #: :data:`TERMS` columns; the ``{name}_status`` column is shared (:func:`fogdrift.fleet.tasks.split_by_quantity`).
 ACCEL_TERMS = tuple((name, spec.suffix.lstrip("_")) for name, spec in ACCEL_TERM_TABLE.items())
 
-__all__ = ["ACCEL_TERMS", "COLUMNS", "UNITS", "write_summary", "read_summary", "schema"]
+__all__ = ["ACCEL_TERMS", "COLUMNS", "SPEC_ITEMS", "UNITS", "write_summary", "read_summary", "schema", "spec_counts",
+           "spec_count_lines"]
+
+#: The datasheet items a batch row can be judged on (``--spec``; :data:`fogdrift.spec.ITEMS`, each item once: the
+#: gyro's and the accelerometer's bias instability share ``spec_bias_instability``, told apart by ``quantity``).
+SPEC_ITEMS = ("arw", "vrw", "bias_instability")
+
+#: The three verdicts of :func:`fogdrift.spec.judge`, in the order they are counted.
+SPEC_VERDICTS = ("pass", "fail", "cannot tell")
 
 #: (column, type, unit or meaning).  Types: str, int, float, bool.
 COLUMNS: tuple = (
@@ -81,6 +89,11 @@ COLUMNS: tuple = (
                                     ">= 5 % lower RMS AND better at most non-overlapping origins): reduces, mixed, "
                                     "none or undetermined"),
     ("compensation_headline", "str", "analyze: the headline verdict sentence"),
+    *[c for item in SPEC_ITEMS for c in (
+        (f"spec_{item}", "str", f"--spec: the {item} datasheet limit of the axis's section (gyro or accel): pass, "
+                                "fail or cannot tell, judged with the 95 % interval (null: no such limit)"),
+        (f"spec_{item}_why", "str", f"--spec: why spec_{item} is what it is"),
+    )],
     ("wall_s", "float", "s, processing time of the file (0 when cached)"),
     ("settings_sha256", "str", "SHA-256 of the command and its settings (re-runs skip unchanged files)"),
 )
@@ -124,3 +137,39 @@ def read_summary(path) -> list[dict]:
     """Rows of a ``summary.parquet`` as dicts (pyarrow, no pandas needed)."""
     pq = require("pyarrow.parquet", "fleet", "reading the batch summary (Parquet)")
     return pq.read_table(Path(path)).to_pylist()
+
+
+def spec_counts(rows) -> dict:
+    """``(kind, item)`` -> ``{"pass": n, "fail": n, "cannot tell": n}`` over the rows' ``spec_<item>`` columns, kind
+    ``gyro`` or ``accel`` from the row's ``quantity`` (error rows and rows without a verdict are not counted).
+
+    Examples
+    --------
+    >>> spec_counts([{"quantity": "angular_rate", "spec_arw": "pass"},
+    ...              {"quantity": "specific_force", "spec_vrw": "fail", "spec_bias_instability": "cannot tell"}])
+    {('gyro', 'arw'): {'pass': 1, 'fail': 0, 'cannot tell': 0}, ('accel', 'vrw'): {'pass': 0, 'fail': 1, \
+'cannot tell': 0}, ('accel', 'bias_instability'): {'pass': 0, 'fail': 0, 'cannot tell': 1}}
+    """
+    out: dict = {}
+    for row in rows:
+        if row.get("status") == "error":
+            continue
+        kind = "accel" if row.get("quantity") == "specific_force" else "gyro"
+        for item in SPEC_ITEMS:
+            verdict = row.get(f"spec_{item}")
+            if verdict is None:
+                continue
+            counts = out.setdefault((kind, item), dict.fromkeys(SPEC_VERDICTS, 0))
+            counts[verdict] = counts.get(verdict, 0) + 1
+    return out
+
+
+def spec_count_lines(rows) -> list[str]:
+    """One line per judged ``kind item`` for the batch's console summary: ``gyro arw: 3 pass, 0 fail, 0 cannot tell
+    (of 3 axes)``; empty when no row was judged."""
+    lines = []
+    for (kind, item), c in spec_counts(rows).items():
+        n = sum(c.values())
+        lines.append(f"{kind} {item}: " + ", ".join(f"{c.get(v, 0)} {v}" for v in SPEC_VERDICTS)
+                     + f" (of {n} ax{'is' if n == 1 else 'es'})")
+    return lines
