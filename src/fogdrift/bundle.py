@@ -246,22 +246,6 @@ def _registry_name(label: str) -> str:
     raise ConfigError(f"fitted model {label!r} is not in the model registry")
 
 
-def _level_of(ma, cfg=None) -> int:
-    """The lifting level the pipeline decided for this axis (:attr:`fogdrift.pipeline.ModelAxis.level`).
-
-    Kept for callers that imported it; read ``ma.level``.
-    """
-    return int(ma.level)
-
-
-def _causal_window(ma, cfg=None, level=None) -> int:
-    """The causal-drift window the pipeline decided (:attr:`fogdrift.pipeline.ModelAxis.causal_window`).
-
-    Kept for callers that imported it; read ``ma.causal_window``.
-    """
-    return int(ma.causal_window)
-
-
 def _allan_noise_model(x, dt_s) -> dict:
     from .allan import allan_variance
     from .noise import fit_noise

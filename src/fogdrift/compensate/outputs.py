@@ -21,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..output import TMP_PREFIX, atomic_path
+from ..output import TMP_PREFIX
+from ..report.figures import _plt, _save, literal
 
 __all__ = ["CsvWriter", "NpzWriter", "AllanAccumulator", "plot_before_after"]
 
@@ -152,16 +153,12 @@ def plot_before_after(curves, path, title, caveats: dict | None = None) -> Path:
     """
     import textwrap
 
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = _plt()  # matplotlib stays lazy (Agg backend), as for every figure of the package
     n = len(curves)
     fig, axs = plt.subplots(1, n, figsize=(5.2 * n, 4.2), squeeze=False)
     for ax, (name, before, after, label) in zip(axs[0], curves):
         positive = False
-        for r, color, text in ((before, "k", "log (bias removed)"), (after, "C3", f"compensated: {label}")):
+        for r, color, text in ((before, "k", "log (bias removed)"), (after, "C3", f"compensated: {literal(label)}")):
             ok = np.asarray(r.adev_dph) > 0  # a log scale shows positive ADEVs only (a constant log has none)
             positive = positive or bool(ok.any())
             yerr = np.vstack([r.adev_dph - r.adev_lo68_dph, r.adev_hi68_dph - r.adev_dph])[:, ok]
@@ -170,17 +167,11 @@ def plot_before_after(curves, path, title, caveats: dict | None = None) -> Path:
         ax.set_yscale("log" if positive else "linear")
         ax.set_xlabel("τ [s]")
         ax.set_ylabel("σ(τ) [deg/h]")
-        ax.set_title(f"{title}: {name}")
+        ax.set_title(literal(f"{title}: {name}"))  # a column name is user text, never mathtext
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
         text = (caveats or {}).get(name)
         if text:
-            ax.text(0.0, -0.17, textwrap.fill(text, width=80), transform=ax.transAxes, ha="left", va="top",
+            ax.text(0.0, -0.17, literal(textwrap.fill(text, width=80)), transform=ax.transAxes, ha="left", va="top",
                     fontsize=7, color="C3" if "not evidence" in text or "not checked" in text else "k")
-    path = Path(path)
-    try:
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    finally:
-        plt.close(fig)
-    return path
+    return _save(fig, path, dpi=110, bbox_inches="tight")  # atomic, and the figure closed whatever happens

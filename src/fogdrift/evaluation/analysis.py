@@ -1,15 +1,16 @@
 """The evaluation as part of an analysis result: heading error, artefact check and verdicts of every axis.
 
-:func:`evaluate_analysis` runs :func:`evaluate_axis` on the test block of every axis of a
+:func:`evaluated_analysis` runs :func:`evaluate_axis` on the test block of every axis of a
 :class:`fogdrift.pipeline.AnalysisResult` (and of its ``apply_to`` result: the models applied unchanged to a
-second recording) and stores an :class:`AxisEvaluation` in ``axis.evaluation``, so that
-``AnalysisResult.to_dict()`` (``analysis.json``) and the report carry it.
+second recording) and returns a new result whose axes carry an :class:`AxisEvaluation` in ``axis.evaluation``,
+so that ``AnalysisResult.to_dict()`` (``analysis.json``) and the report carry it.  :func:`evaluate_analysis` is
+the older in-place form its callers still use.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from ..errors import FogdriftError
 from ..interrupt import checkpoint
@@ -17,7 +18,7 @@ from .artefacts import artefact_check
 from .heading import HORIZONS_S, heading_errors
 from .verdicts import compensation_verdicts, headline_verdict, table2_verdict
 
-__all__ = ["AxisEvaluation", "evaluate_analysis", "evaluate_axis"]
+__all__ = ["AxisEvaluation", "evaluate_analysis", "evaluate_axis", "evaluated_analysis"]
 
 
 @dataclass
@@ -69,9 +70,56 @@ class AxisEvaluation:
         }
 
 
+def evaluated_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, horizons_s=HORIZONS_S,
+                       artefacts: bool = True):
+    """A copy of ``result`` whose every axis (and every axis of ``result.apply_to``) carries its evaluation.
+
+    ``result`` is not changed: each axis is rebuilt with :func:`dataclasses.replace` (``evaluation`` set), and
+    so is the result (``axes``, ``apply_to``).  Parameters as :func:`evaluate_analysis`.
+
+    Returns
+    -------
+    fogdrift.pipeline.AnalysisResult
+        The evaluated result; ``[ax.evaluation for ax in out.axes]`` are the evaluations of the fitted
+        recording, ``out.apply_to.axes`` those of the ``apply_to`` recording.
+    """
+    if result is None:
+        return None
+    axes = [replace(ax, evaluation=_evaluate_one(ax, result.config, calib_s=calib_s, step_s=step_s,
+                                                 horizons_s=horizons_s, artefacts=artefacts))
+            for ax in result.axes]
+    other = getattr(result, "apply_to", None)
+    apply_to = evaluated_analysis(other, calib_s=calib_s, step_s=step_s, horizons_s=horizons_s,
+                                  artefacts=artefacts)
+    return replace(result, axes=axes, apply_to=apply_to) if other is not None else replace(result, axes=axes)
+
+
+def _evaluate_one(ax, cfg, *, calib_s, step_s, horizons_s, artefacts) -> AxisEvaluation:
+    checkpoint("heading-error and artefact evaluation", axis=ax.name)
+    t0 = time.perf_counter()
+    ev = evaluate_axis(ax.models, cfg, artefacts=artefacts, calib_s=calib_s, step_s=step_s,
+                       horizons_s=tuple(horizons_s))
+    reason = "; ".join(n for n in ev["notes"] if "heading" in n) or ""
+    headline = headline_verdict(ev["heading"], ev["artefacts"], axis=ax.name, reason=reason)
+    flag = table2_verdict(getattr(ax, "table2", None) or [], ev["artefacts"], axis=ax.name)
+    verdicts = list(ev["verdicts"])
+    if flag is not None:  # Table 2's practical rows that the artefact check flags (the HTML marks them too)
+        verdicts.append(flag)
+    return AxisEvaluation(
+        axis=ax.name, heading=ev["heading"], artefacts=ev["artefacts"], verdicts=verdicts,
+        headline=headline, notes=list(ev["notes"]),
+        settings={"calibration_window_s": float(calib_s), "origin_step_s": float(step_s),
+                  "horizons_s": [float(h) for h in horizons_s], "artefacts": bool(artefacts)},
+        wall_s=time.perf_counter() - t0)
+
+
 def evaluate_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, horizons_s=HORIZONS_S,
                       artefacts: bool = True) -> list:
-    """Evaluate every axis of ``result`` (and of ``result.apply_to``) in place; return the evaluations.
+    """Evaluate every axis of ``result`` (and of ``result.apply_to``); return the evaluations.
+
+    Kept for its callers (``fogdrift analyze``, ``fleet``), which read the evaluations from ``result``
+    afterwards: it stores each in ``axis.evaluation`` of the given result.  New code should use
+    :func:`evaluated_analysis`, which returns a new, complete result and changes nothing.
 
     Parameters
     ----------
@@ -92,27 +140,14 @@ def evaluate_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, h
         The fitted recording's axes first, then the ``apply_to`` recording's; each is also stored as
         ``axis.evaluation``.
     """
+    done = evaluated_analysis(result, calib_s=calib_s, step_s=step_s, horizons_s=horizons_s, artefacts=artefacts)
     out = []
-    for res in (result, getattr(result, "apply_to", None)):
+    for res, new in ((result, done), (getattr(result, "apply_to", None), getattr(done, "apply_to", None))):
         if res is None:
             continue
-        for ax in res.axes:
-            checkpoint("heading-error and artefact evaluation", axis=ax.name)
-            t0 = time.perf_counter()
-            ev = evaluate_axis(ax.models, res.config, artefacts=artefacts, calib_s=calib_s, step_s=step_s,
-                               horizons_s=tuple(horizons_s))
-            reason = "; ".join(n for n in ev["notes"] if "heading" in n) or ""
-            headline = headline_verdict(ev["heading"], ev["artefacts"], axis=ax.name, reason=reason)
-            flag = table2_verdict(getattr(ax, "table2", None) or [], ev["artefacts"], axis=ax.name)
-            if flag is not None:  # Table 2's practical rows that the artefact check flags (the HTML marks them too)
-                ev["verdicts"].append(flag)
-            ax.evaluation = AxisEvaluation(
-                axis=ax.name, heading=ev["heading"], artefacts=ev["artefacts"], verdicts=ev["verdicts"],
-                headline=headline, notes=list(ev["notes"]),
-                settings={"calibration_window_s": float(calib_s), "origin_step_s": float(step_s),
-                          "horizons_s": [float(h) for h in horizons_s], "artefacts": bool(artefacts)},
-                wall_s=time.perf_counter() - t0)
-            out.append(ax.evaluation)
+        for ax, ax_new in zip(res.axes, new.axes):
+            ax.evaluation = ax_new.evaluation  # the legacy in-place contract (see evaluated_analysis)
+            out.append(ax_new.evaluation)
     return out
 
 
@@ -133,10 +168,8 @@ def evaluate_axis(model_axis, cfg, *, heading=True, artefacts=True, calib_s=300.
         ``{"heading": HeadingResult or None, "artefacts": ArtefactResult or None, "verdicts": [Verdict, ...],
         "notes": [str]}``; an evaluation the test block is too short for is None with a note.
     """
-    from ..bundle import _causal_window, _level_of  # H-signal: a public function replaces these
-
-    level = _level_of(model_axis, cfg)
-    window = _causal_window(model_axis, cfg, level)
+    level = int(model_axis.level)  # decided once by the pipeline and stored on the ModelAxis
+    window = int(model_axis.causal_window)
     e, f = model_axis.split["test"]
     z = model_axis.rate_dph[e:f]
     opts = dict(causal_window=window, wavelet=cfg.wavelet, level=level, mode=cfg.mode, axis=model_axis.name)
