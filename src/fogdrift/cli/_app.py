@@ -48,7 +48,7 @@ from .. import __version__
 from .. import interrupt
 from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
 from ..io import load as _io_load
-from ..io.registry import cli_options
+from ..io.registry import cli_options, reader_by_name, select_reader
 from ..output import OutputDir
 
 app = typer.Typer(
@@ -452,8 +452,6 @@ def echo_record(load: "LoadOptions", record, path=None, *, unit_flag: str = "--u
 def _declared_words(load, path) -> str:
     """A unit the file states, in words: "declared in the header" (text), "declared by the message definition"
     (ROS bags), else "declared by the file" (HDF5/.mat attributes, miniSEED ...)."""
-    from ..io.registry import reader_by_name, select_reader
-
     try:
         spec = reader_by_name(load.format) if load.format else select_reader(path)
     except FogdriftError:

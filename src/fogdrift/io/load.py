@@ -45,6 +45,8 @@ DT_TOLERANCE = 0.01
 SHORT_STEP_FACTOR = 0.7
 #: Largest spread of the time steps (median absolute deviation / sample interval) of a uniform grid.
 JITTER_TOLERANCE = 0.05
+#: A unit the file states, in words, by ``Table.format`` (else "declared by the file": HDF5/.mat attributes, miniSEED).
+_SAID = {"text": "declared in the header", "bag": "declared by the message definition"}.get
 
 
 def load(
@@ -541,13 +543,6 @@ def _resolve_columns(table: Table, columns, time_column, temperature=None):
     return t_idx, r_idx, table_time, tm_idx
 
 
-def _declared(table: Table) -> str:
-    """Where a unit the file states comes from, in words: a text header, a bag's message definition, or the file
-    (HDF5/.mat attributes, miniSEED, npz names)."""
-    return {"text": "declared in the header", "bag": "declared by the message definition"}.get(
-        table.format, "declared by the file")
-
-
 def _header_error(table: Table, message: str, col: int) -> DataFormatError:
     return DataFormatError(message, path=table.path, line=table.header_line or None, column=table.label(col))
 
@@ -590,10 +585,11 @@ def _rate_unit(table: Table, r_idx, unit, notes: list):
             spec = units.parse_unit(declared[j].strip(), None)
         except ConfigError:
             raise _header_error(
-                table, f"unknown unit {declared[j]!r} {_declared(table)}; expected one of {valid_units()} "
-                       f"(or pass {{opt:unit}}), got {declared[j]!r}", j,
+                table, f"unknown unit {declared[j]!r} {_SAID(table.format, 'declared by the file')}; expected one "
+                       f"of {valid_units()} (or pass {{opt:unit}}), got {declared[j]!r}", j,
             ) from None
-        check_name(table.names[j], spec, f"the unit {declared[j]!r} {_declared(table)}", str(table.path))
+        check_name(table.names[j], spec, f"the unit {declared[j]!r} {_SAID(table.format, 'declared by the file')}",
+                   str(table.path))
         # one unit per quantity: a gyro+accelerometer log may declare gx[deg/s] and ax[g], not gx[deg/s], gy[rad/s]
         if first_of.setdefault(spec.quantity, spec.text) != spec.text:
             raise _header_error(table, different, j)
@@ -670,7 +666,7 @@ def _time_scale(table: Table, t_idx, time_unit, notes: list) -> tuple[float, str
         unit = declared.strip()
         if unit not in units.TIME_UNITS:
             raise _header_error(
-                table, f"unknown time unit {unit!r} {_declared(table)}; expected one of "
+                table, f"unknown time unit {unit!r} {_SAID(table.format, 'declared by the file')}; expected one of "
                        f"{list(units.TIME_UNITS)} (or pass {{opt:time_unit}}), got {unit!r}", t_idx,
             )
     elif time_unit_of_name(name) is not None:
