@@ -116,3 +116,25 @@ def test_compensate_figure_draws_a_mathtext_column_name_as_written(tmp_path):
     assert res.exit_code == 0, res.output
     assert "Traceback" not in res.output
     assert (tmp_path / "o" / "compensation_allan.png").stat().st_size > 1000
+
+
+def test_gmwm_ieee_terms_are_noise_terms_and_map_to_the_same_fleet_columns():
+    """One IEEE-term type: GMWM's reading is a NoiseTerm (name, unit of the term table, reason), and N of white
+    noise of known ARW comes back in deg/sqrt(h) (0.1 deg/sqrt(h) = 6 deg/h sqrt(s): sigma = 6/sqrt(dt) deg/h)."""
+    from fogdrift.fleet.commands import ieee_columns
+    from fogdrift.gmwm.analysis import GmwmTerm, analyse_gmwm
+    from fogdrift.noise import NoiseTerm, TERM_UNITS
+
+    dt = 0.1
+    x = np.random.default_rng(3).standard_normal(2**15) * (6.0 / math.sqrt(dt))
+    ax = analyse_gmwm("gx", x, dt, model="WN")
+    terms = ax.ieee_terms()
+    assert GmwmTerm is NoiseTerm and list(terms) == ["Q", "N", "B", "K", "R"]
+    for name, t in terms.items():
+        assert isinstance(t, NoiseTerm) and t.name == name and t.unit == TERM_UNITS[name]
+    n = terms["N"]
+    assert n.status == "resolved" and n.reason == "" and n.lo95 < 0.1 < n.hi95
+    assert n.value == pytest.approx(0.1, rel=0.03)
+    assert terms["K"].status == "absent" and terms["K"].value is None and "not in the selected GMWM model" in terms["K"].reason
+    row = ieee_columns(terms, {})
+    assert row["N_dprh"] == pytest.approx(n.value) and row["K_status"] == "absent"

@@ -26,6 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, DataFormatError
+from ..noise.result import NoiseTerm
+from ..noise.terms import TERM_TABLE
 from .processes import parse_model
 from .selection import SelectionResult, select_model
 from .wvar import WvarResult, from_curve, haar_wvar
@@ -43,14 +45,9 @@ _IEEE_ORDER = (("N_dprh", "N"), ("K_dphrh", "K"), ("R_dph2", "R"), ("Q_urad", "Q
                ("B_dph", "B"))
 
 
-@dataclass(frozen=True)
-class GmwmTerm:
-    """One IEEE-952 term as a GMWM model implies it (the fields a report cell and a summary row need)."""
-
-    value: float | None
-    lo95: float | None
-    hi95: float | None
-    status: str
+#: One IEEE-952 term as a GMWM model implies it: the one IEEE-term value type, :class:`fogdrift.noise.NoiseTerm`
+#: (the name is kept for code that imported it).
+GmwmTerm = NoiseTerm
 
 
 @dataclass
@@ -65,16 +62,16 @@ class GmwmAxis:
     allan_check: dict | None = None
 
     def ieee_terms(self) -> dict:
-        """The five IEEE-952 terms the selected model implies, as :class:`GmwmTerm` keyed Q, N, B, K, R.
+        """The five IEEE-952 terms the selected model implies, as :class:`~fogdrift.noise.NoiseTerm` keyed Q, N, B, K, R.
 
         Units as :data:`fogdrift.noise.TERM_UNITS` (Q urad, N deg/sqrt(h), B deg/h, K deg/h^1.5, R deg/h^2).
         B is the flicker term when the model has one and ``absent`` otherwise: the bias-instability readings of
         a model without one (the minimum of its ADEV, a GM hump) are readings, not terms, and live in
         :attr:`fogdrift.gmwm.ieee.IEEEResult.b_headline` / ``b_details``.  ``status`` is ``resolved`` when the
-        95 % interval excludes zero, ``unresolved`` when it does not, ``absent`` when the model has no such term.
+        95 % interval excludes zero, ``unresolved`` when it does not, ``absent`` when the model has no such term;
+        ``reason`` says why a term is not resolved.  The same type as the Allan fit's terms, so a report cell or a
+        fleet column reads both alike.
         """
-        from ..noise.terms import TERM_TABLE
-
         ie = self.selection.ieee
         out = {}
         for name, spec in TERM_TABLE.items():
@@ -84,7 +81,9 @@ class GmwmAxis:
             else:
                 value, lo, hi = term.value, term.lo95, term.hi95
             status = "absent" if value is None else "resolved" if lo is not None and lo > 0 else "unresolved"
-            out[name] = GmwmTerm(value, lo, hi, status)
+            reason = {"absent": f"not in the selected GMWM model ({self.selection.selected})",
+                      "unresolved": "its 95 % interval reaches 0", "resolved": ""}[status]
+            out[name] = NoiseTerm(name, value, spec.unit, lo, hi, status, reason)
         return out
 
     def to_dict(self) -> dict:
