@@ -8,6 +8,8 @@ one output array passes, a second full-length array (the old path) fails.
 from __future__ import annotations
 
 import math
+import mmap
+import os
 import tracemalloc
 
 import numpy as np
@@ -15,6 +17,7 @@ import pytest
 
 import fogdrift.io as fio
 from fogdrift.errors import DataFormatError
+from fogdrift.io import _checks
 from fogdrift.io._checks import to_dph
 from fogdrift.io.readers import npy as npy_reader
 from fogdrift.noise import spectral
@@ -144,3 +147,45 @@ def test_analyse_spectrum_variance_blockwise(monkeypatch):
     assert one.variance_dph2 == np.var(x)
     assert abs(many.variance_dph2 - np.var(x)) <= 1e-12 * np.var(x)
     assert [ln.freq_hz for ln in many.lines] == [ln.freq_hz for ln in one.lines]
+
+
+# ---------------------------------------------------------------- io: mapped pages dropped after the scans
+
+def _resident_bytes():
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[1]) * mmap.PAGESIZE
+
+
+@pytest.mark.parametrize("cols, scale", [([0], 3600.0), ([0, 2], 1.0), ([1, 2], np.array([2.0, 0.5]))])
+def test_to_dph_memmap_chunks_bit_identical(tmp_path, monkeypatch, cols, scale):
+    raw = (np.random.default_rng(7).standard_normal((1001, 3)) * 5.0).astype(np.float32)
+    p = tmp_path / "m.npy"
+    np.save(p, raw)
+    monkeypatch.setattr(_checks, "CHUNK_ROWS", 4)  # 64-row chunks: 16 chunks, the last one short
+    mm = np.load(p, mmap_mode="r")
+    got = to_dph(_checks.take_columns(mm, cols), scale)
+    ref = raw[:, cols].astype(np.float64) * scale
+    assert type(got) is np.ndarray and got.dtype == np.float64
+    assert np.array_equal(got, ref)
+    assert np.array_equal(np.asarray(mm), raw)  # the map still reads the same after its pages were dropped
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/statm") or not hasattr(mmap, "MADV_DONTNEED"),
+                    reason="needs Linux /proc and madvise")
+def test_drop_mapped_pages_releases_resident_pages(tmp_path):
+    n = 8 << 20  # 32 MiB of float32
+    p = tmp_path / "big.npy"
+    np.save(p, np.ones(n, dtype=np.float32))
+    mm = np.load(p, mmap_mode="r").reshape(-1, 1)
+    assert float(mm.sum(dtype=np.float64)) == n  # every page resident now
+    before = _resident_bytes()
+    _checks.drop_mapped_pages(mm)
+    after = _resident_bytes()
+    assert before - after >= 0.9 * 4 * n
+    assert float(mm[n // 2, 0]) == 1.0  # read again from the file
+
+
+def test_drop_mapped_pages_ignores_plain_arrays():
+    a = np.ones((10, 2))
+    _checks.drop_mapped_pages(a)
+    assert a.sum() == 20.0

@@ -6,6 +6,7 @@ Private: the public entry points (:func:`~fogdrift.io.load`, :func:`~fogdrift.io
 
 from __future__ import annotations
 
+import mmap
 from pathlib import Path
 
 import numpy as np
@@ -66,12 +67,51 @@ def take_columns(a: np.ndarray, idx) -> np.ndarray:
     return a[:, idx]
 
 
+def drop_mapped_pages(block: np.ndarray) -> None:
+    """Let the kernel drop the resident pages of a read-only memory map under ``block`` (a row range).
+
+    For a view of a :class:`numpy.memmap` (the ``.npy`` and HDF5 readers), once a chunked scan is done with it:
+    a file-backed page dropped is read again from the page cache if touched later, so values never change, but
+    the scanned pages stop counting in the process's resident set (a 10^8-sample float32 file: 0.4 GB less at
+    the peak of :func:`fogdrift.io.load`).  Anything else (a plain array, a platform without ``madvise``): no-op.
+    """
+    mm = getattr(block, "_mmap", None)
+    advice = getattr(mmap, "MADV_DONTNEED", None)
+    if mm is None or advice is None or not hasattr(mm, "madvise") or block.size == 0 or block.ndim < 1:
+        return
+    try:
+        base = np.frombuffer(mm, dtype=np.uint8)
+        lo = block.__array_interface__["data"][0] - base.__array_interface__["data"][0]
+        hi = lo + (block.shape[0] - 1) * abs(block.strides[0]) + block.itemsize * (block[0].size or 1)
+        del base
+        page = mmap.PAGESIZE
+        lo = max(0, lo // page * page)
+        hi = min(len(mm), hi)
+        if hi > lo:
+            mm.madvise(advice, lo, hi - lo)
+    except (ValueError, OSError, TypeError, BufferError):
+        return
+
+
 def to_dph(a: np.ndarray, scale: float) -> np.ndarray:
-    """float64 rates in deg/h: no copy when ``a`` is float64 already and ``scale == 1``."""
+    """float64 rates in deg/h: no copy when ``a`` is float64 already and ``scale == 1``.
+
+    Otherwise one float64 array ``a * scale`` (``a`` cast to float64 first, then multiplied: NumPy's buffered
+    cast, no full-size intermediate).  A memory-mapped ``a`` is converted in row chunks, each chunk's mapped
+    pages dropped once converted (:func:`drop_mapped_pages`), so the peak is the output plus one chunk.
+    """
     if np.ndim(scale) == 0 and scale == 1.0 and a.dtype == np.float64:  # scale: one factor, or one per column
         return a
     with np.errstate(over="ignore"):  # an overflow becomes inf, which the callers locate
-        return np.multiply(a, scale, dtype=np.float64)
+        if getattr(a, "_mmap", None) is None or a.ndim != 2:
+            return np.multiply(a, scale, dtype=np.float64)
+        out = np.empty(a.shape, dtype=np.float64)
+        step = CHUNK_ROWS * 16
+        for start in range(0, a.shape[0], step):
+            block = a[start: start + step]
+            np.multiply(block, scale, out=out[start: start + step], dtype=np.float64)
+            drop_mapped_pages(block)
+        return out
 
 
 def first_nonfinite(a: np.ndarray, cols=None):
@@ -90,4 +130,5 @@ def first_nonfinite(a: np.ndarray, cols=None):
         if not ok.all():
             r, c = np.argwhere(~ok)[0]
             return start + int(r), cols[int(c)]
+        drop_mapped_pages(a[start: start + CHUNK_ROWS])
     return None
