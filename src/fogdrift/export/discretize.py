@@ -25,8 +25,9 @@ import math
 import numpy as np
 
 from ..errors import ConfigError
-from ..models.statespace import check_components, components_from_allan, state_space
+from ..models.statespace import check_components, component_densities, components_from_allan, state_space
 from ..noise.terms import TERM_TABLE, TERMS
+from ..units import URAD_PER_ARCSEC
 from .conversions import DEG
 from .model import ChannelModel
 
@@ -105,26 +106,19 @@ def continuous_model(components, scale: float) -> dict:
     Returns ``F``, ``Qc`` (SI rate unit^2 / s), ``H``, ``names``, ``white_density`` (N, SI), ``quantization``
     (Q, SI rate unit x s).
     """
+    d = component_densities(components)
     names = ["bias"]
     qc = [0.0]
     fdiag = [0.0]
-    white2 = 0.0
-    quant2 = 0.0
-    rw = [c for c in components if c["kind"] == "random_walk"]
-    if rw:
+    white2, quant2, ramps = d["white2"], d["quant2"], d["ramps"]
+    if d["random_walk"]:
         names.append("random_walk")
-        qc.append(sum((c["rrw_dphrh"] / 60.0) ** 2 for c in rw))
+        qc.append(d["rw2"])
         fdiag.append(0.0)
-    for c in components:
-        if c["kind"] == "gauss_markov":
-            names.append(f"gm_{c['tc_s']:.4g}s")
-            qc.append(2.0 * c["sigma_dph"] ** 2 / c["tc_s"])
-            fdiag.append(-1.0 / c["tc_s"])
-        elif c["kind"] == "white":
-            white2 += (60.0 * c["arw_dprh"]) ** 2
-        elif c["kind"] == "quantization":
-            quant2 += (c["q_urad"] / (1e6 * DEG / 3600.0)) ** 2
-    ramps = [c["ramp_dph2"] / 3600.0 for c in components if c["kind"] == "ramp"]
+    for tc, sigma in d["gms"]:
+        names.append(f"gm_{tc:.4g}s")
+        qc.append(2.0 * sigma**2 / tc)
+        fdiag.append(-1.0 / tc)
     n = len(names) + (2 if ramps else 0)
     F = np.zeros((n, n))
     Qc = np.zeros((n, n))
@@ -167,7 +161,7 @@ def discrete_model(ch: ChannelModel, rate_hz: float) -> dict:
         if k == "white":
             terms_si.append({"kind": k, "density": 60.0 * c["arw_dprh"] * scale, "unit": f"{si_rate}/sqrt(Hz)"})
         elif k == "quantization":
-            terms_si.append({"kind": k, "q": c["q_urad"] / (1e6 * DEG / 3600.0) * scale,
+            terms_si.append({"kind": k, "q": c["q_urad"] / URAD_PER_ARCSEC * scale,
                              "unit": "rad" if ch.quantity == "gyro" else "m/s"})
         elif k == "random_walk":
             terms_si.append({"kind": k, "density": c["rrw_dphrh"] / 60.0 * scale, "unit": f"{si_rate}/s/sqrt(Hz)"})

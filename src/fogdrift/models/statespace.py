@@ -58,6 +58,7 @@ from ..units import URAD_PER_ARCSEC
 __all__ = [
     "COMPONENT_KINDS",
     "check_components",
+    "component_densities",
     "components_from_allan",
     "flicker_as_gauss_markov",
     "gm_avar_dph2",
@@ -296,6 +297,43 @@ class StateSpace:
         return int(self.H.size)
 
 
+def component_densities(components) -> dict:
+    """The noise densities of a (checked) component list in the Allan-law units, summed per kind.
+
+    The one place the component parameters are turned into densities, for the discrete filter
+    (:func:`state_space`) and the continuous model of :mod:`fogdrift.export.discretize`.
+
+    Returns
+    -------
+    dict
+        ``white2`` white-rate PSD [(deg/h)^2 s] (N in deg/sqrt(h) x 60), ``quant2`` Q^2 [((deg/h) s)^2 = arcsec^2],
+        ``rw2`` rate-random-walk intensity [(deg/h)^2 / s] (K in deg/h^1.5 / 60), ``random_walk`` (bool: any such
+        component), ``gms`` [(tc_s, sigma_dph), ...] in order, ``ramps`` slopes [deg/h/s] (R in deg/h^2 / 3600).
+
+    Examples
+    --------
+    >>> d = component_densities([{"kind": "white", "arw_dprh": 0.1}, {"kind": "quantization", "q_urad": 4.8481368},
+    ...                          {"kind": "random_walk", "rrw_dphrh": 0.6}, {"kind": "ramp", "ramp_dph2": 36.0}])
+    >>> round(d["white2"], 9), round(d["quant2"], 6), round(d["rw2"], 9), d["random_walk"], d["ramps"]
+    (36.0, 1.0, 0.0001, True, [0.01])
+    """
+    out = {"white2": 0.0, "quant2": 0.0, "rw2": 0.0, "random_walk": False, "gms": [], "ramps": []}
+    for c in components:
+        kind = c["kind"]
+        if kind == "white":
+            out["white2"] += (60.0 * c["arw_dprh"]) ** 2
+        elif kind == "quantization":
+            out["quant2"] += (c["q_urad"] / URAD_PER_ARCSEC) ** 2
+        elif kind == "random_walk":
+            out["random_walk"] = True
+            out["rw2"] += (c["rrw_dphrh"] / 60.0) ** 2
+        elif kind == "gauss_markov":
+            out["gms"].append((c["tc_s"], c["sigma_dph"]))
+        elif kind == "ramp":
+            out["ramps"].append(c["ramp_dph2"] / 3600.0)
+    return out
+
+
 def state_space(components, *, dt_s: float, bias_prior_dph: float) -> StateSpace:
     """Build the :class:`StateSpace` of a component list (see the module docstring).
 
@@ -331,24 +369,9 @@ def state_space(components, *, dt_s: float, bias_prior_dph: float) -> StateSpace
         raise ConfigError(f"dt_s must be a finite number > 0; got {dt_s!r}")
     if not (math.isfinite(prior) and prior > 0):
         raise ConfigError(f"bias_prior_dph must be a finite number > 0; got {bias_prior_dph!r}")
-    r = 0.0
-    q_rw = 0.0
-    has_rw = False
-    gms, ramps = [], []
-    for c in comps:
-        kind = c["kind"]
-        if kind == "white":
-            r += (60.0 * c["arw_dprh"]) ** 2 / dt
-        elif kind == "quantization":
-            q = c["q_urad"] / URAD_PER_ARCSEC
-            r += 2.0 * q * q / (dt * dt)
-        elif kind == "random_walk":
-            has_rw = True
-            q_rw += (c["rrw_dphrh"] / 60.0) ** 2 * dt
-        elif kind == "gauss_markov":
-            gms.append((c["tc_s"], c["sigma_dph"]))
-        else:
-            ramps.append(c["ramp_dph2"] / 3600.0)
+    d = component_densities(comps)
+    r = d["white2"] / dt + 2.0 * d["quant2"] / (dt * dt)
+    has_rw, q_rw, gms, ramps = d["random_walk"], d["rw2"] * dt, d["gms"], d["ramps"]
     if not r > 0:
         raise ConfigError("the noise model has no white measurement noise; a Kalman filter needs a 'white' or "
                           "'quantization' component with a value > 0")
