@@ -62,15 +62,21 @@ def print_spec_comparison(spec: dict, channels: dict, out_dir=None, *, source: s
     return print_judgements(spec, compare(spec, channels), out_dir, source=source)
 
 
-def print_judgements(spec: dict, js: list, out_dir=None, *, source: str = "") -> list:
-    """Print judgements made already (:func:`fogdrift.spec.compare`) as :func:`print_spec_comparison` does."""
+def print_judgements(spec: dict, js: list, out_dir=None, *, source: str = "", compact: bool = False) -> list:
+    """Print judgements made already (:func:`fogdrift.spec.compare`) as :func:`print_spec_comparison` does;
+    ``compact``: one :func:`fogdrift.spec.judgement_line` per judgement instead of the table (``analyze``'s short
+    console summary, the lines of the report's first screen)."""
     from ..report import write_json
-    from ..spec import B_COMPARED
+    from ..spec import B_COMPARED, judgement_line
 
     title = f"datasheet comparison: {spec['sensor'] or source}" + (f" ({source})" if spec["sensor"] and source else "")
     if not js:
         say(f"{title}: no limit applies to these channels (the spec has "
             f"{', '.join(sorted({l.kind for l in spec['limits']}))} limits only)", style="yellow")
+    elif compact:
+        say(f"{title}, every limit an upper limit, judged with the 95 % interval:", style="bold")
+        for j in js:
+            say(f"  [{j.verdict.upper()}] {judgement_line(j)}")
     else:
         console.print(fitted_table(title + "; every limit read as an upper limit",
                                    ["channel", "term", "limit", "estimate, 95 % interval", "verdict", "why"],

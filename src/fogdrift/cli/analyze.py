@@ -13,6 +13,7 @@ from ._app import (gyro_only, EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, Mo
                    StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_model_rate, check_plausible, console,
                    csv_list, echo_record, fitted_table, parse_fit_taus, parse_level, parse_taus, parse_terms,
                    progress, run, say, with_load_options)
+from ._spec import SpecOpt, print_judgements, read_spec_option
 from ._tables import metrics_table, noise_table
 from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt, model_axes_text
 
@@ -82,6 +83,7 @@ def analyze(
     sensor: Annotated[Optional[str], typer.Option(
         "--sensor", help="Sensor make, model and serial number for the report's first screen and analysis.json "
                          "(logs do not carry it), e.g. 'KVH DSP-1750 s/n 1234'.")] = None,
+    spec: SpecOpt = None,
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
 ):
@@ -89,12 +91,14 @@ def analyze(
     from ..pipeline import AnalysisConfig, run_analysis
     from ..report import write_report
 
-    with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to], json_out=json_out,
-             expect=("analysis.json", "report.html") + (("report.pdf",) if pdf else ())) as r:
+    with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to, spec], json_out=json_out,
+             expect=("analysis.json", "report.html") + (("report.pdf",) if pdf else ())
+             + (("spec.json",) if spec is not None else ())) as r:
         if pdf:  # no Chromium: refused before any work
             from ..report.pdf import find_chromium
 
             find_chromium()
+        limits = read_spec_option(spec)  # a bad spec file: one line, before any work
         earth = {}
         for item in earth_axis or []:
             name, sep, orient = item.partition("=")
@@ -141,8 +145,15 @@ def analyze(
             say(model_axes_text([ax.models for ax in result.axes], record))
             _print_details(result, load.file.name, apply_to.name if apply_to else "", evaluations)
         print_summary(result, record, evaluated=heading, apply_name=apply_to.name if apply_to else "")
+        spec_doc = None
+        if limits is not None:  # the CLI judges; the report only shows the judgements
+            from ..report.summary import analysis_judgements, spec_summary
+
+            js = print_judgements(limits, analysis_judgements(result, limits), r.out.path, source=spec.name,
+                                  compact=True)
+            spec_doc = spec_summary(limits, js, spec.name)
         path = write_report(result, record, r.out.path, evaluated=heading, pdf=pdf,
-                            sensor=None if sensor is None or not sensor.strip() else sensor.strip())
+                            sensor=None if sensor is None or not sensor.strip() else sensor.strip(), spec=spec_doc)
         # the self-describing bundle 'fogdrift compensate' applies to other logs
         from ..bundle import write_bundle
 

@@ -200,7 +200,15 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     limits = spec_from_settings(settings)
     result = run_analysis(record, cfg)
     evaluations = {ev.axis: ev for ev in evaluate_analysis(result)}
-    write_report(result, record, out_dir, evaluated=True)
+    spec_doc, spec_cols = None, {}
+    if limits is not None:  # as 'analyze --spec': the verdicts on the report's first screen and in the rows
+        from ..report.summary import analysis_judgements, spec_summary
+        from ..spec import spec_columns
+
+        js = analysis_judgements(result, limits)
+        spec_doc = spec_summary(limits, js, (settings.get("spec") or {}).get("source") or "")
+        spec_cols = {ax.name: spec_columns([j for j in js if j.channel == ax.name]) for ax in result.axes}
+    write_report(result, record, out_dir, evaluated=True, spec=spec_doc)
     write_bundle(Path(out_dir) / "bundle", [ax.models for ax in result.axes], cfg, record)
     write_compensated_test_block([ax.models for ax in result.axes], out_dir, t0_s=record.t0_s)
     rows = []
@@ -210,7 +218,7 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
                      "verdict": " ".join(paper_measure_verdict(ax.models).lines),
                      "compensation_outcome": None if ev is None else str(ev.outcome),
                      "compensation_headline": None if ev is None else " ".join(ev.headline.lines),
-                     **_spec_allan(limits, record, ax.name, ax.original.noise)})
+                     **spec_cols.get(ax.name, {})})
     return rows
 
 

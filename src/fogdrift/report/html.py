@@ -25,7 +25,8 @@ from .figures import (_safe, plot_allan, plot_models, plot_residuals, plot_separ
 from .files import write_json
 from .glossary import glossary_entries
 from .settings import settings_rows
-from .summary import OUTCOME_LABELS, cannot_support, noise_headline, recording_rows, summary_dict, verdict_items
+from .summary import (OUTCOME_LABELS, SPEC_LABELS, cannot_support, noise_headline, recording_rows, summary_dict,
+                      verdict_items)
 from .tables import (METRICS_HEADERS, NOISE_HEADERS, _fmt, causal_metrics_rows, fit_cell, metrics_rows, noise_notes, noise_row,
                      readout_text, verdict)
 from .pdf import write_pdf
@@ -150,7 +151,22 @@ def _order(labels) -> list:
 # summary and settings
 
 
-def _summary_section(result, sensor, evaluated) -> str:
+def _spec_block(spec: dict) -> str:
+    """The datasheet comparison (``analyze --spec``, :func:`fogdrift.report.summary.spec_summary`): one verdict line
+    per channel and item, badged pass / fail / cannot tell, and which B reading was compared."""
+    parts = [f"<h3>Does it meet the datasheet? {_e(spec['title'])}: every limit an upper limit, judged with the "
+             "95 % interval</h3>"]
+    if spec["items"]:
+        parts.append('<ul class="verdicts spec">' + "".join(
+            f'<li class="v-{i["outcome"]}"><span class="badge">{SPEC_LABELS[i["verdict"]]}</span>{_e(i["line"])}</li>'
+            for i in spec["items"]) + "</ul>")
+    else:
+        parts.append(f'<p class="note">{_e(spec["note"])}</p>')
+    parts.append(f'<p class="note">{_e(spec["b_compared"])}.</p>')
+    return "\n".join(parts)
+
+
+def _summary_section(result, sensor, evaluated, spec=None) -> str:
     parts = ['<section class="summary" id="summary"><h2>Summary</h2>']
     parts.append(_table(["recording", ""], recording_rows(result, sensor), "kv"))
     headers, rows = noise_headline(result)
@@ -158,6 +174,8 @@ def _summary_section(result, sensor, evaluated) -> str:
     parts.append(_table(headers, rows, "noise"))
     parts.append('<p class="note">“– (&lt; x)”: not in the selected model, x = 95 % upper bound; “n/e”: not '
                  'estimable (why: below). Definitions in the <a href="#glossary">glossary</a>.</p>')
+    if spec is not None:
+        parts.append(_spec_block(spec))
     parts.append("<h3>Did drift compensation help? Heading error after a static calibration, against "
                  "constant-bias compensation (held-out test block)</h3>")
     parts.append('<ul class="verdicts">' + "".join(_verdict_li(v) for v in verdict_items(result, evaluated=evaluated))
@@ -388,8 +406,9 @@ def temperature_block(result, record, fig_dir) -> str:
             + _img(plot_rate_and_temperature(record, fig_dir / "fig_temperature.png")))
 
 
-def render_report(result, record, fig_dir, *, sensor=None, evaluated=True, generated=None) -> str:
-    """The report's HTML text (figures written to ``fig_dir`` and embedded)."""
+def render_report(result, record, fig_dir, *, sensor=None, evaluated=True, generated=None, spec=None) -> str:
+    """The report's HTML text (figures written to ``fig_dir`` and embedded); ``spec``: the datasheet comparison
+    for the first screen (:func:`fogdrift.report.summary.spec_summary`), none when None."""
     fig_dir = Path(fig_dir)
     generated = generated or datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     src = Path(str(result.source)).name
@@ -401,7 +420,7 @@ def render_report(result, record, fig_dir, *, sensor=None, evaluated=True, gener
     body = [f"<h1>fogdrift report: {_e(src)}</h1>",
             f'<p class="meta">{_e(generated)} · fogdrift {_e(result.versions.get("fogdrift", "?"))} · rates in '
             "deg/h, τ in s</p>",
-            _summary_section(result, sensor, evaluated), f"<nav>{''.join(nav)}</nav>",
+            _summary_section(result, sensor, evaluated, spec), f"<nav>{''.join(nav)}</nav>",
             _settings_section(result, generated),
             '<section id="recording"><h2>Recording</h2>',
             '<p class="note">Method: Tang et al., Chinese J. Lasers 39(10) 2012, with the corrected IEEE-952 '
@@ -419,19 +438,22 @@ def render_report(result, record, fig_dir, *, sensor=None, evaluated=True, gener
             f"<title>fogdrift report: {_e(src)}</title><style>{_CSS}</style></head><body>{''.join(body)}</body></html>")
 
 
-def write_report(result, record, out_dir, apply_record=None, *, sensor=None, evaluated=True, pdf=False) -> Path:
+def write_report(result, record, out_dir, apply_record=None, *, sensor=None, evaluated=True, pdf=False,
+                 spec=None) -> Path:
     """Write ``report.html`` (figures embedded as base64, nothing fetched) and ``analysis.json`` (the result,
     with the first screen as data under ``report_summary``); with ``pdf``, also ``report.pdf`` (headless
     Chromium, :mod:`fogdrift.report.pdf`).
 
     ``evaluated`` False says in the report that the heading-error evaluation was skipped on purpose
-    (``analyze --no-heading``); ``sensor`` names the sensor on the first screen.
+    (``analyze --no-heading``); ``sensor`` names the sensor on the first screen; ``spec`` (``analyze --spec``:
+    :func:`fogdrift.report.summary.spec_summary` of judgements the caller made) puts the datasheet verdicts on the
+    first screen and under ``report_summary.spec``.
     """
     out = Path(out_dir)
     doc = result.to_dict()
-    doc["report_summary"] = summary_dict(result, sensor, evaluated=evaluated)
+    doc["report_summary"] = summary_dict(result, sensor, evaluated=evaluated, spec=spec)
     write_json(doc, out / "analysis.json")
-    page = render_report(result, record, out / "figures", sensor=sensor, evaluated=evaluated)
+    page = render_report(result, record, out / "figures", sensor=sensor, evaluated=evaluated, spec=spec)
     path = out / "report.html"
     with atomic_path(path) as tmp:
         tmp.write_text(page, encoding="utf-8")

@@ -17,14 +17,20 @@ from ..noise import TERM_TABLE
 from ..noise.terms import DISPLAY_UNITS, TERMS
 from .tables import _fmt, noise_row, shaped_cell, term_text
 
-__all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "recording_rows", "noise_headline", "verdict_items",
-           "cannot_support", "summary_dict"]
+__all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "SPEC_LABELS", "SPEC_OUTCOMES", "recording_rows", "noise_headline",
+           "verdict_items", "cannot_support", "summary_dict", "analysis_judgements", "spec_summary"]
 
 #: Terms of the headline table, in the order an engineer reads them (white noise first, quantization last).
 HEADLINE_TERMS = ("N", "B", "K", "R", "Q")
 
 #: Outcome of a headline verdict -> badge text (the colour is never the only signal).
 OUTCOME_LABELS = {"reduces": "REDUCES", "mixed": "MIXED", "none": "NO GAIN", "undetermined": "CANNOT JUDGE"}
+
+
+#: Datasheet verdict (:func:`fogdrift.spec.judge`) -> badge text, and the outcome class whose colour it borrows
+#: (pass green, fail red, cannot tell grey; the badge text says it, the colour is never the only signal).
+SPEC_LABELS = {"pass": "PASS", "fail": "FAIL", "cannot tell": "CANNOT TELL"}
+SPEC_OUTCOMES = {"pass": "reduces", "fail": "none", "cannot tell": "undetermined"}
 
 
 def _duration(seconds) -> str:
@@ -244,11 +250,47 @@ def cannot_support(result) -> dict:
             "items": _grouped(items)}
 
 
-def summary_dict(result, sensor: str | None = None, *, evaluated: bool = True) -> dict:
-    """The first screen as JSON-able data (stored in ``analysis.json`` as ``report_summary``)."""
+def analysis_judgements(result, limits: dict, kind: str = "gyro") -> list:
+    """The datasheet judgements (:func:`fogdrift.spec.compare`) of every axis of an analysis, read from the noise
+    model its headline shows: the GMWM axis when every axis has one (``--noise-method gmwm``), else the Allan fit of
+    the whole record.  ``limits``: a parsed spec (:func:`fogdrift.spec.read_spec`; the CLI reads the file, this
+    function reads nothing); ``kind``: the spec section (``analyze`` takes gyro logs).
+
+    Returns
+    -------
+    list of fogdrift.spec.Judgement
+        Per axis, in the spec's order.
+    """
+    from ..spec import compare, readings_from_gmwm, readings_from_noise_fit
+
+    axes = list(result.axes)
+    gmwm = bool(axes) and all(getattr(ax, "gmwm", None) is not None for ax in axes)
+    return compare(limits, {ax.name: (kind, readings_from_gmwm(ax.gmwm, kind) if gmwm
+                                      else readings_from_noise_fit(ax.original.noise, kind)) for ax in axes})
+
+
+def spec_summary(limits: dict, judgements, source: str = "") -> dict:
+    """The first screen's datasheet comparison as JSON-able data: ``title``, one ``items`` dict per judgement
+    (``verdict``, ``outcome`` for its colour, ``line``: :func:`fogdrift.spec.judgement_line`, and the judgement's
+    fields), ``b_compared`` (which B reading was compared, :data:`fogdrift.spec.B_COMPARED`) and ``note`` when no
+    limit applies."""
+    from ..spec import B_COMPARED, judgement_line
+
+    title = f"{limits['sensor'] or source}" + (f" ({source})" if limits["sensor"] and source else "")
+    items = [{**j.to_dict(), "outcome": SPEC_OUTCOMES[j.verdict], "line": judgement_line(j)} for j in judgements]
+    note = None if items else ("no limit applies to these channels (the spec has "
+                               f"{', '.join(sorted({l.kind for l in limits['limits']}))} limits only)")
+    return {"title": title, "items": items, "b_compared": B_COMPARED, "note": note}
+
+
+def summary_dict(result, sensor: str | None = None, *, evaluated: bool = True, spec: dict | None = None) -> dict:
+    """The first screen as JSON-able data (stored in ``analysis.json`` as ``report_summary``); ``spec``: the
+    datasheet comparison (:func:`spec_summary`), under ``spec`` only when given."""
     headers, rows = noise_headline(result)
     out = {"recording": dict(recording_rows(result, sensor)), "noise": {"headers": headers, "rows": rows},
            "verdicts": verdict_items(result, evaluated=evaluated), "cannot_support": cannot_support(result)}
+    if spec is not None:
+        out["spec"] = spec
     if getattr(result, "apply_to", None) is not None:
         out["apply_to_verdicts"] = verdict_items(result.apply_to, evaluated=evaluated)
     return out
