@@ -1,0 +1,74 @@
+"""Tests added for the surviving mutants of ``fogdrift.noise.quantity`` (issue 24 item 2, docs/testing.md "Round 2:
+new modules (issues 21-23)"): :func:`express` re-states every number of a fit (value, interval, B_min and its SI
+copy, read-outs) by the factor of its own term, relabels the units, and leaves a gyro fit alone.
+
+The factors themselves are pinned by hand in ``tests/test_accel.py::test_unit_factor_gyro_to_accel``
+(N: 3600, B: 1/9.80665e-6); here they are written out again as numbers."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from fogdrift.allan import allan_variance
+from fogdrift.noise import fit_noise
+from fogdrift.noise.quantity import express, unit_factor
+from fogdrift.simulate import simulate
+
+# per term: factor from the gyro table's unit to the accelerometer table's, and the accelerometer unit
+ACC = {"N": (3600.0, "m/s/sqrt(h)"), "B": (1.0 / 9.80665e-6, "ug")}
+
+
+@pytest.fixture(scope="module")
+def fit():
+    y = simulate(2**14, 0.01, arw_dprh=0.002, seed=1)
+    f = fit_noise(allan_variance(y, 0.01))
+    # a note and a reason written in gyro units, to be re-stated
+    return dataclasses.replace(f, notes=["N = 0.01 deg/√h sits at its bound"])
+
+
+def test_a_gyro_fit_is_returned_unchanged(fit):
+    assert express(fit, "angular_rate") is fit
+
+
+def test_every_term_value_and_interval_is_scaled_by_its_own_factor(fit):
+    acc = express(fit, "specific_force")
+    assert acc is not fit and acc.quantity == "specific_force"
+    for name, t in fit.terms.items():
+        a = acc.terms[name]
+        f = unit_factor(name, "specific_force")
+        if name in ("N", "B"):
+            assert f == pytest.approx(ACC[name][0], rel=1e-12)
+            assert a.unit == ACC[name][1]
+        assert a.name == name and a.status == t.status
+        for attr in ("value", "lo95", "hi95"):
+            g = getattr(t, attr)
+            assert (getattr(a, attr) is None) if g is None else getattr(a, attr) == pytest.approx(g * f, rel=1e-12)
+    n = acc.terms["N"]
+    assert n.value == pytest.approx(fit.terms["N"].value * 3600.0, rel=1e-12)
+    assert n.lo95 < n.value < n.hi95
+
+
+def test_b_min_is_in_micro_g_and_its_si_copy_in_m_per_s2(fit):
+    acc = express(fit, "specific_force")
+    b, b0 = acc.b_min, fit.b_min
+    assert b["unit"] == "ug" and b["tau_s"] == b0["tau_s"]
+    for k in ("value", "lo95", "hi95"):
+        assert b[k] == pytest.approx(b0[k] / 9.80665e-6, rel=1e-12)
+        assert b["si"][k] == pytest.approx(b0[k], rel=1e-12)   # the internal unit is m/s^2 already
+    assert b["si"]["unit"] == "m/s^2"
+    assert fit.b_min["unit"] == "deg/h"   # the input is not modified
+
+
+def test_read_outs_are_scaled_and_relabelled(fit):
+    acc = express(fit, "specific_force")
+    r0, r = fit.readouts["N"], acc.readouts["N"]
+    assert r.value == pytest.approx(r0.value * 3600.0, rel=1e-12) and r.unit == "m/s/sqrt(h)"
+    assert (r.tau_s, r.slope, r.dominated) == (r0.tau_s, r0.slope, r0.dominated)
+    assert acc.readouts["Q"].value is None
+
+
+def test_notes_are_restated(fit):
+    acc = express(fit, "specific_force")
+    assert acc.notes == ["N = 36 m/s/√h sits at its bound"]
