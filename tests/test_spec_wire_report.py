@@ -106,3 +106,20 @@ def test_allan_help_imports_no_other_command_module():
     mods = json.loads(proc.stdout.split("MODS", 1)[1])
     assert "fogdrift.cli.allan" in mods and "fogdrift.cli._spec" in mods
     assert not {"fogdrift.cli.noise", "fogdrift.cli.batch", "fogdrift.cli.analyze"} & set(mods), mods
+
+
+def test_batch_analyze_rows_and_report_carry_the_verdicts(bundled_path, tmp_path):
+    """``batch --command analyze --spec``: each row's spec columns and the file's report first screen agree."""
+    from fogdrift.fleet import run_batch
+
+    settings = {"load": {"unit": "deg/h", "columns": "gz"},
+                "analysis": {"models": ["ar", "persistence"], "train_fraction": 0.4, "val_fraction": 0.1},
+                "spec": {"source": "rlg.json", **SPEC}}
+    res = run_batch([bundled_path], tmp_path / "b", command="analyze", settings=settings, scheduler="serial")
+    assert res.n_ok == 1, [r.get("error") for r in res.rows]
+    (row,) = res.rows
+    assert (row["axis"], row["spec_arw"], row["spec_bias_instability"], row["spec_vrw"]) == \
+        ("gz", "pass", "cannot tell", None)
+    page = next((tmp_path / "b").glob("*/report.html")).read_text(encoding="utf-8")
+    assert "Does it meet the datasheet? bundled RLG (test limits) (rlg.json)" in page
+    assert '<span class="badge">CANNOT TELL</span>gz bias_instability: cannot tell' in page
