@@ -49,3 +49,73 @@ def test_judge_noise_fit_on_an_accelerometer_channel_reads_the_velocity_random_w
     js = judge_noise_fit(spec, "ax", fit, "accel")
     assert [(j.channel, j.limit.item, j.verdict) for j in js] == [("ax", "vrw", "fail")]
     assert js[0].estimate == "0.36 [0.324, 0.396] m/s/sqrt(h)"
+
+
+def test_lower_bound_at_exactly_the_limit_cannot_tell_and_says_so():
+    from fogdrift.spec import judge
+
+    lim = parse_spec({"gyro": {"arw": "2 deg/sqrt(h)"}})["limits"][0]
+    j = judge(lim, Reading(2.0, None, None, "deg/sqrt(h)", "lower"))
+    assert j.verdict == "cannot tell" and j.estimate == "> 2 deg/sqrt(h)"
+    j = judge(lim, Reading(2.5, None, None, "deg/sqrt(h)", "lower"))
+    assert j.verdict == "fail" and j.estimate == "> 2.5 deg/sqrt(h)"
+
+
+def test_reading_labels_say_where_they_come_from():
+    from fogdrift.spec import readings_from_noise_fit
+
+    n = SimpleNamespace(value=2.4, lo95=2.37, hi95=2.42, unit="deg/sqrt(h)", status="resolved", estimable=True)
+    fit = SimpleNamespace(terms={"N": n}, no_fit=None,
+                          b_min={"value": 20.0, "unit": "deg/h", "tau_s": 100.0, "bound_only": False, "lo95": 15.0,
+                                 "hi95": 24.0})
+    r = readings_from_noise_fit(fit)
+    assert r["arw"].label == "N from the Allan fit"
+    assert r["bias_instability"].label == "B_min at τ = 100 s"
+
+
+@pytest.mark.parametrize("text", ["0.007 deg/sec", "0.007 deg/second", "0.007 °/s"])
+def test_seconds_spelled_out_are_seconds(text):
+    from fogdrift.spec import parse_quantity
+
+    assert parse_quantity(text, "gyro", "bias_instability")[0] == pytest.approx(25.2, rel=1e-12)
+
+
+def test_b_min_reading_keeps_the_unit_the_fit_wrote():
+    from fogdrift.spec import judge, readings_from_noise_fit
+
+    fit = SimpleNamespace(terms={}, no_fit=None,
+                          b_min={"value": 0.005, "unit": "deg/s", "tau_s": 0, "lo95": 0.004, "hi95": 0.006})
+    r = readings_from_noise_fit(fit)["bias_instability"]
+    assert r.unit == "deg/s" and r.label == "B_min"            # tau 0: no "at τ"
+    lim = parse_spec({"gyro": {"bias_instability": "20 deg/h"}})["limits"][0]
+    assert judge(lim, r).estimate == "18 [14.4, 21.6] deg/h"   # 0.005 deg/s = 18 deg/h
+
+
+def test_bracketed_rad_per_s_is_read():
+    from fogdrift.spec import convert
+
+    assert convert(1.0, "(rad/s)/sqrt(Hz)", "gyro", "arw") == pytest.approx(60.0 * 180.0 / 3.141592653589793)
+
+
+def test_gmwm_readings_of_an_accelerometer_are_vrw_and_m_per_s2():
+    from fogdrift.spec import readings_from_gmwm
+
+    n = SimpleNamespace(value=1e-4, lo95=0.9e-4, hi95=1.1e-4, unit="deg/sqrt(h)")
+    b = SimpleNamespace(value_dph=0.003, lo95_dph=0.0025, hi95_dph=0.0035, tau_s=20.0, bound_dph=None, reason="")
+    axis = SimpleNamespace(selection=SimpleNamespace(ieee=SimpleNamespace(terms={"N_dprh": n}, b_min=b)))
+    r = readings_from_gmwm(axis, "accel")
+    assert set(r) == {"vrw", "bias_instability"}
+    assert r["vrw"].value == pytest.approx(0.36) and r["vrw"].unit == "m/s/sqrt(h)"
+    assert r["bias_instability"].unit == "m/s^2" and r["bias_instability"].label.startswith("B_min at τ = 20 s (GMWM)")
+    assert set(readings_from_gmwm(axis)) == {"arw", "bias_instability"}
+
+
+def test_sensor_name_and_judgement_without_a_reading_to_dict():
+    from fogdrift.spec import judge
+
+    spec = parse_spec({"sensor": "ADIS16405", "gyro": {"arw": "2 deg/sqrt(h)"}})
+    assert spec["sensor"] == "ADIS16405"
+    assert parse_spec({"gyro": {"arw": "2 deg/sqrt(h)"}})["sensor"] is None
+    d = judge(spec["limits"][0], None, "gx").to_dict()
+    assert d["reading"] is None and d["verdict"] == "cannot tell" and d["channel"] == "gx"
+    assert d["limit"] == "2 deg/sqrt(h)" and d["limit_canonical"] == 2.0 and d["unit"] == "deg/sqrt(h)"

@@ -1,0 +1,100 @@
+"""Tests added for the surviving mutants of ``fogdrift.evaluation.consistency`` (issue 24 item 2, docs/testing.md
+"Round 2: new modules (issues 21-23)"): the closed forms where the existing by-hand cases sit on a symmetric point
+(quantization at h != T; the Gauss-Markov small-x series branch), the origin-step validator at 0, and the keys and
+units of the returned records."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fogdrift.errors import ConfigError
+from fogdrift.evaluation.consistency import (ConsistencyResult, angle_error_variance_deg2, check_consistency,
+                                             coverage_rows, observed_angle_errors_deg, random_walk_covering)
+
+DEG_PER_URAD = 1e-6 * 180.0 / math.pi
+
+
+def test_quantization_closed_form_at_a_horizon_twice_the_calibration():
+    # angle white noise of 1 deg, h = 2 T: 1 + (1 + 2)^2 + 2^2 = 14 deg^2
+    q = angle_error_variance_deg2([{"kind": "quantization", "q_urad": 1.0 / DEG_PER_URAD}], 10.0, 5.0)
+    assert q[0] == pytest.approx(14.0, rel=1e-12)
+
+
+def test_gauss_markov_on_the_small_x_series_branch():
+    # Tc = 1e7 s, h = 600 s, T = 300 s: x = L/Tc < 1e-4, where the code switches to the series of x - 1 + e^-x.
+    # Reference: the same closed form, V(L) = 2 s^2 Tc^2 (x - 1 + e^-x), with that core summed to 6 terms here.
+    tc, h, T, sigma = 1e7, 600.0, 300.0, 3600.0  # sigma 1 deg/s
+    s2 = (sigma / 3600.0) ** 2
+
+    def core(x):
+        return sum((-x) ** k / math.factorial(k) for k in range(2, 8))
+
+    def v(L):
+        return 2.0 * s2 * tc * tc * core(L / tc)
+
+    cross = s2 * tc * tc * (-math.expm1(-h / tc)) * (-math.expm1(-T / tc))
+    ref = v(h) + (h / T) ** 2 * v(T) - 2.0 * (h / T) * cross
+    got = angle_error_variance_deg2([{"kind": "gauss_markov", "tc_s": tc, "sigma_dph": sigma}], h, T)[0]
+    # (the sum cancels its x^2 terms: the code's 2-term series is good to ~1e-5 of the result here)
+    assert got == pytest.approx(ref, rel=1e-4)
+    # and the series joins the exact form: just above the switch (x = 2e-4) the exact core gives the same law
+    tc2 = h / 2e-4
+    exact = angle_error_variance_deg2([{"kind": "gauss_markov", "tc_s": tc2, "sigma_dph": sigma}], h, T)[0]
+    series = angle_error_variance_deg2([{"kind": "gauss_markov", "tc_s": tc2 * 2.1, "sigma_dph": sigma}], h, T)[0]
+    assert series * 2.1 == pytest.approx(exact, rel=1e-3)   # the leading term is linear in 1/Tc
+
+
+@pytest.mark.parametrize("step", [0.0, -60.0, math.inf, math.nan])
+def test_origin_step_must_be_finite_and_positive(step):
+    y = np.zeros(100)
+    with pytest.raises(ConfigError, match=r"origin_step.* must be a finite number > 0 \[s\]"):
+        observed_angle_errors_deg(y, 1.0, 10.0, [10.0], step_s=step)
+
+
+def test_coverage_rows_default_unit_is_deg():
+    rows = coverage_rows([np.array([0.5, -1.5])], [1.0], [60.0])
+    assert rows[0].unit == "deg" and rows[0].to_dict()["unit"] == "deg"
+
+
+def test_random_walk_covering_returns_the_bound_it_was_given():
+    comps = [{"kind": "white", "arw_dprh": 0.1}, {"kind": "gauss_markov", "tc_s": 50.0, "sigma_dph": 1.0}]
+    d = random_walk_covering(comps, 60.0, 30.0, k_bound_dphrh=2.0)
+    assert d["k_bound_dphrh"] == 2.0 and d["horizon_s"] == 60.0 and d["t_cal_s"] == 30.0
+    assert random_walk_covering(comps, 60.0, 30.0)["k_bound_dphrh"] is None
+
+
+def test_consistency_result_to_dict_keys_and_values():
+    rng = np.random.default_rng(3)
+    logs = [({"gx": rng.normal(0.0, 60.0, 4000)}, 1.0)]   # white noise, N = 1 deg/sqrt(h) at dt = 1 s
+    res = check_consistency("full", {"gx": [{"kind": "white", "arw_dprh": 1.0}]}, logs, t_cal_s=100.0,
+                            horizons_s=[50.0, 100.0])
+    assert isinstance(res, ConsistencyResult)
+    d = res.to_dict()
+    assert d["target"] == "full" and d["t_cal_s"] == 100.0 and d["horizons_s"] == [50.0, 100.0]
+    assert d["notes"] == []
+    ax = d["axes"]["gx"]
+    assert ax["n_logs"] == 1 and ax["quantity"] == "gyro" and ax["components"][0]["kind"] == "white"
+    assert [r["horizon_s"] for r in ax["rows"]] == [50.0, 100.0]
+    assert ax["rows"][0]["n_origins"] == 4000 // 150 and ax["rows"][1]["n_origins"] == 4000 // 200
+
+
+def test_a_one_sample_horizon_is_one_sample():
+    # dt = 1 s, T = 2 s, h = 1 s: a rate 3.6 deg/h above the calibrated mean for one second = 1e-3 deg
+    y = np.array([0.0, 0.0, 3.6, 7.2])
+    _, e = observed_angle_errors_deg(y, 1.0, 2.0, [1.0], step_s=10.0)
+    assert e.shape == (1, 1) and e[0, 0] == pytest.approx(1e-3, rel=1e-12)
+
+
+def test_inflation_interval_when_the_lower_rank_is_the_first_order_statistic():
+    from scipy.stats import binom
+
+    from fogdrift.evaluation.consistency import inflation_factor
+
+    p = 0.6826894921370859
+    assert int(binom.ppf(0.025, 5, p)) == 1
+    lam, lo, hi = inflation_factor([0.5, 1.0, 1.5, 2.0, 3.0], p, 1.0)
+    # lambda: rank ceil(0.6827 * 5) = 4 -> 2.0^2; lower rank 1 -> 0.5^2; upper rank 5 + 1 > n -> NaN
+    assert lam == pytest.approx(4.0) and lo == pytest.approx(0.25) and math.isnan(hi)
