@@ -147,11 +147,11 @@ def analyze(
         print_summary(result, record, evaluated=heading, apply_name=apply_to.name if apply_to else "")
         spec_doc = None
         if limits is not None:  # the CLI judges; the report only shows the judgements
-            from ..report.summary import analysis_judgements, spec_summary
+            from ..report.summary import analysis_judgements
 
             js = print_judgements(limits, analysis_judgements(result, limits), r.out.path, source=spec.name,
                                   compact=True)
-            spec_doc = spec_summary(limits, js, spec.name)
+            spec_doc = {"limits": limits, "judgements": js, "source": spec.name}
         path = write_report(result, record, r.out.path, evaluated=heading, pdf=pdf,
                             sensor=None if sensor is None or not sensor.strip() else sensor.strip(), spec=spec_doc)
         # the self-describing bundle 'fogdrift compensate' applies to other logs

@@ -23,6 +23,8 @@ from typing import Callable
 
 from ..errors import ConfigError, FogdriftError
 from ..noise.terms import TERM_TABLE
+from ..spec import (channel_kind, compare, judge_noise_fit, parse_spec, readings_from_gmwm, readings_from_noise_fit,
+                    spec_columns)
 
 __all__ = ["CommandSpec", "COMMANDS", "command_spec", "noise_columns", "record_columns", "run_allan_command",
            "run_analyze_command", "TERMS", "spec_from_settings", "axis_kind"]
@@ -127,16 +129,12 @@ def spec_from_settings(settings: dict):
     data = settings.get("spec")
     if data is None:
         return None
-    from ..spec import parse_spec
-
     source = data.get("source") if isinstance(data, dict) else None
     return parse_spec(data, source=f"spec {source}" if source else "settings spec")
 
 
 def axis_kind(record, name: str) -> str:
     """``"gyro"`` or ``"accel"``: the spec section an axis is judged against (its channel's quantity)."""
-    from ..spec import channel_kind
-
     try:
         quantity = record.signal.channel(name).quantity
     except (FogdriftError, AttributeError):  # no such channel / no signal description: a gyro, as everywhere else
@@ -148,8 +146,6 @@ def _spec_allan(limits, record, name: str, noise) -> dict:
     """``spec_<item>`` / ``spec_<item>_why`` columns of an Allan fit (none without a spec)."""
     if limits is None:
         return {}
-    from ..spec import judge_noise_fit, spec_columns
-
     return spec_columns(judge_noise_fit(limits, name, noise, axis_kind(record, name)))
 
 
@@ -157,10 +153,18 @@ def _spec_gmwm(limits, record, axis) -> dict:
     """``spec_<item>`` / ``spec_<item>_why`` columns of a GMWM axis (none without a spec)."""
     if limits is None:
         return {}
-    from ..spec import compare, readings_from_gmwm, spec_columns
-
     kind = axis_kind(record, axis.name)
     return spec_columns(compare(limits, {axis.name: (kind, readings_from_gmwm(axis, kind))}))
+
+
+def _analysis_judgements(result, limits: dict) -> list:
+    """The judgements of an analysis, as :func:`fogdrift.report.summary.analysis_judgements` makes them for ``analyze
+    --spec`` (GMWM readings when every axis has a GMWM model, else the Allan fit; gyro limits): repeated here so that
+    this module does not import the report at start-up."""
+    axes = list(result.axes)
+    gmwm = bool(axes) and all(getattr(ax, "gmwm", None) is not None for ax in axes)
+    return compare(limits, {ax.name: ("gyro", readings_from_gmwm(ax.gmwm, "gyro") if gmwm
+                                      else readings_from_noise_fit(ax.original.noise, "gyro")) for ax in axes})
 
 
 def _config(settings: dict):
@@ -202,11 +206,8 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     evaluations = {ev.axis: ev for ev in evaluate_analysis(result)}
     spec_doc, spec_cols = None, {}
     if limits is not None:  # as 'analyze --spec': the verdicts on the report's first screen and in the rows
-        from ..report.summary import analysis_judgements, spec_summary
-        from ..spec import spec_columns
-
-        js = analysis_judgements(result, limits)
-        spec_doc = spec_summary(limits, js, (settings.get("spec") or {}).get("source") or "")
+        js = _analysis_judgements(result, limits)
+        spec_doc = {"limits": limits, "judgements": js, "source": (settings.get("spec") or {}).get("source") or ""}
         spec_cols = {ax.name: spec_columns([j for j in js if j.channel == ax.name]) for ax in result.axes}
     write_report(result, record, out_dir, evaluated=True, spec=spec_doc)
     write_bundle(Path(out_dir) / "bundle", [ax.models for ax in result.axes], cfg, record)

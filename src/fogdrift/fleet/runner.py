@@ -42,7 +42,7 @@ from .. import interrupt
 from ..errors import ConfigError
 from ..io.readers.base import require
 from ..output import OutputDir, active
-from .commands import command_spec
+from .commands import command_spec, spec_from_settings
 from .summary import COLUMNS, write_summary
 from .tasks import MANIFEST, FileTask, run_file
 
@@ -328,8 +328,6 @@ def _validate(settings: dict) -> None:
     unknown = set(settings) - {"load", "gaps", "analysis", "gmwm", "spec"}
     if unknown:
         raise ConfigError(f"unknown batch settings {sorted(unknown)}; expected load, gaps, analysis, gmwm, spec")
-    from .commands import spec_from_settings
-
     spec_from_settings(settings)  # a bad spec: one line before any work
     gmwm = settings.get("gmwm", {})
     if set(gmwm) - {"model", "levels", "robust"}:

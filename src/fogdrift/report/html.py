@@ -25,8 +25,8 @@ from .figures import (_safe, plot_allan, plot_models, plot_residuals, plot_separ
 from .files import write_json
 from .glossary import glossary_entries
 from .settings import settings_rows
-from .summary import (OUTCOME_LABELS, SPEC_LABELS, cannot_support, noise_headline, recording_rows, summary_dict,
-                      verdict_items)
+from .summary import (OUTCOME_LABELS, SPEC_LABELS, cannot_support, noise_headline, recording_rows, spec_summary,
+                      summary_dict, verdict_items)
 from .tables import (METRICS_HEADERS, NOISE_HEADERS, _fmt, causal_metrics_rows, fit_cell, metrics_rows, noise_notes, noise_row,
                      readout_text, verdict)
 from .pdf import write_pdf
@@ -446,10 +446,13 @@ def write_report(result, record, out_dir, apply_record=None, *, sensor=None, eva
 
     ``evaluated`` False says in the report that the heading-error evaluation was skipped on purpose
     (``analyze --no-heading``); ``sensor`` names the sensor on the first screen; ``spec`` (``analyze --spec``:
-    :func:`fogdrift.report.summary.spec_summary` of judgements the caller made) puts the datasheet verdicts on the
-    first screen and under ``report_summary.spec``.
+    ``{"limits": parsed spec, "judgements": [Judgement, ...], "source": file name}``, the judgements the caller
+    made, :func:`fogdrift.report.summary.analysis_judgements`) puts the datasheet verdicts on the first screen and
+    under ``report_summary.spec`` (:func:`fogdrift.report.summary.spec_summary`).
     """
     out = Path(out_dir)
+    if spec is not None:
+        spec = spec_summary(spec["limits"], spec["judgements"], spec.get("source", ""))
     doc = result.to_dict()
     doc["report_summary"] = summary_dict(result, sensor, evaluated=evaluated, spec=spec)
     write_json(doc, out / "analysis.json")

@@ -15,6 +15,7 @@ from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
 from ..gmwm.compare import compare_with_allan
 from ..noise import TERM_TABLE
 from ..noise.terms import DISPLAY_UNITS, TERMS
+from ..spec import B_COMPARED, compare, judgement_line, readings_from_gmwm, readings_from_noise_fit
 from .tables import _fmt, noise_row, shaped_cell, term_text
 
 __all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "SPEC_LABELS", "SPEC_OUTCOMES", "recording_rows", "noise_headline",
@@ -261,8 +262,6 @@ def analysis_judgements(result, limits: dict, kind: str = "gyro") -> list:
     list of fogdrift.spec.Judgement
         Per axis, in the spec's order.
     """
-    from ..spec import compare, readings_from_gmwm, readings_from_noise_fit
-
     axes = list(result.axes)
     gmwm = bool(axes) and all(getattr(ax, "gmwm", None) is not None for ax in axes)
     return compare(limits, {ax.name: (kind, readings_from_gmwm(ax.gmwm, kind) if gmwm
@@ -274,8 +273,6 @@ def spec_summary(limits: dict, judgements, source: str = "") -> dict:
     (``verdict``, ``outcome`` for its colour, ``line``: :func:`fogdrift.spec.judgement_line`, and the judgement's
     fields), ``b_compared`` (which B reading was compared, :data:`fogdrift.spec.B_COMPARED`) and ``note`` when no
     limit applies."""
-    from ..spec import B_COMPARED, judgement_line
-
     title = f"{limits['sensor'] or source}" + (f" ({source})" if limits["sensor"] and source else "")
     items = [{**j.to_dict(), "outcome": SPEC_OUTCOMES[j.verdict], "line": judgement_line(j)} for j in judgements]
     note = None if items else ("no limit applies to these channels (the spec has "
