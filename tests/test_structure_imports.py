@@ -191,8 +191,6 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
         "fogdrift.noise.spectral", "fogdrift.outliers", "fogdrift.units", "fogdrift.io.record",
         "fogdrift.allan.grid", "fogdrift.models.grey", "fogdrift.noise.terms")),
     "fogdrift.io.record": (DEBT("H-signal"), ("fogdrift.temperature",)),
-    "fogdrift.evaluation.analysis": (DEBT("H-signal") + " (private bundle helpers: H-signal gives a public function)", (
-        "fogdrift.bundle",)),
     "fogdrift.compensate.run": (DEBT("H-compensate"), ("fogdrift.evaluation.artefacts",
         "fogdrift.evaluation.heading", "fogdrift.evaluation.verdicts", "fogdrift.report.files")),
     "fogdrift.evaluation.artefacts": (DEBT("unowned"), ("fogdrift.allan",)),
@@ -200,7 +198,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.export": (DEBT("H-export"), ("fogdrift.export.conversions",)),
     "fogdrift.export.targets": (DEBT("H-export"), ("fogdrift.errors",)),
     "fogdrift.io.readers._columns": (DEBT("H-hostile"), ("fogdrift.io.readers.limits",)),
-    "fogdrift.gmwm.analysis": (DEBT("unowned"), ("fogdrift.noise.terms", "fogdrift.units")),
+    "fogdrift.gmwm.analysis": (DEBT("unowned"), ("fogdrift.units",)),
     "fogdrift.gmwm.estimator": (DEBT("unowned"), ("fogdrift.gmwm.ieee", "fogdrift.gmwm.simulate",
         "fogdrift.gmwm.wvar")),
     "fogdrift.gmwm.selection": (DEBT("unowned"), ("fogdrift.gmwm.estimator",)),
