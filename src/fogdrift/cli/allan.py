@@ -32,8 +32,8 @@ def allan(
     from ..pipeline import AnalysisConfig, run_allan
     from ..report import fit_cell, noise_row, shaped_cell, write_allan_outputs
 
-    with run("allan", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
-             expect=("allan.json", "allan.csv", "allan.png")) as r:
+    with run("allan", out, default_out=DEFAULT_OUT, inputs=[load.file, spec], json_out=json_out,
+             expect=("allan.json", "allan.csv", "allan.png") + (("spec.json",) if spec is not None else ())) as r:
         term_list = parse_terms(terms)
         precheck(estimator=estimator, terms=term_list)
         cfg = AnalysisConfig(taus=parse_taus(taus), estimator=estimator, fit_tau_s=parse_fit_taus(fit_taus),
