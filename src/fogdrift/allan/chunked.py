@@ -38,6 +38,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
+from ._kernels import block_sums2
 from .ci import resolve_alpha
 from .core import IEEE952_ALPHAS, result_from_sums
 from .grid import tau_grid
@@ -97,27 +98,6 @@ def _totals_py(y, scale, mu, out, block):  # pragma: no cover - runs compiled
         out[ib] = (a0 + a1) + (a2 + a3)
 
 
-def _block_sums_py(a, b, c, k_first, s, block, out):  # pragma: no cover - runs compiled
-    """Sums of (a[q] - 2 b[q] + c[q])^2 over q with k = k_first + q on the stride lattice, per block of k.
-
-    ``a, b, c`` hold theta at k + 2m, k + m and k for k = k_first .. k_first + len - 1; ``out[j]`` receives
-    the sum over the k of block ``k_first // block + j`` (the in-memory estimator's partial sums).
-    """
-    n = c.size
-    b0 = k_first // block
-    nb = out.size
-    for j in prange(nb):
-        lo = max((b0 + j) * block, k_first)
-        hi = min((b0 + j + 1) * block, k_first + n)
-        kstart = ((lo + s - 1) // s) * s
-        acc = 0.0
-        for k in range(kstart, hi, s):
-            q = k - k_first
-            d = a[q] - 2.0 * b[q] + c[q]
-            acc += d * d
-        out[j] = acc
-
-
 _KERNELS: dict = {}
 prange = range
 
@@ -129,7 +109,6 @@ def _kernels():
         globals()["prange"] = numba.prange
         _KERNELS["totals"] = numba.njit(cache=True, parallel=True)(_totals_py)
         _KERNELS["theta"] = numba.njit(cache=True, parallel=True)(_theta_py)
-        _KERNELS["sums"] = numba.njit(cache=True, parallel=True)(_block_sums_py)
     return _KERNELS
 
 
@@ -213,7 +192,6 @@ def _mean_and_offsets(source, leaf: int, progress):
 # ----------------------------------------------------------------------------------------
 def _second_difference_sums(phase: _Phase, m: np.ndarray, strides: np.ndarray, chunk: int, progress) -> np.ndarray:
     n_phase = phase.n + 1
-    kern = _kernels()["sums"]
     parts = [[] for _ in m]
     k_end_all = n_phase - 2 * int(m.min())           # start indices k < k_end_all for the smallest m
     n_chunks = -(-k_end_all // chunk)
@@ -252,7 +230,7 @@ def _second_difference_sums(phase: _Phase, m: np.ndarray, strides: np.ndarray, c
                 cache.clear()                        # keep at most the window the next m can reuse
                 a = phase.window(start_a, start_a + L)
                 cache[start_a] = a
-            kern(a, bb, c, kstart, s, BLOCK, out)
+            block_sums2(a, bb, c, kstart, s, BLOCK, out)
             del a, bb, c                             # free the windows before the next m reads its own
             first = kstart // BLOCK
             parts[j] += [(first + q, float(v)) for q, v in enumerate(out)]
