@@ -28,6 +28,7 @@ import numpy as np
 from ..errors import ConfigError, DataFormatError
 from ..noise.result import NoiseTerm
 from ..noise.terms import TERM_TABLE
+from ..units import rate_scale_to_dph
 from .processes import parse_model
 from .selection import SelectionResult, select_model
 from .wvar import WvarResult, from_curve, haar_wvar
@@ -172,8 +173,6 @@ AVAR_COLUMNS = ("tau_s", "avar", "n_samples", "sample_rate_hz")
 
 def _table_unit(name, first_row, unit) -> tuple[str, str]:
     """(unit, where it came from) of a curve table: ``--unit`` or the ``unit`` column, never ``unit_inferred``."""
-    from ..units import rate_scale_to_dph
-
     declared = (first_row.get("unit") or "").strip()
     inferred = (first_row.get("unit_inferred") or "").strip()
     if unit:

@@ -56,8 +56,10 @@ from scipy.linalg import lapack
 
 from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError, NotFittedError
 from .covariance import model_wvar_covariance
+from .ieee import to_ieee
 from .processes import LatentModel, parse_model
-from .wvar import WvarResult
+from .simulate import simulate_latent
+from .wvar import WvarResult, haar_wvar
 
 __all__ = ["GMWMFit", "GMWM", "gmwm_fit", "Whitener"]
 
@@ -645,9 +647,6 @@ def gmwm_fit(wvar, model="WN+RW+GM", *, steps=4, scales=None, weights="eta3", V=
 
 
 def _bootstrap(mdl, theta, wv, idx, n_boot, seed, n_starts):
-    from .simulate import simulate_latent
-    from .wvar import haar_wvar
-
     if wv.n_samples < 2:
         raise ConfigError("a parametric bootstrap needs n_samples")
     ss = np.random.SeedSequence(seed)
@@ -728,8 +727,6 @@ class GMWM:
 
     def fit(self, wvar, y=None) -> "GMWM":
         """Fit to a :class:`WvarResult`; returns self."""
-        from .ieee import to_ieee
-
         fit = gmwm_fit(wvar, self.model, steps=self.steps, scales=self.scales, weights=self.weights,
                        n_starts=self.n_starts, n_boot=self.n_boot, seed=self.random_state)
         self.fit_ = fit

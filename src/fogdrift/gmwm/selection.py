@@ -54,7 +54,7 @@ import numpy as np
 
 from ..errors import ConfigError, FogdriftWarning, InsufficientDataError
 from .covariance import wvar_covariance
-from .estimator import GMWMFit, _bounds, _check_wv, _finish, _model_V, _step1
+from .estimator import GMWMFit, Whitener, _bounds, _check_wv, _finish, _model_V, _step1
 from .ieee import IEEEResult, to_ieee
 from .processes import LatentModel, param_label, parse_model
 
@@ -461,8 +461,6 @@ def _scan(wv, models, j0, step1, excluded, *, exclude_short, max_ex, n_check, p_
 
 def _choose(wv, models, idx, step1, opts):
     """Common-Omega fits, checks and the WIC choice; returns (scores, chosen, passed, omega source)."""
-    from .estimator import Whitener
-
     def score_all(ref: LatentModel):
         own = _finish(wv, ref, idx, *step1[ref])  # the reference's own iterated fit
         V = _model_V(ref, own.theta, wv, idx)

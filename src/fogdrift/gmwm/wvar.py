@@ -47,6 +47,7 @@ import numpy as np
 from scipy import stats
 
 from .._util import check_series
+from ..allan import allan_variance
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
 from ..units import check_dt_s, rate_scale_to_dph
 
@@ -363,8 +364,6 @@ def _classical_nu2(x: np.ndarray, dt: float, levels: int) -> np.ndarray:
     """Classical WV of levels 1..J as half the overlapping Allan variance at ``m = 2^(j-1)``
     (exact identity, [GMWM]_ §9.2): the second-difference sums have one home, the compiled
     kernels of :mod:`fogdrift.allan` (compensated phase, parallel blocks)."""
-    from ..allan import allan_variance
-
     m = np.left_shift(1, np.arange(levels)).astype(np.float64)
     return allan_variance(x, dt, taus=m * dt, estimator="overlapping", noise_alpha=0).avar_dph2 / 2.0
 
