@@ -98,3 +98,55 @@ def test_inflation_interval_when_the_lower_rank_is_the_first_order_statistic():
     lam, lo, hi = inflation_factor([0.5, 1.0, 1.5, 2.0, 3.0], p, 1.0)
     # lambda: rank ceil(0.6827 * 5) = 4 -> 2.0^2; lower rank 1 -> 0.5^2; upper rank 5 + 1 > n -> NaN
     assert lam == pytest.approx(4.0) and lo == pytest.approx(0.25) and math.isnan(hi)
+
+
+def test_inflation_interval_bounds_outside_the_sample_are_nan_and_inside_read_their_rank():
+    from scipy.stats import binom
+
+    from fogdrift.evaluation.consistency import inflation_factor
+
+    # n = 3, p = 0.6827: P(X = 0) = 0.317^3 = 0.032 >= 0.025, so the 2.5 % rank is 0 (outside) -> NaN, not the
+    # last value
+    assert int(binom.ppf(0.025, 3, 0.6826894921370859)) == 0
+    assert math.isnan(inflation_factor([1.0, 2.0, 3.0], 0.6826894921370859, 1.0)[1])
+    # n = 40 ratios 0.1, 0.2, ..., 4.0 at p = 0.6827: upper rank = ppf(0.975) + 1, read as the rank-th smallest
+    r = np.arange(1, 41) / 10.0
+    p = 0.6826894921370859
+    hi_rank = int(binom.ppf(0.975, 40, p)) + 1
+    assert hi_rank <= 40
+    assert inflation_factor(r[::-1], p, 1.0)[2] == pytest.approx((hi_rank / 10.0) ** 2, rel=1e-12)
+
+
+def test_coverage_rows_from_a_2d_array_with_rms():
+    e = np.array([[0.5, 1.0], [-1.5, 3.0]])
+    rows = coverage_rows(e, [1.0, 2.0], [10.0, 20.0], unit="m/s")
+    assert [r.n_origins for r in rows] == [2, 2] and rows[1].unit == "m/s"
+    assert rows[0].rms == pytest.approx(math.sqrt((0.25 + 2.25) / 2)) and rows[1].coverage["68 %"] == 0.5
+    d = rows[0].to_dict()
+    assert d["horizon_s"] == 10.0 and d["rms"] == pytest.approx(rows[0].rms) and d["sigma_pred"] == 1.0
+
+
+def test_accelerometer_axes_by_dict_and_the_velocity_sentence():
+    rng = np.random.default_rng(4)
+    logs = [({"gx": rng.normal(0.0, 60.0, 3000), "ax": rng.normal(0.0, 0.01, 3000)}, 1.0)]
+    comps = {"gx": [{"kind": "white", "arw_dprh": 1.0}], "ax": [{"kind": "white", "arw_dprh": 0.6}]}
+    res = check_consistency("full", comps, logs, t_cal_s=100.0, horizons_s=[100.0], quantity={"ax": "accel"})
+    assert res.axes["gx"]["quantity"] == "gyro" and res.axes["gx"]["rows"][0].unit == "deg"
+    assert res.axes["ax"]["quantity"] == "accel" and res.axes["ax"]["rows"][0].unit == "m/s"
+    d = random_walk_covering([{"kind": "white", "arw_dprh": 0.01}, {"kind": "random_walk", "rrw_dphrh": 0.002}],
+                             60.0, 60.0, quantity="accel")
+    assert "(0.002 (m/s^2)/sqrt(h))" in d["sentence"] and "accelerometer_random_walk" in d["sentence"]
+
+
+def test_non_finite_held_out_rate_message():
+    y = np.zeros(50)
+    y[7] = np.nan
+    with pytest.raises(ConfigError, match=r"^the held-out rate has non-finite samples$"):
+        observed_angle_errors_deg(y, 1.0, 10.0, [10.0])
+
+
+def test_integer_horizons_beyond_int64_cubes():
+    # h = 3e6 s as an int: h^3 = 2.7e19 overflows int64; the variance must be that of the float horizon
+    k = [{"kind": "random_walk", "rrw_dphrh": 1.0}]
+    assert angle_error_variance_deg2(k, [3_000_000], 100.0)[0] == pytest.approx(
+        angle_error_variance_deg2(k, [3e6], 100.0)[0], rel=1e-12)

@@ -72,3 +72,27 @@ def test_read_outs_are_scaled_and_relabelled(fit):
 def test_notes_are_restated(fit):
     acc = express(fit, "specific_force")
     assert acc.notes == ["N = 36 m/s/√h sits at its bound"]
+
+
+def test_restate_text_of_the_shaped_units_and_a_bare_rate_unit():
+    from fogdrift.noise.quantity import restate_text
+
+    assert restate_text("q = 0.5 deg/h/√s here", "specific_force") == "q = 0.5 m/s^2/sqrt(s) here"
+    assert restate_text("in deg/h throughout", "specific_force") == "in m/s^2 throughout"
+    assert restate_text("N = 0.01 deg/√h", "angular_rate") == "N = 0.01 deg/√h"
+
+
+def test_unit_factor_of_shaped_terms_is_one():
+    assert unit_factor("S", "specific_force") == 1.0 and unit_factor("M", "specific_force") == 1.0
+
+
+def test_shaped_terms_are_relabelled_and_excluded_reasons_restated(fit):
+    from fogdrift.noise.result import NoiseTerm
+
+    f = dataclasses.replace(fit, terms={**fit.terms, "S": NoiseTerm("S", 2.0, "deg/h", 1.0, 3.0, "resolved", ""),
+                                        "M": NoiseTerm("M", 0.5, "deg/h/sqrt(s)", None, None, "resolved", "")},
+                            excluded=[{"tau_s": 1.0, "why": "above 0.01 deg/√h"}, "kept"])
+    acc = express(f, "specific_force")
+    assert (acc.terms["S"].unit, acc.terms["S"].value, acc.terms["S"].hi95) == ("m/s^2", 2.0, 3.0)
+    assert (acc.terms["M"].unit, acc.terms["M"].value) == ("m/s^2/sqrt(s)", 0.5)
+    assert acc.excluded == [{"tau_s": 1.0, "why": "above 36 m/s/√h"}, "kept"]
