@@ -9,7 +9,7 @@
   (no partial file, no temporary manifest left), a MemoryError inside a command.
 
 Independent checks: the file system (listdir), the exit status and the output lines, the subprocess's peak RSS
-(``ru_maxrss``) and its wall time under hard caps.
+(``VmHWM``, the program's own peak) and its wall time under hard caps.
 """
 
 from __future__ import annotations
@@ -80,7 +80,9 @@ try:
 except FogdriftError as exc:
     out = {"error": str(exc), "type": type(exc).__name__}
 out["wall_s"] = time.perf_counter() - t0
-out["rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+# VmHWM: the peak of THIS program's memory (ru_maxrss keeps the forking pytest worker's peak across exec)
+hwm = [ln for ln in open("/proc/self/status") if ln.startswith("VmHWM:")]
+out["rss_mb"] = (int(hwm[0].split()[1]) if hwm else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) / 1024
 print(json.dumps(out))
 """
 
