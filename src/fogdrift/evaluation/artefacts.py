@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..allan import allan_variance
 from ..errors import ConfigError
 from ..models.causal_predictor import CausalPredictor, causal_weights
 
@@ -118,8 +119,6 @@ def _amplitude_at(d, t, f):
 
 
 def _adev_ratio_fn(base, comp, dt):
-    from ..allan import allan_variance
-
     try:
         a = allan_variance(base, dt, taus="octave")
         b = allan_variance(comp, dt, taus="octave")

@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import ConfigError, FogdriftError, InsufficientDataError
 from ..models.causal_predictor import causal_weights
+from .verdicts import diverges, independent_subset
 
 __all__ = ["HORIZONS_S", "CONSTANT_BIAS", "HeadingRow", "HeadingResult", "heading_errors", "heading_row",
            "angle_error_deg"]
@@ -78,8 +79,6 @@ class HeadingRow:
     worse_independent: int | None = None
 
     def to_dict(self) -> dict:
-        from .verdicts import diverges
-
         out = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in self.__dict__.items()}
         out["diverges"] = diverges(self.rms_deg, self.ratio_to_bias)
         return out
@@ -138,8 +137,6 @@ def heading_row(model, errors_deg, bias_errors_deg, *, horizon_s, step_s, horizo
     >>> r.wins_vs_bias, r.n_independent, r.better_independent, r.worse_independent
     (0.6666666666666666, 3, 1, 2)
     """
-    from .verdicts import independent_subset
-
     e = np.asarray(errors_deg, dtype=np.float64)
     eb = np.asarray(bias_errors_deg, dtype=np.float64)
     with np.errstate(over="ignore", invalid="ignore"):

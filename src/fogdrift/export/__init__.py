@@ -16,6 +16,7 @@ Modules, one concept each:
 from __future__ import annotations
 
 from ..errors import ConfigError
+from .conversions import _rate
 from .model import MISSING_POLICIES, ChannelModel, channels_from_result, load_result
 from .targets import TARGETS, ExportContext, get_target, target_names
 
@@ -63,7 +64,6 @@ def build_context(gyro=(), accel=(), *, results=(), channels=(), rate_hz=None, m
             raise ConfigError(f"the records have different sample rates ({', '.join(f'{r:g}' for r in rates)} Hz); "
                               "pass the filter's IMU rate with {opt:rate}")
         rate_hz = rates[0]
-    from .conversions import _rate
 
     rate = _rate(rate_hz)
     return ExportContext(gyro=[c for c in chans if c.quantity == "gyro"],

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
+from ..errors import ConfigError
 from .writers import (ExportContext, write_gnss_ins_sim, write_json, write_kalibr, write_kfgins, write_matlab,
                       write_openvins, write_orbslam3, write_vins)
 
@@ -68,8 +69,6 @@ def target_names() -> list[str]:
 
 def get_target(name: str) -> Target:
     """The :class:`Target` called ``name``; an unknown name is refused listing the valid ones."""
-    from ..errors import ConfigError
-
     key = str(name).strip().lower()
     if key not in TARGETS:
         raise ConfigError(f"unknown export target {name!r}; expected one of {', '.join(TARGETS)} (or 'all')")

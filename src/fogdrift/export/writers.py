@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 from ..errors import FogdriftError
 from .conversions import DEG, MGAL, gm_discrete, walk_discrete, white_discrete
+from .discretize import discrete_model
 from .model import ChannelModel, bias_gm, describe, resolve
 
 __all__ = ["ExportContext", "fmt", "write_kalibr", "write_openvins", "write_vins", "write_orbslam3", "write_kfgins",
@@ -325,8 +326,6 @@ def write_gnss_ins_sim(ctx: ExportContext) -> str:
 
 
 def write_json(ctx: ExportContext) -> str:
-    from .discretize import discrete_model
-
     chans = []
     for ch in ctx.gyro + ctx.accel:
         d = ch.to_dict()

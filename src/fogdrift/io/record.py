@@ -17,6 +17,7 @@ from .. import units
 from .._util import check_distinct_names
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
 from ..signal import Channel, Sampling, SignalDescription
+from ..temperature import temperature_summary
 from .channel_quantity import check_name
 from ._checks import first_nonfinite, int_arg, split_keys, take_columns, to_dph
 
@@ -427,8 +428,6 @@ class GyroRecord:
             log (:meth:`fogdrift.temperature.TemperatureSummary.to_dict`, deg C and deg C/h);
             ``signal`` is :meth:`fogdrift.signal.SignalDescription.to_dict` of :attr:`signal`.
         """
-        from ..temperature import temperature_summary
-
         temp = None if self.temperature_c is None else temperature_summary(self.temperature_c, self.dt_s).to_dict()
         return {
             "source": self.source,

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import DataFormatError
+from .limits import check_expansion, check_memory, check_rows
 
 __all__ = ["ArrayItem", "Layout", "layout_columns", "unit_list"]
 
@@ -103,8 +104,6 @@ def layout_columns(items: list[ArrayItem], path, what: str) -> Layout:
 def check_layout(layout: Layout, used, path) -> None:
     """Refuse a layout whose used columns exceed the row limit, the memory budget or (as stored) the expansion
     limit against the file's size, before anything is read (:mod:`fogdrift.io.readers.limits`)."""
-    from .limits import check_expansion, check_memory, check_rows
-
     used = sorted(set(used))
     check_rows(layout.n_rows, path)
     check_memory(layout.n_rows * 8.0 * max(len(used), 1), path,

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import ConfigError, DataFormatError
+from ...errors import ConfigError, DataFormatError, ResourceError
 
 __all__ = ["Table", "split_unit_label", "numeric_column", "describe_exception", "PARSER_ERRORS",
            "require", "MissingDependencyError"]
@@ -65,8 +65,6 @@ def require(module: str, extra: str, what: str):
         return importlib.import_module(module)
     except ImportError as exc:
         if "failed to map segment" in str(exc) or isinstance(exc.__cause__ or exc.__context__, MemoryError):
-            from ...errors import ResourceError
-
             raise ResourceError(  # installed, but its shared library does not fit under a memory limit
                 f"{what} needs the Python package {module.split('.')[0]!r}, which is installed but could not be "
                 f"loaded: out of memory ({describe_exception(exc)}); run it with more memory (a process limit: "
