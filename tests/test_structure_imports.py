@@ -190,8 +190,6 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
         "fogdrift.lifting", "fogdrift.metrics", "fogdrift.models", "fogdrift.noise", "fogdrift.noise.periodic",
         "fogdrift.noise.spectral", "fogdrift.outliers", "fogdrift.units", "fogdrift.io.record",
         "fogdrift.allan.grid", "fogdrift.models.grey", "fogdrift.noise.terms")),
-    "fogdrift.compensate.run": (DEBT("H-compensate"), ("fogdrift.evaluation.artefacts",
-        "fogdrift.evaluation.heading", "fogdrift.evaluation.verdicts", "fogdrift.report.files")),
     "fogdrift.lifting.levels": (DEBT("unowned"), ("fogdrift.allan", "fogdrift.units")),
     "fogdrift.models.kalman": (DEBT("unowned"), ("fogdrift.allan", "fogdrift.errors", "fogdrift.noise")),
     "fogdrift.noise": (DEBT("unowned"), ("fogdrift.allan", "fogdrift.noise.periodic")),

@@ -14,9 +14,13 @@ import numpy as np
 from ..allan import allan_variance
 from ..bundle import Bundle, load_bundle
 from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
+from ..evaluation.artefacts import artefact_check
+from ..evaluation.heading import heading_errors
+from ..evaluation.verdicts import adev_caveat, artefact_verdict, heading_verdict, headline_verdict
 from ..interrupt import checkpoint
 from ..models import model_spec
 from ..output import OutputDir, active, atomic_path
+from ..report.files import write_json
 from .engine import BIAS_ONLY, AxisPlan, StreamCompensator
 from .outputs import AllanAccumulator, CsvWriter, NpzWriter, plot_before_after
 from .sources import DEFAULT_CHUNK, match_log, open_log
@@ -303,8 +307,6 @@ def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_ra
 
 def _caveats(result, name, plans, curves, why_not) -> list:
     """Axis -> the artefact check's caveat on the before/after ADEV, per plotted axis (none for 'bias')."""
-    from ..evaluation.verdicts import adev_caveat
-
     if name == BIAS_ONLY or not curves:
         return {}
     label = plans[0].model.label
@@ -319,15 +321,10 @@ def _write_json(obj, path) -> Path:
     """The summary as strict JSON (NaN/inf as null), atomically: the one strict-JSON writer
     (:func:`fogdrift._util.write_json`, imported through ``report.files`` until the structure test's table of the
     compensate <-> evaluation cycle follows)."""
-    from ..report.files import write_json
-
     return write_json(obj, path)
 
 
 def _evaluate(result, b, plans, biases, z_all, *, heading, artefacts, calib_s, step_s, horizons_s):
-    from ..evaluation.artefacts import artefact_check
-    from ..evaluation.heading import heading_errors
-    from ..evaluation.verdicts import artefact_verdict, heading_verdict, headline_verdict
     for k, (p, (_, bias_total)) in enumerate(zip(plans, biases)):
         h = a = None
         ax = p.bundle_axis
