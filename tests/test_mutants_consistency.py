@@ -150,3 +150,22 @@ def test_integer_horizons_beyond_int64_cubes():
     k = [{"kind": "random_walk", "rrw_dphrh": 1.0}]
     assert angle_error_variance_deg2(k, [3_000_000], 100.0)[0] == pytest.approx(
         angle_error_variance_deg2(k, [3e6], 100.0)[0], rel=1e-12)
+
+
+def test_an_error_exactly_on_the_band_edge_is_inside():
+    rows = coverage_rows([np.array([1.0, -1.0, 3.0])], [1.0], [60.0])
+    assert rows[0].coverage["68 %"] == pytest.approx(2.0 / 3.0)
+    d = rows[0].to_dict()
+    assert set(d["inflation"]["95 %"]) == {"lambda", "lo95", "hi95"}
+
+
+@pytest.mark.parametrize("h", [[], [[60.0, 120.0]], [0.0], [math.nan]])
+def test_horizons_must_be_a_non_empty_list_of_positive_numbers(h):
+    with pytest.raises(ConfigError, match="horizons"):
+        angle_error_variance_deg2([{"kind": "white", "arw_dprh": 1.0}], h, 100.0)
+
+
+def test_a_zero_k_bound_is_no_bound():
+    comps = [{"kind": "white", "arw_dprh": 0.1}, {"kind": "gauss_markov", "tc_s": 50.0, "sigma_dph": 1.0}]
+    d = random_walk_covering(comps, 60.0, 60.0, k_bound_dphrh=0.0)
+    assert d["k_bound_dphrh"] is None and d["ratio_to_bound"] is None and d["k_alone_dphrh"] == 0.0

@@ -119,3 +119,13 @@ def test_sensor_name_and_judgement_without_a_reading_to_dict():
     d = judge(spec["limits"][0], None, "gx").to_dict()
     assert d["reading"] is None and d["verdict"] == "cannot tell" and d["channel"] == "gx"
     assert d["limit"] == "2 deg/sqrt(h)" and d["limit_canonical"] == 2.0 and d["unit"] == "deg/sqrt(h)"
+
+
+def test_upper_bound_label_of_a_term_that_is_not_estimable_gives_its_status():
+    from fogdrift.spec import readings_from_noise_fit
+
+    n = SimpleNamespace(value=None, lo95=0.0, hi95=0.5, unit="deg/sqrt(h)", status="absent", estimable=False)
+    r = readings_from_noise_fit(SimpleNamespace(terms={"N": n}, no_fit=None, b_min={}))["arw"]
+    assert r.label == "N: only its 95 % upper bound (absent)" and r.bound == "upper" and r.value == 0.5
+    r = readings_from_noise_fit(SimpleNamespace(terms={"N": n}, no_fit=True, b_min={}))["arw"]
+    assert r.label == "N: only its 95 % upper bound (no model fits)"

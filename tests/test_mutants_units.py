@@ -78,3 +78,39 @@ def test_temperature_offsets(unit, offset):
 def test_unknown_temperature_unit_is_one_line(unit):
     with pytest.raises(ConfigError, match=r"^unknown temperature unit .*; expected one of \[.*\] \(any case\)$"):
         temperature_offset_to_c(unit)
+
+
+def test_parse_unit_records_the_base_and_names_every_quantity_when_none_is_given():
+    from fogdrift.units import parse_unit
+
+    assert parse_unit("deg/s").base == "deg/s" and parse_unit("inc:arcsec").base == "arcsec"
+    with pytest.raises(ConfigError, match=r"^unknown unit 'furlong'; expected a unit of angular rate or specific "
+                                          r"force, one of \['deg/h', "):
+        parse_unit("furlong", None)
+
+
+# the low end 1/DT_MAX_S is inside; the high end 1/DT_MIN_S is 999999999.9999999 in floats, so 1e9 itself is refused
+@pytest.mark.parametrize("rate", [0.5, 1e-9, 5e8, 1.0 / 1e-9])
+def test_check_rate_hz_accepts_its_ends_and_rates_below_one_hertz(rate):
+    from fogdrift.units import check_rate_hz
+
+    assert check_rate_hz(rate) == rate
+
+
+@pytest.mark.parametrize("rate, match", [(True, r"^rate_hz must be a number of Hz > 0, got True$"),
+                                         (0.0, "must be a finite number of Hz > 0"),
+                                         (2e9, r"must be a sample rate between 1e-09 Hz and 1e\+09 Hz")])
+def test_check_rate_hz_messages(rate, match):
+    from fogdrift.units import check_rate_hz
+
+    with pytest.raises(ConfigError, match=match):
+        check_rate_hz(rate)
+
+
+def test_check_dt_s_refuses_infinity_and_time_unit_message():
+    from fogdrift.units import check_dt_s, time_scale_to_s
+
+    with pytest.raises(ConfigError, match=r"^dt_s must be a finite number > 0 \(seconds\); got inf$"):
+        check_dt_s(math.inf)
+    with pytest.raises(ConfigError, match=r"^unknown time unit 'min'; expected one of \['s', 'ms', 'us', 'ns'\]$"):
+        time_scale_to_s("min")
