@@ -96,3 +96,19 @@ def test_shaped_terms_are_relabelled_and_excluded_reasons_restated(fit):
     assert (acc.terms["S"].unit, acc.terms["S"].value, acc.terms["S"].hi95) == ("m/s^2", 2.0, 3.0)
     assert (acc.terms["M"].unit, acc.terms["M"].value) == ("m/s^2/sqrt(s)", 0.5)
     assert acc.excluded == [{"tau_s": 1.0, "why": "above 36 m/s/√h"}, "kept"]
+
+
+def test_restate_text_of_an_interval_scales_both_ends():
+    from fogdrift.noise.quantity import restate_text
+
+    # N 0.01 [0.005, 0.02] deg/√h -> x 3600: 36 [18, 72] m/s/√h
+    assert restate_text("N = 0.01 [0.005, 0.02] deg/√h", "specific_force") == "N = 36 [18, 72] m/s/√h"
+
+
+def test_shaped_markov_and_sinusoid_units_are_relabelled(fit):
+    f = dataclasses.replace(fit, shaped={"M": {"q": 1.0, "q_unit": "deg/h/sqrt(s)", "sigma_unit": "deg/h"},
+                                         "S": {"amplitude": 2.0, "amplitude_unit": "deg/h"}})
+    acc = express(f, "specific_force")
+    assert acc.shaped["M"] == {"q": 1.0, "q_unit": "m/s^2/sqrt(s)", "sigma_unit": "m/s^2"}
+    assert acc.shaped["S"] == {"amplitude": 2.0, "amplitude_unit": "m/s^2"}
+    assert f.shaped["M"]["sigma_unit"] == "deg/h"   # the input is not modified

@@ -129,3 +129,41 @@ def test_upper_bound_label_of_a_term_that_is_not_estimable_gives_its_status():
     assert r.label == "N: only its 95 % upper bound (absent)" and r.bound == "upper" and r.value == 0.5
     r = readings_from_noise_fit(SimpleNamespace(terms={"N": n}, no_fit=True, b_min={}))["arw"]
     assert r.label == "N: only its 95 % upper bound (no model fits)"
+
+
+def test_bound_only_readings_keep_unit_and_direction():
+    from fogdrift.spec import readings_from_gmwm, readings_from_noise_fit
+
+    fit = SimpleNamespace(terms={}, no_fit=None, b_min={"value": 0.01, "unit": "deg/s", "tau_s": 50.0,
+                                                        "bound_only": True})
+    r = readings_from_noise_fit(fit)["bias_instability"]
+    assert (r.unit, r.bound, r.label) == ("deg/s", "upper", "B_min at τ = 50 s, an upper bound")
+    r = readings_from_noise_fit(SimpleNamespace(terms={}, no_fit=None, b_min={"value": 5.0, "bound_only": True}))
+    assert r["bias_instability"].unit == "deg/h"
+    n = SimpleNamespace(value=1.0, lo95=0.9, hi95=1.1, unit="deg/sqrt(h)")
+    b = SimpleNamespace(value_dph=None, bound_dph=3.0, reason="still falling", tau_s=None)
+    g = readings_from_gmwm(SimpleNamespace(selection=SimpleNamespace(ieee=SimpleNamespace(terms={"N_dprh": n},
+                                                                                          b_min=b))))
+    assert g["arw"].label == "N from GMWM"
+    assert (g["bias_instability"].bound, g["bias_instability"].value) == ("upper", 3.0)
+    assert g["bias_instability"].label == "B_min, an upper bound (still falling)"
+
+
+def test_judgement_dict_has_reason_and_the_reading_label():
+    from fogdrift.spec import judge
+
+    lim = parse_spec({"gyro": {"arw": "2 deg/sqrt(h)"}})["limits"][0]
+    d = judge(lim, Reading(1.0, 0.9, 1.1, "deg/sqrt(h)", None, "N from GMWM")).to_dict()
+    assert d["reading"] == "N from GMWM" and d["reason"] == "the whole 95 % interval is within the limit 2 deg/sqrt(h)"
+
+
+def test_spec_file_errors_name_the_yaml_line_and_an_unreadable_path(tmp_path):
+    from fogdrift.errors import ConfigError
+    from fogdrift.spec import read_spec
+
+    p = tmp_path / "s.yaml"
+    p.write_text("gyro:\n  arw: \"2 deg/sqrt(h)\"\n  b: [unclosed\n", encoding="utf-8")
+    with pytest.raises(ConfigError, match=r"s\.yaml:4: not valid YAML"):
+        read_spec(p)
+    with pytest.raises(ConfigError, match=r"^spec file: cannot read .* \(.*\)$"):
+        read_spec(tmp_path)   # a directory
