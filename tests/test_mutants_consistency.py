@@ -169,3 +169,17 @@ def test_a_zero_k_bound_is_no_bound():
     comps = [{"kind": "white", "arw_dprh": 0.1}, {"kind": "gauss_markov", "tc_s": 50.0, "sigma_dph": 1.0}]
     d = random_walk_covering(comps, 60.0, 60.0, k_bound_dphrh=0.0)
     assert d["k_bound_dphrh"] is None and d["ratio_to_bound"] is None and d["k_alone_dphrh"] == 0.0
+
+
+def test_worst_inflation_is_the_largest_finite_lambda_and_the_first_of_ties():
+    from fogdrift.evaluation.consistency import CoverageRow
+
+    def row(h, lam68, lam95):
+        return CoverageRow(horizon_s=h, n_origins=5, sigma_pred=1.0, rms=1.0, coverage={},
+                           inflation={"68 %": (lam68, 0.0, 0.0), "95 %": (lam95, 0.0, 0.0)})
+
+    res = ConsistencyResult("full", {"gx": {"rows": [row(60.0, 2.0, math.inf), row(600.0, 3.0, 3.0)]},
+                                     "gy": {"rows": [row(60.0, math.nan, math.nan)]}}, 100.0, (60.0, 600.0))
+    assert res.worst_inflation("gx") == (3.0, 600.0, "68 %")   # inf is skipped; a tie keeps the first
+    lam, h, band = res.worst_inflation("gy")                     # nothing finite: the empty answer
+    assert lam == -math.inf and math.isnan(h) and band == ""
