@@ -51,10 +51,16 @@ import numpy as np
 
 from . import __version__
 from ._util import safe_name, strict_json
+from .allan import allan_variance
 from .errors import ConfigError, FogdriftError, ModelFileError
 from .io.hashing import file_sha256
+from .lifting import MODES, max_level, wavelist
+from .models import MODELS, MODEL_NAMES, load_model, model_spec
+from .models.base import model_file_paths
+from .noise import fit_noise
 from .output import atomic_path
 from .signal import Channel, Sampling, SignalDescription
+from .units import check_dt_s, parse_unit
 
 __all__ = [
     "BUNDLE_FORMAT",
@@ -228,8 +234,6 @@ class Bundle:
     @property
     def model_names(self) -> tuple:
         """Registry names of the models every axis has, in registry order."""
-        from .models import MODEL_NAMES
-
         common = set.intersection(*(set(a.models) for a in self.axes)) if self.axes else set()
         return tuple(n for n in MODEL_NAMES if n in common)
 
@@ -238,8 +242,6 @@ class Bundle:
 # building
 # ------------------------------------------------------------------------------------------------------
 def _registry_name(label: str) -> str:
-    from .models import MODELS
-
     for spec in MODELS:
         if spec.label == label:
             return spec.name
@@ -247,9 +249,6 @@ def _registry_name(label: str) -> str:
 
 
 def _allan_noise_model(x, dt_s) -> dict:
-    from .allan import allan_variance
-    from .noise import fit_noise
-
     try:
         fit = fit_noise(allan_variance(x, dt_s, taus="octave"))
     except FogdriftError as exc:
@@ -417,11 +416,6 @@ def load_bundle(path) -> Bundle:
         interval, wavelet, mode, level or window, a model file that is missing, modified (SHA-256) or of
         another class.  The message names the file and the key.
     """
-    from .lifting import MODES, max_level, wavelist
-    from .models import load_model, model_spec
-    from .models.base import model_file_paths
-    from .units import check_dt_s, parse_unit
-
     p = Path(path)
     if p.name != MANIFEST and p.is_file():
         raise ModelFileError(f"{p}: is a file; expected a bundle directory (OUT/bundle, written by 'fogdrift analyze' "

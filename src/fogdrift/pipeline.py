@@ -34,11 +34,23 @@ from typing import Callable
 
 import numpy as np
 
+from .allan import ESTIMATORS, STATISTICS
+from .allan.ci import periodic_alpha
+from .allan.grid import MAX_TAUS
 from .errors import ConfigError, FogdriftWarning, InsufficientDataError
+from .gmwm.analysis import analyse_gmwm
 from .interrupt import checkpoint  # a stop point between stages/axes/models; reports the stage to listeners
-from .io import file_sha256
-from .models import MODEL_NAMES  # registry order = report order
+from .io import file_sha256, record as _record
+from .lifting import MODES, causal_drift, choose_level, get_wavelet, level_scan, separate
+from .metrics import evaluate, p0
+from .models import MODEL_NAMES, Persistence, model_spec  # registry order = report order
 from .models import build_model as make_model  # make_model(name, cfg, progress=None), old name kept for now
+from .models.grey import GM11_MIN_LENGTH
+from .noise import express_quantity
+from .noise.periodic import null_taus, periodic_content
+from .noise.spectral import analyse_spectrum
+from .noise.terms import TERM_TABLE
+from .outliers import OUTLIER_ACTIONS, treat_outliers
 from .pipeline_sums import CHUNKED_MIN_SAMPLES, AllanSums  # noqa: F401 (re-exported)
 from .pipeline_results import (
     AllanAxis,
@@ -49,6 +61,7 @@ from .pipeline_results import (
     SeparationAxis,
     _plain,
 )
+from .units import check_rate_hz, earth_rate_projection_dph
 
 __all__ = [
     "AnalysisConfig",
@@ -171,14 +184,11 @@ class AnalysisConfig:
                 f"the training and validation shares ({{opt:train_fraction}} + {{opt:val_fraction}}) must leave a "
                 f"test block; got {self.train_fraction + self.val_fraction:.3g} >= 1"
             )
-        from .models import model_spec
 
         if not self.models:
             raise ConfigError(f"no drift model given; pass {{opt:models}} with one or more of {list(MODEL_NAMES)}")
         # canonical registry names (any case accepted); an unknown name is an error, never a fallback
         models = tuple(dict.fromkeys(model_spec(m).name for m in self.models))
-        from .allan import STATISTICS
-        from .outliers import OUTLIER_ACTIONS
 
         if self.statistic not in STATISTICS:
             raise ConfigError(f"statistic must be one of {tuple(STATISTICS)}, got {self.statistic!r} ({{opt:statistic}})")
@@ -190,8 +200,6 @@ class AnalysisConfig:
                 self.model_rate_hz) or not self.model_rate_hz > 0):
             raise ConfigError(f"the modelling rate ({{opt:model_rate_hz}}) must be > 0 Hz; got {self.model_rate_hz!r}")
         if self.model_rate_hz is not None:
-            from .units import check_rate_hz
-
             check_rate_hz(self.model_rate_hz, "the modelling rate ({opt:model_rate_hz})")
         for key in ("lags", "hidden", "epochs", "gm_window", "seed"):
             value = getattr(self, key)
@@ -200,7 +208,6 @@ class AnalysisConfig:
         if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
             raise ConfigError(f"{{opt:lags}}, {{opt:hidden}} and {{opt:epochs}} must be >= 1; got {self.lags}, "
                               f"{self.hidden}, {self.epochs}")
-        from .models.grey import GM11_MIN_LENGTH
 
         if self.gm_window < GM11_MIN_LENGTH:
             raise ConfigError(f"{{opt:gm_window}} must be an integer >= {GM11_MIN_LENGTH} samples; got {self.gm_window!r}")
@@ -220,8 +227,6 @@ class AnalysisConfig:
             raise ConfigError("an Earth-rate axis orientation ({opt:earth_axes}) was given without a latitude; pass "
                               "{opt:latitude_deg} DEG")
         if self.latitude_deg is not None:
-            from .units import earth_rate_projection_dph
-
             for orient in self.earth_axes.values():
                 earth_rate_projection_dph(self.latitude_deg, orient)  # refuses an unknown orientation
         # activation: checked by the Elman models when built (reading their table here would import JAX)
@@ -256,32 +261,22 @@ def check_options(*, wavelet=None, mode=None, training=None, estimator=None, ter
     analysis configuration.
     """
     if wavelet is not None:
-        from .lifting import get_wavelet
-
         get_wavelet(wavelet)
     if mode is not None:
-        from .lifting import MODES
-
         if mode not in MODES:
             raise ConfigError(f"{{opt:mode}} must be one of {list(MODES)}; got {mode!r}")
     if training is not None and training not in ("bptt", "bp"):
         raise ConfigError(f"{{opt:training}} must be 'bptt' or 'bp'; got {training!r}")
     if estimator is not None:
-        from .allan import ESTIMATORS
-
         if estimator not in ESTIMATORS:
             raise ConfigError(f"{{opt:estimator}} must be one of {list(ESTIMATORS)}; got {estimator!r}")
     if terms is not None:
-        from .noise.terms import TERM_TABLE
-
         bad = [t for t in terms if t not in TERM_TABLE]
         if bad or not terms:
             raise ConfigError(f"{{opt:terms}} must list noise terms among Q, N, B, K, R; got {','.join(terms)!r}")
 
 
 def _check_taus(taus) -> None:
-    from .allan.grid import MAX_TAUS
-
     if isinstance(taus, str):
         if taus.lower() not in ("octave", "decade", "all"):
             raise ConfigError(f"{{opt:taus}} must be 'octave', 'decade', 'all' or a number of taus, got {taus!r}")
@@ -341,17 +336,9 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     missing cluster sizes are computed.  Ignored unless it holds the same array (after outlier treatment), interval,
     statistic and estimator.
     """
-    from .allan.ci import periodic_alpha
-    from .noise import express_quantity, fit_noise
-    from .noise.periodic import null_taus, periodic_content
-
     if check_outliers:
-        from .outliers import treat_outliers
-
         rate_dph, outliers = treat_outliers(rate_dph, cfg.outliers)
     if isinstance(spectrum, str) and spectrum == "auto":
-        from .noise.spectral import analyse_spectrum
-
         spectrum = analyse_spectrum(rate_dph, dt_s)
     content = periodic_content(spectrum)
     # Every grid this analysis may need (display, octave, octave + the null taus of the periodic content) is known
@@ -383,6 +370,8 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     del sums
     lo, hi = cfg.fit_tau_s
     tau_range = None if lo is None and hi is None else (lo, hi)
+    from .noise import fit_noise  # looked up per call: tests spy on fogdrift.noise.fit_noise
+
     noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range,
                       spectrum=spectrum, markov=True)
     if quantity != "angular_rate":
@@ -394,8 +383,6 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
 
 def _treated_record(record, cfg: AnalysisConfig):
     """The record with outliers clipped or replaced per ``cfg.outliers`` (unchanged for "warn"), and the reports."""
-    from .outliers import treat_outliers
-
     data = np.array(record.rate_dph, dtype=np.float64)
     reports = {}
     for k, name in enumerate(record.axis_names):
@@ -415,8 +402,6 @@ def model_factor(record, cfg: AnalysisConfig) -> int:
     :func:`run_separation` (``factor=``), which then do not decide it again.  It is stored on every
     :class:`ModelAxis`, in the bundle, and in the modelling record's signal description.
     """
-    from .io import record as _record
-
     return 1 if cfg.model_rate_hz is None else _record.decimation_factor(record.dt_s, cfg.model_rate_hz)
 
 
@@ -427,8 +412,6 @@ def _model_record(record, cfg: AnalysisConfig, factor: int | None = None):
 
 def drift_reach(wavelet: str, level: int) -> int:
     """Support [samples] of the level-``level`` drift filter of ``wavelet``: ``(filter_length - 1) 2^level``."""
-    from .lifting import get_wavelet
-
     return (get_wavelet(wavelet).filter_length - 1) * 2**int(level)
 
 
@@ -440,15 +423,12 @@ def causal_window_samples(causal_window_s: float, dt_s: float, wavelet: str, lev
 
 
 def _separate(x, cfg: AnalysisConfig, dt_s):
-    from .lifting import separate
-
     return separate(x, wavelet=cfg.wavelet, level=cfg.level, mode=cfg.mode)
 
 
 def _resolved_level(x, cfg: AnalysisConfig, dt_s) -> tuple[int, list | None]:
     if cfg.level != "auto":
         return int(cfg.level), None
-    from .lifting import choose_level, level_scan
 
     scan = level_scan(x, dt_s, wavelet=cfg.wavelet, mode=cfg.mode)
     return int(choose_level(scan)), scan
@@ -464,7 +444,6 @@ def _split_indices(n: int, cfg: AnalysisConfig) -> dict:
 def _earth_rate(name: str, cfg: AnalysisConfig) -> float:
     if cfg.latitude_deg is None or name not in cfg.earth_axes:
         return 0.0
-    from .units import earth_rate_projection_dph
 
     return float(earth_rate_projection_dph(cfg.latitude_deg, cfg.earth_axes[name]))
 
@@ -533,10 +512,6 @@ def _with_level(cfg: AnalysisConfig, level: int) -> AnalysisConfig:
 def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progress=None, fitted=None,
                      factor: int = 1) -> ModelAxis:
     """Split, separate inside each block, fit (unless ``fitted`` models are given) and evaluate one axis."""
-    from .lifting import causal_drift
-    from .metrics import evaluate, p0
-    from .models import Persistence
-
     level = int(cfg.level)
     split = _split_indices(rate.size, cfg)
     reach = drift_reach(cfg.wavelet, level)  # support of the level-J drift filter
@@ -698,8 +673,6 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
                                  outliers=outlier_reports[name], sums=(sums or {}).get(name))
         gmwm = None
         if cfg.noise_method == "gmwm":
-            from .gmwm.analysis import analyse_gmwm
-
             checkpoint("GMWM noise model (native rate)", axis=name)
             gmwm = analyse_gmwm(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s)
         checkpoint("separation", axis=name)

@@ -15,7 +15,14 @@ from pathlib import Path
 
 import numpy as np
 
+from ._util import check_series
+from .allan import _kernels, chunked
+from .allan.core import _fast_strides, result_from_sums
+from .allan.grid import tau_grid
+from .allan.statistics import get_statistic
 from .errors import ConfigError, InsufficientDataError
+from .io.chunked import ChunkSource
+from .units import check_dt_s
 
 __all__ = ["AllanSums", "CHUNKED_MIN_SAMPLES", "OUT_OF_CORE_CHUNK"]
 
@@ -49,10 +56,6 @@ class AllanSums:
     """
 
     def __init__(self, rate_dph, dt_s, statistic: str = "adev", estimator: str = "overlapping"):
-        from ._util import check_series
-        from .allan.statistics import get_statistic
-        from .units import check_dt_s
-
         self.stat = get_statistic(statistic)
         self.source = rate_dph
         self.y = np.ascontiguousarray(check_series(rate_dph, "rate_dph"))
@@ -78,14 +81,10 @@ class AllanSums:
 
     def grid(self, taus) -> np.ndarray:
         """Cluster sizes m of a tau specification (:func:`fogdrift.allan.tau_grid`, default max_fraction)."""
-        from .allan.grid import tau_grid
-
         return tau_grid(self.n, self.dt, taus, statistic=self.stat.name)
 
     def strides(self, m: np.ndarray) -> np.ndarray:
         """Start-index strides of the estimator at cluster sizes ``m`` (as :func:`fogdrift.allan.allan_variance`)."""
-        from .allan.core import _fast_strides
-
         if self.estimator == "fast":
             return _fast_strides(m)
         return m.copy() if self.estimator == "non-overlapping" else np.ones_like(m)
@@ -98,8 +97,6 @@ class AllanSums:
 
     def compute(self, grids, progress=None) -> None:
         """The sums at every m of ``grids`` not yet computed (one pass); ``progress(done, total)`` counts taus."""
-        from .allan import _kernels
-
         if progress is not None and not callable(progress):
             raise ConfigError(f"progress must be a callable(done, total) or None, got {progress!r}")
         want = np.unique(np.concatenate([np.asarray(g, dtype=np.int64) for g in grids]))
@@ -108,9 +105,6 @@ class AllanSums:
             strides = self.strides(m)
             sums = np.empty(m.size)
             if self.chunked:
-                from .allan import chunked
-                from .io.chunked import ChunkSource
-
                 y = self.y
                 source = ChunkSource(path=Path("<memory>"), n_samples=self.n, dt_s=self.dt, name="rate",
                                      scale_to_dph=1.0, describe="in-memory float64", _read=lambda a, b: y[a:b])
@@ -138,8 +132,6 @@ class AllanSums:
     def result(self, m: np.ndarray, noise_alpha="auto"):
         """The :class:`~fogdrift.allan.AllanResult` at cluster sizes ``m`` (computed before) with ``noise_alpha`` as
         for :func:`fogdrift.allan.allan_variance`."""
-        from .allan.core import result_from_sums
-
         m = np.asarray(m, dtype=np.int64)
         idx = np.searchsorted(self.m, m)
         if idx.size and (idx.max() >= self.m.size or not np.array_equal(self.m[idx], m)):
