@@ -145,7 +145,8 @@ def test_bound_only_readings_keep_unit_and_direction():
     g = readings_from_gmwm(SimpleNamespace(selection=SimpleNamespace(ieee=SimpleNamespace(terms={"N_dprh": n},
                                                                                           b_min=b))))
     assert g["arw"].label == "N from GMWM"
-    assert (g["bias_instability"].bound, g["bias_instability"].value) == ("upper", 3.0)
+    assert (g["bias_instability"].bound, g["bias_instability"].value, g["bias_instability"].unit) == ("upper", 3.0,
+                                                                                                      "deg/h")
     assert g["bias_instability"].label == "B_min, an upper bound (still falling)"
 
 
@@ -167,3 +168,16 @@ def test_spec_file_errors_name_the_yaml_line_and_an_unreadable_path(tmp_path):
         read_spec(p)
     with pytest.raises(ConfigError, match=r"^spec file: cannot read .* \(.*\)$"):
         read_spec(tmp_path)   # a directory
+
+
+def test_channel_kind_channel_and_limit_kept_and_greek_mu():
+    from fogdrift.spec import channel_kind, judge, parse_quantity
+
+    assert (channel_kind("specific_force"), channel_kind("angular_rate"), channel_kind(None)) == ("accel", "gyro",
+                                                                                                   "gyro")
+    lim = parse_spec({"gyro": {"arw": "2 deg/sqrt(h)"}})["limits"][0]
+    j = judge(lim, Reading(2.5, None, None, "deg/sqrt(h)"), "gx")          # no interval
+    assert (j.channel, j.limit, j.verdict) == ("gx", lim, "cannot tell")
+    j = judge(lim, Reading(2.0, 1.5, 2.5, "deg/sqrt(h)"), "gy")            # the limit inside the interval
+    assert (j.channel, j.limit, j.verdict) == ("gy", lim, "cannot tell")
+    assert parse_quantity("200 \u03bcg", "accel", "bias_instability")[0] == pytest.approx(1.96133e-3, rel=1e-12)
