@@ -183,3 +183,37 @@ def test_worst_inflation_is_the_largest_finite_lambda_and_the_first_of_ties():
     assert res.worst_inflation("gx") == (3.0, 600.0, "68 %")   # inf is skipped; a tie keeps the first
     lam, h, band = res.worst_inflation("gy")                     # nothing finite: the empty answer
     assert lam == -math.inf and math.isnan(h) and band == ""
+
+
+def test_coverage_row_dict_values_and_interval_ends():
+    from fogdrift.evaluation.consistency import CoverageRow
+
+    r = CoverageRow(horizon_s=60.0, n_origins=3, sigma_pred=1.0, rms=2.0, coverage={"68 %": 0.5},
+                    inflation={"68 %": (2.0, 1.5, 3.0)})
+    d = r.to_dict()
+    assert d["coverage"] == {"68 %": 0.5} and d["inflation"]["68 %"] == {"lambda": 2.0, "lo95": 1.5, "hi95": 3.0}
+
+
+def test_check_consistency_passes_the_origin_step_on():
+    rng = np.random.default_rng(5)
+    logs = [({"gx": rng.normal(0.0, 60.0, 4000)}, 1.0)]
+    res = check_consistency("full", {"gx": [{"kind": "white", "arw_dprh": 1.0}]}, logs, t_cal_s=100.0,
+                            horizons_s=[50.0], step_s=50.0)
+    assert res.axes["gx"]["rows"][0].n_origins == len(range(100, 4000 - 50 + 1, 50))   # 78, not 4000 // 150
+
+
+def test_short_log_error_carries_what_it_needed():
+    from fogdrift.errors import InsufficientDataError
+
+    with pytest.raises(InsufficientDataError) as exc:
+        observed_angle_errors_deg(np.zeros(50), 1.0, 40.0, [20.0])
+    assert exc.value.needed == 60 and exc.value.got == 50
+
+
+def test_covering_sentences_of_a_gyro_and_of_a_white_only_model():
+    d = random_walk_covering([{"kind": "white", "arw_dprh": 0.1}, {"kind": "random_walk", "rrw_dphrh": 2.0}],
+                             60.0, 60.0)
+    assert "use gyroscope_random_walk = " in d["sentence"] and " rad/s^2/sqrt(Hz) (2 deg/h^1.5)" in d["sentence"]
+    d = random_walk_covering([{"kind": "white", "arw_dprh": 0.1}], 60.0, 60.0)
+    assert d["sentence"].endswith(": the model has no drift beyond its white noise, so nothing to cover (a filter may "
+                                  "still want a small K)")

@@ -181,3 +181,11 @@ def test_channel_kind_channel_and_limit_kept_and_greek_mu():
     j = judge(lim, Reading(2.0, 1.5, 2.5, "deg/sqrt(h)"), "gy")            # the limit inside the interval
     assert (j.channel, j.limit, j.verdict) == ("gy", lim, "cannot tell")
     assert parse_quantity("200 \u03bcg", "accel", "bias_instability")[0] == pytest.approx(1.96133e-3, rel=1e-12)
+
+
+def test_no_estimate_judgement_keeps_its_limit():
+    from fogdrift.spec import judge
+
+    lim = parse_spec({"gyro": {"arw": "2 deg/sqrt(h)"}})["limits"][0]
+    j = judge(lim, None, "gx")
+    assert (j.limit, j.verdict, j.estimate) == (lim, "cannot tell", "–")
