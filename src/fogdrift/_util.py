@@ -109,7 +109,7 @@ def json_default(obj):
 
 
 def fmt_number(x, digits: int = 4, *, missing: str = "–", nonfinite: str | None = "–", sci_outside=None,
-               whole_below: float | None = None) -> str:
+               whole_below: float | None = None, zero: str | None = "0", float_literal: bool = False) -> str:
     """A number as a table or text cell: the one number formatter of the reports, the console and the fleet page.
 
     Parameters
@@ -127,6 +127,11 @@ def fmt_number(x, digits: int = 4, *, missing: str = "–", nonfinite: str | Non
         significant digits, ``0`` as ``"0"``.
     whole_below : float, optional
         Whole numbers with ``1e4 <= |x| < whole_below`` written without decimals (counts, sample numbers).
+    zero : str or None
+        Cell of ``0`` under ``sci_outside``; None writes it by the ``g`` rule (``-0.0`` as ``"-0"``).
+    float_literal : bool
+        Put a dot in a mantissa that has none (``1e-05`` as ``1.0e-05``, ``2`` as ``2.0``), so that every YAML
+        parser reads the text as a float; ``nan`` and ``inf`` stay as they are.
 
     Examples
     --------
@@ -136,6 +141,8 @@ def fmt_number(x, digits: int = 4, *, missing: str = "–", nonfinite: str | Non
     ('1.234e+04', '0')
     >>> fmt_number(360000.0, whole_below=1e9), fmt_number(0.5, 3)
     ('360000', '0.5')
+    >>> fmt_number(1e-5, 6, float_literal=True), fmt_number(-0.0, 3, sci_outside=(1e-3, 1e4), zero=None)
+    ('1.0e-05', '-0')
     """
     if x is None:
         return missing
@@ -146,12 +153,18 @@ def fmt_number(x, digits: int = 4, *, missing: str = "–", nonfinite: str | Non
         return nonfinite
     if sci_outside is not None and math.isfinite(x):
         if x == 0:
-            return "0"
-        if abs(x) < sci_outside[0] or abs(x) >= sci_outside[1]:
+            if zero is not None:
+                return zero
+        elif abs(x) < sci_outside[0] or abs(x) >= sci_outside[1]:
             return f"{x:.{digits - 1}e}"
     if whole_below is not None and 1e4 <= abs(x) < whole_below and x == round(x):
         return f"{x:.0f}"
-    return f"{x:.{digits}g}"
+    s = f"{x:.{digits}g}"
+    if float_literal and math.isfinite(x):
+        mant, _, exp = s.partition("e")
+        if "." not in mant:
+            s = mant + ".0" + ("e" + exp if exp else "")
+    return s
 
 
 def finite_or_null(obj):

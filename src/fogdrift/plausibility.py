@@ -61,7 +61,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._util import fmt_number
 from .errors import ConfigError, FogdriftWarning, render_options
+from .pipeline_sums import AllanSums
 from .units import EARTH_RATE_DPH, STANDARD_GRAVITY_MPS2, parse_unit
 
 __all__ = [
@@ -178,7 +180,6 @@ def noise_floor(rate_dph, dt_s, *, keep: list | None = None) -> NoiseFloor:
     >>> round(noise_floor(x, 0.01).estimate, 1)
     0.5
     """
-    from .pipeline_sums import AllanSums
 
     whole = np.asarray(rate_dph, dtype=np.float64)
     x = whole[:MAX_CHECK_SAMPLES]
@@ -228,10 +229,8 @@ def _read_as_increments(unit) -> bool:
 
 
 def _fmt(x: float) -> str:
-    """Three significant digits, plain notation from 1e-3 to 1e4."""
-    if not math.isfinite(x):
-        return "n/a"
-    return f"{x:.3g}" if x == 0 or 1e-3 <= abs(x) < 1e4 else f"{x:.2e}"
+    """Three significant digits, plain from 1e-3 to 1e4, ``n/a`` when not finite (:func:`fogdrift._util.fmt_number`)."""
+    return fmt_number(x, 3, nonfinite="n/a", sci_outside=(1e-3, 1e4), zero=None)
 
 
 def _violations(floors, peaks, means, factor: float = 1.0) -> set:

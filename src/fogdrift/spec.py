@@ -42,6 +42,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from ._util import fmt_number
 from .errors import ConfigError
 
 __all__ = ["ITEMS", "G0", "SpecLimit", "Reading", "Judgement", "parse_quantity", "convert", "read_spec",
@@ -261,7 +262,8 @@ class Judgement:
 
 
 def _g(x) -> str:
-    return f"{x:.3g}"
+    """Three significant digits (``g`` rule, NaN as ``nan``): :func:`fogdrift._util.fmt_number`."""
+    return fmt_number(x, 3, nonfinite=None)
 
 
 def judge(limit: SpecLimit, reading: Reading | None, channel: str = "") -> Judgement:

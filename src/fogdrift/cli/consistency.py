@@ -19,6 +19,7 @@ from typing import Annotated, List, Optional
 
 import typer
 
+from .._util import fmt_number
 from ..errors import ConfigError
 from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run,
                    say, warn, with_load_options)
@@ -83,7 +84,8 @@ def _read_components(path: Path) -> dict:
 
 
 def _fmt(x, d=3) -> str:
-    return "–" if x is None or not math.isfinite(x) else f"{x:.{d}g}"
+    """``d`` significant digits, ``–`` when missing or not finite: :func:`fogdrift._util.fmt_number`."""
+    return fmt_number(x, d)
 
 
 def _lam_cell(t) -> str:

@@ -15,6 +15,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from .._util import fmt_number
+
 __all__ = [
     "Verdict",
     "heading_verdict",
@@ -55,13 +57,8 @@ class Verdict:
 
 
 def _f(x, digits=3) -> str:
-    if x is None or not math.isfinite(x):
-        return "n/a"
-    if x == 0:
-        return "0"
-    if abs(x) >= 1e4 or abs(x) < 1e-3:
-        return f"{x:.{digits - 1}e}"
-    return f"{x:.{digits}g}"
+    """``digits`` significant digits, scientific below 1e-3 and from 1e4, ``n/a`` when missing or not finite."""
+    return fmt_number(x, digits, missing="n/a", nonfinite="n/a", sci_outside=(1e-3, 1e4))
 
 
 def _pct(ratio) -> str:

@@ -13,6 +13,7 @@ import json
 import math
 from dataclasses import dataclass, field
 
+from .._util import fmt_number
 from ..errors import FogdriftError
 from .conversions import DEG, MGAL, gm_discrete, walk_discrete, white_discrete
 from .discretize import discrete_model
@@ -63,11 +64,7 @@ def fmt(x: float) -> str:
     >>> fmt(1e-5), fmt(0.0), fmt(2.5), fmt(123456789.0)
     ('1.0e-05', '0.0', '2.5', '1.23457e+08')
     """
-    s = f"{float(x):.6g}"
-    mant, _, exp = s.partition("e")
-    if "." not in mant and mant not in ("inf", "-inf", "nan"):
-        mant += ".0"
-    return mant + ("e" + exp if exp else "")
+    return fmt_number(float(x), 6, nonfinite=None, float_literal=True)
 
 
 _QWORD = {"gyro": "gyroscope", "accel": "accelerometer"}
