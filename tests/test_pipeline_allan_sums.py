@@ -66,8 +66,9 @@ def _series(n, periodic: bool, seed=3):
 
 @pytest.fixture
 def fit_spy(monkeypatch):
-    """Capture the curve handed to the noise fit."""
+    """Capture the curve handed to the noise fit (patched where the pipeline looks it up, and on the package)."""
     import fogdrift.noise as noise_pkg
+    import fogdrift.pipeline as pipeline_mod
 
     seen = []
 
@@ -78,6 +79,7 @@ def fit_spy(monkeypatch):
         return real(curve, **kw)
 
     monkeypatch.setattr(noise_pkg, "fit_noise", spy)
+    monkeypatch.setattr(pipeline_mod, "fit_noise", spy)
     return seen
 
 

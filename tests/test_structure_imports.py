@@ -166,7 +166,6 @@ def DEBT(owner: str) -> str:  # noqa: N802 - reads as a label in the table
 
 DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift": (ROOT, ("fogdrift.errors",)),
-    "fogdrift.output": (DEBT("H-hostile") + " (reads the version from the package root)", ("fogdrift",)),
     "fogdrift.cli": (CLI, ("*",)),
     "fogdrift.cli.*": (CLI, ("*",)),
     "fogdrift.fleet.commands": (BATCH, ("fogdrift.bundle", "fogdrift.evaluation", "fogdrift.evaluation.verdicts",
@@ -183,16 +182,6 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
         "fogdrift.io.registry",)),
     "fogdrift.lifting._kernels": (NUMBA, ("fogdrift.lifting._numba",)),
     "fogdrift.noise.engine": (NUMBA, ("fogdrift.noise._kernels",)),
-    "fogdrift.allan.ci": (DEBT("unowned"), ("fogdrift.errors",)),
-    "fogdrift.pipeline": ("fit_noise is looked up per call: test_pipeline_allan_sums's fit_spy patches "
-        "fogdrift.noise.fit_noise (a module-level binding would bypass it; the test can patch fogdrift.pipeline too)", (
-        "fogdrift.noise",)),
-    "fogdrift.lifting.levels": (DEBT("unowned"), ("fogdrift.allan", "fogdrift.units")),
-    "fogdrift.models.kalman": (DEBT("unowned"), ("fogdrift.allan", "fogdrift.errors", "fogdrift.noise")),
-    "fogdrift.noise": (DEBT("unowned"), ("fogdrift.allan", "fogdrift.noise.periodic")),
-    "fogdrift.noise.identify": (DEBT("unowned"), ("fogdrift.allan.ci",)),
-    "fogdrift.noise.notes": (DEBT("unowned"), ("fogdrift.noise.spectral",)),
-    "fogdrift.plausibility": (DEBT("H-speed"), ("fogdrift.pipeline_sums",)),
 }
 
 #: Cycles known today -> the plan that removes them.  A key is the set of modules that identifies the cycle: a

@@ -35,6 +35,7 @@ import threading
 import time
 from pathlib import Path
 
+from . import __version__
 from ._util import strict_json
 from .errors import ConfigError, FogdriftError, ResourceError
 from .interrupt import check, critical
@@ -467,7 +468,6 @@ class OutputDir:
         return doc if isinstance(doc, dict) and doc.get("fogdrift_manifest") == 1 else {}
 
     def _write_manifest(self) -> None:
-        from . import __version__
 
         doc = {"fogdrift_manifest": 1, "command": self.command, "fogdrift_version": __version__,
                "started": self._started, "complete": self.complete, "files": self.written,

@@ -46,7 +46,7 @@ from .metrics import evaluate, p0
 from .models import MODEL_NAMES, Persistence, model_spec  # registry order = report order
 from .models import build_model as make_model  # make_model(name, cfg, progress=None), old name kept for now
 from .models.grey import GM11_MIN_LENGTH
-from .noise import express_quantity
+from .noise import express_quantity, fit_noise
 from .noise.periodic import null_taus, periodic_content
 from .noise.spectral import analyse_spectrum
 from .noise.terms import TERM_TABLE
@@ -370,8 +370,6 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     del sums
     lo, hi = cfg.fit_tau_s
     tau_range = None if lo is None and hi is None else (lo, hi)
-    from .noise import fit_noise  # looked up per call: tests spy on fogdrift.noise.fit_noise
-
     noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms), tau_range_s=tau_range,
                       spectrum=spectrum, markov=True)
     if quantity != "angular_rate":

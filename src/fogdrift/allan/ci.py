@@ -45,7 +45,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, InsufficientDataError
 
 __all__ = [
     "edf_simple",
@@ -366,7 +366,6 @@ def edf_greenhall(alpha, d, m, n_phase, *, overlapping=True, modified=False) -> 
     >>> round(edf_greenhall(0, 3, 16, 1025), 2)        # overlapping HVAR
     74.35
     """
-    from ..errors import InsufficientDataError
 
     a = _check_alpha(alpha)
     if d not in (1, 2, 3) or int(d) != d:

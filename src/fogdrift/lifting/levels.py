@@ -14,9 +14,11 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..allan import allan_variance
 from ..errors import ConfigError, InsufficientDataError
 from ._drift import _drift_1d
 from .schemes import get_wavelet
+from ..units import check_dt_s
 from .transform import _as_signal, _check_level, _check_mode, _max_level
 
 __all__ = ["LevelDiagnostic", "level_scan", "choose_level"]
@@ -60,7 +62,6 @@ class LevelDiagnostic:
 
 def _oadev_octaves(y: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Overlapping ADEV of rate samples y at octave taus m = 1, 2, 4, ... <= n/10 (via :mod:`fogdrift.allan`)."""
-    from ..allan import allan_variance  # lazy: lifting stays importable on its own
 
     res = allan_variance(y, dt_s, taus="octave", max_fraction=0.1)
     return res.tau_s, res.adev_dph
@@ -103,7 +104,6 @@ def level_scan(x, dt_s, wavelet="db2", max_level=None, mode="periodization") -> 
     scheme = get_wavelet(wavelet)
     mode = _check_mode(mode)
     y = _as_signal(x)
-    from ..units import check_dt_s
 
     dt_s = check_dt_s(dt_s)
     n = y.shape[0]

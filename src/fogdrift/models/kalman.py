@@ -30,8 +30,10 @@ import warnings
 import numpy as np
 
 from .._util import check_series
-from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError
+from ..allan import allan_variance
+from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError, ModelFileError
 from ..gmwm.analysis import analyse_gmwm
+from ..noise import fit_noise
 from ..noise.terms import TERMS
 from .base import DriftModel
 from .components import components_from_gmwm
@@ -72,8 +74,6 @@ def identify_components(y, dt_s: float, *, terms=TERMS) -> tuple[list[dict], dic
     >>> abs(r / 36.0 - 1) < 0.05, info["method"]
     (True, 'allan')
     """
-    from ..allan import allan_variance
-    from ..noise import fit_noise
 
     info = {"method": "allan", "A": None, "tau_range_s": None, "reason": ""}
     comps: list[dict] = []
@@ -361,7 +361,6 @@ class Kalman(DriftModel):
         self._ss = state_space(self.components_, dt_s=self._validate(), bias_prior_dph=self.bias_prior_dph_)
         self.state_names_ = self._ss.names
         if tuple(meta["state_names_"]) != self.state_names_:
-            from ..errors import ModelFileError
 
             raise ModelFileError(f"Kalman model file: states {meta['state_names_']} do not match the components "
                                  f"({list(self.state_names_)})")

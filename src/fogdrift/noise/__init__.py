@@ -21,9 +21,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..allan import edf_simple
 from ..errors import ConfigError
 from .convert import coefficients_from_A, paper_table1_from_A
 from .identify import POOR_CHI2_RED, identify, thin_taus
+from .periodic import null_taus, periodic_content
 from .quantity import express as express_quantity
 from .readouts import Readout, slope_readouts
 from .result import TERM_STATUSES, NoiseFit, NoiseTerm
@@ -92,7 +94,6 @@ def _inflation(allan):
     est = getattr(allan, "estimator", "overlapping")
     if est == "overlapping":
         return None
-    from ..allan import edf_simple
 
     n = int(allan.n_samples)
     out = []
@@ -176,7 +177,6 @@ def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penal
         terms = tuple(t for t in TERMS if t in terms)
     var = np.asarray(allan.var_dph2, dtype=np.float64)
     hi = np.asarray(allan.dev_hi95_dph, dtype=np.float64) ** 2
-    from .periodic import null_taus, periodic_content
 
     content = periodic_content(spectrum)
     keep = None

@@ -39,6 +39,7 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.stats import chi2, t as student_t
 
+from ..allan.ci import edf_simple_safe
 from ..errors import ConfigError, InsufficientDataError
 from .checks import _check_floor, _classical_b, _drop_rejected, _point_limits, _q_at_whole_periods
 from .covariance import estimator_covariance, expected_variance, ieee_spectrum, ramp_cross_variance
@@ -188,7 +189,6 @@ class _Context:
             # a periodic error's share of each estimate gets the white-FM EDF of that tau (independent between
             # taus): a line's amplitude wanders, and as a deterministic sinusoid it would lend the points it
             # dominates a white-PM-like EDF of thousands.  At whole periods its share is 0 and nothing is added.
-            from ..allan.ci import edf_simple_safe
 
             share = self.X[:, i_s] * A[i_s] / mu
             nu_w = np.array([edf_simple_safe(self.n + 1, float(mm), 0) for mm in self.m])

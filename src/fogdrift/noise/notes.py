@@ -14,6 +14,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from .checks import _point_limits, _points_outside
+from .spectral import sinusoid_avar
 from .terms import ALL_TERMS, DISPLAY_UNITS
 
 if TYPE_CHECKING:
@@ -45,7 +46,6 @@ def _lines_that_matter(periodic, tau, y) -> list:
     amplitude) is at least :data:`LINE_SHARE` of the measured variance ``y`` at some tau of ``tau``."""
     if periodic is None or len(tau) == 0:
         return []
-    from .spectral import sinusoid_avar
 
     out = []
     for f, rel in periodic.lines:
