@@ -107,6 +107,7 @@ def test_gmwm_readings_of_an_accelerometer_are_vrw_and_m_per_s2():
     assert set(r) == {"vrw", "bias_instability"}
     assert r["vrw"].value == pytest.approx(0.36) and r["vrw"].unit == "m/s/sqrt(h)"
     assert r["bias_instability"].unit == "m/s^2" and r["bias_instability"].label.startswith("B_min at τ = 20 s (GMWM)")
+    assert (r["bias_instability"].lo95, r["bias_instability"].hi95) == (pytest.approx(0.0025), pytest.approx(0.0035))
     assert set(readings_from_gmwm(axis)) == {"arw", "bias_instability"}
 
 
@@ -188,4 +189,4 @@ def test_no_estimate_judgement_keeps_its_limit():
 
     lim = parse_spec({"gyro": {"arw": "2 deg/sqrt(h)"}})["limits"][0]
     j = judge(lim, None, "gx")
-    assert (j.limit, j.verdict, j.estimate) == (lim, "cannot tell", "–")
+    assert (j.channel, j.limit, j.verdict, j.estimate) == ("gx", lim, "cannot tell", "–")
