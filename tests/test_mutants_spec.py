@@ -190,3 +190,11 @@ def test_no_estimate_judgement_keeps_its_limit():
     lim = parse_spec({"gyro": {"arw": "2 deg/sqrt(h)"}})["limits"][0]
     j = judge(lim, None, "gx")
     assert (j.channel, j.limit, j.verdict, j.estimate) == ("gx", lim, "cannot tell", "–")
+
+
+def test_foreign_unit_judgement_keeps_channel_and_limit():
+    from fogdrift.spec import judge
+
+    lim = parse_spec({"accel": {"vrw": "0.2 m/s/sqrt(h)"}})["limits"][0]
+    j = judge(lim, Reading(2.4, 2.3, 2.5, "deg/sqrt(h)"), "ax")
+    assert (j.channel, j.limit, j.verdict, j.estimate) == ("ax", lim, "cannot tell", "–")
