@@ -171,11 +171,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.fleet.commands": (BATCH, ("fogdrift.bundle", "fogdrift.evaluation", "fogdrift.evaluation.verdicts",
         "fogdrift.gmwm.analysis", "fogdrift.gmwm.compare", "fogdrift.pipeline", "fogdrift.report",
         "fogdrift.report.gmwm", "fogdrift.compensate.holdout")),
-    "fogdrift.fleet.runner": (BATCH, ("fogdrift.fleet.page", "fogdrift.gmwm.analysis", "fogdrift.io.load",
-        "fogdrift.output", "fogdrift.pipeline")),
-    "fogdrift.fleet.tasks": (BATCH, ("fogdrift.errors", "fogdrift.fleet.commands", "fogdrift.io",
-        "fogdrift.io.hashing", "fogdrift.io.load", "fogdrift.output", "fogdrift.plausibility",
-        "fogdrift.fleet.summary")),
+    "fogdrift.fleet.runner": (BATCH, ("fogdrift.fleet.page", "fogdrift.gmwm.analysis", "fogdrift.pipeline")),
     "fogdrift.io.chunked": ("optional readers: the binary/HDF5 readers and the registry load only for the format opened", (
         "fogdrift.io.readers.binary", "fogdrift.io.registry")),
     "fogdrift.io.load": ("optional readers: the reader registry imports a reader module on first use", (

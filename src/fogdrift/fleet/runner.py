@@ -40,8 +40,10 @@ from typing import Callable
 
 from .. import interrupt
 from ..errors import ConfigError
+from ..io import load as load_fn
+from ..io.load import _options
 from ..io.readers.base import require
-from ..output import OutputDir, active
+from ..output import LOCK, TMP_PREFIX, OutputDir, _FolderLock, active
 from .commands import command_spec, spec_from_settings
 from .summary import COLUMNS, write_summary
 from .tasks import MANIFEST, FileTask, run_file
@@ -342,13 +344,10 @@ def _validate(settings: dict) -> None:
             raise ConfigError(f"{{opt:scales}} must be an integer >= 1; got {levels!r}")
     if settings.get("gaps", "error") not in ("error", "longest"):
         raise ConfigError(f"gaps must be 'error' or 'longest'; got {settings.get('gaps')!r} in {{opt:gaps}}")
-    from ..io.load import _options
     from ..pipeline import AnalysisConfig
 
     load = dict(settings.get("load", {}))
     import inspect
-
-    from ..io import load as load_fn
 
     allowed = set(inspect.signature(load_fn).parameters) - {"path", "gaps"}
     if set(load) - allowed:
@@ -484,8 +483,6 @@ def _remove_temporaries(tasks) -> None:
     """Remove the temporary files killed workers left in the files' folders (never a complete file), and their
     lock files: a worker killed between its folder's last file and the end of its run leaves the (dead) lock
     file of :class:`fogdrift.output.OutputDir`."""
-    from ..output import LOCK, TMP_PREFIX, _FolderLock
-
     deadline = time.monotonic() + STALE_LOCK_WAIT_S
     for task in tasks:
         folder = Path(task.out_dir)

@@ -21,7 +21,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .._util import strict_json
-from ..errors import FogdriftError, ResourceError
+from ..errors import FogdriftError, ResourceError, render_options
+from ..io import load, load_segments
+from ..io.hashing import path_sha256
+from ..output import OutputDir, atomic_path
+from ..plausibility import check_record
+from .commands import TERMS, command_spec
+from .summary import ACCEL_TERMS
 
 __all__ = ["FileTask", "run_file", "load_record", "split_by_quantity", "MANIFEST"]
 
@@ -45,8 +51,6 @@ class FileTask:
 
 def load_record(path, settings: dict):
     """Load a record with the batch's load settings; ``gaps="longest"`` keeps the longest gap-free segment."""
-    from ..io import load, load_segments
-
     kwargs = dict(settings.get("load", {}))
     gaps = settings.get("gaps", "error")
     if gaps == "longest":
@@ -84,9 +88,6 @@ def split_by_quantity(record, rows: list[dict], b_in_mps2: bool = False) -> list
     A gyro row is unchanged but for ``quantity``.  So no accelerometer figure sits in a deg/h column.
     ``b_in_mps2``: the rows' B figures are in m/s^2 (a GMWM reading, :mod:`fogdrift.gmwm.quantity`), converted
     to ug here (1 ug = 9.80665e-6 m/s^2)."""
-    from .commands import TERMS
-    from .summary import ACCEL_TERMS
-
     out = []
     for row in rows:
         name = row.get("axis")
@@ -113,14 +114,10 @@ def split_by_quantity(record, rows: list[dict], b_in_mps2: bool = False) -> list
 
 def _plausibility(record, flags) -> list[str]:
     """The plausibility findings the single commands print as warnings (a likely wrong unit or time unit)."""
-    from ..plausibility import check_record
-
     return [f"implausible: {f.render(flags)}" for f in check_record(record)]
 
 
 def _warning_text(w, flags) -> str:
-    from ..errors import render_options
-
     return f"{w.category.__name__}: {render_options(str(w.message), flags)}"
 
 
@@ -130,10 +127,6 @@ def run_file(task: FileTask) -> list[dict]:
     Never raises for a bad file or a failing command; only an interruption (:mod:`fogdrift.interrupt`,
     a ``KeyboardInterrupt``) passes through, leaving the file's folder without ``batch.json``.
     """
-    from ..io.hashing import path_sha256
-    from ..output import OutputDir, atomic_path
-    from .commands import command_spec
-
     t0 = time.perf_counter()
     out = Path(task.out_dir)
     sha256 = None
