@@ -379,7 +379,7 @@ def check_rate_hz(rate_hz, name: str = "rate_hz") -> float:
         raise ConfigError(f"{name} must be a number of Hz > 0, got {rate_hz!r}") from None
     if not (fs > 0 and math.isfinite(fs)):
         raise ConfigError(f"{name} must be a finite number of Hz > 0, got {rate_hz!r}")
-    if not 1.0 / DT_MAX_S <= fs <= 1.0 / DT_MIN_S:
+    if not DT_MIN_S <= 1.0 / fs <= DT_MAX_S:  # the interval check_dt_s takes (1 / 1e9 Hz is exactly 1e-9 s)
         raise ConfigError(f"{name} must be a sample rate between {1.0 / DT_MAX_S:g} Hz and {1.0 / DT_MIN_S:g} Hz, "
                           f"got {rate_hz!r}")
     return fs
