@@ -47,9 +47,10 @@ from rich.text import Text
 from .. import __version__
 from .. import interrupt
 from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
+from ..io import load, load_segments
 from ..io import load as _io_load
 from ..io.registry import cli_options, reader_by_name, select_reader
-from ..output import OutputDir
+from ..output import OutputDir, active
 
 app = typer.Typer(
     add_completion=False,
@@ -160,8 +161,6 @@ class _LoadOptionsBase:
         """Load ``path`` (default: ``file``) with these options; ``--gaps longest`` keeps the longest segment.
 
         ``unit`` / ``time_unit`` override ``--unit`` / ``--time-unit`` (a second recording's own units)."""
-        from ..io import load, load_segments
-
         path = self.file if path is None else path
         kwargs = self.load_kwargs()
         kwargs.update(unit=unit or self.unit, time_unit=time_unit or self.time_unit)
@@ -358,8 +357,6 @@ def _interrupted(out: OutputDir | None):
 def emergency_exit() -> None:
     """The SIGINT watchdog's action when the main thread did not stop in time (fogdrift.cli.main): remove
     unfinished temporary files, print the one line, end the process with 130.  Runs in another thread."""
-    from ..output import active
-
     if _state["finish"].acquire(timeout=0.3):
         out = active()
         if out is not None:

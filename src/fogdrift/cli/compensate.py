@@ -11,7 +11,7 @@ from typing import Annotated, Optional
 import typer
 from rich.text import Text
 
-from ..errors import render_options
+from ..errors import ConfigError, render_options
 from ._app import (FLAGS, LOAD_PARAMS, LoadOptions, OutOpt, app, console, csv_list, fitted_table, progress_count, run,
                    warn)
 
@@ -85,7 +85,6 @@ def compensate(
     the heading-error table.  FILE is read with the same options as every command (a .npy is streamed in chunks);
     a FILE that declares no unit needs --unit."""
     from ..compensate import compensate_file
-    from ..errors import ConfigError
 
     fmts = tuple(csv_list(formats) or ())
     with run("compensate", out, default_out=DEFAULT_OUT, inputs=[load.file],

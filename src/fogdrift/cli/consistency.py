@@ -21,6 +21,7 @@ import typer
 
 from .._util import fmt_number
 from ..errors import ConfigError
+from ..io import file_sha256
 from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run,
                    say, warn, with_load_options)
 
@@ -193,7 +194,6 @@ def consistency(
              json_out=json_out, expect=("consistency.json",)) as r:
         from ..evaluation.consistency import (check_consistency, components_from_noise_fit, random_walk_covering,
                                               reduced_model)
-        from ..io import file_sha256
         from ..report import write_json
 
         if not held_out:

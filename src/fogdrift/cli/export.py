@@ -11,6 +11,8 @@ from typing import Annotated, Optional
 
 import typer
 
+from .._util import json_default
+from ..errors import ConfigError
 from ._app import FLAGS, app, check_plausible, echo_record, progress, run, say, warn
 from .batch import _with_reader_options
 
@@ -55,7 +57,6 @@ def export(
 ):
     """Export the noise model to the estimators' own files, every number with its source, interval, continuous and
     discrete value and conversion in a comment."""
-    from ..errors import ConfigError
     from ..export import build_context, parse_targets, render
     from ..export.model import channels_from_result
     from ..export.targets import TARGETS
@@ -69,7 +70,6 @@ def export(
             raise ConfigError("nothing to export: give a log, or saved results with --gyro / --accel / --result")
         channels = []
         if log is not None:
-            from .._util import json_default
             from ..pipeline import AnalysisConfig, run_allan
             from ..report import write_allan_outputs
 
