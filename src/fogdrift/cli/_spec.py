@@ -12,6 +12,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..spec import B_COMPARED, channel_kind, compare, judgement_line, read_spec, readings_from_noise_fit
 from ._app import console, fitted_table, say
 
 __all__ = ["SpecOpt", "channel_kinds", "read_spec_option", "print_spec_comparison", "print_spec_for_allan",
@@ -28,7 +29,6 @@ def read_spec_option(spec: Path | None):
     a bad spec file is one line (:class:`~fogdrift.errors.ConfigError`), nothing computed."""
     if spec is None:
         return None
-    from ..spec import read_spec
 
     return read_spec(spec)
 
@@ -46,8 +46,6 @@ def spec_settings(limits: dict, source: str) -> dict:
 
 def channel_kinds(record) -> dict:
     """Axis name -> ``"gyro"`` or ``"accel"`` from the record's channel quantities (gyro when not stated)."""
-    from ..spec import channel_kind
-
     sig = getattr(record, "signal", None)
     chans = {c.name: getattr(c, "quantity", None) for c in getattr(sig, "channels", ())} if sig is not None else {}
     return {name: channel_kind(chans.get(name)) for name in record.axis_names}
@@ -57,8 +55,6 @@ def print_spec_comparison(spec: dict, channels: dict, out_dir=None, *, source: s
     """Judge ``spec`` (:func:`fogdrift.spec.read_spec`) on ``channels`` (name -> (kind, {item: Reading})), print the
     table and the line saying which B was compared; write spec.json into ``out_dir`` when given.  Returns the
     judgements.  (Callable from any command that has Allan or GMWM readings.)"""
-    from ..spec import compare
-
     return print_judgements(spec, compare(spec, channels), out_dir, source=source)
 
 
@@ -67,7 +63,6 @@ def print_judgements(spec: dict, js: list, out_dir=None, *, source: str = "", co
     ``compact``: one :func:`fogdrift.spec.judgement_line` per judgement instead of the table (``analyze``'s short
     console summary, the lines of the report's first screen)."""
     from ..report import write_json
-    from ..spec import B_COMPARED, judgement_line
 
     title = f"datasheet comparison: {spec['sensor'] or source}" + (f" ({source})" if spec["sensor"] and source else "")
     if not js:
@@ -92,8 +87,6 @@ def print_judgements(spec: dict, js: list, out_dir=None, *, source: str = "", co
 def print_spec_for_allan(limits: dict, results, record, out_dir, source: str) -> list:
     """``--spec`` after an Allan fit (``fogdrift allan``, ``noise --method allan``): the comparison of every axis of
     ``results`` (:func:`fogdrift.pipeline.run_allan`), printed and written to ``out_dir/spec.json``."""
-    from ..spec import readings_from_noise_fit
-
     kinds = channel_kinds(record)
     return print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_noise_fit(a.noise, kinds[a.name]))
                                           for a in results}, out_dir, source=source)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..plausibility import check_record
+from ..temperature import summary_line
 from ._app import (FLAGS, EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, StatisticOpt, TausOpt, TermsOpt, app,
                    console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, progress, run, warn,
                    with_load_options)
@@ -43,8 +45,6 @@ def allan(
         echo_record(load, record)
         # the plausibility check (as _app.check_plausible) keeps the octave ADEV sums of its noise floors: the
         # Allan analysis reuses them instead of computing that pass again
-        from ..plausibility import check_record
-
         sums = {}
         for finding in check_record(record, sums=sums):
             warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
@@ -68,8 +68,6 @@ def allan(
             print_noise_notes(a.name, a.noise, a.outliers, record.dt_s)
         temp = record.metadata()["temperature"]
         if temp is not None:
-            from ..temperature import summary_line
-
             console.print("  " + summary_line(temp), highlight=False)
         if limits is not None:
             print_spec_for_allan(limits, results, record, r.out.path, spec.name)

@@ -15,6 +15,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import ConfigError
+from ..spec import B_COMPARED
 from ._app import (FLAGS, LOAD_PARAMS, EstOpt, FitTausOpt, LoadOptions, OutliersOpt, StatisticOpt, TausOpt, TermsOpt,
                    app, csv_list, parse_fit_taus, parse_taus, parse_terms, precheck, progress_count, run, say)
 from ._spec import SpecOpt, read_spec_option, spec_settings
@@ -66,7 +67,6 @@ def _print_spec_counts(rows, limits: dict, source: str) -> None:
     """The batch's datasheet comparison in counts: one line per judged item (pass / fail / cannot tell), and which B
     was compared; the verdict and reason of every axis are the summary's ``spec_<item>`` columns."""
     from ..fleet.summary import spec_count_lines
-    from ..spec import B_COMPARED
 
     lines = spec_count_lines(rows)
     title = f"datasheet comparison: {limits['sensor'] or source}" + (f" ({source})" if limits["sensor"] else "")

@@ -19,6 +19,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import ConfigError
+from ..spec import readings_from_gmwm
 from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run, say,
                    with_load_options)
 # (the --spec helpers live in the light cli._spec; imported here under their old names too)
@@ -172,8 +173,6 @@ def noise(
             kinds = channel_kinds(record)
         print_gmwm((curve or load.file).name, axes, None if curve else quantities)
         if limits is not None:
-            from ..spec import readings_from_gmwm
-
             print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_gmwm(a, kinds[a.name]))
                                            for a in axes}, r.out.path, source=spec.name)
         files = write_gmwm_outputs(axes, r.out.path, source=source, record=meta)
