@@ -22,6 +22,7 @@ from ..errors import ConfigError
 from ..spec import readings_from_gmwm
 from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run, say,
                    with_load_options)
+from ._tables import noise_table, print_noise_notes
 # (the --spec helpers live in the light cli._spec; imported here under their old names too)
 from ._spec import SpecOpt, channel_kinds, print_spec_comparison, print_spec_for_allan, read_spec_option  # noqa: F401
 
@@ -184,7 +185,6 @@ def _allan(load, r, limits=None, spec_path=None):
     """--method allan: the Allan noise fit of every axis (as 'fogdrift allan'), written as noise.json/noise.png."""
     from ..pipeline import AnalysisConfig, run_allan
     from ..report import noise_row, plot_allan, write_json
-    from ._tables import noise_table, print_noise_notes
 
     record = load.load()
     echo_record(load, record)
