@@ -51,6 +51,7 @@ from ..io import load, load_segments
 from ..io import load as _io_load
 from ..io.registry import cli_options, reader_by_name, select_reader
 from ..output import OutputDir, active
+from ..plausibility import check_record
 
 app = typer.Typer(
     add_completion=False,
@@ -479,8 +480,6 @@ def gyro_only(record, command: str) -> None:
 
 def check_plausible(record) -> None:
     """Warn (one line each) when the record is implausible for any gyro: a wrong --unit or --time-unit."""
-    from ..plausibility import check_record
-
     for finding in check_record(record):
         warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
 
