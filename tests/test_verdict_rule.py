@@ -307,9 +307,9 @@ def test_model_labels_the_paper_measure(tmp_path):
 
 
 def test_analysis_evaluation_carries_the_table2_flag_for_the_console():
-    """evaluate_analysis adds the Table 2 flag as a verdict (printed by analyze --details through print_evaluation):
+    """evaluated_analysis adds the Table 2 flag as a verdict (printed by analyze --details through print_evaluation):
     persistence of the causal drift is a 128-s high-pass, flagged by the artefact check on a random-walk record."""
-    from fogdrift.evaluation import evaluate_analysis, table2_marks
+    from fogdrift.evaluation import evaluated_analysis, table2_marks
     from fogdrift.io import from_array
     from fogdrift.pipeline import AnalysisConfig, run_analysis
     from fogdrift.simulate import simulate
@@ -317,7 +317,8 @@ def test_analysis_evaluation_carries_the_table2_flag_for_the_console():
     x = simulate(20000, 1.0, arw_dprh=0.05, rrw_dphrh=20.0, bias_dph=3.0, seed=4)
     res = run_analysis(from_array(x[:, None], dt_s=1.0, unit="deg/h", axis_names=["gz"]),
                        AnalysisConfig(models=("persistence",), model_rate_hz=None))
-    (ev,) = evaluate_analysis(res)
+    res = evaluated_analysis(res)
+    (ev,) = [ax.evaluation for ax in res.axes]
     marks = table2_marks(res.axes[0].table2, ev.artefacts)
     assert list(marks) == ["persistence: output - causal prediction (practical)"]
     flag = next(v for v in ev.verdicts if v.kind == "table2")

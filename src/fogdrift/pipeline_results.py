@@ -153,7 +153,7 @@ class AnalysisAxis:
     separation: SeparationAxis  # whole record at the modelling rate (figures 5, 6)
     models: ModelAxis
     table2: list  # CompensatedSignal rows, test block at the modelling rate
-    evaluation: AxisEvaluation | None = None  # compensation evidence (fogdrift.evaluation.evaluate_analysis)
+    evaluation: AxisEvaluation | None = None  # compensation evidence (fogdrift.evaluation.evaluated_analysis)
     gmwm: GmwmAxis | None = None  # GMWM noise model of the native-rate record (noise_method "gmwm")
 
     def to_dict(self) -> dict:

@@ -136,9 +136,10 @@ def analyze(
                                   apply_to_factor=other_factor)
         evaluations = []
         if heading:  # compensation evidence on the held-out test block, stored in the result (fogdrift.evaluation)
-            from ..evaluation import evaluate_analysis
+            from ..evaluation import evaluated_analysis, evaluations as evaluations_of
 
-            evaluations = evaluate_analysis(result, calib_s=calibration, step_s=origin_step, horizons_s=hs)
+            result = evaluated_analysis(result, calib_s=calibration, step_s=origin_step, horizons_s=hs)
+            evaluations = evaluations_of(result)
         if result.apply_to is not None:
             say(apply_note(result, apply_to))
         if details:

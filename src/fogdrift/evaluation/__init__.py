@@ -5,11 +5,11 @@
 * :mod:`.verdicts` -- the verdict sentences and tables, headline first (heading error), the paper's one-step
   figures last and labelled;
 * :mod:`.analysis` -- :func:`evaluate_axis`: both evaluations on the test block of one axis of a pipeline run;
-  :func:`evaluate_analysis` stores them (:class:`AxisEvaluation`) in every axis of an
-  analysis result, so ``analysis.json`` and the report carry them.
+  :func:`evaluated_analysis` returns a new analysis result whose every axis carries them
+  (:class:`AxisEvaluation`), so ``analysis.json`` and the report carry them.
 """
 
-from .analysis import AxisEvaluation, evaluate_analysis, evaluate_axis
+from .analysis import AxisEvaluation, evaluate_axis, evaluated_analysis, evaluations
 from .artefacts import ArtefactResult, ArtefactRow, artefact_check, default_frequencies
 from .heading import CONSTANT_BIAS, HORIZONS_S, HeadingResult, HeadingRow, angle_error_deg, heading_errors
 from .verdicts import (OUTCOMES, Verdict, artefact_table, artefact_verdict, causal_verdict, compensation_verdicts,
@@ -38,7 +38,8 @@ __all__ = [
     "headline_verdict",
     "OUTCOMES",
     "evaluate_axis",
-    "evaluate_analysis",
+    "evaluated_analysis",
+    "evaluations",
     "AxisEvaluation",
 ]
 

@@ -3,8 +3,8 @@
 :func:`evaluated_analysis` runs :func:`evaluate_axis` on the test block of every axis of a
 :class:`fogdrift.pipeline.AnalysisResult` (and of its ``apply_to`` result: the models applied unchanged to a
 second recording) and returns a new result whose axes carry an :class:`AxisEvaluation` in ``axis.evaluation``,
-so that ``AnalysisResult.to_dict()`` (``analysis.json``) and the report carry it.  :func:`evaluate_analysis` is
-the older in-place form its callers still use.
+so that ``AnalysisResult.to_dict()`` (``analysis.json``) and the report carry it; the given result is not
+changed (results are complete when built).  :func:`evaluations` lists them.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from .artefacts import artefact_check
 from .heading import HORIZONS_S, heading_errors
 from .verdicts import compensation_verdicts, headline_verdict, table2_verdict
 
-__all__ = ["AxisEvaluation", "evaluate_analysis", "evaluate_axis", "evaluated_analysis"]
+__all__ = ["AxisEvaluation", "evaluate_axis", "evaluated_analysis", "evaluations"]
 
 
 @dataclass
@@ -75,7 +75,20 @@ def evaluated_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, 
     """A copy of ``result`` whose every axis (and every axis of ``result.apply_to``) carries its evaluation.
 
     ``result`` is not changed: each axis is rebuilt with :func:`dataclasses.replace` (``evaluation`` set), and
-    so is the result (``axes``, ``apply_to``).  Parameters as :func:`evaluate_analysis`.
+    so is the result (``axes``, ``apply_to``).
+
+    Parameters
+    ----------
+    result : fogdrift.pipeline.AnalysisResult
+    calib_s, step_s : float
+        Calibration window before each rolling origin and the origins' spacing [s].  The default spacing, 60 s,
+        is the shortest horizon: the 60-s error windows do not overlap (the 300-s calibration windows do), so a
+        held-out block of 30 min gives about 25 independent 60-s origins; the verdicts count only origins with
+        non-overlapping horizons (:func:`~fogdrift.evaluation.verdicts.independent_origins`).
+    horizons_s : sequence of float
+        Free-run forecast horizons [s] (those the test block cannot hold are dropped, with a note).
+    artefacts : bool
+        Also run the filtering-artefact check (injected step, ramp, sinusoids).
 
     Returns
     -------
@@ -92,6 +105,14 @@ def evaluated_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, 
     apply_to = evaluated_analysis(other, calib_s=calib_s, step_s=step_s, horizons_s=horizons_s,
                                   artefacts=artefacts)
     return replace(result, axes=axes, apply_to=apply_to) if other is not None else replace(result, axes=axes)
+
+
+def evaluations(result) -> list:
+    """The evaluations an :func:`evaluated_analysis` result carries: the fitted recording's axes, then ``apply_to``'s."""
+    out = [ax.evaluation for ax in result.axes]
+    if getattr(result, "apply_to", None) is not None:
+        out += [ax.evaluation for ax in result.apply_to.axes]
+    return out
 
 
 def _evaluate_one(ax, cfg, *, calib_s, step_s, horizons_s, artefacts) -> AxisEvaluation:
@@ -111,44 +132,6 @@ def _evaluate_one(ax, cfg, *, calib_s, step_s, horizons_s, artefacts) -> AxisEva
         settings={"calibration_window_s": float(calib_s), "origin_step_s": float(step_s),
                   "horizons_s": [float(h) for h in horizons_s], "artefacts": bool(artefacts)},
         wall_s=time.perf_counter() - t0)
-
-
-def evaluate_analysis(result, *, calib_s: float = 300.0, step_s: float = 60.0, horizons_s=HORIZONS_S,
-                      artefacts: bool = True) -> list:
-    """Evaluate every axis of ``result`` (and of ``result.apply_to``); return the evaluations.
-
-    Kept for its callers (``fogdrift analyze``, ``fleet``), which read the evaluations from ``result``
-    afterwards: it stores each in ``axis.evaluation`` of the given result.  New code should use
-    :func:`evaluated_analysis`, which returns a new, complete result and changes nothing.
-
-    Parameters
-    ----------
-    result : fogdrift.pipeline.AnalysisResult
-    calib_s, step_s : float
-        Calibration window before each rolling origin and the origins' spacing [s].  The default spacing, 60 s,
-        is the shortest horizon: the 60-s error windows do not overlap (the 300-s calibration windows do), so a
-        held-out block of 30 min gives about 25 independent 60-s origins; the verdicts count only origins with
-        non-overlapping horizons (:func:`~fogdrift.evaluation.verdicts.independent_origins`).
-    horizons_s : sequence of float
-        Free-run forecast horizons [s] (those the test block cannot hold are dropped, with a note).
-    artefacts : bool
-        Also run the filtering-artefact check (injected step, ramp, sinusoids).
-
-    Returns
-    -------
-    list of AxisEvaluation
-        The fitted recording's axes first, then the ``apply_to`` recording's; each is also stored as
-        ``axis.evaluation``.
-    """
-    done = evaluated_analysis(result, calib_s=calib_s, step_s=step_s, horizons_s=horizons_s, artefacts=artefacts)
-    out = []
-    for res, new in ((result, done), (getattr(result, "apply_to", None), getattr(done, "apply_to", None))):
-        if res is None:
-            continue
-        for ax, ax_new in zip(res.axes, new.axes):
-            ax.evaluation = ax_new.evaluation  # the legacy in-place contract (see evaluated_analysis)
-            out.append(ax_new.evaluation)
-    return out
 
 
 def evaluate_axis(model_axis, cfg, *, heading=True, artefacts=True, calib_s=300.0, step_s=300.0,

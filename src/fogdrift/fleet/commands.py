@@ -195,7 +195,7 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     axis (``compensated_test_<axis>.csv``) and one row per axis with the verdicts."""
     from ..bundle import write_bundle
     from ..compensate.holdout import write_compensated_test_block
-    from ..evaluation import evaluate_analysis
+    from ..evaluation import evaluated_analysis
     from ..pipeline import run_analysis
     from ..evaluation.verdicts import paper_measure_verdict
     from ..report import write_report
@@ -203,7 +203,8 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     cfg = _config(settings)
     limits = spec_from_settings(settings)
     result = run_analysis(record, cfg)
-    evaluations = {ev.axis: ev for ev in evaluate_analysis(result)}
+    result = evaluated_analysis(result)
+    evaluations = {ax.name: ax.evaluation for ax in result.axes}
     spec_doc, spec_cols = None, {}
     if limits is not None:  # as 'analyze --spec': the verdicts on the report's first screen and in the rows
         js = _analysis_judgements(result, limits)
