@@ -228,20 +228,38 @@ if _clashes(LOAD_PARAMS):
                       f"{_clashes(LOAD_PARAMS)}; expected other names and flags")
 
 
-def with_load_options(func):
-    """Add the shared load parameters to a command; the command receives them as ``load: LoadOptions``."""
+def with_load_options(func=None, *, file: str = "first"):
+    """Add the shared load parameters to a command; the command receives them as ``load: LoadOptions``.
+
+    ``file``: where the FILE argument goes: ``"first"`` (``allan FILE [options]``), ``"after"`` the command's own
+    positional arguments (``compensate BUNDLE FILE``), or ``"none"`` (``batch``/``export``, which name their files
+    otherwise: only the reading options are added and ``load.file`` is ``.``).
+    """
+    if func is None:
+        return functools.partial(with_load_options, file=file)
+    if file not in ("first", "after", "none"):
+        raise ValueError(f"file must be 'first', 'after' or 'none', got {file!r}")
     sig = inspect.signature(func)
     hints = typing.get_type_hints(func, include_extras=True)  # resolve string annotations (PEP 563)
     own = [p.replace(annotation=hints.get(p.name, p.annotation)) for p in sig.parameters.values() if p.name != "load"]
     shared = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=ann)
               for name, ann, default in LOAD_PARAMS]
-    # the file argument first, then the command's own options, then the shared reading options
-    params = [shared[0].replace(kind=inspect.Parameter.POSITIONAL_OR_KEYWORD)] + \
-             [p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in own] + shared[1:]
+    file_arg, reading = shared[0].replace(kind=inspect.Parameter.POSITIONAL_OR_KEYWORD), shared[1:]
+    keyword = [p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in own]
+    if file == "first":  # the file argument first, then the command's own options, then the reading options
+        params = [file_arg] + keyword + reading
+    elif file == "after":
+        positional = [p.replace(kind=inspect.Parameter.POSITIONAL_OR_KEYWORD) for p in own
+                      if p.default is inspect.Parameter.empty]
+        params = positional + [file_arg] + [p for p in keyword if p.default is not inspect.Parameter.empty] + reading
+    else:
+        params = own[:1] + keyword[1:] + reading
+    names = [name for name, _, _ in LOAD_PARAMS if file != "none" or name != "file"]
 
     @functools.wraps(func)
     def wrapper(**kwargs):
-        opts = LoadOptions(**{name: kwargs.pop(name) for name, _, _ in LOAD_PARAMS})
+        given = {name: kwargs.pop(name) for name in names}
+        opts = LoadOptions(**given) if file != "none" else LoadOptions(file=Path("."), **given)
         return func(load=opts, **kwargs)
 
     wrapper.__signature__ = sig.replace(parameters=params)

@@ -6,9 +6,6 @@ The library side is :mod:`fogdrift.fleet`; ``--command`` takes a name of its com
 
 from __future__ import annotations
 
-import functools
-import inspect
-import typing
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -16,30 +13,13 @@ import typer
 
 from ..errors import ConfigError
 from ..spec import B_COMPARED
-from ._app import (FLAGS, LOAD_PARAMS, EstOpt, FitTausOpt, LoadOptions, OutliersOpt, StatisticOpt, TausOpt, TermsOpt,
-                   app, csv_list, parse_fit_taus, parse_taus, parse_terms, precheck, progress_count, run, say)
+from ._app import (FLAGS, EstOpt, FitTausOpt, OutliersOpt, StatisticOpt, TausOpt, TermsOpt,
+                   app, csv_list, parse_fit_taus, parse_taus, parse_terms, precheck, progress_count, run, say,
+                   with_load_options)
 from ._spec import SpecOpt, read_spec_option, spec_settings
 from .noise import ModelOpt, RobustOpt, ScalesOpt
 
 FLAGS.update({"glob": "--glob", "command": "--command", "scheduler": "--scheduler", "workers": "--workers"})
-
-
-def _with_reader_options(func):
-    """Add the shared reading options (all of LOAD_PARAMS but the file argument); the command gets ``load``."""
-    sig = inspect.signature(func)
-    hints = typing.get_type_hints(func, include_extras=True)
-    own = [p.replace(annotation=hints.get(p.name, p.annotation)) for p in sig.parameters.values() if p.name != "load"]
-    shared = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=ann)
-              for name, ann, default in LOAD_PARAMS[1:]]
-
-    @functools.wraps(func)
-    def wrapper(**kwargs):
-        opts = LoadOptions(file=Path("."), **{name: kwargs.pop(name) for name, _, _ in LOAD_PARAMS[1:]})
-        return func(load=opts, **kwargs)
-
-    wrapper.__signature__ = sig.replace(parameters=[own[0]] + [p.replace(kind=inspect.Parameter.KEYWORD_ONLY)
-                                                               for p in own[1:]] + shared)
-    return wrapper
 
 
 def _set_items(items) -> dict:
@@ -88,7 +68,7 @@ def _command_help() -> str:
 
 
 @app.command()
-@_with_reader_options
+@with_load_options(file="none")
 def batch(
     inputs: Annotated[list[Path], typer.Argument(help="Logs, folders (with --glob), ROS 2 bag folders or wildcards.")],
     load,

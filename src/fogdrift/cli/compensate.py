@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import functools
-import inspect
-import typing
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -12,8 +9,8 @@ import typer
 from rich.text import Text
 
 from ..errors import ConfigError, render_options
-from ._app import (FLAGS, LOAD_PARAMS, LoadOptions, OutOpt, app, console, csv_list, fitted_table, progress_count, run,
-                   warn)
+from ._app import (FLAGS, LoadOptions, OutOpt, app, console, csv_list, fitted_table, progress_count, run,
+                   warn, with_load_options)
 
 DEFAULT_OUT = Path("out/compensate")
 
@@ -21,33 +18,8 @@ DEFAULT_OUT = Path("out/compensate")
 EXPECTED = ("compensated.csv", "compensated.npz", "compensation.json")
 
 
-def with_load_options_after(func):
-    """:func:`fogdrift.cli._app.with_load_options` for a command whose own positional arguments come before FILE
-    (``compensate BUNDLE FILE``): the shared reading options, FILE second; the command receives ``load``.
-
-    (A candidate for ``cli/_app.py``: ``with_load_options(func, after=("bundle",))``.)
-    """
-    sig = inspect.signature(func)
-    hints = typing.get_type_hints(func, include_extras=True)
-    own = [p.replace(annotation=hints.get(p.name, p.annotation)) for p in sig.parameters.values() if p.name != "load"]
-    positional = [p for p in own if p.default is inspect.Parameter.empty]
-    options = [p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in own if p.default is not inspect.Parameter.empty]
-    shared = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=ann)
-              for name, ann, default in LOAD_PARAMS]
-    params = [p.replace(kind=inspect.Parameter.POSITIONAL_OR_KEYWORD) for p in positional] + \
-             [shared[0].replace(kind=inspect.Parameter.POSITIONAL_OR_KEYWORD)] + options + shared[1:]
-
-    @functools.wraps(func)
-    def wrapper(**kwargs):
-        opts = LoadOptions(**{name: kwargs.pop(name) for name, _, _ in LOAD_PARAMS})
-        return func(load=opts, **kwargs)
-
-    wrapper.__signature__ = sig.replace(parameters=params)
-    return wrapper
-
-
 @app.command()
-@with_load_options_after
+@with_load_options(file="after")
 def compensate(
     bundle: Annotated[Path, typer.Argument(help="Bundle directory written by 'analyze' or 'model' (OUT/bundle).")],
     load: LoadOptions,

@@ -13,8 +13,7 @@ import typer
 
 from .._util import json_default
 from ..errors import ConfigError
-from ._app import FLAGS, app, check_plausible, echo_record, progress, run, say, warn
-from .batch import _with_reader_options
+from ._app import FLAGS, app, check_plausible, echo_record, progress, run, say, warn, with_load_options
 
 FLAGS.update({"missing": "--missing", "gyro": "--gyro", "accel": "--accel", "result": "--result",
               "rate": "--update-rate", "target": "--target"})
@@ -30,7 +29,7 @@ def _targets_help() -> str:
 
 
 @app.command("export")
-@_with_reader_options
+@with_load_options(file="none")
 def export(
     log: Annotated[Optional[Path], typer.Argument(
         help="A gyro or accelerometer log to fit first (its unit says which); or give saved results with "
