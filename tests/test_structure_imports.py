@@ -193,6 +193,8 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.fleet.runner": (BATCH, ("fogdrift.fleet.page", "fogdrift.gmwm.analysis", "fogdrift.pipeline")),
     "fogdrift.io.chunked": ("optional readers: the binary/HDF5 readers and the registry load only for the format opened", (
         "fogdrift.io.readers.binary", "fogdrift.io.registry")),
+    "fogdrift.pipeline": ("model modules load on use, through the registry (test_model_registry: importing the "
+                          "pipeline imports no model module)", ("fogdrift.models.grey",)),
     "fogdrift.io.load": ("optional readers: the reader registry imports a reader module on first use", (
         "fogdrift.io.registry",)),
     "fogdrift.lifting._kernels": (NUMBA, ("fogdrift.lifting._numba",)),
