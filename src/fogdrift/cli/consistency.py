@@ -22,6 +22,7 @@ import typer
 from .._util import fmt_number
 from ..errors import ConfigError
 from ..io import file_sha256
+from ..io._checks import check_path
 from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run,
                    say, warn, with_load_options)
 
@@ -199,6 +200,8 @@ def consistency(
         if not held_out:
             raise ConfigError("give at least one --held-out log (a static log of the same sensor, not the "
                               "training log)")
+        for path in held_out:  # every input exists before the training log is read and fitted
+            check_path(path, allow_dir=True)
         h = _parse_horizons(horizons)
         if not (math.isfinite(calibration) and calibration > 0):
             raise ConfigError(f"--calibration must be a number > 0 [s]; got {calibration!r}")
