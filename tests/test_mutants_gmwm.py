@@ -1,0 +1,366 @@
+"""Rules of the GMWM read-outs that mutation round 3 (issue 24) found unpinned: the accelerometer re-statement
+(:mod:`fogdrift.gmwm.quantity`), the GMWM-vs-Allan sentences (:mod:`fogdrift.gmwm.compare`) and the model selection
+(:mod:`fogdrift.gmwm.selection`: WIC ordering, checks, exclusion scan, fallbacks).
+
+Every expected value is written here by hand from the rule (the factor table of ``gmwm/quantity.py``'s docstring,
+the comparison rules of ``gmwm/compare.py``'s docstring, the check rules of ``gmwm/selection.py``'s docstring); the
+objects fed to the read-outs are built by hand (only the public attributes the functions read), so each case runs in
+milliseconds.  The few selection cases that fit models use small seeded simulations (2^12-2^15 samples).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from fogdrift.gmwm import compare as cmp
+from fogdrift.gmwm.compare import attach_allan_checks, compare_with_allan
+from fogdrift.gmwm.ieee import BiasInstability, IEEEResult, IEEEValue
+from fogdrift.gmwm.quantity import GMWM_ACCEL_UNITS, UG_PER_MPS2, accel_rows, express_gmwm
+from fogdrift.noise.quantity import restate_text
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# gmwm/quantity.py: an accelerometer's GMWM reading
+# ---------------------------------------------------------------------------------------------------------------
+def _iv(name, value, lo, hi, unit, comp="WN"):
+    return IEEEValue(name=name, value=value, lo95=lo, hi95=hi, unit=unit, se_log=0.1, component=comp)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Sel:
+    ieee: IEEEResult
+    selected: str = "WN+RW+GM"
+
+
+@dataclasses.dataclass(frozen=True)
+class _Axis:
+    name: str
+    selection: _Sel
+    allan_check: dict | None
+
+
+def _bi(value=None, lo=None, hi=None, tau=None, bound=None, reason="", label="min of the model's ADEV",
+        rule="min-avar"):
+    return BiasInstability(rule=rule, value_dph=value, lo95_dph=lo, hi95_dph=hi, tau_s=tau, bound_dph=bound,
+                           reason=reason, label=label)
+
+
+def _gyro_axis(check=None):
+    terms = {
+        "N_dprh": _iv("N_dprh", 2.0, 1.0, 4.0, "deg/sqrt(h)"),
+        "K_dphrh": _iv("K_dphrh", 3.0, 2.0, 5.0, "deg/h/sqrt(h)", "RW"),
+        "R_dph2": _iv("R_dph2", 7.0, 6.0, 8.0, "deg/h^2", "DR"),
+        "Q_urad": _iv("Q_urad", 48.48137, 24.240685, 96.96274, "urad", "QN"),
+        "Q_arcsec": _iv("Q_arcsec", 10.0, 5.0, 20.0, "arcsec", "QN"),
+        "B_dph": _iv("B_dph", 0.5, 0.25, 1.0, "deg/h", "FLICKER"),
+        "extra_s": _iv("extra_s", 9.0, 8.0, 10.0, "s", "X"),  # not in the table: passed on unchanged
+    }
+    gm = [{"sigma_gm_dph": _iv("sigma_gm_dph", 0.25, 0.125, 0.5, "deg/h", "GM1"),
+           "tc_s": _iv("tc_s", 12.0, 6.0, 24.0, "s", "GM1")},
+          {"tc_s": _iv("tc_s", 30.0, 15.0, 60.0, "s", "GM2")}]  # no sigma: left as it is
+    ie = IEEEResult(model="WN+RW+GM", terms=terms, gm=gm, b_gm=None, b_min=_bi(0.5, 0.4, 0.6, 10.0), dt_s=0.01,
+                    n_samples=4096)
+    return _Axis(name="az", selection=_Sel(ie), allan_check=check)
+
+
+def test_accel_restatement_multiplies_value_and_interval_by_the_table_factor_and_sets_the_unit():
+    """N x 3600 (m/s/sqrt(h) per deg/sqrt(h) number), Q_urad / 4.848137 (urad per arcsec), every other key x 1; the
+    unit of each value is the accelerometer unit; Q_arcsec (the gyro's second spelling of Q) is dropped; a key not in
+    the table, the model and the GM's T_c pass unchanged."""
+    acc = express_gmwm(_gyro_axis(), "specific_force")
+    t = acc.selection.ieee.terms
+    want = {"N_dprh": ((7200.0, 3600.0, 14400.0), "m/s/sqrt(h)"),
+            "K_dphrh": ((3.0, 2.0, 5.0), "m/s^2/sqrt(h)"),
+            "R_dph2": ((7.0, 6.0, 8.0), "m/s^2/h"),
+            "Q_urad": ((10.0, 5.0, 20.0), "m/s"),
+            "B_dph": ((0.5, 0.25, 1.0), "m/s^2")}
+    for key, ((v, lo, hi), unit) in want.items():
+        np.testing.assert_allclose([t[key].value, t[key].lo95, t[key].hi95], [v, lo, hi], rtol=1e-6, err_msg=key)
+        assert t[key].unit == unit, key
+        assert t[key].component == _gyro_axis().selection.ieee.terms[key].component
+    assert "Q_arcsec" not in t
+    assert t["extra_s"] == _gyro_axis().selection.ieee.terms["extra_s"]
+    assert list(t) == ["N_dprh", "K_dphrh", "R_dph2", "Q_urad", "B_dph", "extra_s"]
+    g1, g2 = acc.selection.ieee.gm
+    s = g1["sigma_gm_dph"]
+    assert (s.value, s.lo95, s.hi95, s.unit) == (0.25, 0.125, 0.5, "m/s^2")
+    assert g1["tc_s"].unit == "s" and g1["tc_s"].value == 12.0
+    assert g2 == _gyro_axis().selection.ieee.gm[1]
+    assert acc.selection.selected == "WN+RW+GM" and acc.name == "az"
+    assert acc.selection.ieee.b_min == _gyro_axis().selection.ieee.b_min
+    assert acc.allan_check is None  # no comparison: stays None
+
+
+def test_accel_factor_table_by_hand():
+    """The docstring's table: 1 m/s^2 read as a gyro number of 1 deg/h gives N 60 m/s/sqrt(h) per 1/60 deg/sqrt(h)."""
+    assert GMWM_ACCEL_UNITS["N_dprh"] == ("m/s/sqrt(h)", 3600.0)
+    assert GMWM_ACCEL_UNITS["Q_urad"][0] == "m/s"
+    assert GMWM_ACCEL_UNITS["Q_urad"][1] == pytest.approx(1.0 / 4.8481368, rel=1e-7)
+    assert UG_PER_MPS2 == pytest.approx(101971.62, rel=1e-7)
+
+
+def test_accel_restatement_restates_the_allan_check_lines_and_keeps_its_verdicts():
+    lines = ["N agrees: GMWM 0.01 [0.009, 0.011] deg/√h, the Allan fit 0.0105 deg/√h", "B differs: GMWM B 0.5 deg/h"]
+    check = {"agree": False, "n_agree": True, "b_agree": False, "lines": lines}
+    acc = express_gmwm(_gyro_axis(check), "specific_force")
+    got = acc.allan_check
+    assert {k: got[k] for k in ("agree", "n_agree", "b_agree")} == {"agree": False, "n_agree": True, "b_agree": False}
+    assert got["lines"] == [restate_text(ln, "specific_force") for ln in lines]
+    assert got["lines"][0] != lines[0] and "deg" not in got["lines"][0] and "deg" not in got["lines"][1]
+    assert "36 [32.4, 39.6]" in got["lines"][0]  # 0.01 deg/√h -> 36 m/s/√h: the x 3600 of N
+    # a check without lines gets an empty list
+    assert express_gmwm(_gyro_axis({"agree": None}), "specific_force").allan_check == {"agree": None, "lines": []}
+    # a gyro (or any other quantity) is returned as it is
+    gyro = _gyro_axis(check)
+    assert express_gmwm(gyro, "angular_rate") is gyro
+
+
+def test_accel_rows_show_b_in_micro_g():
+    """Only a B row in deg/h (the law unit, m/s^2 for an accelerometer) is converted: numbers x 1/9.80665e-6, a
+    bound "< x" likewise (3 significant digits), a dash stays a dash; the note column is kept."""
+    rows = [["N", 0.36, 0.3, 0.4, "m/s/sqrt(h)", "white noise"],
+            ["B", 1e-4, 5e-5, 2e-4, "deg/h", "min of the model's ADEV"],
+            ["B", "< 2e-05", "–", "–", "deg/h", "bound"],
+            ["B", 3.0, 2.0, 4.0, "µg", "already converted"]]
+    out = accel_rows(rows)
+    assert out[0] is rows[0] and out[3] is rows[3]
+    b = out[1]
+    assert b[0] == "B" and b[4] == "µg" and b[5] == "min of the model's ADEV"
+    np.testing.assert_allclose(b[1:4], [10.19716, 5.09858, 20.39432], rtol=1e-6)
+    assert out[2] == ["B", "< 2.04", "–", "–", "µg", "bound"]
+    assert len(out) == 4
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# gmwm/compare.py: GMWM against the Allan fit, in words
+# ---------------------------------------------------------------------------------------------------------------
+def _n(value, lo=None, hi=None, reason=None):
+    ns = SimpleNamespace(value=value, lo95=lo, hi95=hi)
+    if reason is not None:
+        ns.reason = reason
+    return ns
+
+
+def _gaxis(n=None, b=None, b_gm=None, *, robust=False, selected="WN+RW", excluded=2, tau_range=(0.02, 40.96)):
+    terms = {} if n is None else {"N_dprh": n}
+    ie = SimpleNamespace(terms=terms, b_headline=b if b is not None else _bi(reason="no reading"), b_gm=b_gm,
+                         tau_range_s=tau_range)
+    sel = SimpleNamespace(ieee=ie, selected=selected, fit=SimpleNamespace(scale_s=np.array([0.02, 0.04, 81.92])),
+                          excluded=[object()] * excluded)
+    return SimpleNamespace(selection=sel, wvar=SimpleNamespace(robust=robust))
+
+
+def _afit(n=None, b_min=None, *, selected=("N", "B"), tau_min=0.01, tau_max=100.0, **extra):
+    return SimpleNamespace(terms={} if n is None else {"N": n}, b_min=b_min, selected=selected, tau_min_s=tau_min,
+                           tau_max_s=tau_max, **extra)
+
+
+G_N = _n(0.01, 0.009, 0.011)
+G_N_TEXT = "GMWM 0.01 [0.009, 0.011] deg/√h"
+
+
+def test_n_line_nothing_on_either_side():
+    for fit in (SimpleNamespace(), _afit(), _afit(_n(None))):
+        c = compare_with_allan(_gaxis(), fit)
+        assert c["n_agree"] is None
+        assert c["lines"][0] == "N cannot be compared: neither GMWM nor the Allan fit has a white-noise term"
+
+
+def test_n_line_one_side_missing():
+    c = compare_with_allan(_gaxis(selected="RW"), _afit(_n(0.0123456, 0.011, 0.014)))
+    assert c["n_agree"] is False
+    assert c["lines"][0] == ("N differs: the GMWM model RW has no white-noise term; the Allan fit finds N "
+                             "0.01235 [0.011, 0.014] deg/√h")
+    c = compare_with_allan(_gaxis(selected="RW"), _afit(_n(0.0123456, None, 0.014)))
+    assert c["lines"][0].endswith("finds N 0.01235 deg/√h")  # half an interval is no interval
+    c = compare_with_allan(_gaxis(G_N), _afit(_n(None, reason="below the quantisation")))
+    assert c["n_agree"] is False
+    assert c["lines"][0] == f"N differs: {G_N_TEXT}; the Allan fit gives no N (below the quantisation)"
+    for fit in (_afit(_n(None, reason="")), _afit(_n(None)), _afit()):
+        assert compare_with_allan(_gaxis(G_N), fit)["lines"][0] == \
+            f"N differs: {G_N_TEXT}; the Allan fit gives no N (not in its model)"
+
+
+def test_n_line_agrees_when_the_intervals_overlap_even_at_one_point():
+    for a in (_n(0.0105, 0.01, 0.012), _n(0.008, 0.007, 0.009), _n(0.012, 0.011, 0.013),
+              _n(0.0105, None, None), _n(0.0105, None, 0.02), _n(0.0105, 0.001, None)):
+        c = compare_with_allan(_gaxis(G_N), _afit(a))
+        assert c["n_agree"] is True and c["agree"] is True, vars(a)
+        assert c["lines"][0].startswith(f"N agrees: {G_N_TEXT}, the Allan fit ")
+        assert c["lines"][0].endswith(" deg/√h (the 95 % intervals overlap)")
+    c = compare_with_allan(_gaxis(G_N), _afit(_n(0.008, 0.007, 0.009)))
+    assert c["lines"][0] == f"N agrees: {G_N_TEXT}, the Allan fit 0.008 [0.007, 0.009] deg/√h (the 95 % intervals overlap)"
+    # a value without an interval is its own interval
+    for a in (_n(0.005, None, None), _n(0.02, None, None), _n(0.005, 0.001, None), _n(0.02, None, 0.03)):
+        assert compare_with_allan(_gaxis(G_N), _afit(a))["n_agree"] is False, vars(a)
+
+
+def test_n_line_differs_says_by_how_much_and_why():
+    both = f"{G_N_TEXT}, the Allan fit 0.02 [0.018, 0.022] deg/√h"
+    why = ("GMWM WN+RW is fitted to wavelet scales 0.02-81.92 s (2 short excluded), the Allan fit N+B to τ 0.01-100 s: "
+           "the two models give the short-τ slope to different terms")
+    c = compare_with_allan(_gaxis(G_N), _afit(_n(0.02, 0.018, 0.022)))
+    assert c["n_agree"] is False and c["agree"] is False
+    assert c["lines"][0] == f"N differs by 0.5x: {both}; {why}"
+    c = compare_with_allan(_gaxis(G_N, robust=True), _afit(_n(0.02, 0.018, 0.022)))
+    assert c["lines"][0] == (f"N differs by 0.5x: {both}; GMWM used the robust (Huber) wavelet variance, which "
+                             f"discounts the outlying samples the Allan variance keeps; {why}")
+    # a fit without model names or tau range: question marks
+    bare = SimpleNamespace(terms={"N": _n(0.005, 0.004, 0.006)}, b_min=None)
+    line = compare_with_allan(_gaxis(G_N, excluded=0), bare)["lines"][0]
+    assert line.startswith("N differs by 2x: ")
+    assert "(0 short excluded), the Allan fit ? to τ ?-? s:" in line
+    assert compare_with_allan(_gaxis(G_N), _afit(_n(0.005, 0.004, 0.006), selected=()))["lines"][0].count(
+        "the Allan fit ? to τ 0.01-100 s") == 1
+
+
+B_G = _bi(0.5, 0.4, 0.6, 10.0, label="min of the model's ADEV")
+B_G_TEXT = "GMWM B 0.5 [0.4, 0.6] deg/h at τ = 10 s (min of the model's ADEV)"
+B_A = {"value": 0.55, "lo95": 0.5, "hi95": 0.6, "tau_s": 12.0, "bound_only": False}
+B_A_TEXT = "the Allan fit's B_min is 0.55 [0.5, 0.6] deg/h at τ = 12 s"
+
+
+def test_b_line_values_agree_or_differ_by_height():
+    c = compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, B_A))
+    assert c["b_agree"] is True and c["agree"] is True
+    assert c["lines"][1] == f"B agrees: {B_G_TEXT}; {B_A_TEXT} (the 95 % ranges overlap)"
+    assert len(c["lines"]) == 2  # no hump
+    # touching ranges agree (both ends)
+    for lo, hi in ((0.6, 0.7), (0.3, 0.4)):
+        assert compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {**B_A, "lo95": lo, "hi95": hi}))["b_agree"] is True
+    # a value without an interval is its own interval
+    assert compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {"value": 0.55, "tau_s": 12.0}))["b_agree"] is True
+    assert compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {"value": 0.65, "tau_s": 12.0}))["b_agree"] is False
+    assert compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {"value": 0.35, "lo95": 0.3, "tau_s": 1}))["b_agree"] \
+        is False
+    assert compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {"value": 0.65, "hi95": 0.7, "tau_s": 1}))["b_agree"] \
+        is False
+    g_point = _bi(0.5, None, None, 10.0)
+    assert compare_with_allan(_gaxis(G_N, g_point), _afit(G_N, B_A))["b_agree"] is True  # 0.5 touches [0.5, 0.6]
+    c = compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {**B_A, "value": 0.8, "lo95": 0.7, "hi95": 0.9}))
+    assert c["b_agree"] is False and c["agree"] is False and c["n_agree"] is True
+    assert c["lines"][1] == (f"B differs: {B_G_TEXT}; the Allan fit's B_min is 0.8 [0.7, 0.9] deg/h at τ = 12 s; "
+                             "the GMWM model and the Allan fit put the ADEV minimum at different heights")
+
+
+def test_b_line_point_values_without_intervals():
+    g_point = _bi(0.5, None, None, None, label="flicker term")
+    c = compare_with_allan(_gaxis(G_N, g_point), _afit(G_N, {"value": 0.5}))
+    assert c["b_agree"] is True
+    assert c["lines"][1] == ("B agrees: GMWM B 0.5 deg/h (flicker term); the Allan fit's B_min is 0.5 deg/h at τ = ? s "
+                             "(the 95 % ranges overlap)")
+    assert compare_with_allan(_gaxis(G_N, g_point), _afit(G_N, {"value": 0.51}))["b_agree"] is False
+    assert compare_with_allan(_gaxis(G_N, g_point), _afit(G_N, {"value": 0.49}))["b_agree"] is False
+
+
+def test_b_line_bounds():
+    g_bound = _bi(None, bound=0.3, tau=20.48, reason="still falls")
+    g_text = "GMWM B < 0.3 deg/h (its model's ADEV has no minimum within τ 0.02-40.96 s)"
+    a_bound = {"value": 0.7, "tau_s": 50.0, "bound_only": True, "rule": "end of record"}
+    c = compare_with_allan(_gaxis(G_N, g_bound), _afit(G_N, a_bound, tau_max=50.0))
+    assert c["b_agree"] is True
+    assert c["lines"][1] == (f"B agrees, both only as upper bounds: {g_text}; the Allan fit finds no ADEV minimum "
+                             "within τ ≤ 50 s (B_min < 0.7 deg/h)")
+    c = compare_with_allan(_gaxis(G_N, g_bound), _afit(G_N, a_bound, tau_max=None))
+    assert c["lines"][1].endswith("; the Allan fit gives only B_min < 0.7 deg/h")
+    c = compare_with_allan(_gaxis(G_N, g_bound), _afit(G_N, {**a_bound, "rule": "floor above the measured curve"}))
+    assert c["lines"][1].endswith("; the Allan fit gives B_min < 0.7 deg/h (its fitted floor lies above the measured "
+                                  "curve)")
+    # a GMWM value against an Allan bound that reaches it: agrees as ranges, not "both only as upper bounds"
+    c = compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {**a_bound, "value": 0.45}, tau_max=50.0))
+    assert c["b_agree"] is True and c["lines"][1].startswith(f"B agrees: {B_G_TEXT}; ")
+    assert c["lines"][1].endswith("(B_min < 0.45 deg/h) (the 95 % ranges overlap)")
+    # a GMWM bound against an Allan value inside [0, bound]: also a plain agreement
+    c = compare_with_allan(_gaxis(G_N, g_bound), _afit(G_N, {**B_A, "value": 0.25, "lo95": 0.2, "hi95": 0.3}))
+    assert c["b_agree"] is True and c["lines"][1].startswith(f"B agrees: {g_text}; ")
+    # one reaches a minimum and the other does not
+    other = "one of them reaches an ADEV minimum inside the record and the other does not: the models bend the " \
+            "longest τ differently"
+    c = compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {**a_bound, "value": 0.3}, tau_max=50.0))
+    assert c["b_agree"] is False and c["lines"][1].endswith(f"(B_min < 0.3 deg/h); {other}")
+    c = compare_with_allan(_gaxis(G_N, g_bound), _afit(G_N, B_A))
+    assert c["b_agree"] is False
+    assert c["lines"][1] == f"B differs: {g_text}; {B_A_TEXT}; {other}"
+    # a bound reaches down to 0
+    assert compare_with_allan(_gaxis(G_N, g_bound), _afit(G_N, {"value": 0.0, "tau_s": 1.0}))["b_agree"] is True
+
+
+def test_b_line_cannot_compare():
+    c = compare_with_allan(_gaxis(G_N, _bi(reason="too short")), _afit(G_N, B_A))
+    assert c["b_agree"] is None and c["agree"] is True  # only N was comparable, and it agrees
+    assert c["lines"][1] == f"B cannot be compared: GMWM reads no B (too short); {B_A_TEXT}"
+    for b_min in (None, {}, {"tau_s": 3.0}):
+        c = compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, b_min))
+        assert c["b_agree"] is None
+        assert c["lines"][1] == f"B cannot be compared: {B_G_TEXT}; the Allan fit has no ADEV-minimum reading"
+    c = compare_with_allan(_gaxis(None, _bi(reason="x")), _afit(None, None))
+    assert c == {"agree": None, "n_agree": None, "b_agree": None, "lines": [
+        "N cannot be compared: neither GMWM nor the Allan fit has a white-noise term",
+        "B cannot be compared: GMWM reads no B (x); the Allan fit has no ADEV-minimum reading"]}
+
+
+def test_agree_is_all_comparable_verdicts():
+    c = compare_with_allan(_gaxis(G_N, B_G), _afit(_n(0.02, 0.018, 0.022), B_A))
+    assert (c["n_agree"], c["b_agree"], c["agree"]) == (False, True, False)
+    c = compare_with_allan(_gaxis(None, B_G), _afit(None, B_A))
+    assert (c["n_agree"], c["b_agree"], c["agree"]) == (None, True, True)
+
+
+def test_hump_line_is_a_third_line_read_without_the_allan_interval():
+    hump = _bi(0.123456, 0.1, 0.15, 5.0, label="max of a GM's ADEV (GM1, T_c 2.64 s)", rule="gm-max")
+    c = compare_with_allan(_gaxis(G_N, B_G, hump), _afit(G_N, B_A))
+    assert len(c["lines"]) == 3
+    assert c["lines"][2] == ("GMWM B 0.1235 deg/h at τ = 5 s is read from a GM hump (GM1, T_c 2.64 s): a detail, not "
+                             "a bias-instability floor; the Allan fit's B_min is 0.55 deg/h at τ = 12 s")
+    c = compare_with_allan(_gaxis(G_N, B_G, hump), _afit(G_N, {"value": 0.7, "bound_only": True, "rule": ""},
+                                                          tau_max=50.0))
+    assert c["lines"][2].endswith("floor; the Allan fit finds no ADEV minimum within τ ≤ 50 s (B_min < 0.7 deg/h)")
+    c = compare_with_allan(_gaxis(G_N, B_G, hump), _afit(G_N, {"value": 0.7, "bound_only": True, "rule": ""},
+                                                          tau_max=None))
+    assert c["lines"][2].endswith("floor; the Allan fit gives only B_min < 0.7 deg/h")
+    assert compare_with_allan(_gaxis(G_N, B_G, hump), SimpleNamespace(terms={"N": G_N}))["lines"][2].endswith(
+        "floor; the Allan fit has no ADEV-minimum reading")
+    # a hump without a value: no third line
+    assert len(compare_with_allan(_gaxis(G_N, B_G, _bi(reason="none")), _afit(G_N, B_A))["lines"]) == 2
+
+
+def test_number_formats_of_the_sentences():
+    assert cmp._t(None) == "?" and cmp._t(12.0) == "12" and cmp._t(12345.6) == "1.235e+04"
+    assert cmp._t(0.123456) == "0.1235"
+    assert cmp._g(float("nan")) == "nan" and cmp._g(1.23456) == "1.23" and cmp._g(1.23456, 4) == "1.235"
+    assert cmp._iv(None, 1.0) == "" and cmp._iv(1.0, None) == "" and cmp._iv(0.5, 2.0) == " [0.5, 2]"
+    assert cmp._b_interval(None, None, None, None) is None
+    assert cmp._b_interval(None, 1.0, 2.0, 3.0) == (0.0, 3.0)
+    assert cmp._b_interval(1.5, None, None, 3.0) == (1.5, 1.5)
+    assert cmp._b_interval(1.5, 1.0, 2.0, None) == (1.0, 2.0)
+    assert cmp._b_interval(1.5, 1.0, None, None) == (1.0, 1.5)
+    assert cmp._b_interval(1.5, None, 2.0, None) == (1.5, 2.0)
+
+
+def test_attach_allan_checks_sets_each_named_axis_and_says_when_the_record_is_too_short():
+    from fogdrift.io import from_array
+
+    x = 0.1 * np.random.default_rng(5).standard_normal((2**11, 1))
+    rec = from_array(x, dt_s=0.01, unit="deg/h", axis_names=["gx"])
+    ax = SimpleNamespace(name="gx", allan_check="untouched", **vars(_gaxis(G_N, B_G)))
+    other = SimpleNamespace(name="nope", allan_check="untouched", **vars(_gaxis(G_N, B_G)))
+    out = attach_allan_checks(rec, [ax, other])
+    assert out == [ax, other] and other.allan_check == "untouched"
+    assert set(ax.allan_check) == {"agree", "n_agree", "b_agree", "lines"}
+    assert ax.allan_check["lines"][0].startswith("N ")
+    # the Allan fit's N of white noise of 0.1 deg/h per sample at 0.01 s: 0.1 * sqrt(0.01 s) / 60 deg/√h
+    n = float(ax.allan_check["lines"][0].split("the Allan fit ")[1].split(" ")[0])
+    assert n == pytest.approx(0.1 * math.sqrt(0.01) / 60.0, rel=0.1)
+    short = from_array(x[:8], dt_s=0.01, unit="deg/h", axis_names=["gx"])
+    axes = [SimpleNamespace(name="gx", allan_check=None), SimpleNamespace(name="zz", allan_check=None)]
+    assert attach_allan_checks(short, axes) is axes
+    for a in axes:
+        chk = a.allan_check
+        assert (chk["agree"], chk["n_agree"], chk["b_agree"]) == (None, None, None)
+        (line,) = chk["lines"]
+        assert line.startswith("no comparison: the Allan fit needs more data (") and line.endswith(")")
