@@ -107,7 +107,7 @@ def tau_grid(n_samples, dt_s, taus="octave", *, max_fraction=0.25, statistic="ad
         if m.min() < 1 or m.max() > m_top:
             bad = t[(m < 1) | (m > m_top)][0]
             raise ConfigError(
-                f"tau {bad!r} s is outside the computable range of the {stat.long_name}; expected "
+                f"tau {float(bad)!r} s is outside the computable range of the {stat.long_name}; expected "
                 f"{dt} s <= tau <= {m_top * dt} s (1 <= m <= {m_top} for {n} samples at {dt} s)"
             )
         if m.size > MAX_TAUS:
