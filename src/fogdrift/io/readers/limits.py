@@ -263,6 +263,7 @@ class GuardedStream(io.RawIOBase):
             last = max(chunk.rfind(b"\n"), chunk.rfind(b"\r") if b"\r" in chunk else -1)
             self.current = n - last - 1
             self.lines += breaks
+            self._line_check(self.current, self.lines + 1)  # the part after the last break (a chunk > the limit)
         self._prev_cr = chunk[-1:] == b"\r"
         if self.max_lines is not None and self.lines > self.max_lines:
             self._too_many()
@@ -280,7 +281,7 @@ class GuardedStream(io.RawIOBase):
         pos = np.flatnonzero((a == 10) | (a == 13))
         if pos.size > 1:
             gaps = np.diff(pos) - 1
-            k = int(np.argmax(gaps))
+            k = int(np.argmax(gaps > self.max_line))  # the first line over the limit (the one a small chunk finds)
             before = chunk[:int(pos[k]) + 1]
             line = self.lines + 1 + _count_breaks(before)
             self._line_check(int(gaps[k]), line)
