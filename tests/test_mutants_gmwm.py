@@ -364,3 +364,132 @@ def test_attach_allan_checks_sets_each_named_axis_and_says_when_the_record_is_to
         assert (chk["agree"], chk["n_agree"], chk["b_agree"]) == (None, None, None)
         (line,) = chk["lines"]
         assert line.startswith("no comparison: the Allan fit needs more data (") and line.endswith(")")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# gmwm/selection.py: the sanity checks, on hand-built fits (the rules of the module docstring, step 4)
+# ---------------------------------------------------------------------------------------------------------------
+from fogdrift.errors import ConfigError, FogdriftWarning, InsufficientDataError  # noqa: E402
+from fogdrift.gmwm import haar_wvar, select_model, simulate_latent  # noqa: E402
+from fogdrift.gmwm import selection as sel_mod  # noqa: E402
+from fogdrift.gmwm.processes import parse_model  # noqa: E402
+
+SCALES = 0.02 * 2.0 ** np.arange(8)  # 0.02 ... 2.56 s at dt = 0.01 s
+
+
+def _fake_fit(comp, *, at_bound=(), se_z=(0.5, 0.5, 0.5), converged=True, beta=0.05, z_resid=None, resid=None,
+              sd=0.5, model="WN+GM"):
+    """A fit of WN+GM (WN.sigma2, GM1.beta, GM1.sigma2) on 8 scales with the WV 1.0 at each scale; ``comp`` the
+    (2, 8) component WV, ``beta`` the GM's 1/T_c per sample (T_c = 0.01 s / beta)."""
+    nu_hat = np.ones(8)
+    resid = np.array([0.1, -0.1] * 4) if resid is None else np.asarray(resid, float)
+    mdl = parse_model(model)
+    theta = np.array([1.0, beta, 0.5])
+    return SimpleNamespace(
+        at_bound=tuple(at_bound), component_wv=lambda: np.asarray(comp, float), nu2_hat=nu_hat,
+        nu2_fit=nu_hat - resid, sd_nu2=np.full(8, sd), se_z=np.asarray(se_z, float),
+        param_names=mdl.param_names, converged=converged, scale_s=SCALES, dt_s=0.01, theta=theta,
+        z_resid=np.zeros(8) if z_resid is None else np.asarray(z_resid, float), latent_model=mdl), mdl
+
+
+OPTS = dict(z_max=3.0, se_log_max=1.0, run_alpha=0.01, share_min=0.01, snr_min=2.0)
+
+
+def _identity(d):
+    return np.asarray(d, float)
+
+
+def test_checks_pass_on_every_boundary_value():
+    """Each check is strict: share == share_min, SNR == snr_min, |z| == z_max, se(log) == se_log_max all pass;
+    a GM whose WV peak (3.785 T_c) lies between 2 x the first and 1/4 of the last scale passes."""
+    comp = [[1.0] * 8, [0.01] + [0.005] * 7]  # GM: share 0.01 exactly, SNR 0.01 / 0.5 = 0.02
+    fit, mdl = _fake_fit(comp, se_z=(1.0, 0.5, 1.0), beta=0.05, z_resid=[0, 0, -3.0, 3.0, 0, 0, 0, 0])
+    # beta 0.05: T_c = 0.2 s, peak 0.757 s within [0.04, 0.64]? no: 0.757 > 0.64 -> use a faster GM
+    fit.theta[1] = 0.1  # T_c = 0.1 s, peak 0.3785 s, inside [0.04 s, 0.64 s]
+    assert sel_mod._checks(fit, mdl, whiten=_identity, **{**OPTS, "snr_min": 0.02}) == []
+    # the same with snr_min a little above: the GM is "not detectable" (soft), with its SNR in two digits
+    assert sel_mod._checks(fit, mdl, whiten=_identity, **{**OPTS, "snr_min": 0.021}) == [
+        "soft: GM1 changes the WV by at most 0.02 SD at any scale (not detectable)"]
+    # share_min a little above 0.01: collapsed (hard), and then the SNR is not looked at
+    assert sel_mod._checks(fit, mdl, whiten=_identity, **{**OPTS, "share_min": 0.0101, "snr_min": 0.03}) == [
+        "hard: GM1 explains at most 1.0e-02 of the WV at every scale (collapsed)"]
+    # z_max and se_log_max a little below: both soft reasons, the largest |z| (the first of equal ones) named
+    assert sel_mod._checks(fit, mdl, whiten=_identity, **{**OPTS, "snr_min": 0.02, "z_max": 2.9,
+                                                          "se_log_max": 0.99}) == [
+        "soft: residual z = -3.00 at scale 0.08 s (|z| > 2.9)",
+        "soft: not identified, standard error of the log above 0.99: WN variance 1.00, GM1 variance 1.00"]
+
+
+def test_checks_name_every_failure_in_order():
+    comp = [[0.005] * 8, [0.75] + [0.1] * 7]  # WN: share 0.005 (collapsed); GM: SNR 0.75 / 0.5 = 1.5
+    fit, mdl = _fake_fit(comp, at_bound=("WN.sigma2", "GM1.beta"), se_z=(np.inf, 0.5, 2.0), converged=False,
+                         beta=1.0, z_resid=[0.5, 3.5, -4.0, 1, 1, 1, 1, 1], resid=[0.1] * 8)
+    assert sel_mod._checks(fit, mdl, whiten=_identity, **OPTS) == [
+        "hard: at a bound: WN variance, GM1 inverse correlation time 1/T_c",
+        "hard: WN explains at most 5.0e-03 of the WV at every scale (collapsed)",
+        "soft: GM1 changes the WV by at most 1.5 SD at any scale (not detectable)",
+        "hard: not identified (singular information): WN variance",
+        "soft: the optimiser did not report convergence",
+        "soft: GM1 T_c = 0.01 s puts its WV peak (scale 0.0379 s) less than two octaves inside the observed scales "
+        "0.02-2.56 s, so its rise is not observed (then it is indistinguishable from WN)",
+        "soft: residual z = -4.00 at scale 0.08 s (|z| > 3)",
+        "soft: 8 same-sign innovation residuals in a row (p = 0.0078 < 0.01)",
+        "soft: not identified, standard error of the log above 1: GM1 variance 2.00",
+    ]
+
+
+def test_checks_slow_gm_and_the_run_test_use_the_whitened_residuals():
+    comp = [[1.0] * 8, [1.5] * 8]
+    fit, mdl = _fake_fit(comp, beta=0.001)  # T_c = 10 s: peak 37.85 s beyond 2.56 / 4
+    assert sel_mod._checks(fit, mdl, whiten=_identity, **OPTS) == [
+        "soft: GM1 T_c = 10 s puts its WV peak (scale 37.9 s) less than two octaves inside the observed scales "
+        "0.02-2.56 s, so its decay is not observed (then it is indistinguishable from RW)"]
+    fit, mdl = _fake_fit(comp, beta=0.1, resid=[0.1, -0.1] * 4)
+    assert sel_mod._checks(fit, mdl, whiten=_identity, **OPTS) == []  # alternating residuals: no run
+    # the run test reads the whitened residuals: a whitener that flips every other sign makes a run of 8
+    flip = np.array([1.0, -1.0] * 4)
+    assert sel_mod._checks(fit, mdl, whiten=lambda d: flip * d, **OPTS) == [
+        "soft: 8 same-sign innovation residuals in a row (p = 0.0078 < 0.01)"]
+    # 7 in a row of 8: p = longest_run_pvalue(8, 7) = 6 / 256 = 0.023 > 0.01: passes; at run_alpha 0.05 it fails
+    fit, mdl = _fake_fit(comp, beta=0.1, resid=[0.1] * 7 + [-0.1])
+    assert sel_mod._checks(fit, mdl, whiten=_identity, **OPTS) == []
+    assert sel_mod._checks(fit, mdl, whiten=_identity, **{**OPTS, "run_alpha": 0.05}) == [
+        "soft: 7 same-sign innovation residuals in a row (p = 0.023 < 0.05)"]
+
+
+def test_longest_run_counts_equal_nonzero_signs():
+    assert sel_mod._longest_run(np.array([1.0, 2.0, -1.0, -3.0, -0.5, 4.0])) == 3
+    assert sel_mod._longest_run(np.array([0.0, 0.0, 0.0])) == 1  # a zero starts no run
+    assert sel_mod._longest_run(np.array([1.0, 0.0, 1.0, 1.0])) == 2
+    assert sel_mod._longest_run(np.array([-1.0, -1.0])) == 2
+    assert sel_mod._longest_run(np.array([5.0])) == 1
+    assert sel_mod.longest_run_pvalue(8, 7) == pytest.approx(6 / 256, rel=1e-12)  # by hand: 3 patterns x 2 signs
+
+
+def test_unresolved_fast_gms_lists_gms_peaking_below_twice_the_first_scale():
+    mdl = parse_model("WN+2GM")  # WN.sigma2, GM1.beta, GM1.sigma2, GM2.beta, GM2.sigma2
+    fit = SimpleNamespace(latent_model=mdl, dt_s=0.01, scale_s=SCALES, theta=np.array([1.0, 1.0, 0.5, 0.01, 0.5]))
+    assert sel_mod._unresolved_fast_gms(fit) == ["GM1 (T_c = 0.01 s)"]  # peak 0.0379 s < 0.04 s; GM2's 3.785 s
+    fit.theta[3] = 0.5  # GM2 T_c = 0.02 s: peak 0.0757 s, not below 0.04 s
+    assert sel_mod._unresolved_fast_gms(fit) == ["GM1 (T_c = 0.01 s)"]
+    fit.theta[3] = 2.0  # GM2 T_c = 0.005 s
+    assert sel_mod._unresolved_fast_gms(fit) == ["GM1 (T_c = 0.01 s)", "GM2 (T_c = 0.005 s)"]
+    fit.theta[1] = 0.9  # GM1 T_c = 0.0111 s: peak 0.0421 s
+    assert sel_mod._unresolved_fast_gms(fit) == ["GM2 (T_c = 0.005 s)"]
+
+
+def test_degenerate_step1_fits():
+    """A fit is degenerate when a (log) parameter is within 1e-3 of its bound or a component reaches less than
+    share_min of the WV at every scale."""
+    mdl = parse_model("WN+RW")
+    tau = 2.0 ** np.arange(1, 11)
+    nu = mdl.wv([1.0, 1e-4], tau)
+    assert not sel_mod._degenerate(mdl, np.array([1.0, 1e-4]), nu, tau, 0.01)
+    assert sel_mod._degenerate(mdl, np.array([1.0, 1e-4]), nu, tau, 0.9)  # RW below 90 % everywhere
+    share_rw = np.max(mdl.wv_components([1.0, 1e-4], tau)[1] / nu)
+    assert not sel_mod._degenerate(mdl, np.array([1.0, 1e-4]), nu, tau, share_rw)  # exactly share_min: kept
+    lo, hi = sel_mod._bounds(mdl, nu, tau)
+    for z in ([hi[0] - 5e-4, math.log(1e-4)], [math.log(1.0), lo[1] + 5e-4]):
+        assert sel_mod._degenerate(mdl, np.exp(z), nu, tau, 0.0), z
+    for z in ([hi[0] - 2e-3, math.log(1e-4)], [math.log(1.0), lo[1] + 2e-3]):
+        assert not sel_mod._degenerate(mdl, np.exp(z), nu, tau, 0.0), z
