@@ -38,8 +38,8 @@ class MovingFraction:
 
     input_kind = "rate"
 
-    def __init__(self, c, M, noise=0.0, seed=5):
-        self.c, self.M, self.noise, self.seed = float(c), int(M), float(noise), seed
+    def __init__(self, c, M, noise=0.0, seed=5, gaps=()):
+        self.c, self.M, self.noise, self.seed, self.gaps = float(c), int(M), float(noise), seed, list(gaps)
 
     def filter(self, z, state=None):
         z = np.asarray(z, dtype=np.float64)
@@ -50,6 +50,7 @@ class MovingFraction:
             p[M:] = self.c * np.lib.stride_tricks.sliding_window_view(z, M)[:-1].mean(axis=1)
         if self.noise:
             p = p + self.noise * np.random.default_rng(self.seed).normal(0.0, 1.0, n)
+        p[self.gaps] = np.nan  # no prediction there
         return p, np.zeros(n), state
 
 
@@ -235,3 +236,40 @@ def test_flag_thresholds_are_the_arguments():
     assert res.row("half").flagged_hz == () and res.row("half + noise").flagged_hz == ()
     res = artefact_check(z, 1.0, models, causal_window=128, frequencies_hz=freqs, removal=0.47)
     assert res.row("half").flagged_hz == (0.001, 0.01)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# small rules
+
+
+def test_a_sample_without_a_prediction_is_left_uncompensated():
+    """A compensator that predicts 0 except at three samples inside the active block where it has no prediction
+    (NaN): those samples are left as they are (p = 0), so its output is the input and its ADEV ratio is exactly 1
+    at every tau, its gains 1.  Catches: a missing prediction replaced by anything but 0."""
+    z = np.random.default_rng(49).normal(0.0, 5.0, 3000)
+    res = artefact_check(z, 1.0, {"gappy": MovingFraction(0.0, 10, gaps=[1500, 1501, 2900])}, causal_window=128,
+                         frequencies_hz=[0.002, 0.02, 0.2])
+    row = res.row("gappy")
+    assert all(row.adev_ratio[f] == pytest.approx(1.0, rel=1e-12) for f in (0.002, 0.02, 0.2))
+    assert all(row.gains[f] == pytest.approx(1.0, rel=1e-9) for f in (0.002, 0.02, 0.2))
+
+
+def test_default_band_is_the_1_2_5_series_from_1_mhz_to_5_khz():
+    """The series spans 10^-3 .. 5 x 10^3 Hz (k = -3 .. 3): at dt = 20 us (Nyquist 25 kHz) it ends at 5 kHz, at
+    dt = 0.1 ms (Nyquist 5 kHz, inclusive) too, at dt = 0.125 ms (4 kHz) at 2 kHz."""
+    from fogdrift.evaluation.artefacts import default_frequencies
+
+    top = [0.001 * m * 10.0 ** k for k in range(7) for m in (1, 2, 5)]
+    top = [float(f"{f:.12g}") for f in top]
+    assert default_frequencies(2e-5, 3600.0) == top
+    assert default_frequencies(1e-4, 3600.0) == top
+    assert default_frequencies(1.25e-4, 3600.0) == top[:-1]
+
+
+def test_row_lookup_names_the_missing_model():
+    z = np.random.default_rng(50).normal(0.0, 5.0, 600)
+    res = artefact_check(z, 1.0, {}, causal_window=128, frequencies_hz=[0.1], axis="gx")
+    assert [r.model for r in res.rows] == ["constant bias"] and res.axis == "gx"
+    with pytest.raises(KeyError) as info:
+        res.row("persistence")
+    assert info.value.args == ("persistence",)
