@@ -493,3 +493,154 @@ def test_degenerate_step1_fits():
         assert sel_mod._degenerate(mdl, np.exp(z), nu, tau, 0.0), z
     for z in ([hi[0] - 2e-3, math.log(1e-4)], [math.log(1.0), lo[1] + 2e-3]):
         assert not sel_mod._degenerate(mdl, np.exp(z), nu, tau, 0.0), z
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# gmwm/selection.py: select_model on small seeded records (0.1-0.6 s each)
+# ---------------------------------------------------------------------------------------------------------------
+def _filtered(n, taps, seed=8):
+    """WN+RW (sigma2 1, gamma2 1e-5 per sample) through a ``taps``-point moving average (an output low-pass
+    filter): the first octaves are lowered far below what any candidate can produce."""
+    y = simulate_latent("WN+RW", [1.0, 1e-5], n, seed=seed)
+    return haar_wvar(np.convolve(y, np.ones(taps) / taps, mode="valid"), 0.01)
+
+
+def _assert_selection_rules(sel, wv, *, z_max=3.0, n_check=3):
+    """The rules every selection keeps, whatever the record."""
+    J = len(wv.level)
+    ex = [e.level for e in sel.excluded]
+    assert ex == list(range(1, len(ex) + 1))  # leading scales only, in order
+    assert list(sel.levels_used) == list(range(len(ex) + 1, J + 1))  # the rest, every one of them
+    for e in sel.excluded:
+        assert e.best_abs_z > z_max and f"{e.best_abs_z:.3g} > {z_max:g}" in e.reason
+        assert e.scale_s == pytest.approx(0.02 * 2.0 ** (e.level - 1), rel=1e-12)
+        assert f"{e.scale_s:.4g} s" in e.reason
+        assert e.best_model in [c.model for c in sel.candidates]
+    # WIC = Q + penalty for every fitted candidate; the chosen one is the smallest WIC of those that passed, else
+    # of those without hard failures
+    fitted = [c for c in sel.candidates if c.fit is not None]
+    for c in fitted:
+        assert c.wic == pytest.approx(c.q + c.penalty, rel=1e-12)
+        assert c.passed == (not c.reasons)
+        np.testing.assert_array_equal(c.fit.V, sel.fit.V)  # one common Omega
+    passed = [c for c in fitted if c.passed]
+    pool = passed or [c for c in fitted if not c.hard_failure] or fitted
+    assert sel.selected == min(pool, key=lambda c: c.wic).model
+    assert sel.passed_checks == bool(passed)
+    assert sel.fit is sel.candidate(sel.selected).fit
+    assert sel.omega_source.startswith("common: V at the iterated fit of ")
+    assert sel.omega_source.split(" of ")[-1] in [c.model for c in sel.candidates]
+    # the kept scales' first n_check are explained, or the scan says it stopped at its limit
+    zfirst = float(np.max(np.abs(sel.fit.z_resid[:n_check])))
+    if sel.scan_note:
+        assert sel.scan_note.startswith(f"the exclusion scan stopped at its limit of {len(ex)} excluded short scales; ")
+        if zfirst > z_max:
+            assert sel.scan_note.endswith(f"still not explained (max |z| = {zfirst:.3g}): read the result with care")
+        else:
+            assert sel.scan_note.endswith(f"; the first kept scales are explained (max |z| = {zfirst:.3g})")
+
+
+def test_selection_excludes_filtered_scales_until_a_candidate_explains_them():
+    wv = _filtered(2**13, 4)
+    assert len(wv.level) == 11  # 8189 samples: at most 11 // 3 = 3 scales are excluded
+    sel = select_model(wv, ["WN", "WN+RW"], max_excluded=4)
+    _assert_selection_rules(sel, wv)
+    assert [e.level for e in sel.excluded] == [1, 2, 3] and sel.selected == "WN+RW" and sel.passed_checks
+    assert sel.excluded[0].reason.startswith("no candidate explains the scales from 0.02 s: the closest (")
+    assert sel.excluded[0].reason.endswith(" > 3 over the first 3")
+    assert sel.scan_note == ""  # stopped because the scales from 0.16 s are explained, not at the limit
+    default = select_model(wv, ["WN", "WN+RW"])  # the same three, now at the default limit J // 3: it says so
+    _assert_selection_rules(default, wv)
+    assert [e.level for e in default.excluded] == [1, 2, 3] and default.passed_checks
+    assert default.scan_note.startswith("the exclusion scan stopped at its limit of 3 excluded short scales; the "
+                                        "first kept scales are explained (max |z| = ")
+    # a larger z_max excludes fewer scales (8.9 is then explained), a smaller max_excluded stops the scan there
+    lenient = select_model(wv, ["WN", "WN+RW"], z_max=10.0)
+    _assert_selection_rules(lenient, wv, z_max=10.0)
+    assert [e.level for e in lenient.excluded] == [1, 2]
+    with pytest.warns(FogdriftWarning, match="no candidate passed every sanity check") as rec:
+        capped = select_model(wv, ["WN", "WN+RW"], max_excluded=1)
+    _assert_selection_rules(capped, wv)
+    assert [e.level for e in capped.excluded] == [1] and not capped.passed_checks
+    assert "still not explained" in capped.scan_note
+    msg = str(rec[0].message)
+    c = capped.candidate(capped.selected)
+    assert msg == (f"no candidate passed every sanity check; {capped.selected} (smallest WIC among the candidates "
+                   f"without hard failures) is returned although it failed: {'; '.join(c.reasons)} "
+                   f"({capped.scan_note})")
+    # no scan at all, or a limit of 0: nothing excluded, no note
+    for kw in ({"exclude_short": False}, {"max_excluded": 0}):
+        with pytest.warns(FogdriftWarning, match="no candidate passed every sanity check") as rec:
+            s = select_model(wv, ["WN", "WN+RW"], **kw)
+        assert s.excluded == [] and s.scan_note == "" and list(s.levels_used) == list(range(1, 12))
+        assert str(rec[0].message).endswith(")") and "(the exclusion scan" not in str(rec[0].message)
+
+
+def test_selection_excludes_a_scale_the_chosen_models_final_fit_does_not_explain():
+    wv = _filtered(2**14, 2)
+    sel = select_model(wv, ["WN", "WN+RW"])
+    _assert_selection_rules(sel, wv)
+    assert [e.level for e in sel.excluded] == [1, 2, 3] and sel.passed_checks
+    last = sel.excluded[2]
+    assert last.best_model == "WN+RW"
+    assert last.reason == (f"the selected model WN+RW leaves max |z| = {last.best_abs_z:.3g} > 3 over the first 3 "
+                           "scales from 0.08 s")
+
+
+def test_scan_checks_n_check_scales():
+    wv = _filtered(2**13, 4)
+    sel = select_model(wv, ["WN", "WN+RW"], n_check=1, max_excluded=5)
+    _assert_selection_rules(sel, wv, n_check=1)
+    assert [e.level for e in sel.excluded] == [1, 2, 3] and sel.scan_note == "" and sel.passed_checks
+    assert all(e.reason.endswith(" > 3 over the first 1") for e in sel.excluded)
+
+
+def test_selection_on_white_noise_and_the_result_dicts():
+    wv = haar_wvar(simulate_latent("WN+RW", [1.0, 1e-5], 2**13, seed=2), 0.01)
+    sel = select_model(wv, ["WN", "wn+rw", "RW+WN"])  # spellings of one model count once
+    _assert_selection_rules(sel, wv)
+    assert [c.model for c in sel.candidates] == ["WN", "WN+RW"] and sel.excluded == []
+    assert sel.candidate("rw+wn") is sel.candidates[1]
+    with pytest.raises(ConfigError, match=r"WN\+GM was not a candidate; candidates: \['WN', 'WN\+RW'\]"):
+        sel.candidate("gm+wn")
+    d = sel.to_dict()
+    assert set(d) == {"selected", "fit", "ieee", "candidates", "excluded", "levels_used", "omega_source",
+                      "passed_checks", "scan_note"}
+    assert d["selected"] == sel.selected and d["omega_source"] == sel.omega_source and d["scan_note"] == ""
+    assert d["passed_checks"] is sel.passed_checks and d["levels_used"] == list(range(1, 13))
+    assert all(type(v) is int for v in d["levels_used"]) and d["excluded"] == []
+    assert d["fit"] == sel.fit.to_dict() and d["ieee"] == sel.ieee.to_dict()
+    for cd, c in zip(d["candidates"], sel.candidates):
+        assert set(cd) == {"model", "n_params", "q", "penalty", "wic", "passed", "reasons", "theta", "se_log",
+                           "j_pvalue"}
+        assert (cd["model"], cd["n_params"], cd["passed"], cd["reasons"]) == (c.model, c.n_params, c.passed,
+                                                                              list(c.reasons))
+        assert (cd["q"], cd["penalty"], cd["wic"], cd["j_pvalue"]) == (c.q, c.penalty, c.wic, c.fit.j_pvalue)
+        assert type(cd["q"]) is float and type(cd["passed"]) is bool
+        assert cd["theta"] == dict(zip(c.fit.param_names, c.fit.theta.tolist()))
+        assert cd["se_log"] == dict(zip(c.fit.param_names, c.fit.se_z.tolist()))
+    # a candidate without a fit has no fit keys
+    bare = sel_mod.CandidateScore("WN+RW+2GM", 7, float("nan"), float("nan"), float("nan"), False,
+                                  ("hard: too few scales for this model",))
+    bd = bare.to_dict()
+    assert set(bd) == {"model", "n_params", "q", "penalty", "wic", "passed", "reasons"} and bare.hard_failure
+    assert bd["reasons"] == ["hard: too few scales for this model"] and bd["n_params"] == 7 and math.isnan(bd["q"])
+    assert not sel_mod.CandidateScore("WN", 1, 1.0, 2.0, 3.0, False, ("soft: x",)).hard_failure
+    e = sel_mod.ExcludedScale(level=np.int64(2), scale_s=np.float64(0.04), best_abs_z=np.float64(7.5),
+                              best_model="WN", reason="why")
+    ed = e.to_dict()
+    assert ed == {"level": 2, "scale_s": 0.04, "best_abs_z": 7.5, "best_model": "WN", "reason": "why"}
+    assert type(ed["level"]) is int and type(ed["scale_s"]) is float and type(ed["best_abs_z"]) is float
+    # the excluded scales of a real selection go into the dict the same way
+    wf = _filtered(2**13, 4)
+    sf = select_model(wf, ["WN", "WN+RW"])
+    assert sf.to_dict()["excluded"] == [x.to_dict() for x in sf.excluded] and len(sf.excluded) == 3
+
+
+def test_selection_input_errors():
+    wv = haar_wvar(simulate_latent("WN", [1.0], 16, seed=1), 0.01)  # 3 scales
+    with pytest.raises(InsufficientDataError, match=r"^3 scales are too few for any candidate \(need 4\)$") as ei:
+        select_model(wv, ["WN+RW", "WN+RW+GM"])
+    assert (ei.value.needed, ei.value.got) == (4, 3)
+    one = select_model(wv, "WN")  # a single model string is one candidate (3 scales >= 1 + 2)
+    assert [c.model for c in one.candidates] == ["WN"] and one.selected == "WN"
