@@ -1,0 +1,396 @@
+"""Rules of the noise-identification checks, the periodic content and the spectral-line null, pinned by hand
+(mutation round 3, issue 24 item 2).
+
+Every expected value is computed here from a closed form, independently of the module under test:
+
+* ``noise/checks.py``: the ~4-sigma point limit and the 95 % interval of a chi-squared point (chi2 with 2 degrees
+  of freedom has ``ppf(p) = -2 ln(1 - p)``); the refusal of a flat B floor above the measured minimum and its
+  classical bound ``B <= min ADEV / 0.664`` (IEEE Std 952-1997 C.2, 0.664 = sqrt(2 ln 2 / pi)); the minimum of a
+  fitted N + K curve, ``sigma^2 = a / tau + b tau`` -> ``2 sqrt(a b)`` at ``tau = sqrt(a / b)``; the quantization
+  versus tone rule (Q is not told apart from a line whose tau^-2 envelope ``Omega^2 / (pi f)^2`` is larger); the
+  sub-covariance rebuilt from a known correlation and EDF.
+* ``noise/periodic.py``: a tone's ADEV ``A^2 sin^4(pi f tau) / (pi f tau)^2`` (IEEE Std 952-1997 C.7) vanishes at
+  the taus :func:`null_taus` returns; the relative powers ``(a / a_ref)^2`` and the periods of
+  :func:`periodic_content`.
+* ``noise/_spectral_null.py``: for a half-window of one bin and EDF 2 the statistic is ``P / max(X1, X2)`` with
+  three independent Exp(1) variates, whose survival function is ``2 / ((1 + r) (2 + r))``; for a very wide window
+  the median is ln 2 and the survival tends to ``2^-r``.
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from scipy.stats import chi2
+
+from fogdrift.noise import checks
+from fogdrift.noise._spectral_null import _MedianNull, _null_and_critical
+from fogdrift.noise.periodic import NULL_TOLERANCE, PeriodicContent, null_taus, periodic_content
+from fogdrift.noise.result import NoiseTerm
+from fogdrift.noise.terms import ALL_TERMS, laws_of
+
+IB, IN, IK, IQ, IS = (ALL_TERMS.index(t) for t in "BNKQS")
+B664 = math.sqrt(2.0 * math.log(2.0) / math.pi)  # 0.6643: min ADEV of a flat floor / B
+
+
+def _chi2_2_ppf(p):
+    """chi2 with 2 degrees of freedom: CDF 1 - exp(-x / 2)."""
+    return -2.0 * math.log1p(-p)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# checks: point limits and intervals
+
+
+def test_point_limit_is_the_4_sigma_lower_chi2_quantile():
+    y = np.array([1.0, 4.0])
+    got = checks._point_limits(y, np.array([2.0, 2.0]))
+    np.testing.assert_allclose(got, y * 2.0 / _chi2_2_ppf(3.17e-5), rtol=1e-9)
+    assert got[0] == pytest.approx(1.0 / 3.17e-5, rel=1e-4)  # ~31500 y: one point bounds little
+
+
+def test_points_outside_their_own_95_interval():
+    """nu = 2: the interval of y is [y / 3.689, y / 0.02532] = [0.2711 y, 39.50 y]."""
+    lo, hi = 2.0 / _chi2_2_ppf(0.975), 2.0 / _chi2_2_ppf(0.025)
+    assert lo == pytest.approx(0.27108, rel=1e-4) and hi == pytest.approx(39.4983, rel=1e-4)
+    y = np.ones(6)
+    mu = np.array([0.99 * lo, 1.01 * lo, 1.0, 0.99 * hi, 1.01 * hi, 0.5])
+    out = checks._points_outside(y, mu, np.full(6, 2.0))
+    assert out.tolist() == [0, 4]
+    # an EDF of 0 is floored at 1e-6: the upper limit is then infinite, the lower one tiny, nothing is outside
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# checks: the refused flat floor and the classical bias-instability reading
+
+
+def _ctx(tau, y, y_hi, statistic="adev", lines=(), tc_s=None):
+    return SimpleNamespace(tau=np.asarray(tau, float), y=np.asarray(y, float), y_hi=np.asarray(y_hi, float),
+                           dt=0.01, statistic=statistic, laws=laws_of(statistic), lines=tuple(lines), tc_s=tc_s)
+
+
+def _floor_ctx():
+    # measured ADEV^2 [(deg/h)^2]: minimum 0.04 at tau = 10 s (ADEV 0.2 deg/h), its 95 % upper bound 0.09
+    tau = [1.0, 10.0, 100.0]
+    return _ctx(tau, [1.0, 0.04, 0.25], [2.0, 0.09, 0.5])
+
+
+def test_flat_floor_above_the_measured_minimum_is_refused_with_the_classical_bound():
+    c = _floor_ctx()
+    A = np.zeros(len(ALL_TERMS))
+    scale = 2.0 * math.log(2.0) / math.pi
+    A[IB] = 0.0901  # just above y_hi at the minimum
+    terms = {}
+    checks._check_floor(terms, c, A)
+    t = terms["B"]
+    assert isinstance(t, NoiseTerm) and t.status == "not_estimable" and t.value is None and t.lo95 is None
+    assert t.unit == "deg/h" and t.hi95 == pytest.approx(0.2 / B664, rel=1e-9)  # 0.301 deg/h
+    msg = t.reason
+    assert f"{math.sqrt(0.0901 / scale):.3g} deg/h" in msg  # the refused floor, B = sqrt(A / 0.4413)
+    assert "falls to 0.2 deg/h at tau = 10 s" in msg
+    assert "B <= min ADEV / 0.6643 = 0.301 deg/h" in msg
+    # at (or below) the upper bound the floor stands
+    A[IB] = 0.09
+    terms = {}
+    checks._check_floor(terms, c, A)
+    assert terms == {}
+
+
+@pytest.mark.parametrize("statistic, name", [("hdev", "HDEV"), ("mdev", "MDEV")])
+def test_refused_floor_names_the_statistic(statistic, name):
+    c = _floor_ctx()
+    c.statistic, c.laws = statistic, laws_of(statistic)
+    A = np.zeros(len(ALL_TERMS))
+    A[IB] = 1.0
+    terms = {}
+    checks._check_floor(terms, c, A)
+    scale = laws_of(statistic)["B"].scale(0.01)
+    assert f"B <= min {name} / {math.sqrt(scale):.4g} = {math.sqrt(0.04 / scale):.3g} deg/h" in terms["B"].reason
+
+
+def test_classical_b_of_a_refused_floor_is_the_measured_minimum_over_0_664():
+    c = _floor_ctx()
+    got = checks._classical_b(c, np.zeros(len(ALL_TERMS)), floor_refused=True)
+    assert got["value"] == pytest.approx(0.2 / B664, rel=1e-12)
+    assert got["tau_s"] == 10.0 and got["bound_only"] is True and got["lo95"] is None and got["unit"] == "deg/h"
+    assert got["hi95"] == pytest.approx(0.3 / B664, rel=1e-12)
+    assert "upper bound" in got["rule"] and "measured" in got["rule"]
+
+
+def _nk_ctx(a, b, taus):
+    """Measured points on the N + K model itself, sigma^2 = a / tau + b tau, with +-20 % (in deviation) bounds."""
+    tau = np.asarray(taus, float)
+    y = a / tau + b * tau
+    A = np.zeros(len(ALL_TERMS))
+    A[IN], A[IK] = a, b  # the fit's coefficients of the design columns tau^-1 and tau^1
+    return _ctx(tau, y, y * 1.44), A
+
+
+def test_classical_b_is_the_minimum_of_the_fitted_curve():
+    """a / tau + b tau has its minimum 2 sqrt(a b) at tau = sqrt(a / b) = 10 s (inside 0.1 .. 1000 s)."""
+    a, b = 1.0, 0.01
+    c, A = _nk_ctx(a, b, np.logspace(-1, 3, 9))
+    got = checks._classical_b(c, A)
+    assert got["value"] == pytest.approx(math.sqrt(2.0 * math.sqrt(a * b)) / B664, rel=1e-4)
+    assert got["tau_s"] == pytest.approx(10.0, rel=0.03)  # the 400-point grid's step is 2.3 %
+    assert got["bound_only"] is False
+    j = 4  # the measured tau nearest 10 s is 10 s itself
+    assert got["hi95"] == pytest.approx(math.sqrt(c.y_hi[j]) / B664, rel=1e-12)
+    assert got["lo95"] == pytest.approx(math.sqrt(c.y[j] / 1.44) / B664, rel=1e-12)
+    assert "fitted" in got["rule"]
+
+
+def test_classical_b_at_the_longest_tau_is_a_bound_the_tighter_of_two():
+    """Pure white noise: the fitted curve still falls at the longest tau (an upper bound); the measured minimum is
+    lower when the last measured point dips below the curve, and then it is the reading."""
+    tau = np.array([1.0, 10.0, 100.0])
+    A = np.zeros(len(ALL_TERMS))
+    A[IN] = 1.0
+    y = 1.0 / tau
+    c = _ctx(tau, y, 1.44 * y)
+    got = checks._classical_b(c, A)
+    assert got["bound_only"] is True and got["lo95"] is None
+    assert got["value"] == pytest.approx(0.1 / B664, rel=1e-9) and got["tau_s"] == pytest.approx(100.0)
+    c = _ctx(tau, [1.0, 0.1, 0.0064], [1.44, 0.144, 0.0064 * 1.44])  # last point ADEV 0.08 < 0.1
+    got = checks._classical_b(c, A)
+    assert got["value"] == pytest.approx(0.08 / B664, rel=1e-12) and got["tau_s"] == 100.0
+    assert got["hi95"] == pytest.approx(0.096 / B664, rel=1e-9) and got["bound_only"] is True
+
+
+def test_classical_b_at_the_second_last_grid_point_is_still_the_edge():
+    """The minimum on the 400-point grid at index 398 (just inside the longest tau) counts as the edge."""
+    a, b = 1.0, 0.01
+    tau_end = 10.0 * 1.006  # sqrt(a / b) = 10 s: the minimum sits a hair before the last grid point
+    c, A = _nk_ctx(a, b, [0.1, 1.0, tau_end])
+    got = checks._classical_b(c, A)
+    assert got["bound_only"] is True and got["lo95"] is None
+
+
+def test_classical_b_reads_the_measured_curve_when_the_fit_misses_its_minimum():
+    """A fitted curve far above the measured points at its minimum (a poor fit): the measured minimum is read."""
+    a, b = 1.0, 0.01
+    c, A = _nk_ctx(a, b, np.logspace(-1, 3, 9))
+    c.y = c.y / 100.0  # measured 10x lower in deviation
+    c.y_hi = c.y * 1.44
+    got = checks._classical_b(c, A)
+    jm = int(np.argmin(c.y))
+    assert got["value"] == pytest.approx(math.sqrt(c.y[jm]) / B664, rel=1e-12)
+    assert got["tau_s"] == pytest.approx(c.tau[jm]) and got["bound_only"] is False
+    assert got["lo95"] == pytest.approx(math.sqrt(c.y[jm] / 1.44) / B664, rel=1e-12)
+    assert got["hi95"] == pytest.approx(math.sqrt(c.y_hi[jm]) / B664, rel=1e-12)
+    assert "misses the measured points" in got["rule"]
+    # a curve 10x too LOW is also a miss
+    c, A = _nk_ctx(a, b, np.logspace(-1, 3, 9))
+    c.y, c.y_hi = c.y * 100.0, c.y * 144.0
+    assert "misses" in checks._classical_b(c, A)["rule"]
+
+
+def test_classical_b_includes_the_shaped_terms_of_the_printed_model():
+    """A Gauss-Markov M term or a periodic S term in the model lifts the fitted curve, hence its minimum."""
+    from fogdrift.noise.terms import markov_shape, periodic_shape
+
+    a, b = 1.0, 0.01
+    tau = np.logspace(-1, 3, 9)
+    c, A = _nk_ctx(a, b, tau)
+    base = checks._classical_b(c, A)["value"]
+    grid = np.logspace(-1, 3, 400)
+    for col, kw, shape in ((ALL_TERMS.index("M"), {"tc_s": 10.0}, markov_shape(grid, 10.0, "adev", 0.01)),
+                           (IS, {"lines": ((0.03, 1.0),)}, periodic_shape(grid, ((0.03, 1.0),), 0.01, "adev"))):
+        A2 = A.copy()
+        A2[col] = 5.0
+        c2 = _ctx(tau, c.y, c.y_hi * 100.0, **kw)
+        var = a / grid + b * grid + 5.0 * shape
+        got = checks._classical_b(c2, A2)["value"]
+        assert got == pytest.approx(math.sqrt(var.min()) / B664, rel=1e-9) and got > base * 1.01
+        # without the shaped context (no tc / no lines) the term is not added
+        c3 = _ctx(tau, c.y, c.y_hi * 100.0)
+        assert checks._classical_b(c3, A2)["value"] == pytest.approx(base, rel=1e-12)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# checks: quantization versus a tone
+
+
+def _q_terms():
+    return {"Q": NoiseTerm("Q", 1.0, "urad", 0.5, 2.0, "estimated", "")}
+
+
+def test_q_below_the_lines_envelope_is_unresolved():
+    """Lines (20 Hz, power 1) and (40 Hz, power 0.25): envelope A_S (1 / (20 pi)^2 + 0.25 / (40 pi)^2)."""
+    env1 = 1.0 / (math.pi * 20.0) ** 2 + 0.25 / (math.pi * 40.0) ** 2
+    c = _ctx([0.01, 0.1], [1.0, 1.0], [2.0, 2.0], lines=((20.0, 1.0), (40.0, 0.25)))
+    periodic = SimpleNamespace(periods_s=(0.05, 0.3))
+    A = np.zeros(len(ALL_TERMS))
+    A[IS] = 2.0
+    A[IQ] = 2.0 * env1 * 0.999
+    out = _q_terms()
+    checks._q_at_whole_periods(c, None, (IQ, IS), A, 1.0, periodic, out)
+    t = out["Q"]
+    assert t.status == "unresolved" and t.lo95 == 0.0 and t.value == 1.0 and t.hi95 == 2.0 and t.unit == "urad"
+    assert f"{math.sqrt(1 / 0.999):.3g}x Q in deviation" in t.reason and "envelope" in t.reason
+    # no periodic content: nothing to tell apart, Q untouched
+    out = _q_terms()
+    checks._q_at_whole_periods(c, None, (IQ, IS), A, 1.0, None, out)
+    checks._q_at_whole_periods(c, None, (IQ, IS), A, 1.0, SimpleNamespace(periods_s=()), out)
+    assert out["Q"].status == "estimated"
+
+
+def test_q_above_the_envelope_without_enough_taus_past_the_period_is_unresolved():
+    """Q above the envelope, but fewer than (number of terms + 1) taus from the shortest period on: lower bound 0,
+    the whole-period reason (the shortest period, 0.05 s, is the one named)."""
+    c = _ctx([0.01, 0.02, 0.05, 0.1], [1.0] * 4, [2.0] * 4, lines=((20.0, 1.0),))
+    A = np.zeros(len(ALL_TERMS))
+    A[IS], A[IQ] = 1.0, 1.0
+    prob = SimpleNamespace()
+    out = _q_terms()
+    checks._q_at_whole_periods(c, prob, (IQ, IS), A, 1.0, SimpleNamespace(periods_s=(0.3, 0.05)), out)
+    t = out["Q"]
+    assert t.status == "unresolved" and t.lo95 == 0.0 and "tau >= 0.05 s" in t.reason
+
+
+def test_sub_covariance_is_the_correlation_scaled_by_the_edf():
+    """W = inv(chol(R)): the rebuilt covariance is R_ij sqrt(2 / nu_i) sqrt(2 / nu_j), from row/column k0 on."""
+    R = np.array([[1.0, 0.5, 0.2], [0.5, 1.0, 0.4], [0.2, 0.4, 1.0]])
+    nu = np.array([2.0, 8.0, 50.0])
+    prob = SimpleNamespace(W=np.linalg.inv(np.linalg.cholesky(R)), nu=nu)
+    want = R * np.outer(np.sqrt(2 / nu), np.sqrt(2 / nu))
+    np.testing.assert_allclose(checks._sub_cov(prob, 0), want, rtol=1e-12)
+    np.testing.assert_allclose(checks._sub_cov(prob, 1), want[1:, 1:], rtol=1e-12)
+    assert checks._sub_cov(prob, 1)[0, 1] == pytest.approx(0.4 * 0.5 * 0.2, rel=1e-12)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# periodic: the tone's nulls and the content of a spectrum
+
+
+def _tone_avar(f, tau):
+    """ADEV^2 of a unit-amplitude sinusoid (IEEE Std 952-1997 C.7)."""
+    x = math.pi * f * np.asarray(tau, float)
+    return np.sin(x) ** 4 / x**2
+
+
+def test_null_taus_are_whole_cycles_of_each_of_the_first_two_periods():
+    dt = 0.001
+    got = null_taus([0.05, 0.13, 0.7], dt, dt, 10.0)
+    # 0.05 s: 1, 2, 4, 8, 16 periods; 0.13 s: 1, 2, 4, 8, 16 periods (k <= 16); 0.7 s is the third: left out
+    want = sorted({0.05 * k for k in (1, 2, 4, 8, 16)} | {0.13 * k for k in (1, 2, 4, 8, 16)})
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+    for f in (1 / 0.05, 1 / 0.13):
+        on = np.isclose((got * f) % 1.0, 0.0, atol=1e-6) | np.isclose((got * f) % 1.0, 1.0, atol=1e-6)
+        assert np.all(_tone_avar(f, got[on]) < 1e-20)
+    # with the third period too: 0.7, 1.4, 2.8, 5.6 s (16 periods would be 11.2 s > 10 s)
+    assert null_taus([0.05, 0.13, 0.7], dt, dt, 10.0, max_components=3).size == 14
+    assert null_taus([0.05], dt, dt, 10.0, max_periods=4).tolist() == pytest.approx([0.05, 0.1, 0.2])
+
+
+def test_null_taus_respect_the_tau_range_and_skip_bad_periods():
+    np.testing.assert_allclose(null_taus([0.05], 0.01, 0.1, 0.4), [0.1, 0.2, 0.4])  # 0.05 below tau_min
+    np.testing.assert_allclose(null_taus([0.05], 0.01, 0.05, 0.4), [0.05, 0.1, 0.2, 0.4])  # both ends inclusive
+    assert null_taus([0.05], 0.01, 0.01, 0.39).tolist() == pytest.approx([0.05, 0.1, 0.2])
+    for bad in ([0.0], [-0.05], [math.inf], [math.nan]):
+        assert null_taus(bad, 0.01, 0.01, 1.0).size == 0
+    np.testing.assert_allclose(null_taus([0.0, 0.05], 0.01, 0.01, 0.1), [0.05, 0.1])
+
+
+def test_null_taus_take_the_nearest_sample_multiple_within_the_tolerance():
+    """Period 0.035 s at dt = 0.01 s: 1 period is 3.5 samples (half a cycle off) and 2 periods 7 samples exactly;
+    the search for k = 1 tries 1 period only, so the first null is at 2 periods (0.07 s); the tone's ADEV at every
+    returned tau is below sin^4(pi 0.05) ~ 6e-3 of its 1/(pi f tau)^2 envelope."""
+    got = null_taus([0.035], 0.01, 0.01, 1.0)
+    assert got[0] == pytest.approx(0.07)
+    cyc = got / 0.035
+    assert np.all(np.abs(cyc - np.round(cyc)) <= NULL_TOLERANCE)
+    x = math.pi / 0.035 * got
+    assert np.all(_tone_avar(1 / 0.035, got) <= np.sin(math.pi * NULL_TOLERANCE) ** 4 / x**2 * (1 + 1e-9))
+    # the nearest sample multiple of one period (10 samples, 0.1 s) is 1.049 cycles: kept; 1.051 cycles: not
+    assert null_taus([0.1 / 1.049], 0.01, 0.01, 0.15).tolist() == pytest.approx([0.1])
+    assert null_taus([0.1 / 1.051], 0.01, 0.01, 0.15).size == 0
+
+
+def _line(f, a):
+    return {"freq_hz": f, "amplitude_dph": a, "harmonic_of": None}
+
+
+def test_periodic_content_of_lines_and_components():
+    spec = {
+        "lines": [_line(20.0, 8.0), _line(3.0, 2.0), _line(0.0, 5.0), _line(7.0, 0.0)],
+        "components": [
+            {"fundamental_hz": 4.0, "period_s": 0.25, "power_dph2": 1.0,
+             "lines": [_line(4.0, 4.0), _line(8.0, 2.0), _line(12.0, 1.0)]},
+            {"fundamental_hz": 20.0, "period_s": 0.05, "power_dph2": 32.0, "lines": [_line(20.0, 8.0)]},
+        ],
+        "rolloff_hz": 30,
+    }
+    pc = periodic_content(spec)
+    assert isinstance(pc, PeriodicContent)
+    # the lines: 20, 3 (from the line list; 0 Hz and 0 deg/h dropped), then 4, 8, 12 added from the component
+    assert [f for f, _ in pc.lines] == [20.0, 3.0, 4.0, 8.0, 12.0]
+    np.testing.assert_allclose([p for _, p in pc.lines], [1.0, (2 / 8) ** 2, (4 / 8) ** 2, (2 / 8) ** 2, (1 / 8) ** 2])
+    assert pc.ref_freq_hz == 20.0 and pc.ref_amplitude_dph == 8.0
+    # components by power, strongest first, then the line outside every component (3 Hz: 1/3 s)
+    assert pc.periods_s == pytest.approx((0.05, 0.25, 1 / 3.0))
+    assert pc.descriptions == ("spectral line at 20 Hz, 8 deg/h", "periodic error, period 0.25 s (4 Hz and 2 "
+                               "harmonic(s))", "spectral line at 3 Hz, 2 deg/h")
+    assert pc.text() == "; ".join(pc.descriptions)
+    assert pc.rolloff_hz == 30.0 and isinstance(pc.rolloff_hz, float)
+
+
+def test_periodic_content_attributes_and_defaults():
+    """Duck-typed objects work as dicts do; a component without a period takes 1 / f0; no roll-off is None."""
+    ln = SimpleNamespace(freq_hz=5.0, amplitude_dph=3.0)
+    comp = SimpleNamespace(fundamental_hz=5.0, lines=[ln])
+    pc = periodic_content(SimpleNamespace(lines=[], components=[comp]))
+    assert pc.lines == ((5.0, 1.0),) and pc.periods_s == pytest.approx((0.2,)) and pc.rolloff_hz is None
+    assert pc.descriptions == ("spectral line at 5 Hz, 3 deg/h",)
+    assert periodic_content(None) is None
+    assert periodic_content({"lines": [_line(0.0, 1.0)], "components": []}) is None
+    assert periodic_content({"lines": None, "components": None}) is None
+    # a component with one line listed only in the component: its period is printed once
+    pc = periodic_content({"lines": [_line(5.0, 3.0)], "components": [{"fundamental_hz": 5.0, "lines": [
+        _line(5.0, 3.0)]}]})
+    assert pc.periods_s == pytest.approx((0.2,)) and len(pc.lines) == 1
+    # a component with no line: its amplitude is unknown
+    pc = periodic_content({"lines": [_line(5.0, 3.0)], "components": [{"fundamental_hz": 2.0, "period_s": 0.5}]})
+    assert pc.descriptions[0] == "spectral line at 2 Hz, nan deg/h" and pc.periods_s == pytest.approx((0.5, 0.2))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# _spectral_null: the survival function of P / max(median_left, median_right)
+
+
+def test_median_null_of_single_bins_is_the_closed_form():
+    """w = 1, EDF 2: P, X1, X2 independent Exp(1): P(P >= r max(X1, X2)) = E[exp(-r M)] = 2 / ((1 + r)(2 + r))."""
+    null = _MedianNull(2.0, 1, 1.0)
+    r = np.array([0.5, 1.0, 3.0, 10.0, 30.0])
+    np.testing.assert_allclose(null.sf(r), 2.0 / ((1 + r) * (2 + r)), rtol=2e-3)
+    assert null.critical(0.1) == pytest.approx(3.0, rel=2e-3)  # 2 / (4 * 5) = 0.1
+    # the bin correlation shrinks the effective window: w = 3 at correlation 3 is w = 1
+    np.testing.assert_allclose(_MedianNull(2.0, 3, 3.0).sf(r), null.sf(r), rtol=1e-12)
+    # and never below one variate
+    np.testing.assert_allclose(_MedianNull(2.0, 1, 5.0).sf(r), null.sf(r), rtol=1e-12)
+
+
+def test_median_null_of_a_wide_window_tends_to_the_chi2_survival():
+    """A median over many bins is the distribution's median, ln 2 for Exp(1): sf(r) -> exp(-r ln 2) = 2^-r."""
+    null = _MedianNull(2.0, 20001, 1.0)
+    r = np.array([1.0, 3.0, 6.0])
+    np.testing.assert_allclose(null.sf(r), 2.0 ** -r, rtol=0.03)
+    assert null.sf(2.0).shape == (1,)
+
+
+def test_median_null_sf_in_blocks_of_256():
+    null = _MedianNull(4.0, 5, 1.3)
+    r = np.linspace(0.5, 20.0, 600)
+    whole = null.sf(r)
+    np.testing.assert_allclose(whole[300:], null.sf(r[300:]), rtol=1e-12)
+    assert np.all(np.diff(whole) < 0) and whole[0] < 1.0
+
+
+def test_cached_null_and_critical_agree():
+    null, crit = _null_and_critical(8.0, 7, 1.5, 1e-3)
+    assert float(null.sf(crit)[0]) == pytest.approx(1e-3, rel=1e-3)
+    assert _null_and_critical(8.0, 7, 1.5, 1e-3)[0] is null
+    assert null.nu == 8.0
