@@ -309,3 +309,238 @@ def test_sigma_is_nan_for_axes_without_a_rate_model():
                             model_dt_s=1.0, wavelet="haar", mode="periodization")
     out = _run(eng, np.column_stack([_log(10), _log(10, 5)]), 3)
     assert np.isfinite(out["sigma"][:, 0]).all() and np.isnan(out["sigma"][:, 1]).all()
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the log source and its matching to a bundle
+
+
+def _csv(path, header, x, t=None):
+    x = np.asarray(x, dtype=float).reshape(len(x), -1)
+    t = np.arange(x.shape[0], dtype=float) if t is None else t
+    np.savetxt(path, np.column_stack([t, x]), delimiter=",", header=header, comments="", fmt="%.17g")
+    return path
+
+
+def _all(src, chunk):
+    parts = list(src.chunks(chunk))
+    assert all(p[0].shape[0] <= chunk for p in parts)
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+
+def test_open_log_reads_the_declared_unit_and_chunks_any_size(tmp_path):
+    from fogdrift.compensate.sources import DEFAULT_CHUNK, open_log
+
+    v = 0.01 + 1e-3 * np.arange(23)
+    src = open_log(_csv(tmp_path / "s.csv", "t_s,gz[deg/s]", v, t=5.0 + 0.5 * np.arange(23)))
+    assert (src.unit, src.unit_given, src.declared_unit, src.scale_to_dph) == ("deg/s", False, "deg/s", 3600.0)
+    assert src.axis_names == ("gz",) and src.dt_s == 0.5 and src.t0_s == 5.0 and src.n_samples == 23
+    assert src.path == tmp_path / "s.csv" and len(src.sha256) == 64
+    assert not any("read in chunks" in n for n in src.notes)
+    for chunk in (1, 7, 64, DEFAULT_CHUNK):
+        t, x = _all(src, chunk)
+        assert_allclose(t, 5.0 + 0.5 * np.arange(23), rtol=1e-15)
+        assert_allclose(x[:, 0], v * 3600.0, rtol=1e-12)
+    assert DEFAULT_CHUNK == 1048576
+    assert len(list(src.chunks())) == 1
+    for bad in (0, -1, 1.5, True, "7", None):
+        with pytest.raises(ConfigError) as info:
+            list(src.chunks(bad))
+        assert str(info.value) == f"chunk_samples= must be an integer >= 1 (rows read at a time); got {bad!r}"
+    t, x = _all(src, np.int64(5))
+    assert t.size == 23
+
+    given = open_log(tmp_path / "s.csv", unit="deg/h")  # the option takes precedence over the file's unit
+    assert (given.unit, given.unit_given, given.declared_unit, given.scale_to_dph) == ("deg/h", True, "deg/s", 1.0)
+    assert_allclose(_all(given, 7)[1][:, 0], v, rtol=1e-12)
+
+
+def test_npy_is_streamed_from_the_file_and_other_options_load_it(tmp_path, monkeypatch):
+    import fogdrift.compensate.sources as sources
+
+    np.save(tmp_path / "r.npy", np.column_stack([np.arange(10.0), -np.arange(10.0)]))
+    calls = []
+    real_load = sources.load
+    real_segments = sources.load_segments
+    monkeypatch.setattr(sources, "load", lambda *a, **k: calls.append(k) or real_load(*a, **k))
+    monkeypatch.setattr(sources, "load_segments", lambda *a, **k: calls.append(k) or real_segments(*a, **k))
+    src = sources.open_log(tmp_path / "r.npy", unit="deg/s", rate_hz=2.0)
+    assert calls == [] and any("read in chunks" in n for n in src.notes)
+    assert src.axis_names == ("col0", "col1") and src.dt_s == 0.5 and src.declared_unit is None
+    assert (src.unit, src.unit_given, src.scale_to_dph) == ("deg/s", True, 3600.0)
+    for chunk in (1, 3, 64):
+        t, x = _all(src, chunk)
+        assert_array_equal(t, 0.5 * np.arange(10))
+        assert_allclose(x, 3600.0 * np.column_stack([np.arange(10.0), -np.arange(10.0)]), rtol=1e-15)
+    src = sources.open_log(tmp_path / "r.npy", unit="deg/s", rate_hz=2.0, columns=["col1"], format="npy")
+    assert calls == [] and src.axis_names == ("col1",)
+    assert_allclose(_all(src, 4)[1][:, 0], -3600.0 * np.arange(10.0))
+    for kw in (dict(gaps="split"), dict(format="table")):
+        calls.clear()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                src = sources.open_log(tmp_path / "r.npy", unit="deg/s", rate_hz=2.0, **kw)
+            except (ConfigError, DataFormatError):
+                pass
+        assert len(calls) == 1, kw
+        assert calls[0]["unit"] == "deg/s" and "reader_options" not in calls[0] and "temperature" not in calls[0]
+        assert calls[0].get("gaps") == (None if "gaps" in kw else "error")
+
+
+def test_a_log_without_a_unit_is_refused_suggesting_the_bundles(tmp_path):
+    from fogdrift.compensate.sources import open_log
+
+    log = _csv(tmp_path / "n.csv", "t_s,gz", np.arange(5.0))
+    with pytest.raises(ConfigError) as info:
+        open_log(log, bundle_unit="deg/s")
+    assert str(info.value) == (f"{log}: the log declares no rate unit and none was given; pass unit= deg/s (the bundle "
+                               "was trained on deg/s) or the unit of its numbers (units are never guessed)")
+    assert info.value.__cause__ is None and info.value.__suppress_context__
+    with pytest.raises(ConfigError) as info:  # no bundle unit to suggest: the reader's own line
+        open_log(log)
+    assert str(info.value).startswith(f"{log}: no rate unit: the file declares none for gz; pass unit= (")
+    assert open_log(log, unit="deg/h", bundle_unit="deg/s").unit == "deg/h"
+    np.save(tmp_path / "r.npy", np.arange(10.0))  # no interval either: that is the line, not the unit's
+    with pytest.raises(ConfigError) as info:
+        open_log(tmp_path / "r.npy", unit="deg/h", bundle_unit="deg/h")
+    assert "the log declares no rate unit" not in str(info.value)
+    with pytest.raises(ConfigError, match="declares no rate unit and none was given; pass unit= deg/h"):
+        open_log(tmp_path / "r.npy", rate_hz=1.0, bundle_unit="deg/h")
+
+
+def test_accelerometer_channels_are_refused_naming_them(tmp_path):
+    from fogdrift.compensate.sources import open_log
+
+    one = _csv(tmp_path / "a1.csv", "t_s,ax[m/s^2]", np.ones((5, 1)))
+    with pytest.raises(ConfigError) as info:
+        open_log(one)
+    assert str(info.value) == (f"{one}: compensate applies a gyro drift model; ax is an accelerometer channel (specific "
+                               "force, from its unit): leave them out with columns=")
+    two = _csv(tmp_path / "a2.csv", "t_s,ax[m/s^2],ay[m/s^2]", np.ones((5, 2)))
+    with pytest.raises(ConfigError) as info:
+        open_log(two)
+    assert str(info.value) == (f"{two}: compensate applies a gyro drift model; ax, ay are accelerometer channels "
+                               "(specific force, from its unit): leave them out with columns=")
+
+
+def test_one_declared_unit_for_every_rate_column():
+    from fogdrift.compensate.sources import _one_declared
+
+    assert _one_declared([], "p") is None and _one_declared([None, None], "p") is None
+    assert _one_declared(["deg/s", "deg/s"], "p") == "deg/s"
+    with pytest.raises(DataFormatError) as info:
+        _one_declared(["deg/s", "deg/h", None], "p.csv")
+    assert str(info.value) == ("p.csv: rate columns declare different units ['None', 'deg/h', 'deg/s']; expected one "
+                               "unit (choose columns with columns=)")
+
+
+def test_gaps_split_compensates_the_longest_segment_and_says_so(tmp_path):
+    from fogdrift.compensate.sources import open_log
+    from fogdrift.errors import FogdriftWarning
+
+    t = np.r_[np.arange(10.0), 30.0 + np.arange(25.0)]
+    log = _csv(tmp_path / "g.csv", "t_s,gz[deg/h]", np.arange(35.0), t=t)
+    with pytest.warns(FogdriftWarning) as rec:
+        src = open_log(log, gaps="split")
+    assert [str(w.message) for w in rec] == [
+        f"{log}: 2 segments between gaps; compensating the longest (25 samples, segment 2 of 2: samples 10-34 "
+        "(lines 12-36), after a gap of 21 s)"]
+    assert rec[0].filename == __file__  # stacklevel: the caller of open_log
+    assert src.n_samples == 25 and src.t0_s == 30.0
+    t_, x_ = _all(src, 7)
+    assert_array_equal(t_, 30.0 + np.arange(25.0)) and assert_array_equal(x_[:, 0], np.arange(10.0, 35.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        src = open_log(_csv(tmp_path / "ok.csv", "t_s,gz[deg/h]", np.arange(9.0)), gaps="split")  # one: no warning
+    assert src.n_samples == 9
+    with pytest.raises(DataFormatError):
+        open_log(log)
+
+
+def _bundle(**kw):
+    d = dict(input_unit="deg/h", native_dt_s=0.1, block_average_factor=10, model_dt_s=1.0, axis_names=("gx", "gz"))
+    d.update(kw)
+    return SimpleNamespace(**d)
+
+
+def _source(**kw):
+    d = dict(unit="deg/h", unit_given=False, declared_unit="deg/h", scale_to_dph=1.0, dt_s=0.1, axis_names=("gz",),
+             path="log.csv")
+    d.update(kw)
+    return SimpleNamespace(**d)
+
+
+def test_match_log_units_by_hand():
+    from fogdrift.compensate.sources import match_log
+
+    m = match_log(_source(), _bundle())
+    assert m.unit == "deg/h" and m.scale_to_dph == 1.0 and m.factor == 10 and type(m.factor) is int
+    assert m.axes == (("gz", "gz"),) and m.notes == ("axes of the bundle not in the log (not compensated): gx",)
+    with pytest.raises(ConfigError) as info:
+        match_log(_source(unit="deg/s", declared_unit="deg/s", scale_to_dph=3600.0), _bundle())
+    assert str(info.value) == ("log.csv: the log declares unit deg/s but the bundle was trained on deg/h; pass unit= "
+                               "deg/s to convert it")
+    m = match_log(_source(unit="deg/s", unit_given=True, declared_unit=None, scale_to_dph=3600.0), _bundle())
+    assert m.unit == "deg/s" and m.scale_to_dph == 3600.0
+    assert m.notes[:2] == ("unit: the log declares none; its numbers are read as deg/s ({opt:unit})",
+                           "unit: the log is read as deg/s ({opt:unit}) and converted; the bundle was trained on deg/h")
+    m = match_log(_source(unit="deg/h", unit_given=True, declared_unit=" deg/s "), _bundle())
+    assert m.notes[0] == "unit: the log declares deg/s; its numbers are read as deg/h ({opt:unit} takes precedence)"
+    assert len(m.notes) == 2  # the unit is the bundle's: nothing converted
+    m = match_log(_source(unit="deg/h", unit_given=True, declared_unit="deg/h"), _bundle())
+    assert m.notes == ("axes of the bundle not in the log (not compensated): gx",)
+
+
+def test_match_log_rates_exactly_at_the_tolerance():
+    from fogdrift.compensate.sources import match_log
+
+    b = _bundle()
+    for dt in (0.1, 0.1 * (1 + 0.9e-6), 0.1 * (1 - 0.9e-6)):
+        assert match_log(_source(dt_s=dt), b).factor == 10
+    with pytest.raises(ConfigError) as info:
+        match_log(_source(dt_s=0.1 * (1 + 1.1e-6)), b)
+    assert str(info.value) == ("log.csv: the log is sampled at 9.99999 Hz, the bundle's training log at 10 Hz (models "
+                               "at 1 Hz); pass accept_rate= to block-average it to the bundle's modelling rate")
+    m = match_log(_source(dt_s=0.02), b, accept_rate=True)
+    assert m.factor == 50 and type(m.factor) is int
+    assert m.notes[0] == "rate: the log (50 Hz) differs from the training log (10 Hz); block-averaged x50 to the modelling rate"
+    assert match_log(_source(dt_s=0.1), b, accept_rate=True).notes[0].startswith("axes")  # same rate: no note
+    with pytest.raises(ConfigError) as info:
+        match_log(_source(dt_s=0.3), b, accept_rate=True)
+    assert str(info.value) == ("log.csv: the log's 3.33333 Hz cannot be block-averaged to the bundle's modelling rate "
+                               "1 Hz by an integer factor")
+    assert info.value.__cause__ is None
+
+
+def test_match_log_axes_by_name_and_map():
+    from fogdrift.compensate.sources import match_log, parse_axis_map
+
+    assert parse_axis_map(None) == {} and parse_axis_map("") == {} and parse_axis_map(" , ") == {}
+    assert parse_axis_map({0: "gz", "a": 1}) == {"0": "gz", "a": "1"}
+    assert parse_axis_map(" col0 = gz ,col1=gx,") == {"col0": "gz", "col1": "gx"}
+    for bad in ("col0", "=gz", "col0=", " = ", "col0=gz,col1"):
+        with pytest.raises(ConfigError) as info:
+            parse_axis_map(bad)
+        item = bad.split(",")[-1].strip()
+        assert str(info.value) == (f"axis map entries look like LOG_AXIS=BUNDLE_AXIS (e.g. col0=gz); got {item!r} in "
+                                   "axis_map=")
+    b = _bundle()
+    m = match_log(_source(axis_names=("col0", "col1")), b, axis_map="col0=gz,col1=gx")
+    assert m.axes == (("col0", "gz"), ("col1", "gx"))
+    assert m.notes == ("axis: log col0 -> bundle gz", "axis: log col1 -> bundle gx")
+    m = match_log(_source(axis_names=("gx", "gz")), b)
+    assert m.axes == (("gx", "gx"), ("gz", "gz")) and m.notes == ()
+    with pytest.raises(ConfigError) as info:
+        match_log(_source(axis_names=("gz",)), b, axis_map="col9=gz,col8=gx")
+    assert str(info.value) == "axis map names ['col9', 'col8'], not axes of the log ['gz']; check axis_map="
+    with pytest.raises(ConfigError) as info:
+        match_log(_source(axis_names=("gy",)), b)
+    assert str(info.value) == ("log.csv: log axis 'gy' has no model in the bundle, whose axes are ['gx', 'gz'] (pass "
+                               "axis_map= gy=AXIS, or choose columns with columns=)")
+    with pytest.raises(ConfigError) as info:
+        match_log(_source(axis_names=("col0",)), b, axis_map="col0=gy")
+    assert str(info.value) == "log.csv: log axis 'col0' has no model in the bundle, whose axes are ['gx', 'gz']"
+    with pytest.raises(ConfigError) as info:
+        match_log(_source(axis_names=("col0", "gz")), b, axis_map={"col0": "gz"})
+    assert str(info.value) == "log axes 'col0' and 'gz' both map to bundle axis 'gz'; check axis_map="
