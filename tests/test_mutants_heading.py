@@ -12,6 +12,7 @@ FIR of the causal-drift weights.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -116,7 +117,12 @@ def test_heading_row_with_a_zero_reference_and_without_origins():
     assert (r.better_independent, r.worse_independent) == (0, 2)
     r = heading_row("m", [0.0, 0.0], [1.0, -3.0], horizon_s=60.0, step_s=300.0)
     assert r.ratio_to_bias == 0.0 and r.wins_vs_bias == 1.0 and r.better_independent == 2
-    r = heading_row("m", [], [], horizon_s=60.0, step_s=300.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "mean of empty slice": every statistic of no origins is NaN by rule
+        r = heading_row("m", [], [], horizon_s=60.0, step_s=300.0)
+        # an overflowing square is an infinite RMS, silently (the verdicts call it diverged)
+        big = heading_row("m", [1e200, 1.0], [1.0, 1.0], horizon_s=60.0, step_s=300.0)
+    assert big.rms_deg == math.inf and big.ratio_to_bias == math.inf
     assert r.n_origins == 0 and r.n_independent == 0
     for v in (r.rms_deg, r.ratio_to_bias, r.median_abs_deg, r.p90_abs_deg, r.wins_vs_bias):
         assert math.isnan(v)
@@ -297,8 +303,6 @@ def test_result_row_lookup_and_dict():
 def test_angle_error_that_overflows_is_infinite_or_nan_without_a_warning():
     """A diverging forecast: the accumulated error overflows to inf (or inf - inf = NaN) silently; the
     verdicts count it as diverged.  At dt = 7200 s a residual of 1 deg/h is 2 deg per sample."""
-    import warnings
-
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         e = angle_error_deg([1e308, 1e308, 1.0], 0.0, [0.0, 0.0, 0.0], 3600.0)
@@ -353,7 +357,7 @@ def test_batched_forecasts_of_the_wrong_shape_or_failing_fall_back_to_the_loop()
 
     calib = [(0.0, np.zeros(5), np.zeros(3), 4), (0.0, np.zeros(5), np.zeros(3), 7)]
     good = ConstDriftMany(1.5)
-    out = hmod._batched_forecasts({"w": WrongShape(1.0), "r": Raising(1.0), "g": good, "p": ConstDrift(1.0)}, calib)
+    out = hmod._batched_forecasts({"p": ConstDrift(1.0), "w": WrongShape(1.0), "r": Raising(1.0), "g": good}, calib)
     assert list(out) == ["g"] and out["g"].shape == (2, 7) and np.all(out["g"] == 1.5)
     assert good.many[0][0] == 7 and good.many[0][1].shape == (2, 3)
     assert hmod._batched_forecasts({"g": good}, []) == {}
@@ -363,3 +367,31 @@ def test_batched_forecasts_of_the_wrong_shape_or_failing_fall_back_to_the_loop()
         res = heading_errors(r, 1.0, {"m": m}, causal_window=128, horizons_s=(60.0,))
         assert len(m.calls) == res.origins_s.size  # one per-origin forecast each
         assert_allclose(res.errors["m"][:, 0], res.errors[CONSTANT_BIAS][:, 0] - 2.0 * 60 / 3600.0, rtol=1e-9)
+
+
+def test_mixed_models_each_get_their_own_path_and_the_defaults():
+    """A batched model, a per-origin one, a failing one and a plain object without ``input_kind`` (a drift model
+    by default), in every order: each keeps its own constant-forecast error E_bias - f H / 3600; the axis name
+    defaults to ""; a 0.5-s horizon at dt = 0.5 s (one sample) is kept and the dropped 4000-s horizon's note
+    gives the record in seconds (1000 s = 2000 samples)."""
+
+    class Plain:
+        def forecast(self, h, *, history=None):
+            return np.full(int(h), -3.0)
+
+    r = 1.0 + np.random.default_rng(6).normal(0.0, 1.0, 2000)
+    levels = {"many": 1.0, "one": 2.0, "plain": -3.0}
+    for order in (("many", "bad", "one", "plain"), ("plain", "one", "bad", "many")):
+        make = {"many": lambda: ConstDriftMany(1.0), "one": lambda: ConstDrift(2.0), "bad": Failing, "plain": Plain}
+        res = heading_errors(r, 0.5, {k: make[k]() for k in order}, causal_window=64, calib_s=150.0, step_s=50.0,
+                             horizons_s=(0.5, 60.0, 4000.0))
+        assert res.axis == "" and res.horizons_s == (0.5, 60.0)
+        assert res.notes == ["horizon 4000 s dropped: the record (1000 s) does not hold a 150-s calibration plus "
+                             "4000 s", "bad: no forecast (cannot forecast today)"]
+        for label, f in levels.items():
+            for j, H in enumerate((0.5, 60.0)):
+                assert_allclose(res.errors[label][:, j], res.errors[CONSTANT_BIAS][:, j] - f * H / 3600.0,
+                                rtol=1e-9, atol=1e-12)
+        assert_allclose(res.errors[CONSTANT_BIAS][:, 0], (r[300::100][:res.origins_s.size] - [
+            np.mean(r[t - 300:t]) for t in range(300, 300 + 100 * res.origins_s.size, 100)]) * 0.5 / 3600.0,
+                        rtol=1e-9)
