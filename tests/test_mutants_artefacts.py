@@ -273,3 +273,16 @@ def test_row_lookup_names_the_missing_model():
     with pytest.raises(KeyError) as info:
         res.row("persistence")
     assert info.value.args == ("persistence",)
+
+
+def test_no_claim_where_the_allan_deviation_cannot_be_computed():
+    """The claim's reader gives None (no claim, never flagged) when either ADEV cannot be computed (here a
+    compensated block that overflowed to inf); inside the curve it interpolates the log ratio."""
+    from fogdrift.evaluation.artefacts import _adev_ratio_fn
+
+    base = np.random.default_rng(51).normal(0.0, 1.0, 256)
+    at = _adev_ratio_fn(base, np.where(np.arange(256) == 9, np.inf, base), 1.0)
+    assert at(1.0) is None and at(4.0) is None
+    at = _adev_ratio_fn(base, 2.0 * base, 1.0)
+    assert at(1.0) == pytest.approx(2.0, rel=1e-12) and at(3.0) == pytest.approx(2.0, rel=1e-12)
+    assert at(0.99) is None and at(1e4) is None
