@@ -134,7 +134,7 @@ class AllanAccumulator:
         for i, x in enumerate((before, after)):
             x = np.concatenate([self._carry[i], x])
             nb = x.shape[0] // self.f
-            self._out[i].append(x[: nb * self.f].reshape(nb, self.f, -1).mean(axis=1))
+            self._out[i].append(x[: nb * self.f].reshape(nb, self.f, x.shape[1]).mean(axis=1))  # nb may be 0
             self._carry[i] = x[nb * self.f:]
 
     def series(self, start: int = 0):
