@@ -544,3 +544,218 @@ def test_match_log_axes_by_name_and_map():
     with pytest.raises(ConfigError) as info:
         match_log(_source(axis_names=("col0", "gz")), b, axis_map={"col0": "gz"})
     assert str(info.value) == "log axes 'col0' and 'gz' both map to bundle axis 'gz'; check axis_map="
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the streamed writers
+
+
+def test_csv_writer_header_and_rows_by_hand(tmp_path):
+    from fogdrift.compensate.outputs import CsvWriter
+
+    w = CsvWriter(tmp_path / "c.csv", ["gx", "gz"], "deg/s", with_sigma=False)
+    w.write(np.array([0.0, 0.5]), np.array([[1.0, 2.0], [3.0, 1 / 3]]), np.array([[0.1, 0.2], [0.3, 0.4]]), None)
+    w.write(np.array([1.0]), np.array([[5.0, 6.0]]), np.array([[7.0, 8.0]]), None)
+    w.close()
+    assert w._fh.closed
+    assert (tmp_path / "c.csv").read_text().splitlines() == [
+        "t_s,gx[deg/s],gz[deg/s],gx_drift[deg/s],gz_drift[deg/s]", "0,1,2,0.1,0.2", "0.5,3,0.333333333333,0.3,0.4",
+        "1,5,6,7,8"]
+    w = CsvWriter(tmp_path / "s.csv", ["gz"], "deg/h", with_sigma=True)
+    w.write(np.array([2.0]), np.array([[1.0]]), np.array([[-2.0]]), np.array([[0.25]]))
+    w.abort()
+    assert w._fh.closed
+    assert (tmp_path / "s.csv").read_text() == "t_s,gz[deg/h],gz_drift[deg/h],gz_drift_sigma[deg/h]\n2,1,-2,0.25\n"
+
+
+@pytest.mark.parametrize("with_sigma", (False, True))
+@pytest.mark.parametrize("name", ("c.npz", ".fogdrift-tmp-77-c.npz"))
+def test_npz_writer_assembles_the_archive_from_member_files(tmp_path, with_sigma, name):
+    import zipfile
+
+    from fogdrift.compensate.outputs import NpzWriter
+    from fogdrift.output import TMP_PREFIX
+
+    t = np.arange(5.0)
+    comp = np.column_stack([t * 2, t * 3])
+    drift = np.column_stack([-t, t / 7])
+    sigma = np.column_stack([t + 0.5, t + 1.5])
+    w = NpzWriter(tmp_path / name, 5, ["gx", "gz"], "deg/s", 3600.0, with_sigma)
+    stem = name if name.startswith(TMP_PREFIX) else f"{TMP_PREFIX}{os.getpid()}-{name}"
+    members = ["t_s", "compensated", "drift_estimate"] + (["drift_sigma"] if with_sigma else [])
+    assert sorted(os.listdir(tmp_path)) == sorted(f"{stem}.{m}.npy" for m in members)
+    w.write(t[:2], comp[:2], drift[:2], sigma[:2] if with_sigma else None)
+    w.write(t[2:], comp[2:], drift[2:], sigma[2:] if with_sigma else None)
+    assert w.n == 5
+    w.close()
+    assert os.listdir(tmp_path) == [name]  # the member files are gone
+    with zipfile.ZipFile(tmp_path / name) as zf:
+        assert {i.compress_type for i in zf.infolist()} == {zipfile.ZIP_STORED}
+        assert sorted(zf.namelist()) == sorted(m + ".npy" for m in members + ["axis_names", "unit", "scale_to_dph"])
+        with zf.open("compensated.npy") as fh:
+            assert np.lib.format.read_magic(fh) == (2, 0)
+    with np.load(tmp_path / name, allow_pickle=False) as z:
+        assert_array_equal(z["t_s"], t) and assert_array_equal(z["compensated"], comp)
+        assert_array_equal(z["drift_estimate"], drift)
+        assert z["compensated"].dtype == np.float64 and z["compensated"].shape == (5, 2)
+        assert z["axis_names"].tolist() == ["gx", "gz"] and str(z["unit"]) == "deg/s"
+        assert float(z["scale_to_dph"]) == 3600.0 and z["scale_to_dph"].dtype == np.float64
+        if with_sigma:
+            assert_array_equal(z["drift_sigma"], sigma)
+
+
+def test_npz_writer_abort_and_a_short_write_leave_nothing(tmp_path, monkeypatch):
+    from fogdrift.compensate.outputs import NpzWriter
+
+    w = NpzWriter(tmp_path / "a.npz", 3, ["gz"], "deg/h", 1.0, True)
+    w.write(np.arange(2.0), np.ones((2, 1)), np.ones((2, 1)), np.ones((2, 1)))
+    w.abort()
+    assert os.listdir(tmp_path) == [] and all(fh.closed for fh in w._files.values())
+    w = NpzWriter(tmp_path / "b.npz", 3, ["gz"], "deg/h", 1.0, False)
+    w.write(np.arange(2.0), np.ones((2, 1)), np.ones((2, 1)), None)
+    with pytest.raises(RuntimeError, match=r"^NPZ writer got 2 rows, expected 3$"):
+        w.close()
+    assert os.listdir(tmp_path) == []
+    calls = []
+
+    def header_fails_on_the_second(fh, d):
+        calls.append(d)
+        if len(calls) == 2:
+            raise OSError("disk full")
+        real(fh, d)
+
+    real = np.lib.format.write_array_header_2_0
+    monkeypatch.setattr(np.lib.format, "write_array_header_2_0", header_fails_on_the_second)
+    with pytest.raises(OSError, match="disk full"):
+        NpzWriter(tmp_path / "c.npz", 3, ["gx", "gz"], "deg/h", 1.0, False)
+    assert os.listdir(tmp_path) == []
+    assert calls[0] == {"descr": "<f8", "fortran_order": False, "shape": (3,)}
+    assert calls[1] == {"descr": "<f8", "fortran_order": False, "shape": (3, 2)}
+
+
+@pytest.mark.parametrize("chunk", (1, 3, 7, None))
+def test_allan_accumulator_block_means_by_hand(chunk):
+    from fogdrift.compensate.outputs import AllanAccumulator
+
+    assert AllanAccumulator(1 << 22, 1).f == 1 and AllanAccumulator((1 << 22) + 1, 1).f == 2
+    assert AllanAccumulator(0, 1).f == 1
+    acc = AllanAccumulator(10, 2, max_points=3)  # f = ceil(10 / 3) = 4
+    assert acc.f == 4
+    x = np.column_stack([np.arange(10.0), 100.0 + np.arange(10.0)])
+    step = 10 if chunk is None else chunk
+    for lo in range(0, 10, step):
+        acc.add(x[lo:lo + step], -x[lo:lo + step])
+    before, after = acc.series()
+    assert_allclose(before, [[1.5, 101.5], [5.5, 105.5]]) and assert_allclose(after, -before)
+    assert_allclose(acc.series(1)[0], [[5.5, 105.5]])  # from native sample 1: the next whole block
+    assert_allclose(acc.series(4)[0], [[5.5, 105.5]]) and acc.series(5)[0].shape == (0, 2)
+    assert acc.series(8)[1].shape == (0, 2)
+
+
+def test_plot_before_after_draws_what_it_says(monkeypatch, tmp_path):
+    import fogdrift.compensate.outputs as outputs
+    from fogdrift.report.figures import literal
+
+    saved = {}
+
+    def fake_save(fig, path, **kw):
+        saved.update(fig=fig, path=path, kw=kw)
+        return "returned"
+
+    monkeypatch.setattr(outputs, "_save", fake_save)
+
+    def res(adev):
+        adev = np.asarray(adev, dtype=float)
+        return SimpleNamespace(tau_s=np.array([1.0, 2.0, 4.0]), adev_dph=adev, adev_lo68_dph=adev * 0.5,
+                               adev_hi68_dph=adev * 1.25)
+
+    curves = [("gx", res([0.0, 2.0, 1.0]), res([3.0, 1.5, 0.5]), "AR$x$"), ("g$z", res([0, 0, 0]), res([0, 0, 0]), "b")]
+    caveats = {"gx": "the lower ADEV is not evidence " + "word " * 30, "g$z": "fine"}
+    assert outputs.plot_before_after(curves, tmp_path / "f.png", "T$1$", caveats) == "returned"
+    fig = saved["fig"]
+    assert saved["path"] == tmp_path / "f.png" and saved["kw"] == {"dpi": 110, "bbox_inches": "tight"}
+    assert_allclose(fig.get_size_inches(), [10.4, 4.2])
+    axs = fig.axes
+    assert len(axs) == 2
+    for ax, name in zip(axs, ("gx", "g$z")):
+        assert ax.get_xscale() == "log" and ax.get_xlabel() == "τ [s]" and ax.get_ylabel() == "σ(τ) [deg/h]"
+        assert ax.get_title() == literal(f"T$1$: {name}")
+        assert ax.xaxis.get_gridlines()[0].get_visible() and ax.xaxis.get_gridlines()[0].get_alpha() == 0.3
+        assert ax.get_legend().get_texts()[0].get_fontsize() == 7
+    assert axs[0].get_yscale() == "log" and axs[1].get_yscale() == "linear"  # all-zero ADEVs: a linear axis
+    assert [t.get_text() for t in axs[0].get_legend().get_texts()] == ["log (bias removed)",
+                                                                        "compensated: " + literal("AR$x$")]
+    before, after = axs[0].containers
+    line = before.lines[0]
+    assert_array_equal(line.get_xdata(), [2.0, 4.0]) and assert_array_equal(line.get_ydata(), [2.0, 1.0])
+    assert line.get_color() == "k" and line.get_marker() == "o" and line.get_linestyle() == "-"
+    assert line.get_markersize() == 3 and line.get_linewidth() == 0.8
+    assert after.lines[0].get_color() == "C3"
+    assert_array_equal(after.lines[0].get_xdata(), [1, 2, 4])
+    segs = before.lines[2][0].get_segments()  # yerr: adev - lo68 below, hi68 - adev above
+    assert_allclose([s[0][1] for s in segs], [1.0, 0.5]) and assert_allclose([s[1][1] for s in segs], [2.5, 1.25])
+    assert axs[1].containers[0].lines[0].get_xdata().size == 0
+    [text] = axs[0].texts
+    assert text.get_position() == (0.0, -0.17) and text.get_transform() == axs[0].transAxes
+    assert text.get_ha() == "left" and text.get_va() == "top" and text.get_fontsize() == 7 and text.get_color() == "C3"
+    import textwrap
+
+    assert text.get_text() == literal(textwrap.fill(caveats["gx"], width=80)) and "\n" in text.get_text()
+    assert [t.get_text() for t in axs[1].texts] == ["fine"] and axs[1].texts[0].get_color() == "k"
+    outputs._plt().close(fig)
+    for cav in (None, {}, {"gx": ""}, {"gz": "not checked"}):
+        outputs.plot_before_after(curves[:1], tmp_path / "g.png", "t", cav)
+        assert len(saved["fig"].axes[0].texts) == 0
+        assert_allclose(saved["fig"].get_size_inches(), [5.2, 4.2])
+        outputs._plt().close(saved["fig"])
+    outputs.plot_before_after(curves[:1], tmp_path / "g.png", "t", {"gx": "x not checked"})
+    assert saved["fig"].axes[0].texts[0].get_color() == "C3"
+    outputs._plt().close(saved["fig"])
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the compensated test block of analyze
+
+
+def _model_axis():
+    rate = np.array([0.5, -1.0, 2.0, 0.25, 1.0, -0.5, 3.0])  # bias and Earth rate removed
+    return SimpleNamespace(name="g z", split={"train": (0, 3), "test": (3, 7)}, bias_dph=4.0, earth_rate_dph=EARTH_30,
+                           rate_dph=rate, dt_s=0.5,
+                           causal_predictions={"AR(p)": np.array([0.1, np.nan, 0.3, 0.4]),
+                                               "persistence": [1.0, 2.0, 3.0, 4.0], "custom": np.zeros(4)})
+
+
+def test_compensated_test_block_by_definition_by_hand():
+    from fogdrift.compensate.holdout import compensated_test_block
+
+    cols = compensated_test_block(_model_axis(), t0_s=10.0)
+    assert list(cols) == ["t_s", "measured", "bias", "ar", "persistence", "custom"]
+    measured = np.array([0.25, 1.0, -0.5, 3.0]) + 4.0 + EARTH_30
+    assert_allclose(cols["t_s"], [11.5, 12.0, 12.5, 13.0])
+    assert_allclose(cols["measured"], measured, rtol=1e-15)
+    assert_allclose(cols["bias"], measured - 4.0, rtol=1e-15)  # the Earth rate stays
+    assert_allclose(cols["ar"], measured - 4.0 - [0.1, np.nan, 0.3, 0.4], rtol=1e-15)
+    assert_allclose(cols["persistence"], measured - 4.0 - [1, 2, 3, 4], rtol=1e-15)
+    assert cols["persistence"].dtype == np.float64
+    assert_allclose(compensated_test_block(_model_axis())["t_s"], [1.5, 2.0, 2.5, 3.0])
+
+
+def test_write_compensated_test_block_by_hand(tmp_path):
+    from fogdrift.compensate.holdout import write_compensated_test_block
+    from fogdrift.io import load
+
+    ma = _model_axis()
+    ma.causal_predictions = {"AR(p)": np.array([0.1, np.nan, 0.3, 0.4])}
+    ma.rate_dph = np.array([0.5, -1.0, 2.0, 1.0, 2.0, 1 / 3, 5.0])
+    ma.earth_rate_dph = 0.0
+    other = _model_axis()
+    other.name = "gx"
+    paths = write_compensated_test_block([ma, other], tmp_path, t0_s=0.0)
+    assert paths == [tmp_path / "compensated_test_g_z.csv", tmp_path / "compensated_test_gx.csv"]
+    assert sorted(os.listdir(tmp_path)) == ["compensated_test_g_z.csv", "compensated_test_gx.csv"]  # no temporaries
+    assert paths[0].read_text().splitlines() == [
+        "t_s,measured[deg/h],bias[deg/h],ar[deg/h]", "1.5,5,1,0.9", "2,6,2,", "2.5,4.33333333333,0.333333333333,0.0333333333333",
+        "3,9,5,4.6"]
+    back = load(paths[1], columns=["measured", "persistence"])
+    assert back.dt_s == 0.5 and back.n_samples == 4 and back.axis_names == ("measured", "persistence")
+    assert write_compensated_test_block([], tmp_path) == []
