@@ -194,7 +194,9 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.io.chunked": ("optional readers: the binary/HDF5 readers and the registry load only for the format opened", (
         "fogdrift.io.readers.binary", "fogdrift.io.registry")),
     "fogdrift.pipeline": ("model modules load on use, through the registry (test_model_registry: importing the "
-                          "pipeline imports no model module)", ("fogdrift.models.grey",)),
+                          "pipeline imports no model module); GMWM (gmwm.estimator: scipy.optimize's least squares, "
+                          "gmwm.simulate: scipy.signal) only for noise_method='gmwm', so allan, separate and model "
+                          "never load it (test_speed_imports)", ("fogdrift.models.grey", "fogdrift.gmwm.analysis")),
     "fogdrift.io.load": ("optional readers: the reader registry imports a reader module on first use", (
         "fogdrift.io.registry",)),
     "fogdrift.lifting._kernels": (NUMBA, ("fogdrift.lifting._numba",)),

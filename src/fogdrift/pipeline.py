@@ -38,7 +38,6 @@ from .allan import ESTIMATORS, STATISTICS
 from .allan.ci import periodic_alpha
 from .allan.grid import MAX_TAUS
 from .errors import ConfigError, FogdriftWarning, InsufficientDataError
-from .gmwm.analysis import analyse_gmwm
 from .interrupt import checkpoint  # a stop point between stages/axes/models; reports the stage to listeners
 from .io import file_sha256, record as _record
 from .lifting import MODES, causal_drift, choose_level, get_wavelet, level_scan, separate
@@ -673,6 +672,8 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
         gmwm = None
         if cfg.noise_method == "gmwm":
             checkpoint("GMWM noise model (native rate)", axis=name)
+            from .gmwm.analysis import analyse_gmwm  # deferred: allan/separate/model never load GMWM (scipy.optimize)
+
             gmwm = analyse_gmwm(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s)
         checkpoint("separation", axis=name)
         rate, bias, earth = _prepared_axis(rec_m, name, cfg)
