@@ -286,3 +286,92 @@ def test_no_claim_where_the_allan_deviation_cannot_be_computed():
     at = _adev_ratio_fn(base, 2.0 * base, 1.0)
     assert at(1.0) == pytest.approx(2.0, rel=1e-12) and at(3.0) == pytest.approx(2.0, rel=1e-12)
     assert at(0.99) is None and at(1e4) is None
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# compensators whose response depends on the signal's size or on its whole past
+
+
+class Square:
+    """Rate-input, nonlinear: prediction ``k * z[j-1]**2`` (NaN at j = 0)."""
+
+    input_kind = "rate"
+
+    def __init__(self, k):
+        self.k = float(k)
+
+    def filter(self, z, state=None):
+        z = np.asarray(z, dtype=np.float64)
+        p = np.full(z.size, np.nan)
+        p[1:] = self.k * z[:-1] ** 2
+        return p, np.zeros(z.size), state
+
+
+class CumulativeMean:
+    """Rate-input with an infinite memory (a bias re-estimated from all the past): ``c * mean(z[:j])``."""
+
+    input_kind = "rate"
+
+    def __init__(self, c):
+        self.c = float(c)
+
+    def filter(self, z, state=None):
+        z = np.asarray(z, dtype=np.float64)
+        p = np.full(z.size, np.nan)
+        p[1:] = self.c * np.cumsum(z)[:-1] / np.arange(1, z.size)
+        return p, np.zeros(z.size), state
+
+
+@pytest.mark.parametrize("dt", [1.0, 0.5])
+def test_ramp_survival_of_a_nonlinear_compensator_depends_on_the_ramp_as_stated(dt):
+    """p = k z[j-1]^2 on a (nearly) zero record with A = 2 deg/h: the ramp rises by a = A / (n - k0) per sample from k0
+    (0 at k0), so over the fit (active samples i = 1936 .. 3871 from k0, n = 4000, k0 = 128) the output is
+    a i - k a^2 (i - 1)^2, whose least-squares slope is a - 2 k a^2 (mean(i) - 1): survival
+    1 - 2 k a (2903.5 - 1), the same at every dt.  Catches: the ramp's size (slope x or / (n - k0) dt, n + k0),
+    its origin (t + k0 dt, k0 / dt), a ramp divided by t."""
+    n, k0, A, k = 4000, 128, 2.0, 1.0 / 6.0
+    z = 1e-9 * np.random.default_rng(54).normal(0.0, 1.0, n)  # (the noise's cross term 2 k z s is ~1e-9 of it)
+    res = artefact_check(z, dt, {"square": Square(k)}, causal_window=128, amplitude_dph=A,
+                         frequencies_hz=[0.01], step_delays_s=())
+    a = A / (n - k0)
+    i_mean = ((n - k0) // 2 + (n - k0 - 1)) / 2.0
+    assert i_mean == 2903.5
+    assert_allclose(res.row("square").ramp_survival, 1.0 - 2.0 * k * a * (i_mean - 1.0), rtol=1e-6)
+
+
+def test_a_compensator_with_an_infinite_memory_sees_only_the_injected_signals():
+    """p = 0.8 mean(z[:j]) (n = 3000, dt = 1 s, W = 128 so k0 = 128): the injected ramp is 0 before k0 and
+    A (i - k0) / (n - k0) from k0, the step A from k_step = k0 + (n - k0) // 4 = 846; the response is
+    s - 0.8 cummean(s) (written out here from the prediction), its step survival k samples after the step
+    1 - 0.8 A k / ((K + k) A) with K = 846 averaged over +-w, its ramp survival the least-squares slope of the
+    response over the second half of the active block / the ramp's slope.
+    Catches: anything added to the ramp before it starts, the step at another place in the block."""
+    n, W, c = 3000, 128, 0.8
+    z = np.random.default_rng(52).normal(0.0, 5.0, n)
+    res = artefact_check(z, 1.0, {"cm": CumulativeMean(c)}, causal_window=W, frequencies_hz=[0.01],
+                         step_delays_s=(10.0, 100.0, 1000.0))
+    A = res.amplitude_dph
+    k0, K = 128, 128 + (n - 128) // 4
+    assert K == 846
+    row = res.row("cm")
+    for delay in (10.0, 100.0, 1000.0):
+        k, w = int(delay), max(1, int(round(0.05 * delay)))
+        want = np.mean([1.0 - c * j / (K + j) for j in range(k - w, k + w + 1)])
+        assert_allclose(row.step_survival[delay], want, rtol=1e-7)
+    i = np.arange(n)
+    s = np.where(i >= k0, A * (i - k0) / (n - k0), 0.0)
+    resp = s.copy()
+    resp[1:] -= c * np.cumsum(s)[:-1] / np.arange(1, n)
+    half = slice(k0 + (n - k0) // 2, n)
+    want = np.polyfit(i[half].astype(float), resp[half], 1)[0] / (A / (n - k0))
+    assert 0.1 < want < 0.9
+    assert_allclose(row.ramp_survival, want, rtol=1e-7)
+
+
+def test_ramp_read_over_the_second_half_of_the_active_block():
+    """p = 0.5 x (1000-sample moving mean), n = 3000 = 3 k0: the second half of the active block starts exactly
+    where the ramp's transient ends (sample 2000), survival 0.5; a fit from (n + k0) // 2 would have no samples."""
+    z = np.random.default_rng(53).normal(0.0, 5.0, 3000)
+    res = artefact_check(z, 1.0, {"ma": MovingFraction(0.5, 1000)}, causal_window=128, frequencies_hz=[0.01],
+                         step_delays_s=())
+    assert_allclose(res.row("ma").ramp_survival, 0.5, rtol=1e-9)
