@@ -759,3 +759,20 @@ def test_write_compensated_test_block_by_hand(tmp_path):
     back = load(paths[1], columns=["measured", "persistence"])
     assert back.dt_s == 0.5 and back.n_samples == 4 and back.axis_names == ("measured", "persistence")
     assert write_compensated_test_block([], tmp_path) == []
+
+
+def test_a_failure_while_writing_the_test_block_leaves_no_file(tmp_path, monkeypatch):
+    from fogdrift.compensate.holdout import write_compensated_test_block
+
+    calls = []
+
+    def fails_in_the_second_row(v):
+        calls.append(v)
+        if len(calls) > 10:
+            raise KeyboardInterrupt
+        return math.isfinite(v)
+
+    monkeypatch.setattr(np, "isfinite", fails_in_the_second_row)
+    with pytest.raises(KeyboardInterrupt):
+        write_compensated_test_block([_model_axis()], tmp_path)
+    assert os.listdir(tmp_path) == []
