@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -257,8 +258,8 @@ def test_gravity_rule_is_1_g_within_10_percent():
     assert pl.accel_findings(_accel((0.0, 0.0, -0.91 * g), "m/s^2")) == []
     over = pl.accel_findings(_accel((0.0, 0.6 * 1.11, 0.8 * 1.11), "g"))
     assert [f.rule for f in over] == ["gravity"] and over[0].axes == ("ax", "ay", "az")
-    assert "mean vector of these 3 accelerometer axes is 1.11 g (10.89 m/s^2); a static triad reads 1 g" \
-        in over[0].message
+    assert over[0].message.startswith("with the specific force read as g the mean vector of these 3 accelerometer "
+                                      "axes is 1.11 g (10.89 m/s^2); a static triad reads 1 g")
     assert over[0].likely_units == () and "check {opt:unit} (or the triad was not static)" in over[0].message
     assert [f.rule for f in pl.accel_findings(_accel((0.0, 0.0, 0.89), "g"))] == ["gravity"]
     # 1000 mg read as g: 1000 g; the numbers fit mg
@@ -382,3 +383,56 @@ def test_statistic_limit_binds_named_grids_and_refuses_explicit_taus(statistic, 
     assert tau_grid(n, 1.0, [float(top)], statistic=statistic).tolist() == [top]
     with pytest.raises(ConfigError, match=rf"1 <= m <= {top} for {n} samples"):
         tau_grid(n, 1.0, [float(top + 1)], statistic=statistic)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# plausibility: messages and mixed records
+
+
+def test_floor_figures_between_1e_4_and_1e_3_are_written_in_scientific_notation():
+    """N = 0.1 x 0.1 / 60 = 1.7e-4 deg/sqrt(h): written 1.6xe-04 (three digits, plain only from 1e-3 to 1e4)."""
+    msg = check_record(_triad((0.6, 0.8, 0.0), sd=0.1))[0].message
+    assert re.search(r"\(white-noise floor N <= 1\.\d\de-04 deg/√h\)", msg), msg
+
+
+def test_too_short_a_record_has_no_floor_and_says_n_a():
+    """Fewer than 8 samples: no noise floor (NaN, class unknown); a range finding still names the unit that fits."""
+    found = check_record(from_array(np.full(5, 2e4), dt_s=0.01, unit="deg/s"))
+    assert [f.rule for f in found] == ["range"] and found[0].likely_units[0] == "deg/h"
+    assert "the numbers fit deg/h (N <= n/a deg/√h, class unknown or better)" in found[0].message
+
+
+def test_range_finding_names_only_the_axes_above_the_range():
+    """An axis exactly at 1e4 deg/s is within the range; the one at 2e4 deg/s is not."""
+    x = np.column_stack([np.full(1000, 2e4) + np.random.default_rng(0).normal(0.0, 1.0, 1000), np.full(1000, 1e4)])
+    found = [f for f in check_record(from_array(x, dt_s=0.01, unit="deg/s", axis_names=("a", "b")))
+             if f.rule == "range"]
+    assert found[0].axes == ("a",) and "max |rate| a 2e+04 deg/s with" in found[0].message
+
+
+def test_check_record_hands_back_the_sums_of_each_axis():
+    from fogdrift.pipeline_sums import AllanSums
+
+    sums = {}
+    rec = _triad((0.0, 0.0, 15.0), sd=1.0, n=2000)
+    check_record(rec, sums=sums)
+    assert set(sums) == set(AXES) and all(isinstance(s, AllanSums) for s in sums.values())
+
+
+def test_mixed_record_applies_the_gyro_rules_to_the_gyros_and_gravity_to_the_accelerometers(tmp_path):
+    """Gyros in deg/s noisier than any gyro (N = 1e3 x 3600 x 0.1 / 60 deg/sqrt(h)) and accelerometers at 1000 g
+    (mg read as g): one white-noise finding on the three gyro axes, one gravity finding naming mg, and the sample
+    rate checked once."""
+    from fogdrift.io import load
+
+    rng = np.random.default_rng(8)
+    n = 2000
+    t = np.arange(n) * 0.01
+    g = rng.normal(0.0, 1e3, (n, 3))
+    a = np.column_stack([np.zeros(n), np.zeros(n), np.full(n, 1000.0)]) + rng.normal(0.0, 0.1, (n, 3))
+    p = tmp_path / "mixed.csv"
+    head = "t_s,gx[deg/s],gy[deg/s],gz[deg/s],ax[g],ay[g],az[g]"
+    np.savetxt(p, np.column_stack([t, g, a]), delimiter=",", header=head, comments="", fmt="%.9g")
+    found = check_record(load(p))
+    assert [f.rule for f in found] == ["white-noise", "gravity"]
+    assert found[0].axes == AXES and found[1].axes == ("ax", "ay", "az") and found[1].likely_units == ("mg",)
