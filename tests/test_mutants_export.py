@@ -11,8 +11,9 @@ the parser its project uses (PyYAML, OpenCV FileStorage), and the state-space mo
 
 from __future__ import annotations
 
-import json
+import json  # noqa: F401
 import math
+import re
 
 import pytest
 
@@ -218,3 +219,236 @@ def test_gmwm_units_that_say_two_quantities_are_refused():
     ax["selection"]["ieee"]["terms"]["K_dphrh"] = _t(1e-4, 5e-5, 2e-4, "m/s^2/sqrt(s)", "RW")
     with pytest.raises(DataFormatError, match=r"n\.json: axis gx: the terms' units do not say one quantity"):
         _one(ax, path="n.json")
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# writers: what each file says beside its numbers (units, discretisation, provenance), read back
+# ------------------------------------------------------------------------------------------------------------------
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).parent))
+from test_export import _accel_result, _gyro_result  # noqa: E402  (the hand-made result files of test_export)
+
+from fogdrift.export import build_context, render  # noqa: E402
+
+
+@pytest.fixture
+def both(tmp_path):
+    return build_context([_gyro_result(tmp_path)], [_accel_result(tmp_path)])
+
+
+#: The first line of each file: the target and the reader it was written for (its project's documentation).
+_HEADERS = {
+    "kalibr": "# fogdrift export --target kalibr: noise model for Kalibr imu.yaml (continuous-time densities; "
+              "Kalibr discretises at update_rate)",
+    "openvins": "# fogdrift export --target openvins: noise model for OpenVINS kalibr_imu_chain.yaml "
+                "(read with cv::FileStorage)",
+    "vins-fusion": "# fogdrift export --target vins-fusion: noise model for VINS-Fusion config (IMU noise block; "
+                   "cv::FileStorage)",
+    "orbslam3": "# fogdrift export --target orbslam3: noise model for ORB-SLAM3 settings (IMU block; cv::FileStorage)",
+    "kf-gins": "# fogdrift export --target kf-gins: noise model for KF-GINS imunoise block (merge into kf-gins.yaml)",
+    "matlab": "% fogdrift export --target matlab: noise model for MATLAB imuSensor (gyroparams / accelparams, "
+              "Navigation / Sensor Fusion Toolbox)",
+    "gnss-ins-sim": "# fogdrift export --target gnss-ins-sim: noise model for gnss-ins-sim imu_err dictionary "
+                    "(README 'Step 1.1'; imu_model.IMU)",
+}
+
+#: Lines each file must carry: where its conventions come from (cited documentation) and what is not written.
+_CITED = {
+    "openvins": ["# T_i_b is the identity: fogdrift does not calibrate extrinsics"],
+    "vins-fusion": [
+        "# merge these keys into your VINS-Fusion config.  Its comments call them 'measurement noise standard",
+        "# deviation' and 'bias random work noise standard deviation' without saying continuous or discrete time "
+        "(questions open",
+        "# in VINS-Mono issues #102, #327); written here: the continuous-time densities, the Kalibr values; the",
+        "# per-sample (discrete) values at the update rate are in the comments.  VINS's own EuRoC config uses values",
+        "# 10-100x the EuRoC Kalibr densities (inflated by hand)."],
+    "orbslam3": ["# ORB-SLAM3 reads continuous densities and discretises itself: noise x sqrt(IMU.Frequency), "
+                 "walk / sqrt(IMU.Frequency) (Tracking: IMU::Calib(Tbc, Ng*sf, Na*sf, Ngw/sf, Naw/sf), "
+                 "sf = sqrt(freq))"],
+    "kf-gins": ["# KF-GINS models each bias as one first-order Gauss-Markov process: gbstd/abstd its 1-sigma,",
+                "# corrtime its correlation time (one value for all biases); a random walk K has no place in it",
+                "  # gsstd, asstd (scale-factor instability [ppm]): not written: a static record does not observe "
+                "scale factors; take them from the datasheet"],
+    "matlab": ["% Units per the gyroparams / accelparams reference pages: NoiseDensity (rad/s)/sqrt(Hz) and "
+               "(m/s^2)/sqrt(Hz), RandomWalk (rad/s)*sqrt(Hz) and (m/s^2)*sqrt(Hz), BiasInstability rad/s and m/s^2",
+               "% (MathWorks Answers 1631045: RandomWalk is the rate random walk K, NoiseDensity the white density N)",
+               "% BiasInstability is B (the flicker floor); BiasInstabilityCoefficients is left at its default"],
+    "gnss-ins-sim": ["# b_stability is the 1-sigma of a first-order Gauss-Markov bias with correlation time b_corr "
+                     "(gnss-ins-sim's bias_drift)",
+                     "    # constant bias: not a noise term (removed by calibration); 0 = a calibrated sensor"],
+}
+
+
+@pytest.mark.parametrize("target", list(_HEADERS))
+def test_each_file_names_its_target_reader_and_conventions(both, target):
+    lines = render(target, both).splitlines()
+    pre = "% " if target == "matlab" else "# "
+    body = lines[2:] if lines[0] == "%YAML:1.0" else lines
+    if lines[0] == "%YAML:1.0":
+        assert lines[1] == ""                                   # OpenCV wants the directive alone on line 1
+    assert body[0] == _HEADERS[target]
+    assert body[2] == f"{pre}update rate 100.0 Hz; --missing bound"
+    assert f"{pre}gyro gx: allan model N+B+K (chi2_red 1.1, good)" in body
+    assert f"{pre}accel az: allan model N+B+K (chi2_red 1.1, good)" in body
+    assert (f"{pre}continuous -> discrete: white sigma_d = N sqrt(f), random-walk step sigma_bd = K / sqrt(f) "
+            "(Kalibr wiki 'IMU Noise Model')") in body
+    for line in _CITED.get(target, []):
+        assert line in lines, line
+    assert lines[-1] != "" and render(target, both).endswith("\n") and not render(target, both).endswith("\n\n")
+
+
+_DISC = {"N": "(x sqrt(f))", "K": "(/ sqrt(f))", "B": "a standard deviation: the same in continuous and discrete time"}
+
+
+@pytest.mark.parametrize("target", ["kalibr", "openvins", "vins-fusion", "orbslam3", "kf-gins", "matlab",
+                                    "gnss-ins-sim"])
+def test_every_term_comment_says_how_it_is_discretised(both, target):
+    # a term's description line is followed by its continuous value and the rule that makes it discrete
+    lines = render(target, both).splitlines()
+    seen = set()
+    for i, line in enumerate(lines):
+        m = re.match(r"^\s*[#%] ([ga][xyz]): ([NKB]) = ", line)
+        if m:
+            nxt = lines[i + 1]
+            assert nxt.lstrip("#% ").startswith("continuous "), nxt
+            assert nxt.endswith(_DISC[m.group(2)]), nxt
+            if m.group(2) != "B":
+                assert " per sample at 100.0 Hz " in nxt or " per-sample bias step at 100.0 Hz " in nxt
+            seen.add(m.group(2))
+    assert seen == ({"N", "K", "B"} if target == "matlab" else {"N"} if target in ("kf-gins", "gnss-ins-sim")
+                    else {"N", "K"})
+
+
+#: Per target: each "written ..." comment line (the output unit of the value under it).
+_WRITTEN = {
+    "kf-gins": ["  # written per axis (gx, gy, gz) in deg/sqrt(h)", "  # written per axis (ax, ay, az) in m/s/sqrt(h)",
+                "  # written per axis: sigma in deg/h, T_c in h", "  # written per axis: sigma in mGal, T_c in h"],
+    "matlab": ["% written per axis (gx, gy, gz) in (rad/s)/sqrt(Hz)", "% written per axis (gx, gy, gz) in (rad/s)*sqrt(Hz)",
+               "% written per axis (gx, gy, gz) in rad/s", "% written per axis (ax, ay, az) in (m/s^2)/sqrt(Hz)",
+               "% written per axis (ax, ay, az) in (m/s^2)*sqrt(Hz)", "% written per axis (ax, ay, az) in m/s^2"],
+    "gnss-ins-sim": ["    # written per axis (gx, gy, gz) in deg/sqrt(h)", "    # written per axis: sigma in deg/h, T_c in s",
+                     "    # written per axis (ax, ay, az) in m/s/sqrt(h)", "    # written per axis: sigma in m/s^2, T_c in s"],
+}
+
+#: Per target: the unit in the bracket after each key (targets.py's units, from each project's documentation).
+_KEY_UNITS = {
+    "kf-gins": {"arw": "deg/sqrt(h)", "vrw": "m/s/sqrt(h)", "gbstd": "deg/h", "abstd": "mGal", "corrtime": "h"},
+    "gnss-ins-sim": {"'gyro_b'": "deg/h", "'gyro_arw'": "deg/sqrt(h)", "'gyro_b_stability'": "deg/h",
+                     "'gyro_b_corr'": "s", "'accel_b'": "m/s^2", "'accel_vrw'": "m/s/sqrt(h)",
+                     "'accel_b_stability'": "m/s^2", "'accel_b_corr'": "s"},
+}
+
+
+@pytest.mark.parametrize("target", list(_WRITTEN))
+def test_per_axis_values_say_their_units(both, target):
+    lines = render(target, both).splitlines()
+    assert [ln for ln in lines if re.match(r"^\s*[#%] written per axis", ln)] == _WRITTEN[target]
+    if target in _KEY_UNITS:
+        got = {m.group(1): m.group(2) for m in (re.match(r"^\s*('?\w+'?): .*# \[(.+)\]$", ln) for ln in lines) if m}
+        assert got == _KEY_UNITS[target]
+
+
+def test_gauss_markov_comment_by_hand(both):
+    # gx: B = 2 deg/h read at tau_B = 100 s: sigma = 1.0760 * 2 deg/h, T_c = 100 / 1.8926 s; at 100 Hz
+    # phi = exp(-0.01 / T_c), driving sigma = sigma sqrt(1 - phi^2)
+    text = render("kf-gins", both)
+    tc = 100.0 / 1.8926
+    sigma = 1.0760 * 2.0 * DPH
+    phi = math.exp(-0.01 / tc)
+    m = re.search(r"# gx: bias Gauss-Markov: one GM matched to B \(estimate\): .*\n\s*# +sigma = (\S+) rad/s "
+                  r"\(95 % \[(\S+), (\S+)\] deg/h\), T_c = (\S+) s; discrete at 100.0 Hz: phi = exp\(-dt/T_c\) = "
+                  r"(\S+), driving sigma = sigma sqrt\(1 - phi\^2\) = (\S+) rad/s", text)
+    assert m, text
+    s, lo, hi, t, p, q = (float(v) for v in m.groups())
+    assert s == pytest.approx(sigma, rel=1e-4) and t == pytest.approx(tc, rel=1e-4)
+    assert lo == pytest.approx(1.0760 * 1.5, rel=1e-3) and hi == pytest.approx(1.0760 * 2.5, rel=1e-3)  # deg/h
+    assert p == pytest.approx(math.exp(-0.01 / t), abs=2e-9)            # the identity, on the printed T_c
+    assert q == pytest.approx(sigma * math.sqrt(1 - phi * phi), rel=1e-3)
+    assert ("# corrtime: the longest gyroscope correlation time; per axis: gyro 0.0146769, 0.0146769, 0.0146769 h, "
+            "accel 0.0146769, 0.0146769, 0.0146769 h") in text        # 52.8369 s = 0.0146769 h
+
+
+def test_openvins_extrinsics_identity_and_keys_read_by_opencv(both, tmp_path):
+    cv2 = pytest.importorskip("cv2")
+    p = tmp_path / "ov.yaml"
+    p.write_text(render("openvins", both))
+    fs = cv2.FileStorage(str(p), cv2.FILE_STORAGE_READ)
+    imu0 = fs.getNode("imu0")
+    t = imu0.getNode("T_i_b")
+    rows = [[t.at(i).at(j).real() for j in range(t.at(i).size())] for i in range(t.size())]
+    assert rows == [[1.0 if i == j else 0.0 for j in range(4)] for i in range(4)]
+    assert imu0.getNode("time_offset").isReal() and imu0.getNode("time_offset").real() == 0.0
+    assert imu0.getNode("model").string() == "kalibr" and imu0.getNode("rostopic").string() == "/imu0"
+    fs.release()
+
+
+def test_matlab_file_is_comments_and_four_statements(both):
+    code = [ln for ln in render("matlab", both).splitlines() if not ln.startswith("% ")]
+    assert [ln.split("(")[0] for ln in code if not ln.startswith("    '")] == \
+        ["gyro = gyroparams", "accel = accelparams", "imu = imuSensor"]
+    assert len(code) == 9 and all(ln.endswith(("( ...", ", ...", ");", "% (rad/s)/sqrt(Hz)", "% (rad/s)*sqrt(Hz)", "% rad/s",
+                                               "% (m/s^2)/sqrt(Hz)", "% (m/s^2)*sqrt(Hz)", "% m/s^2")) for ln in code)
+
+
+def _gyro_only(tmp_path):
+    return build_context([_gyro_result(tmp_path)])
+
+
+def _accel_only(tmp_path):
+    return build_context(accel=[_accel_result(tmp_path)])
+
+
+_NOT_WRITTEN = ("not written: no {w} result was given (fogdrift export --{q} RESULT.json); fogdrift never writes a "
+                "noise figure it did not measure")
+
+
+def test_gnss_ins_sim_with_one_quantity(tmp_path):
+    for ctx, have, miss, w in ((_gyro_only(tmp_path), "gyro", "accel", "accelerometer"),
+                               (_accel_only(tmp_path), "accel", "gyro", "gyroscope")):
+        text = render("gnss-ins-sim", ctx)
+        assert text.splitlines()[0] == _HEADERS["gnss-ins-sim"]
+        keys = [f"{miss}_b", f"{miss}_{'arw' if miss == 'gyro' else 'vrw'}", f"{miss}_b_stability", f"{miss}_b_corr"]
+        assert f"    # {', '.join(keys)}: " + _NOT_WRITTEN.format(w=w, q=miss) in text.splitlines()
+        ns = {}
+        exec(text, ns)  # noqa: S102 - our own generated file
+        err = ns["imu_err"]
+        assert sorted(err) == sorted([f"{have}_b", f"{have}_{'arw' if have == 'gyro' else 'vrw'}",
+                                      f"{have}_b_stability", f"{have}_b_corr"])
+        assert list(err[f"{have}_b_corr"]) == pytest.approx([100 / 1.8926] * 3, rel=1e-4)
+
+
+def test_kfgins_and_matlab_with_one_quantity(tmp_path):
+    g = _gyro_only(tmp_path)
+    kf = render("kf-gins", g).splitlines()
+    assert kf[0] == _HEADERS["kf-gins"]
+    assert "  # vrw: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in kf
+    assert "  # abstd: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in kf
+    m = render("matlab", g).splitlines()
+    assert m[0] == _HEADERS["matlab"]
+    assert "% accelparams: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in m
+    assert m[-1] == "imu = imuSensor('accel-gyro', 'SampleRate', 100.0, 'Gyroscope', gyro);"
+    a = _accel_only(tmp_path)
+    m = render("matlab", a).splitlines()
+    assert "% gyroparams: " + _NOT_WRITTEN.format(w="gyroscope", q="gyro") in m
+    assert m[-1] == "imu = imuSensor('accel-gyro', 'SampleRate', 100.0, 'Accelerometer', accel);"
+    kf = render("kf-gins", a).splitlines()
+    assert "  # arw: " + _NOT_WRITTEN.format(w="gyroscope", q="gyro") in kf
+    assert "  # corrtime: the longest accelerometer correlation time; per axis: accel 0.0146769, 0.0146769, " \
+           "0.0146769 h" in kf
+    assert any("no gyroscope result given (--gyro FILE): the gyroscope fields of every target are left out "
+               "(each file says which)" == n for n in a.notes)
+    assert "kf-gins: gsstd, asstd not written (scale factors are not observable in a static record)" in a.notes
+
+
+@pytest.mark.parametrize("target, keys", [
+    ("kalibr", "accelerometer_noise_density, accelerometer_random_walk"),
+    ("openvins", "accelerometer_noise_density, accelerometer_random_walk"),
+    ("vins-fusion", "acc_n, acc_w"), ("orbslam3", "IMU.NoiseAcc, IMU.AccWalk")])
+def test_kalibr_family_with_the_gyro_only(tmp_path, target, keys):
+    text = render(target, _gyro_only(tmp_path))
+    ind = "  " if target == "openvins" else ""
+    assert text.splitlines().count(f"{ind}# {keys}: " + _NOT_WRITTEN.format(w="accelerometer", q="accel")) == 1
+    body = [ln for ln in text.splitlines() if not ln.lstrip().startswith("#") and ":" in ln]
+    assert not any(k in ln for ln in body for k in keys.split(", "))
