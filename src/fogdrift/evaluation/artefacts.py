@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..allan import allan_variance
-from ..errors import ConfigError
+from ..errors import ConfigError, InsufficientDataError
 from ..models.causal_predictor import CausalPredictor, causal_weights
 
 __all__ = ["ArtefactRow", "ArtefactResult", "artefact_check", "default_frequencies", "ALLAN_PEAK"]
@@ -167,6 +167,13 @@ def artefact_check(rate_dph, dt_s, models, *, causal_window: int, wavelet="db2",
     ArtefactResult
         Rows for every model plus ``"constant bias"`` (gain 1 by construction).
 
+    Raises
+    ------
+    ConfigError
+        ``rate_dph`` is not a finite 1-D block of at least 4 causal windows.
+    InsufficientDataError
+        A compensator predicts nothing before the last 4 samples of the block.
+
     Examples
     --------
     Persistence of the causal drift is a high-pass: a slow sinusoid barely survives, a fast one does.
@@ -192,6 +199,11 @@ def artefact_check(rate_dph, dt_s, models, *, causal_window: int, wavelet="db2",
     notes = [f"amplitude {A:.6g} deg/h for every injected signal"]
     bases = {label: _one_step(z, model, g) for label, model in models.items()}
     k0 = max([int(np.argmax(ok)) if ok.any() else n for _, ok in bases.values()] + [int(causal_window)])
+    if n - k0 < 4:  # (was a ZeroDivisionError / numpy TypeError further down)
+        late = [label for label, (_, ok) in bases.items() if not ok[:n - 3].any()]
+        raise InsufficientDataError(f"the artefact check needs compensated samples to read: no prediction from "
+                                    f"{', '.join(late)} before sample {k0} of the {n}-sample block", needed=4,
+                                    got=n - k0)
     active = slice(k0, n)
     freqs = list(frequencies_hz) if frequencies_hz is not None else default_frequencies(dt, (n - k0) * dt)
     dropped = [f for f in freqs if f * (n - k0) * dt < 2.0 or f > 0.5 / dt * (1 + 1e-12)]
