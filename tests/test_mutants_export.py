@@ -16,6 +16,7 @@ import math
 import re
 
 import pytest
+import yaml
 
 from fogdrift.errors import ConfigError, DataFormatError
 from fogdrift.export.model import _rw_bound_from_wv, channels_from_result
@@ -452,3 +453,101 @@ def test_kalibr_family_with_the_gyro_only(tmp_path, target, keys):
     assert text.splitlines().count(f"{ind}# {keys}: " + _NOT_WRITTEN.format(w="accelerometer", q="accel")) == 1
     body = [ln for ln in text.splitlines() if not ln.lstrip().startswith("#") and ":" in ln]
     assert not any(k in ln for ln in body for k in keys.split(", "))
+
+
+def test_every_axis_of_a_per_axis_value_is_described(both):
+    for target, n in (("kf-gins", 1), ("matlab", 1), ("gnss-ins-sim", 1)):
+        lines = render(target, both).splitlines()
+        for ax in ("gx", "gy", "gz", "ax", "ay", "az"):
+            assert sum(1 for ln in lines if re.match(rf"^\s*[#%] {ax}: N = ", ln)) == n, (target, ax)
+            assert sum(1 for ln in lines if re.match(rf"^\s*[#%] {ax}: bias Gauss-Markov: ", ln)) == \
+                (0 if target == "matlab" else 1), (target, ax)
+
+
+def _gmwm_file(tmp_path):
+    ax1 = _full_gmwm_axis()
+    ax2 = _full_gmwm_axis()
+    ax2["name"] = "gy"
+    ax2["selection"]["ieee"]["gm"] = [_gm(40.0, 2.0, ci=False)]
+    ax3 = _full_gmwm_axis()
+    ax3["name"] = "gz"
+    g3 = _gm(60.0, 1.0)
+    g3["tc_s"]["hi95"] = None                                  # T_c bounded on one side only: no T_c interval
+    ax3["selection"]["ieee"]["gm"] = [g3]
+    p = tmp_path / "noise.json"
+    p.write_text(json.dumps({"record": {"fs_hz": 100.0}, "axes": [ax1, ax2, ax3]}))
+    return p
+
+
+def test_gm_comment_gives_the_intervals_it_has(tmp_path):
+    text = render("kf-gins", build_context([_gmwm_file(tmp_path)])).splitlines()
+    sig = [ln.strip() for ln in text if ln.strip().startswith("#   sigma = ")]
+    # gx: sigma 4 deg/h [2, 8], T_c 100 s [50, 200]; gy: no intervals; gz: sigma [0.5, 2], T_c without an upper end
+    assert sig[0].startswith(f"#   sigma = {4.0 * DPH:.6g} rad/s (95 % [2.0, 8.0] deg/h), T_c = 100.0 s [50.0, 200.0] s; "
+                             "discrete at 100.0 Hz: phi = exp(-dt/T_c) = ")
+    assert sig[1].startswith(f"#   sigma = {2.0 * DPH:.6g} rad/s, T_c = 40.0 s; discrete at 100.0 Hz: ")
+    assert sig[2].startswith(f"#   sigma = {1.0 * DPH:.6g} rad/s (95 % [0.5, 2.0] deg/h), T_c = 60.0 s; ")
+    d = yaml.safe_load("\n".join(text))["imunoise"]
+    assert d["gbstd"] == pytest.approx([4.0, 2.0, 1.0], rel=1e-5)
+    assert d["corrtime"] == pytest.approx(100.0 / 3600.0, rel=1e-5)
+
+
+_TERM_KEYS = {"name", "value", "lo95", "hi95", "unit", "status", "reason", "si", "si_lo95", "si_hi95", "si_unit",
+              "conversion", "source"}
+
+
+def test_json_target_fields_by_hand(tmp_path):
+    ctx = build_context([_gyro_result(tmp_path)], [_accel_result(tmp_path)], rate_hz=400.0)
+    d = json.loads(render("json", ctx))
+    assert d["fogdrift_export"] == "json" and d["update_rate_hz"] == 400.0 and d["missing"] == "bound"
+    assert d["conventions"]["si_rate_units"] == {"gyro": "rad/s", "accel": "m/s^2"}
+    assert [c["name"] for c in d["channels"]] == ["gx", "gy", "gz", "ax", "ay", "az"]
+    gx = d["channels"][0]
+    assert set(gx) == {"name", "quantity", "method", "fit", "no_fit", "source_file", "sha256", "rate_hz",
+                       "tau_range_s", "b_tau_s", "terms", "gauss_markov", "export_values", "bias_gauss_markov",
+                       "state_space"}
+    assert (gx["quantity"], gx["method"], gx["no_fit"], gx["rate_hz"]) == ("gyro", "allan", False, 100.0)
+    assert gx["tau_range_s"] == [0.1, 1000.0] and gx["b_tau_s"] == 100.0 and gx["sha256"] == "ab" * 32
+    assert gx["fit"] == "model N+B+K (chi2_red 1.1, good)" and gx["gauss_markov"] == []
+    assert set(gx["terms"]) == {"Q", "N", "B", "K", "R"} and set(gx["terms"]["N"]) == _TERM_KEYS
+    ev = gx["export_values"]
+    assert list(ev) == ["N", "K", "B", "Q", "R"]
+    n_si = 0.15 * D / 60.0
+    assert ev["N"] == {"si": pytest.approx(n_si, rel=1e-12), "si_unit": "rad/s/sqrt(Hz)", "how": "estimate",
+                       "note": "", "conversion": gx["terms"]["N"]["conversion"],
+                       "discrete_sigma": pytest.approx(n_si * 20.0, rel=1e-12),                 # x sqrt(400)
+                       "discrete_note": "per-sample 1-sigma = N sqrt(f)"}
+    k_si = 0.5 * RRW
+    assert ev["K"]["discrete_sigma"] == pytest.approx(k_si / 20.0, rel=1e-12)               # / sqrt(400)
+    assert ev["K"]["discrete_note"] == "per-sample bias step 1-sigma = K / sqrt(f)"
+    assert ev["K"]["si_unit"] == "rad/s^2/sqrt(Hz)"
+    assert set(ev["B"]) == {"si", "si_unit", "how", "note", "conversion"}                   # a level: no discrete
+    assert ev["Q"]["how"] == "bound" and ev["Q"]["si"] == pytest.approx(0.3e-6, rel=1e-12)  # 0.3 urad -> rad
+    assert "95 % upper bound" in ev["Q"]["note"]
+    gm = gx["bias_gauss_markov"]
+    tc = 100.0 / 1.8926
+    assert gm["tc_s"] == pytest.approx(tc, rel=1e-4) and gm["sigma_si"] == pytest.approx(1.0760 * 2.0 * DPH, rel=1e-4)
+    assert gm["phi"] == pytest.approx(math.exp(-0.0025 / gm["tc_s"]), rel=1e-12)             # dt = 1/400 s
+    assert gm["driving_sigma_si"] == pytest.approx(gm["sigma_si"] * math.sqrt(1 - gm["phi"] ** 2), rel=1e-9)
+    assert gm["how"].startswith("one GM matched to B (estimate)")
+    assert "caveat" not in gx["state_space"]
+    ax = d["channels"][3]
+    assert ax["quantity"] == "accel" and ax["export_values"]["N"]["si_unit"] == "m/s^2/sqrt(Hz)"
+    assert ax["state_space"]["rate_unit"] == "m/s^2"
+
+
+def test_json_target_reports_refused_terms_and_no_fit(tmp_path):
+    d = json.loads(render("json", build_context([_gyro_result(tmp_path)], missing="refuse")))
+    gz = d["channels"][2]
+    k = gz["export_values"]["K"]
+    assert set(k) == {"si", "how", "note"} and k["si"] is None and k["how"] == "refused"
+    assert k["note"].startswith("gyro gz: K is not resolved by the record: not in the model")
+    assert gz["export_values"]["N"]["how"] == "estimate"          # the others are kept
+    p = _gyro_result(tmp_path, name="nofit.json", no_fit={"best_candidate": "N+B+K"})
+    d = json.loads(render("json", build_context([p], missing="refuse")))
+    gx = d["channels"][0]
+    assert gx["no_fit"] is True and gx["fit"].startswith("no model fits; best candidate N+B+K")
+    assert gx["bias_gauss_markov"]["how"] == "refused" and "no model fits the record" in \
+        gx["bias_gauss_markov"]["note"]
+    assert gx["state_space"]["caveat"] == ("no model fits this record: the state-space model uses the best "
+                                           "candidate's values, which are not a result")
