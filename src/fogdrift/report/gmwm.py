@@ -17,7 +17,7 @@ import numpy as np
 from .._util import fmt_number
 from ..gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
 from ..output import atomic_path
-from .figures import _save, literal
+from .figures import _place, _save, literal
 from .files import write_json
 
 __all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
@@ -59,7 +59,8 @@ def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
                              f"J = {fit.q:.3g}, df {fit.df}, p = {fit.j_pvalue:.2g}"), fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    return _save(fig, path, dpi=110, bbox_inches="tight")
+    _place(fig)  # margins measured once (bbox_inches="tight" drew the figure twice)
+    return _save(fig, path, dpi=110)
 
 
 def write_gmwm_outputs(axes: list[GmwmAxis], out_dir, *, source: str, record: dict | None = None) -> dict:
