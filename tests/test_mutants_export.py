@@ -551,3 +551,104 @@ def test_json_target_reports_refused_terms_and_no_fit(tmp_path):
         gx["bias_gauss_markov"]["note"]
     assert gx["state_space"]["caveat"] == ("no model fits this record: the state-space model uses the best "
                                            "candidate's values, which are not a result")
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# discretize: the state-space model of a channel, by hand
+# ------------------------------------------------------------------------------------------------------------------
+import numpy as np  # noqa: E402
+
+from fogdrift.export.discretize import channel_components, discrete_model  # noqa: E402
+from fogdrift.export.model import ChannelModel, GaussMarkov, _term  # noqa: E402
+
+
+def _chan(quantity, terms, *, gms=(), tau=(0.1, 1000.0), rate=100.0, no_fit=False):
+    return ChannelModel(name="x1", quantity=quantity, method="allan",
+                        terms={k: _term(k, *v, "test") for k, v in terms.items()}, gms=list(gms),
+                        tau_range_s=tau, rate_hz=rate, no_fit=no_fit)
+
+
+def test_gyro_state_space_by_hand():
+    # Q 2 urad, N 0.15 deg/sqrt(h), K 0.5 deg/h^1.5, R 0.02 deg/h^2 (a ramp state), B not in the model
+    ch = _chan("gyro", {"Q": (2.0, 1.0, 3.0, "urad", "resolved", ""), "N": (0.15, 0.14, 0.16, "deg/sqrt(h)", "resolved", ""),
+                        "B": (None, 0.0, 0.3, "deg/h", "absent", "not in the model"),
+                        "K": (0.5, 0.3, 0.7, "deg/h^1.5", "resolved", ""), "R": (0.02, 0.01, 0.03, "deg/h^2", "resolved", "")})
+    d = discrete_model(ch, 50.0)
+    n, k, q, r = 0.15 * D / 60.0, 0.5 * RRW, 2e-6, 0.02 * D / 3600.0 ** 2
+    assert d["rate_unit"] == "rad/s" and d["components_rate_unit"] == "deg/h"
+    assert d["components_note"] == "statespace components (fogdrift.models.statespace) in its own units (deg/h)"
+    assert d["terms_left_out"] == [{"term": "B", "reason": "not in the model", "hi95": 0.3, "unit": "deg/h"}]
+    ct = {t["kind"]: t for t in d["continuous_terms"]}
+    assert set(ct) == {"white", "quantization", "random_walk", "ramp"}
+    assert ct["white"]["density"] == pytest.approx(n, rel=1e-9) and ct["white"]["unit"] == "rad/s/sqrt(Hz)"
+    assert ct["quantization"]["q"] == pytest.approx(q, rel=1e-9) and ct["quantization"]["unit"] == "rad"
+    assert ct["random_walk"]["density"] == pytest.approx(k, rel=1e-9)
+    assert ct["random_walk"]["unit"] == "rad/s/s/sqrt(Hz)"
+    assert ct["ramp"]["slope_sigma"] == pytest.approx(r, rel=1e-9) and ct["ramp"]["unit"] == "rad/s/s"
+    c = d["continuous"]
+    assert c["states"] == ["bias", "random_walk", "ramp", "ramp_slope"]
+    assert np.array_equal(c["F"], [[0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1.0], [0, 0, 0, 0]])
+    assert np.allclose(c["Qc"], np.diag([0.0, k * k, 0.0, 0.0]), rtol=1e-9, atol=0)
+    assert c["H"] == [1.0, 1.0, 1.0, 0.0] and c["Qc_unit"] == "(rad/s)^2/s"
+    assert c["white_density"] == pytest.approx(n, rel=1e-9) and c["white_density_unit"] == "rad/s/sqrt(Hz)"
+    assert c["quantization"] == pytest.approx(q, rel=1e-9) and c["quantization_unit"] == "rad"
+    assert c["ramp_slope_sigma"] == pytest.approx(r, rel=1e-9) and c["ramp_slope_unit"] == "rad/s/s"
+    z = d["discrete"]
+    dt = 0.02
+    assert z["rate_hz"] == 50.0 and z["dt_s"] == dt and z["states"] == c["states"] and z["H"] == c["H"]
+    assert np.allclose(z["Phi"], [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, dt], [0, 0, 0, 1]], rtol=0, atol=1e-15)
+    assert z["Qd"][1][1] == pytest.approx(k * k * dt, rel=1e-9)
+    assert z["r"] == pytest.approx(n * n / dt + 2.0 * q * q / dt ** 2, rel=1e-9)
+    assert (z["Qd_unit"], z["r_unit"]) == ("(rad/s)^2", "(rad/s)^2")
+    assert z["method"] == "Van Loan (1978): expm([[-F, Qc], [0, F^T]] dt); r = N^2/dt + 2 Q^2/dt^2"
+    assert 0.0 <= d["check_max_abs"] < 1e-9
+    assert d["check_note"] == ("largest |difference| (Phi absolute, Qd and r relative) from statespace.state_space's "
+                               "closed forms")
+
+
+def test_accelerometer_state_space_with_a_gauss_markov_by_hand():
+    ch = _chan("accel", {"N": (0.06, 0.05, 0.07, "m/s/sqrt(h)", "resolved", "")},
+               gms=[GaussMarkov(sigma_si=2e-4, tc_s=300.0)])
+    d = discrete_model(ch, 10.0)
+    assert d["rate_unit"] == "m/s^2" and d["components_rate_unit"] == "m/s^2"
+    assert d["components_note"] == ("statespace components (fogdrift.models.statespace) in m/s^2 in place of deg/h "
+                                    "(its formulas are linear in the rate unit)")
+    gm = next(t for t in d["continuous_terms"] if t["kind"] == "gauss_markov")
+    assert gm == {"kind": "gauss_markov", "sigma": pytest.approx(2e-4, rel=1e-12), "unit": "m/s^2", "tc_s": 300.0}
+    white = next(t for t in d["continuous_terms"] if t["kind"] == "white")
+    assert white["density"] == pytest.approx(0.001, rel=1e-9) and white["unit"] == "m/s^2/sqrt(Hz)"
+    c, z = d["continuous"], d["discrete"]
+    assert c["states"] == ["bias", "gm_300s"] and c["quantization_unit"] == "m/s" and c["Qc_unit"] == "(m/s^2)^2/s"
+    assert c["F"][1][1] == pytest.approx(-1.0 / 300.0, rel=1e-12)
+    assert c["Qc"][1][1] == pytest.approx(2.0 * 4e-8 / 300.0, rel=1e-12)       # 2 sigma^2 / T
+    assert z["Phi"][1][1] == pytest.approx(math.exp(-0.1 / 300.0), rel=1e-12)  # Van Loan for a 1-state GM
+    assert z["Qd"][1][1] == pytest.approx(4e-8 * (1.0 - math.exp(-0.2 / 300.0)), rel=1e-9)
+    assert z["r"] == pytest.approx(1e-6 / 0.1, rel=1e-9) and z["r_unit"] == "(m/s^2)^2"
+    assert d["check_max_abs"] < 1e-9
+
+
+def test_no_white_noise_no_check_and_the_terms_that_enter():
+    ch = _chan("gyro", {"K": (0.5, 0.3, 0.7, "deg/h^1.5", "resolved", ""),
+                        "N": (0.0, 0.0, 0.1, "deg/sqrt(h)", "unresolved", "")})    # N = 0: not a component
+    comps, left = channel_components(ch)
+    assert [c["kind"] for c in comps] == ["random_walk"]
+    assert left == [{"term": "N", "reason": "not in the selected model", "hi95": 0.1, "unit": "deg/sqrt(h)"}]
+    assert discrete_model(ch, 100.0)["check_max_abs"] is None
+    # no model fits: the best candidate's values enter (flagged by the caller), a term without a value does not
+    ch = _chan("gyro", {"N": (0.15, 0.14, 0.16, "deg/sqrt(h)", "no_fit", "no model fits"),
+                        "K": (None, 0.0, 0.3, "deg/h^1.5", "absent", "")}, no_fit=True)
+    comps, left = channel_components(ch)
+    assert [c["kind"] for c in comps] == ["white"]
+    assert left == [{"term": "K", "reason": "not in the selected model", "hi95": 0.3, "unit": "deg/h^1.5"}]
+    ch.no_fit = False                                      # the same values, but the record has a fit: N is missing
+    assert channel_components(ch)[0] == []
+
+
+@pytest.mark.parametrize("tau", [(math.nan, math.nan), (5.0, 5.0), (0.0, 100.0), (200.0, 50.0), (1.0, math.inf)])
+def test_flicker_range_falls_back_to_one_sample_to_1e4_s(tau):
+    b = {"B": (2.0, 1.5, 2.5, "deg/h", "resolved", "")}
+    want, _ = channel_components(_chan("gyro", b, tau=(0.1, 1e4), rate=10.0))
+    got, _ = channel_components(_chan("gyro", b, tau=tau, rate=10.0))
+    assert got == want and len(got) == 4                  # at most 4 Gauss-Markov terms stand in for B
+    other, _ = channel_components(_chan("gyro", b, tau=(1.0, 100.0), rate=10.0))
+    assert other != want                                   # a valid range is used as it is
