@@ -20,8 +20,9 @@ import typer
 
 from ..errors import ConfigError
 from ..spec import readings_from_gmwm
-from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run, say,
-                   with_load_options)
+from ..plausibility import check_record
+from ._app import (FLAGS, JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run,
+                   say, warn, with_load_options)
 from ._tables import noise_table, print_noise_notes
 # (the --spec helpers live in the light cli._spec; imported here under their old names too)
 from ._spec import SpecOpt, channel_kinds, print_spec_comparison, print_spec_for_allan, read_spec_option  # noqa: F401
@@ -161,11 +162,16 @@ def noise(
                 raise ConfigError("--sensor belongs to --curve")
             record = load.load()
             echo_record(load, record)
-            check_plausible(record)
+            # the plausibility check (as _app.check_plausible) keeps the octave Allan sums of its noise floors: the
+            # Allan fit of the GMWM-vs-Allan lines reuses them instead of computing that pass again
+            sums = {}
+            for finding in check_record(record, sums=sums):
+                warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
             with progress("noise", record.axis_names):
                 axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=model, levels=scales, robust=robust)
                         for name in record.axis_names]
-                attach_allan_checks(record, axes)
+                attach_allan_checks(record, axes, sums=sums)
+            del sums
             from ..gmwm.quantity import express_gmwm
 
             quantities = {c.name: c.quantity for c in record.signal.channels}

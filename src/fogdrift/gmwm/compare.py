@@ -176,14 +176,18 @@ def compare_with_allan(axis, noise_fit) -> dict:
     return {"agree": (all(known) if known else None), "n_agree": n_ok, "b_agree": b_ok, "lines": lines}
 
 
-def attach_allan_checks(record, axes) -> list:
+def attach_allan_checks(record, axes, *, sums=None) -> list:
     """Set ``allan_check`` on each GMWM axis of a record: its comparison with the Allan fit of the same axis (the
     default fit of ``fogdrift allan``, :func:`fogdrift.pipeline.run_allan`).  Used by ``fogdrift noise`` and
-    ``fogdrift batch --command noise`` alike; returns ``axes``."""
+    ``fogdrift batch --command noise`` alike; returns ``axes``.
+
+    ``sums``: axis name -> :class:`~fogdrift.pipeline_sums.AllanSums` the plausibility check already took of that
+    axis (:func:`fogdrift.plausibility.check_record` ``sums=``), handed to :func:`~fogdrift.pipeline.run_allan`, which
+    reuses them instead of computing the octave Allan sums again (the same fit, field by field)."""
 
     try:
         # both readings in the units of the internal unit (the GMWM's are re-stated per quantity afterwards)
-        fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate(), own_units=False)}
+        fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate(), own_units=False, sums=sums)}
     except InsufficientDataError as exc:  # too short for the Allan fit: the GMWM result stands, and says so
         for a in axes:
             a.allan_check = {"agree": None, "n_agree": None, "b_agree": None,
