@@ -263,6 +263,25 @@ class _Problem:
         self.tau = np.asarray(tau, dtype=np.float64)
         self.W = whitener
         self.lo, self.hi = _bounds(model, self.nu_hat, self.tau)
+        self._ev = model.evaluator(self.tau)  # the WV and Jacobian at tau for the optimiser (_fun, _jac)
+
+    # The optimiser's residuals and Jacobian (:meth:`solve`): the same values as :meth:`resid` and :meth:`jac`
+    # (same operations: tested bit for bit), without their per-call overhead (argument conversion, validation of
+    # theta, two np.errstate contexts per call: :meth:`solve` enters one for the whole run).
+    def _fun(self, z):
+        nu = self._ev.wv(np.exp(z))
+        if not np.isfinite(nu).all():
+            return np.full(self.nu_hat.size, 1e10)
+        d = self.nu_hat - nu
+        W = self.W
+        return W.w * d if W.C is None else np.einsum("ij,j->i", W.Cinv, d)
+
+    def _jac(self, z):
+        a = self._ev.jac(np.exp(z))
+        if not np.isfinite(a).all():
+            a = np.nan_to_num(a, nan=0.0, posinf=0.0, neginf=0.0)
+        W = self.W
+        return -(W.w[:, None] * a if W.C is None else np.einsum("ij,jk->ik", W.Cinv, a))
 
     def nu(self, z):
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
@@ -289,12 +308,16 @@ class _Problem:
         return float(r @ r)
 
     def solve(self, z0, max_nfev=2000):
-        z0 = np.clip(np.asarray(z0, dtype=np.float64), self.lo + 1e-6, self.hi - 1e-6)
-        with warnings.catch_warnings():
+        z0 = self.clipped(z0)
+        with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
-            res = optimize.least_squares(self.resid, z0, jac=self.jac, bounds=(self.lo, self.hi), method="trf",
+            res = optimize.least_squares(self._fun, z0, jac=self._jac, bounds=(self.lo, self.hi), method="trf",
                                          xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=max_nfev, x_scale="jac")
         return res.x, float(2.0 * res.cost), bool(res.success)
+
+    def clipped(self, z0) -> np.ndarray:
+        """The start :meth:`solve` really uses: ``z0`` moved 1e-6 inside the bounds."""
+        return np.clip(np.asarray(z0, dtype=np.float64), self.lo + 1e-6, self.hi - 1e-6)
 
 
 def _refs(model: LatentModel, nu_hat, tau):
@@ -388,10 +411,11 @@ def _starts(model: LatentModel, nu_hat, tau, weights) -> list[np.ndarray]:
             cands.append(assemble(vals, gms))
     w = np.sqrt(weights)
     scored = []
-    for th in cands:
-        nu = model.wv(th, tau)
-        r = w * (nu_hat - nu)
-        scored.append((float(r @ r), th))
+    ev = model.evaluator(tau)  # the values of model.wv(th, tau), without its per-call overhead (hundreds of starts)
+    with np.errstate(over="ignore", invalid="ignore"):
+        for th in cands:
+            r = w * (nu_hat - ev.wv(th))
+            scored.append((float(r @ r), th))
     scored.sort(key=lambda s: s[0])
     return [th for _, th in scored]
 
@@ -463,9 +487,13 @@ def _best_solution(prob: _Problem, starts, n_keep, screen_nfev=150):
     """Optimise from each start with a small budget (most good starts converge in < 50
     evaluations; degenerate ones creep towards a bound for thousands), then polish the best
     with the full budget.  Returns the best (q, z, converged) and all (q, z, ok) sorted."""
-    sols = []
+    sols, done = [], {}
     for z0 in starts[:n_keep]:
-        z, q, ok = prob.solve(z0, max_nfev=screen_nfev)
+        # a start equal (once clipped into the bounds) to one already run gives the same run: not run again
+        key = prob.clipped(z0).tobytes()
+        if key not in done:
+            done[key] = prob.solve(z0, max_nfev=screen_nfev)
+        z, q, ok = done[key]
         sols.append((q, z, ok))
     sols.sort(key=lambda s: s[0])
     q, z, ok = sols[0]
