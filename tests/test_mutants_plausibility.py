@@ -370,6 +370,10 @@ def test_max_fraction_and_too_short_records():
     with pytest.raises(InsufficientDataError, match="needs at least 3 rate samples, got 2"):
         tau_grid(2, 1.0, statistic="hdev")
     assert tau_grid(3, 1.0, statistic="hdev", max_fraction=0.5).tolist() == [1]
+    # the modified Allan deviation at m = 1 spans 2 samples (one second difference of the phase)
+    assert tau_grid(2, 1.0, statistic="mdev").tolist() == [1]
+    with pytest.raises(InsufficientDataError, match="needs at least 2 rate samples, got 1"):
+        tau_grid(1, 1.0, statistic="mdev")
     assert tau_grid(2.9, 1.0).tolist() == [1]  # n_samples as int
     with pytest.raises(ConfigError):
         tau_grid(100, 0.0)
