@@ -652,3 +652,183 @@ def test_flicker_range_falls_back_to_one_sample_to_1e4_s(tau):
     assert got == want and len(got) == 4                  # at most 4 Gauss-Markov terms stand in for B
     other, _ = channel_components(_chan("gyro", b, tau=(1.0, 100.0), rate=10.0))
     assert other != want                                   # a valid range is used as it is
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# Allan results (allan.json), the --missing policy and the words of the comments
+# ------------------------------------------------------------------------------------------------------------------
+from test_export import _allan_axis  # noqa: E402
+
+from fogdrift.export.model import bias_gm, describe, load_result, resolve  # noqa: E402
+
+
+def _allan_doc(ax, record=None):
+    return {"record": {"fs_hz": 100.0} if record is None else record, "axes": [ax]}
+
+
+def test_allan_channel_fields_by_hand():
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved"), "B": (2.0, 1.5, 2.5, "resolved"),
+                            "K": (0.5, 0.0, 0.7, "unresolved", "its interval reaches 0")}, b_tau=120.0)
+    (ch,) = channels_from_result(_allan_doc(ax, {"fs_hz": 50.0, "sha256": "ef" * 32}), "a.json")
+    assert (ch.method, ch.quantity, ch.rate_hz, ch.sha256, ch.source_file) == ("allan", "gyro", 50.0, "ef" * 32,
+                                                                                "a.json")
+    assert ch.fit == "model N+B+K (chi2_red 1.1, good)" and ch.no_fit is False
+    assert ch.tau_range_s == (0.1, 1000.0) and ch.b_tau_s == 120.0 and ch.b_is_flicker is True
+    n = ch.terms["N"]
+    assert (n.status, n.reason, n.source) == ("resolved", "", "allan fit: N (selected model N+B+K, fit good)")
+    k = ch.terms["K"]
+    assert (k.status, k.reason, k.lo95) == ("unresolved", "its interval reaches 0", 0.0) and k.has_estimate
+    r = ch.terms["R"]
+    assert (r.status, r.value, r.hi95) == ("absent", None, 0.3) and not r.has_estimate
+    # no fs_hz: the rate is 1 / dt_s
+    (ch,) = channels_from_result(_allan_doc(ax, {}), "a.json")
+    assert ch.rate_hz == pytest.approx(100.0, rel=1e-12) and ch.sha256 == ""
+
+
+def test_allan_no_fit_reason_and_status():
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved", "a reason")}, no_fit={"best_candidate": "N"})
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    n = ch.terms["N"]
+    assert ch.no_fit is True and n.status == "no_fit" and not n.has_estimate
+    assert n.reason == ("no model fits the record (best candidate N+B+K, chi2_red 1.1): the coefficient is no "
+                        "result; a reason")
+    assert ch.fit == "no model fits; best candidate N+B+K (chi2_red 1.1, good)"
+    assert ch.terms["Q"].status == "absent"                 # an absent term stays absent
+    assert ch.terms["Q"].reason.startswith("no model fits the record (best candidate N+B+K, chi2_red 1.1): the "
+                                           "coefficient is no result; not in the model")
+
+
+def test_allan_b_min_reading_when_the_model_has_no_flicker():
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")}, selected=("N",))
+    ax["noise"]["b_min"].update(value=1.2, lo95=1.0, hi95=1.5, tau_s=80.0, rule="min of the fitted ADEV / 0.664")
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    b = ch.terms["B"]
+    assert (b.value, b.lo95, b.hi95, b.unit, b.status, b.reason) == (1.2, 1.0, 1.5, "deg/h", "resolved", "")
+    assert b.source == "allan fit: B_min, min of the fitted ADEV / 0.664"
+    assert ch.b_is_flicker is False and ch.b_tau_s == 80.0
+    g, how = bias_gm(ch, "bound")                            # one GM matched to the B reading at tau_B = 80 s
+    assert g.sigma_si == pytest.approx(1.0760 * 1.2 * DPH, rel=1e-4) and g.tc_s == pytest.approx(80 / 1.8926, rel=1e-4)
+    assert g.sigma_lo95_si == pytest.approx(1.0760 * 1.0 * DPH, rel=1e-4)
+    assert g.sigma_hi95_si == pytest.approx(1.0760 * 1.5 * DPH, rel=1e-4)
+    assert g.source == "from B at tau = 80 s"
+    assert how == ("one GM matched to B (estimate): sigma = 1.0760 B, T_c = tau_B/1.8926 with tau_B = 80 s "
+                   "(its Allan peak equals the flicker floor 0.664 B there)")
+    # the reading is only a bound: B absent with the bound's rule as its reason; the GM has no interval
+    ax["noise"]["b_min"].update(bound_only=True, value=2.0, lo95=None, hi95=3.0, rule="no minimum: a bound")
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    b = ch.terms["B"]
+    assert (b.value, b.hi95, b.status, b.reason) == (None, 3.0, "absent", "no minimum: a bound")
+    g, how = bias_gm(ch, "bound")
+    assert g.sigma_si == pytest.approx(1.0760 * 3.0 * DPH, rel=1e-4)
+    assert g.sigma_lo95_si is None and g.sigma_hi95_si is None
+    assert how.startswith("one GM matched to B (bound: B is its 95 % upper bound 3 deg/h, not an estimate")
+    # no fit: the b_min reading is not used
+    ax["noise"]["no_fit"] = {"best_candidate": "N"}
+    ax["noise"]["b_min"].update(bound_only=False, value=1.2)
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    assert ch.terms["B"].value is None
+
+
+def test_allan_markov_term_becomes_a_gauss_markov():
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")}, selected=("N", "M"))
+    ax["noise"]["terms"]["M"] = {"name": "M", "value": 0.5, "unit": "deg/h/sqrt(s)", "lo95": 0.3, "hi95": 0.7,
+                                 "status": "resolved"}
+    ax["noise"]["shaped"] = {"M": {"tc_s": 30.0, "tc_lo95_s": 20.0, "tc_hi95_s": 45.0, "sigma_dph": 0.6,
+                                   "q_unit": "deg/h/sqrt(s)"}}
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    (g,) = ch.gms
+    assert g.sigma_si == pytest.approx(0.6 * DPH, rel=1e-12) and g.tc_s == 30.0
+    assert (g.tc_lo95_s, g.tc_hi95_s) == (20.0, 45.0)
+    assert g.source == "allan fit: M (exponentially correlated, IEEE-952 C.6)"
+    for cut in ("tc_lo95_s", "tc_hi95_s"):                   # a T_c without its interval is not used
+        ax2 = json.loads(json.dumps(ax))
+        ax2["noise"]["shaped"]["M"][cut] = None
+        assert channels_from_result(_allan_doc(ax2), "a.json")[0].gms == []
+    ax2 = json.loads(json.dumps(ax))
+    ax2["noise"]["selected"] = ["N"]                          # M not selected
+    assert channels_from_result(_allan_doc(ax2), "a.json")[0].gms == []
+    ax2 = json.loads(json.dumps(ax))
+    ax2["noise"]["terms"]["M"]["status"] = "unresolved"
+    assert channels_from_result(_allan_doc(ax2), "a.json")[0].gms == []
+
+
+def test_allan_axis_without_a_fit_and_bad_files_are_refused(tmp_path):
+    with pytest.raises(DataFormatError) as ei:
+        channels_from_result({"axes": [{"name": "gx", "noise": {"statistic": "adev"}}]}, "a.json")
+    assert "a.json" in str(ei.value) and ("axis 'gx' has no noise fit ('noise.terms'); expected an allan result "
+                                          "with the IEEE-952 fit") in str(ei.value)
+    with pytest.raises(DataFormatError, match="an entry of 'axes' is not an object"):
+        channels_from_result({"axes": [3]}, "a.json")
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")})
+    del ax["noise"]["dt_s"]
+    with pytest.raises(DataFormatError) as ei:
+        channels_from_result(_allan_doc(ax, {}), "a.json")       # no rate anywhere
+    assert "axis 'gx' is not a complete fogdrift allan result (TypeError:" in str(ei.value)
+    assert "\n" not in str(ei.value)
+    p = tmp_path / "axes.json"
+    for text in ('{"axes": []}', '{"axes": {}}', "[1, 2]"):
+        p.write_text(text)
+        with pytest.raises(DataFormatError, match="not a fogdrift allan or noise result: no 'axes' list"):
+            load_result(p)
+    p.write_bytes(b"\xff\xfe{")
+    with pytest.raises(DataFormatError, match=r"not a JSON file \(UnicodeDecodeError: "):
+        load_result(p)
+    p.write_text('{"axes": [{"name": "gx"}]}')
+    assert load_result(p) == {"axes": [{"name": "gx"}]}
+
+
+def test_wrong_quantity_flag_names_the_axis_and_the_unit(tmp_path):
+    a = json.loads(_accel_result(tmp_path).read_text())
+    with pytest.raises(DataFormatError) as ei:
+        channels_from_result(a, "acc.json", expect="gyro")
+    assert "--gyro was given a accel result (axis ax: N in m/s/sqrt(h)); pass it as --accel" in str(ei.value)
+    assert channels_from_result(a, "acc.json", expect="accel")[0].quantity == "accel"
+
+
+def test_resolve_messages_by_hand(tmp_path):
+    ax = _allan_axis("gz", {"N": (0.1, 0.0, 0.2, "unresolved"), "B": (1.0, 0.5, 1.5, "resolved")}, selected=("N", "B"))
+    (ch,) = channels_from_result(_allan_doc(ax), "g.json")
+    r = resolve(ch, "N", "refuse")                           # an estimate is written under every policy
+    assert (r.how, r.si) == ("estimate", pytest.approx(0.1 * D / 60, rel=1e-12))
+    assert r.note == "N = 0.1 deg/sqrt(h) is the estimate, not resolved from zero: its 95 % interval reaches 0"
+    assert resolve(ch, "B", "zero").note == "" and resolve(ch, "B", "zero").how == "estimate"
+    r = resolve(ch, "K", "zero")
+    assert (r.si, r.how) == (0.0, "zero")
+    assert r.note == "K written as 0 (--missing zero): not in the model: the curve shows no sign of it"
+    r = resolve(ch, "K", "bound")
+    assert r.note == ("K is its 95 % upper bound 0.3 deg/h^1.5, not an estimate (--missing bound): not in the model: "
+                      "the curve shows no sign of it")
+    with pytest.raises(ConfigError) as ei:
+        resolve(ch, "K", "refuse")
+    assert str(ei.value) == ("gyro gz: K is not resolved by the record: not in the model: the curve shows no sign of "
+                             "it; its 95 % upper bound is 0.3 deg/h^1.5; pass --missing bound or zero to write its "
+                             "bound or 0, or export from a record that resolves it").replace("--missing ", "missing= ")
+    ch.terms["K"] = _term("K", None, None, None, "deg/h^1.5", "absent", "", "s")   # no bound, no reason
+    with pytest.raises(ConfigError) as ei:
+        resolve(ch, "K", "bound")
+    assert str(ei.value) == ("gyro gz: K is not resolved by the record: not in the selected model; the record gives "
+                             "no upper bound either; pass missing= zero to write 0 with a warning, or export from a "
+                             "record that resolves it")
+    with pytest.raises(ConfigError) as ei:
+        resolve(ch, "K", "refuse")
+    assert str(ei.value).startswith("gyro gz: K is not resolved by the record: not in the selected model; pass ")
+    ch.terms["K"] = _term("K", None, 0.0, 0.0, "deg/h^1.5", "absent", "", "s")      # a bound of 0 is no bound
+    with pytest.raises(ConfigError, match="the record gives no upper bound either"):
+        resolve(ch, "K", "bound")
+    with pytest.raises(ConfigError, match=r"^gyro gz: the result has no term M$"):
+        resolve(ch, "M", "bound")
+    with pytest.raises(ConfigError) as ei:
+        resolve(ch, "N", "Bound")
+    assert str(ei.value) == "missing= must be one of bound, refuse, zero; got 'Bound'"
+
+
+def test_describe_in_words():
+    t = _term("N", 0.15, 0.14, 0.16, "deg/sqrt(h)", "resolved", "", "allan fit: N")
+    assert describe(t) == "N = 0.15 [0.14, 0.16] deg/sqrt(h) [resolved]; from allan fit: N"
+    t = _term("N", 0.15, None, None, "deg/sqrt(h)", "resolved", "", "gmwm: N")
+    assert describe(t) == "N = 0.15 deg/sqrt(h) [resolved]; from gmwm: N"
+    t = _term("K", None, 0.0, 0.3, "deg/h^1.5", "absent", "", "x")
+    assert describe(t) == "K = < 0.3 deg/h^1.5 (95 % upper bound) [absent]; from x"
+    t = _term("K", None, None, None, "deg/h^1.5", "absent", "", "x")
+    assert describe(t) == "K = no value [absent]; from x"
+    assert t.to_dict()["si_unit"] == "rad/s^2/sqrt(Hz)" and set(t.to_dict()) == _TERM_KEYS
