@@ -346,14 +346,15 @@ def test_attach_allan_checks_sets_each_named_axis_and_says_when_the_record_is_to
     from fogdrift.io import from_array
 
     x = 0.1 * np.random.default_rng(5).standard_normal((2**11, 1))
-    rec = from_array(x, dt_s=0.01, unit="deg/h", axis_names=["gx"])
-    ax = SimpleNamespace(name="gx", allan_check="untouched", **vars(_gaxis(G_N, B_G)))
+    rec = from_array(x, dt_s=0.01, unit="m/s^2", axis_names=["ax"])  # an accelerometer: compared in m/s^2
+    ax = SimpleNamespace(name="ax", allan_check="untouched", **vars(_gaxis(G_N, B_G)))
     other = SimpleNamespace(name="nope", allan_check="untouched", **vars(_gaxis(G_N, B_G)))
     out = attach_allan_checks(rec, [ax, other])
     assert out == [ax, other] and other.allan_check == "untouched"
     assert set(ax.allan_check) == {"agree", "n_agree", "b_agree", "lines"}
     assert ax.allan_check["lines"][0].startswith("N ")
-    # the Allan fit's N of white noise of 0.1 deg/h per sample at 0.01 s: 0.1 * sqrt(0.01 s) / 60 deg/√h
+    # both readings in the internal unit (the GMWM's are re-stated afterwards): the Allan fit's N of white noise of
+    # 0.1 m/s^2 per sample at 0.01 s is the gyro table's number 0.1 * sqrt(0.01 s) / 60, not its m/s/√h (x 3600)
     n = float(ax.allan_check["lines"][0].split("the Allan fit ")[1].split(" ")[0])
     assert n == pytest.approx(0.1 * math.sqrt(0.01) / 60.0, rel=0.1)
     short = from_array(x[:8], dt_s=0.01, unit="deg/h", axis_names=["gx"])
