@@ -738,6 +738,11 @@ def test_compensated_test_block_by_definition_by_hand():
     assert_allclose(cols["persistence"], measured - 4.0 - [1, 2, 3, 4], rtol=1e-15)
     assert cols["persistence"].dtype == np.float64
     assert_allclose(compensated_test_block(_model_axis())["t_s"], [1.5, 2.0, 2.5, 3.0])
+    ma = _model_axis()
+    ma.rate_dph = ma.rate_dph.astype(np.float32) + np.float32(0.1)  # float32 in: the columns are float64
+    cols = compensated_test_block(ma)
+    assert all(v.dtype == np.float64 for v in cols.values())
+    assert_allclose(cols["measured"][0], float(np.float32(0.25) + np.float32(0.1)) + 4.0 + EARTH_30, rtol=1e-15)
 
 
 def test_write_compensated_test_block_by_hand(tmp_path):
@@ -759,6 +764,13 @@ def test_write_compensated_test_block_by_hand(tmp_path):
     back = load(paths[1], columns=["measured", "persistence"])
     assert back.dt_s == 0.5 and back.n_samples == 4 and back.axis_names == ("measured", "persistence")
     assert write_compensated_test_block([], tmp_path) == []
+    (tmp_path / "t0").mkdir()
+    write_compensated_test_block([ma], tmp_path / "t0", t0_s=100.0)
+    assert [ln.split(",")[0] for ln in (tmp_path / "t0" / "compensated_test_g_z.csv").read_text().splitlines()] == \
+        ["t_s", "101.5", "102", "102.5", "103"]
+    (tmp_path / "d").mkdir()
+    write_compensated_test_block([ma], tmp_path / "d")  # default time origin 0
+    assert (tmp_path / "d" / "compensated_test_g_z.csv").read_text().splitlines()[1].startswith("1.5,")
 
 
 def test_a_failure_while_writing_the_test_block_leaves_no_file(tmp_path, monkeypatch):
