@@ -394,3 +394,105 @@ def test_cached_null_and_critical_agree():
     assert float(null.sf(crit)[0]) == pytest.approx(1e-3, rel=1e-3)
     assert _null_and_critical(8.0, 7, 1.5, 1e-3)[0] is null
     assert null.nu == 8.0
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# checks: the re-selection without a term at its data bound or a refused floor
+
+IM = ALL_TERMS.index("M")
+TAU3 = np.array([1.0, 10.0, 100.0])
+
+
+def _prob(upper):
+    """Three points y = 1 of EDF 2: each point's 4-sigma limit is 1 / 3.17e-5; the K column (tau) is largest, so the
+    limit over it is smallest, at tau = 100 s; the N column (1 / tau) at tau = 1 s."""
+    X = np.zeros((3, len(ALL_TERMS)))
+    X[:, IN], X[:, IK], X[:, IS], X[:, IM] = 1.0 / TAU3, TAU3, TAU3 / 10.0, TAU3 / 100.0
+    return SimpleNamespace(upper=np.asarray(upper, float), y=np.ones(3), nu=np.full(3, 2.0), X=X)
+
+
+def _a(**kw):
+    a = np.zeros(len(ALL_TERMS))
+    for k, v in kw.items():
+        a[ALL_TERMS.index(k)] = v
+    return a
+
+
+def _res(ic_n=12.0, a_k=4.0):
+    return {(IN, IK): {"ic": 10.0, "a": _a(N=1.0, K=a_k)}, (IN,): {"ic": ic_n, "a": _a(N=1.2)},
+            (IK,): {"ic": 40.0, "a": _a(K=1.0)}}
+
+
+def _upper(k=4.0, s=0.0, m=0.0):
+    u = np.zeros(len(ALL_TERMS))
+    u[IN], u[IK], u[IS], u[IM] = 100.0, k, s, m
+    return u
+
+
+def test_term_at_its_bound_is_dropped_when_a_model_without_it_is_plausible():
+    c = _ctx(TAU3, [1.0, 1.0, 1.0], [2.0, 2.0, 2.0])
+    best, dropped = checks._drop_rejected(c, _prob(_upper()), _res(), (IN, IK))
+    assert best == (IN,) and list(dropped) == [IK]
+    t = dropped[IK]
+    bound = 60.0 / math.sqrt(1.0 / 3.0) * 2.0  # to_unit / sqrt(law scale) x sqrt(upper) = 207.8 deg/h^1.5
+    assert t.name == "K" and t.value is None and t.lo95 is None and t.status == "not_estimable"
+    assert t.unit == "deg/h^1.5" and t.hi95 == pytest.approx(bound, rel=1e-12)
+    assert t.reason == (f"left out of the model: its fit ran into its data bound ({bound:.4g} deg/h^1.5, set by the "
+                        "point at tau = 100 s alone), so the data bound it but do not measure it; the model was "
+                        "re-selected without it")
+
+
+def test_term_at_its_bound_stays_when_every_model_without_it_is_far_worse():
+    c = _ctx(TAU3, [1.0, 1.0, 1.0], [2.0, 2.0, 2.0])
+    assert checks._drop_rejected(c, _prob(_upper()), _res(ic_n=16.5), (IN, IK)) == ((IN, IK), {})
+    # exactly plausible_delta worse still counts as plausible; the threshold is the argument
+    assert checks._drop_rejected(c, _prob(_upper()), _res(ic_n=16.0), (IN, IK))[0] == (IN,)
+    assert checks._drop_rejected(c, _prob(_upper()), _res(ic_n=16.5), (IN, IK), plausible_delta=7.0)[0] == (IN,)
+
+
+def test_at_bound_means_within_1e_3_of_the_bound_and_needs_another_term():
+    c = _ctx(TAU3, [1.0, 1.0, 1.0], [2.0, 2.0, 2.0])
+    assert checks._drop_rejected(c, _prob(_upper()), _res(a_k=4.0 * (1 - 0.999e-3)), (IN, IK))[0] == (IN,)
+    assert checks._drop_rejected(c, _prob(_upper()), _res(a_k=4.0 * (1 - 1.001e-3)), (IN, IK)) == ((IN, IK), {})
+    assert checks._drop_rejected(c, _prob(_upper(k=0.0)), _res(), (IN, IK)) == ((IN, IK), {})  # no bound
+    res = {(IK,): {"ic": 10.0, "a": _a(K=4.0)}, (IN,): {"ic": 11.0, "a": _a(N=1.0)}}
+    assert checks._drop_rejected(c, _prob(_upper()), res, (IK,)) == ((IK,), {})  # a lone term stays
+
+
+def test_shaped_terms_at_their_bound_are_named_in_deg_h():
+    """S: bound sqrt(u) deg/h; M: sqrt(u) / tc deg/h/sqrt(s) (the point: the largest column, tau = 100 s)."""
+    c = _ctx(TAU3, [1.0, 1.0, 1.0], [2.0, 2.0, 2.0], tc_s=4.0)
+    res = {(IN, IS): {"ic": 10.0, "a": _a(N=1.0, S=9.0)}, (IN,): {"ic": 11.0, "a": _a(N=1.0)}}
+    best, dropped = checks._drop_rejected(c, _prob(_upper(s=9.0)), res, (IN, IS))
+    t = dropped[IS]
+    assert best == (IN,) and t.name == "S" and t.unit == "deg/h" and t.hi95 == pytest.approx(3.0)
+    assert "(3 deg/h, set by the point at tau = 100 s alone)" in t.reason
+    res = {(IN, IM): {"ic": 10.0, "a": _a(N=1.0, M=16.0)}, (IN,): {"ic": 11.0, "a": _a(N=1.0)}}
+    t = checks._drop_rejected(c, _prob(_upper(m=16.0)), res, (IN, IM))[1][IM]
+    assert t.unit == "deg/h/√s" and t.hi95 == pytest.approx(1.0) and "(1 deg/h/√s, set by" in t.reason
+    c.tc_s = None  # no correlation time: divided by 1
+    assert checks._drop_rejected(c, _prob(_upper(m=16.0)), res, (IN, IM))[1][IM].hi95 == pytest.approx(4.0)
+
+
+def test_re_selection_takes_the_best_model_without_the_term_and_its_non_zero_part():
+    """Without K the best is (N, Q) at IC 11, whose Q came out 0: the model is then (N,) itself."""
+    c = _ctx(TAU3, [1.0, 1.0, 1.0], [2.0, 2.0, 2.0])
+    res = _res()
+    res[(IQ, IN)] = {"ic": 11.0, "a": _a(N=1.0, Q=0.0)}
+    res[(IQ, IN, IK)] = {"ic": 9.0, "a": _a(N=1.0, Q=0.0, K=1.0)}  # holds K: never the alternative
+    assert checks._drop_rejected(c, _prob(_upper()), res, (IN, IK))[0] == (IN,)
+    del res[(IN,)]
+    assert checks._drop_rejected(c, _prob(_upper()), res, (IN, IK))[0] == (IQ, IN)  # (N,) was not fitted
+
+
+def test_refused_floor_is_dropped_however_much_worse_the_model_without_it():
+    c = _floor_ctx()
+    res = {(IN, IB): {"ic": 10.0, "a": _a(N=0.01, B=1.0)}, (IN,): {"ic": 100.0, "a": _a(N=0.01)}}
+    best, dropped = checks._drop_rejected(c, _prob(_upper()), res, (IN, IB))
+    assert best == (IN,) and dropped[IB].status == "not_estimable"
+    assert dropped[IB].hi95 == pytest.approx(0.2 / B664, rel=1e-9) and "contradicted" in dropped[IB].reason
+    # a floor below the curve's upper bound stays; no alternative at all: nothing is dropped
+    res[(IN, IB)]["a"] = _a(N=0.01, B=0.05)
+    assert checks._drop_rejected(c, _prob(_upper()), res, (IN, IB)) == ((IN, IB), {})
+    res = {(IN, IB): {"ic": 10.0, "a": _a(N=0.01, B=1.0)}}
+    assert checks._drop_rejected(c, _prob(_upper()), res, (IN, IB)) == ((IN, IB), {})
