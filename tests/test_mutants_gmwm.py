@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from types import SimpleNamespace
 
 import numpy as np
@@ -645,3 +646,28 @@ def test_selection_input_errors():
     assert (ei.value.needed, ei.value.got) == (4, 3)
     one = select_model(wv, "WN")  # a single model string is one candidate (3 scales >= 1 + 2)
     assert [c.model for c in one.candidates] == ["WN"] and one.selected == "WN"
+
+
+def test_a_candidate_with_more_parameters_than_scales_allow_is_scored_as_not_fitted():
+    """A model needs at least n_params + 2 scales: with 5 scales WN+2GM (5 parameters) is listed, not fitted."""
+    wv = haar_wvar(simulate_latent("WN", [1.0], 64, seed=1), 0.01)
+    assert len(wv.level) == 5
+    sel = select_model(wv, ["WN", "WN+2GM"])
+    assert sel.selected == "WN" and sel.passed_checks
+    c = sel.candidate("WN+2GM")
+    assert (c.model, c.n_params, c.passed, c.reasons, c.fit) == ("WN+2GM", 5, False,
+                                                                 ("hard: too few scales for this model",), None)
+    assert math.isnan(c.q) and math.isnan(c.penalty) and math.isnan(c.wic) and c.hard_failure
+
+
+def test_the_scan_always_keeps_enough_scales_for_the_largest_candidate():
+    """A 32-tap moving average lowers every octave up to ~0.3 s: the scan excludes leading scales while no candidate
+    explains them, but never leaves fewer than (largest n_params) + 2 = 4 scales."""
+    y = simulate_latent("WN+RW", [1.0, 1e-5], 2**11, seed=8)
+    wv = haar_wvar(np.convolve(y, np.ones(32) / 32, mode="valid"), 0.01)
+    assert len(wv.level) == 9
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FogdriftWarning)
+        sel = select_model(wv, ["WN", "WN+RW"], max_excluded=20)
+    assert [e.level for e in sel.excluded] == [1, 2, 3, 4, 5] and list(sel.levels_used) == [6, 7, 8, 9]
+    assert sel.scan_note == ""  # stopped by the scales left, not by max_excluded
