@@ -140,6 +140,7 @@ def test_gmwm_b_headline_bound_and_flicker_term():
     assert (b.value, b.lo95, b.hi95, b.status) == (None, 0.0, 9.0, "absent")
     assert b.si_hi95 == pytest.approx(9.0 * DPH, rel=1e-12) and b.si_lo95 == 0.0
     assert b.reason == "95 % upper bound: no minimum in the range" and not b.has_estimate
+    assert b.source == "gmwm WN+RW+GM: B, min of the model's ADEV / 0.664"
     assert ch.b_is_flicker is False and ch.b_tau_s == 800.0
     # a flicker component (B_dph) in the model: B is that term, not the headline, and b_is_flicker is set
     ax["selection"]["ieee"]["terms"]["B_dph"] = _t(0.7, 0.5, 0.9, "deg/h", "FLK")
@@ -147,6 +148,20 @@ def test_gmwm_b_headline_bound_and_flicker_term():
     assert ch.b_is_flicker is True
     b = ch.terms["B"]
     assert (b.value, b.status, b.source) == (0.7, "resolved", "gmwm WN+RW+GM: B (component FLK)")
+
+
+def test_gmwm_headline_without_label_and_n_without_unit():
+    ax = _full_gmwm_axis()
+    ie = ax["selection"]["ieee"]
+    del ie["b_headline"]["label"]
+    ie["terms"]["N_dprh"] = _t(0.3, 0.27, 0.33)            # no unit: deg/sqrt(h), a gyro
+    ch = _one(ax)
+    assert ch.terms["B"].source == "gmwm WN+RW+GM: B, " and ch.terms["B"].status == "resolved"
+    assert ch.quantity == "gyro" and ch.terms["N"].unit == "deg/sqrt(h)"
+    assert ch.terms["N"].si == pytest.approx(0.3 * D / 60.0, rel=1e-12)
+    del ie["terms"]["N_dprh"]                                # no N at all: absent, in the gyro's unit
+    n = _one(ax).terms["N"]
+    assert (n.unit, n.status, n.value, n.hi95) == ("deg/sqrt(h)", "absent", None, None)
 
 
 def test_gmwm_accelerometer_defaults_are_specific_force_units():
