@@ -496,3 +496,34 @@ def test_refused_floor_is_dropped_however_much_worse_the_model_without_it():
     assert checks._drop_rejected(c, _prob(_upper()), res, (IN, IB)) == ((IN, IB), {})
     res = {(IN, IB): {"ic": 10.0, "a": _a(N=0.01, B=1.0)}}
     assert checks._drop_rejected(c, _prob(_upper()), res, (IN, IB)) == ((IN, IB), {})
+
+
+def _qs_problem(a_q, a_n, nu=1e4):
+    """Exact Q + N + S curve (a 20-Hz line) at octave taus 0.01 .. 10.24 s, EDF ``nu`` at every point."""
+    from fogdrift.noise.engine import ScoreProblem
+    from fogdrift.noise.terms import periodic_shape
+
+    dt, lines = 0.01, ((20.0, 1.0),)
+    tau = dt * 2.0 ** np.arange(11)
+    X = np.zeros((tau.size, len(ALL_TERMS)))
+    X[:, IQ], X[:, IN], X[:, IS] = tau**-2.0, 1.0 / tau, periodic_shape(tau, lines, dt, "adev")
+    y = X @ _a(Q=a_q, N=a_n, S=1.0)
+    prob = ScoreProblem(X, y, np.diag(np.full(tau.size, 2.0 / nu)), np.full(len(ALL_TERMS), 1e6))
+    c = _ctx(tau, y, 2.0 * y, lines=lines)
+    c.dt = dt
+    return c, prob
+
+
+def test_q_above_the_envelope_is_kept_only_if_resolved_at_whole_periods():
+    """Envelope 1 / (20 pi)^2 = 2.5e-4: Q = 1e-3 is above it.  With N = 1e-3 the taus from 0.05 s on (0.08 .. 10.24 s)
+    still see Q (1e-3 / tau^2 against 1e-3 / tau): resolved, Q kept; with N = 1e3 (a million times Q's share at
+    0.08 s) Q is not resolved from zero there: unresolved, lower bound 0."""
+    best = (IQ, IN, IS)
+    for a_n, resolved in ((1e-3, True), (1e3, False)):
+        c, prob = _qs_problem(1e-3, a_n)
+        out = _q_terms()
+        checks._q_at_whole_periods(c, prob, best, _a(Q=1e-3, N=a_n, S=1.0), 3.84, SimpleNamespace(periods_s=(0.05,)),
+                                   out)
+        assert (out["Q"].status == "estimated") == resolved
+        if not resolved:
+            assert out["Q"].lo95 == 0.0 and "whole periods of the periodic error (tau >= 0.05 s)" in out["Q"].reason
