@@ -671,3 +671,12 @@ def test_the_scan_always_keeps_enough_scales_for_the_largest_candidate():
         sel = select_model(wv, ["WN", "WN+RW"], max_excluded=20)
     assert [e.level for e in sel.excluded] == [1, 2, 3, 4, 5] and list(sel.levels_used) == [6, 7, 8, 9]
     assert sel.scan_note == ""  # stopped by the scales left, not by max_excluded
+
+
+def test_a_degenerate_candidate_listed_first_does_not_hide_the_others_from_the_scan():
+    """The scan skips a collapsed step-1 fit (WN+GM with the GM at a bound on the filtered octaves) and scores the
+    candidates after it: the same leading scales are excluded by the scan, whatever the order of the candidates."""
+    wv = _filtered(2**13, 4)
+    sel = select_model(wv, ["WN+GM", "WN", "WN+RW"])
+    assert [e.level for e in sel.excluded] == [1, 2, 3] and sel.selected == "WN+RW"
+    assert all(e.reason.startswith("no candidate explains the scales from ") for e in sel.excluded)
