@@ -847,3 +847,14 @@ def test_describe_in_words():
     t = _term("K", None, None, None, "deg/h^1.5", "absent", "", "x")
     assert describe(t) == "K = no value [absent]; from x"
     assert t.to_dict()["si_unit"] == "rad/s^2/sqrt(Hz)" and set(t.to_dict()) == _TERM_KEYS
+
+
+def test_json_keeps_the_terms_after_one_the_result_lacks(tmp_path):
+    doc = json.loads(_gyro_result(tmp_path).read_text())
+    for ax in doc["axes"]:
+        del ax["noise"]["terms"]["Q"]                        # an older allan.json without Q
+    p = tmp_path / "noq.json"
+    p.write_text(json.dumps(doc))
+    d = json.loads(render("json", build_context([p])))
+    assert list(d["channels"][0]["export_values"]) == ["N", "K", "B", "R"]
+    assert d["channels"][0]["export_values"]["R"]["how"] == "bound"
