@@ -378,16 +378,18 @@ def test_ramp_read_over_the_second_half_of_the_active_block():
 
 
 def test_a_compensator_that_never_predicts_is_refused_with_one_line():
-    """A 700-sample moving mean on a 600-sample block predicts nothing: InsufficientDataError naming it (the
-    callers turn it into "artefact check skipped"), not a ZeroDivisionError; one that starts predicting 4
-    samples before the end is read."""
+    """A 700-sample moving mean on a 600-sample block predicts nothing, a 597-sample one only the last 3 samples:
+    InsufficientDataError naming both (the callers turn it into "artefact check skipped"), not a
+    ZeroDivisionError; one that predicts the last 4 samples is not named, and alone it is read."""
     from fogdrift.errors import InsufficientDataError
 
     z = np.random.default_rng(55).normal(0.0, 1.0, 600)
     with pytest.raises(InsufficientDataError) as info:
-        artefact_check(z, 1.0, {"ok": MovingFraction(0.5, 10), "never": MovingFraction(0.5, 700)}, causal_window=128)
-    assert str(info.value) == ("the artefact check needs compensated samples to read: no prediction from never "
-                               "before sample 600 of the 600-sample block")
+        artefact_check(z, 1.0, {"ok": MovingFraction(0.5, 10), "four": MovingFraction(0.5, 596),
+                                "three": MovingFraction(0.5, 597), "never": MovingFraction(0.5, 700)},
+                       causal_window=128)
+    assert str(info.value) == ("the artefact check needs compensated samples to read: no prediction from three, "
+                               "never before sample 600 of the 600-sample block")
     assert (info.value.needed, info.value.got) == (4, 0)
     res = artefact_check(z, 1.0, {"late": MovingFraction(0.0, 596)}, causal_window=128, step_delays_s=())
     assert res.frequencies_hz == [0.5]  # Nyquist: 2 periods in 4 samples
