@@ -141,6 +141,11 @@ def test_default_band_at_half_a_second_starts_at_exactly_two_periods():
     res = artefact_check(z, 0.5, {"persistence": Persistence().fit([0.0])}, causal_window=128)
     assert res.frequencies_hz == [0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0]
     assert len(res.notes) == 1  # nothing dropped from the default band
+    # the band is the ACTIVE block's: k0 = 1000 (a 1000-sample moving mean), n = 3000: again 1000 s, not the
+    # record's 1500 s nor n + k0 = 2000 s (which would list 0.001 Hz, then drop it with a note)
+    res = artefact_check(np.random.default_rng(44).normal(0.0, 5.0, 3000), 0.5, {"ma": MovingFraction(0.5, 1000)},
+                         causal_window=128)
+    assert res.frequencies_hz == [0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0] and len(res.notes) == 1
     # the same edge for a given list: 0.002 Hz kept, 0.0019 Hz dropped with a note
     res = artefact_check(z, 0.5, {"persistence": Persistence().fit([0.0])}, causal_window=128,
                          frequencies_hz=[0.0019, 0.002, 1.0, 1.01])
