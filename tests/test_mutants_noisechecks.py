@@ -136,7 +136,7 @@ def test_classical_b_is_the_minimum_of_the_fitted_curve():
     got = checks._classical_b(c, A)
     assert got["value"] == pytest.approx(math.sqrt(2.0 * math.sqrt(a * b)) / B664, rel=1e-4)
     assert got["tau_s"] == pytest.approx(10.0, rel=0.03)  # the 400-point grid's step is 2.3 %
-    assert got["bound_only"] is False
+    assert got["bound_only"] is False and got["unit"] == "deg/h"
     j = 4  # the measured tau nearest 10 s is 10 s itself
     assert got["hi95"] == pytest.approx(math.sqrt(c.y_hi[j]) / B664, rel=1e-12)
     assert got["lo95"] == pytest.approx(math.sqrt(c.y[j] / 1.44) / B664, rel=1e-12)
@@ -407,7 +407,7 @@ def _prob(upper):
     """Three points y = 1 of EDF 2: each point's 4-sigma limit is 1 / 3.17e-5; the K column (tau) is largest, so the
     limit over it is smallest, at tau = 100 s; the N column (1 / tau) at tau = 1 s."""
     X = np.zeros((3, len(ALL_TERMS)))
-    X[:, IN], X[:, IK], X[:, IS], X[:, IM] = 1.0 / TAU3, TAU3, TAU3 / 10.0, TAU3 / 100.0
+    X[:, IN], X[:, IK], X[:, IS], X[:, IM] = 1.0 / TAU3, TAU3, [0.0, 1.0, 10.0], TAU3 / 100.0  # S: a null at 1 s
     return SimpleNamespace(upper=np.asarray(upper, float), y=np.ones(3), nu=np.full(3, 2.0), X=X)
 
 
@@ -460,10 +460,15 @@ def test_at_bound_means_within_1e_3_of_the_bound_and_needs_another_term():
 
 
 def test_shaped_terms_at_their_bound_are_named_in_deg_h():
-    """S: bound sqrt(u) deg/h; M: sqrt(u) / tc deg/h/sqrt(s) (the point: the largest column, tau = 100 s)."""
+    """S: bound sqrt(u) deg/h; M: sqrt(u) / tc deg/h/sqrt(s) (the point: the largest column, tau = 100 s; a point
+    where the column is 0, the S null at 1 s, bounds nothing and is not divided by)."""
+    import warnings
+
     c = _ctx(TAU3, [1.0, 1.0, 1.0], [2.0, 2.0, 2.0], tc_s=4.0)
     res = {(IN, IS): {"ic": 10.0, "a": _a(N=1.0, S=9.0)}, (IN,): {"ic": 11.0, "a": _a(N=1.0)}}
-    best, dropped = checks._drop_rejected(c, _prob(_upper(s=9.0)), res, (IN, IS))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        best, dropped = checks._drop_rejected(c, _prob(_upper(s=9.0)), res, (IN, IS))
     t = dropped[IS]
     assert best == (IN,) and t.name == "S" and t.unit == "deg/h" and t.hi95 == pytest.approx(3.0)
     assert "(3 deg/h, set by the point at tau = 100 s alone)" in t.reason
