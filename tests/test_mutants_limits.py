@@ -266,6 +266,9 @@ def test_a_long_line_inside_one_chunk_is_found_with_its_line_number(monkeypatch)
             assert isinstance(e, ResourceLimitError) and e.line == line, (data, k, e)
             assert "more than 4 bytes without a line break" in e.reason
     assert _err(b"a\nbbbb\ncccc\ndddd\n" * 3, 64) is None
+    e = _err(b"a\nEEEEE\n", 64)  # two breaks in the chunk: the line between them
+    assert isinstance(e, ResourceLimitError) and e.line == 2
+    assert _err(b"abcd\nefgh", 64) is None and _err(b"ab\rcd", 64) is None  # one break: nothing inside
 
 
 @pytest.mark.parametrize("k", CHUNKS)
@@ -274,7 +277,7 @@ def test_rows_exactly_at_and_one_above(monkeypatch, k):
     assert _err(b"1\n2\n3\n4\n5\n", k) is None
     assert _err(b"1\r\n2\r\n3\r\n4\r\n5\r\n6", k) is None  # 5 breaks; the last line is not counted yet
     e = _err(b"1\n2\n3\n4\n5\n6\n", k)
-    assert isinstance(e, ResourceLimitError) and e.limit == "FOGDRIFT_MAX_ROWS"
+    assert isinstance(e, ResourceLimitError) and e.limit == "FOGDRIFT_MAX_ROWS" and e.path == "t.csv"
     assert e.reason == (f"more than 5 lines; expected at most 5 (FOGDRIFT_MAX_ROWS); stopped while reading; "
                         f"{RAISE.format('FOGDRIFT_MAX_ROWS')}")
     e = _err(b"1\r2\r3\r4\r5\r6\r", k)
@@ -286,7 +289,7 @@ def test_memory_limits_the_lines_by_bytes_per_row(monkeypatch, k):
     monkeypatch.setenv(limits.ENV_MEMORY, "80")  # 80 bytes / (2 columns x 8 bytes) = 5 lines
     assert _err(b"1,2\n" * 5, k, bytes_per_row=16) is None
     e = _err(b"1,2\n" * 6, k, bytes_per_row=16)
-    assert isinstance(e, ResourceLimitError) and e.limit == "FOGDRIFT_MAX_MEMORY"
+    assert isinstance(e, ResourceLimitError) and e.limit == "FOGDRIFT_MAX_MEMORY" and e.path == "t.csv"
     assert e.reason == ("more than 5 lines of 2 columns: the table would need more than 80 bytes of memory; expected "
                         "at most the memory budget 80 bytes (FOGDRIFT_MAX_MEMORY); stopped while reading; "
                         f"{RAISE.format('FOGDRIFT_MAX_MEMORY')}")
