@@ -409,6 +409,11 @@ def test_checks_pass_on_every_boundary_value():
     # beta 0.05: T_c = 0.2 s, peak 0.757 s within [0.04, 0.64]? no: 0.757 > 0.64 -> use a faster GM
     fit.theta[1] = 0.1  # T_c = 0.1 s, peak 0.3785 s, inside [0.04 s, 0.64 s]
     assert sel_mod._checks(fit, mdl, whiten=_identity, **{**OPTS, "snr_min": 0.02}) == []
+    # the GM window's ends are inside it: peak = 3.785 x 0.01 s / beta exactly 2 x 0.02 s and exactly 2.56 s / 4
+    for beta in (0.94625, 0.059140625):
+        fit.theta[1] = beta
+        assert sel_mod._checks(fit, mdl, whiten=_identity, **{**OPTS, "snr_min": 0.02}) == [], beta
+    fit.theta[1] = 0.1
     # the same with snr_min a little above: the GM is "not detectable" (soft), with its SNR in two digits
     assert sel_mod._checks(fit, mdl, whiten=_identity, **{**OPTS, "snr_min": 0.021}) == [
         "soft: GM1 changes the WV by at most 0.02 SD at any scale (not detectable)"]
