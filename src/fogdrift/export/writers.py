@@ -362,10 +362,20 @@ def write_json(ctx: ExportContext) -> str:
                            "gauss_markov": "phi = exp(-dt/T_c), driving 1-sigma = sigma sqrt(1 - phi^2)",
                            "source": "Kalibr wiki 'IMU Noise Model'; IEEE Std 952-1997 Annex C"},
            "channels": chans}
-    return json.dumps(doc, indent=1, allow_nan=False, default=_json_default) + "\n"
+    return json.dumps(_json_safe(doc), indent=1, allow_nan=False, default=_json_default) + "\n"
+
+
+def _json_safe(x):
+    """``x`` with every non-finite float replaced by None (JSON null): json.dumps never passes a float to
+    ``default``, so a NaN (a GMWM result without ``tau_range_s``, say) would otherwise stop the export."""
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {k: _json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_json_safe(v) for v in x]
+    return x
 
 
 def _json_default(x):
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
     raise TypeError(type(x).__name__)
