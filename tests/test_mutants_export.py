@@ -439,6 +439,7 @@ def test_kfgins_and_matlab_with_one_quantity(tmp_path):
     g = _gyro_only(tmp_path)
     kf = render("kf-gins", g).splitlines()
     assert kf[0] == _HEADERS["kf-gins"]
+    assert yaml.safe_load("\n".join(kf))["imunoise"]["arw"] == pytest.approx([0.15, 0.20, 0.10], rel=1e-5)
     assert "  # vrw: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in kf
     assert "  # abstd: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in kf
     m = render("matlab", g).splitlines()
@@ -515,7 +516,13 @@ def test_json_target_fields_by_hand(tmp_path):
     ctx = build_context([_gyro_result(tmp_path)], [_accel_result(tmp_path)], rate_hz=400.0)
     d = json.loads(render("json", ctx))
     assert d["fogdrift_export"] == "json" and d["update_rate_hz"] == 400.0 and d["missing"] == "bound"
-    assert d["conventions"]["si_rate_units"] == {"gyro": "rad/s", "accel": "m/s^2"}
+    assert d["conventions"] == {"si_rate_units": {"gyro": "rad/s", "accel": "m/s^2"},
+                                "white": "continuous density N; discrete 1-sigma N sqrt(f)",
+                                "random_walk": "continuous density K; discrete step 1-sigma K / sqrt(f)",
+                                "gauss_markov": "phi = exp(-dt/T_c), driving 1-sigma = sigma sqrt(1 - phi^2)",
+                                "source": "Kalibr wiki 'IMU Noise Model'; IEEE Std 952-1997 Annex C"}
+    text = render("json", ctx).splitlines()                   # one key per line, one space per level
+    assert text[0] == "{" and text[1] == ' "fogdrift_export": "json",' and text[-1] == "}"
     assert [c["name"] for c in d["channels"]] == ["gx", "gy", "gz", "ax", "ay", "az"]
     gx = d["channels"][0]
     assert set(gx) == {"name", "quantity", "method", "fit", "no_fit", "source_file", "sha256", "rate_hz",
