@@ -154,6 +154,9 @@ def test_classical_b_at_the_longest_tau_is_a_bound_the_tighter_of_two():
     got = checks._classical_b(c, A)
     assert got["bound_only"] is True and got["lo95"] is None
     assert got["value"] == pytest.approx(0.1 / B664, rel=1e-9) and got["tau_s"] == pytest.approx(100.0)
+    c = _ctx(tau, [1.0, 0.1, 0.0144], [1.44, 0.144, 0.0144 * 1.44])  # measured minimum 0.12 above the fit's end
+    got = checks._classical_b(c, A)
+    assert got["value"] == pytest.approx(0.1 / B664, rel=1e-9) and got["hi95"] == pytest.approx(0.144 / B664)
     c = _ctx(tau, [1.0, 0.1, 0.0064], [1.44, 0.144, 0.0064 * 1.44])  # last point ADEV 0.08 < 0.1
     got = checks._classical_b(c, A)
     assert got["value"] == pytest.approx(0.08 / B664, rel=1e-12) and got["tau_s"] == 100.0
@@ -200,14 +203,24 @@ def test_classical_b_includes_the_shaped_terms_of_the_printed_model():
     for col, kw, shape in ((ALL_TERMS.index("M"), {"tc_s": 10.0}, markov_shape(grid, 10.0, "adev", 0.01)),
                            (IS, {"lines": ((0.03, 1.0),)}, periodic_shape(grid, ((0.03, 1.0),), 0.01, "adev"))):
         A2 = A.copy()
-        A2[col] = 5.0
+        A2[col] = 0.9
         c2 = _ctx(tau, c.y, c.y_hi * 100.0, **kw)
-        var = a / grid + b * grid + 5.0 * shape
+        var = a / grid + b * grid + 0.9 * shape
         got = checks._classical_b(c2, A2)["value"]
         assert got == pytest.approx(math.sqrt(var.min()) / B664, rel=1e-9) and got > base * 1.01
         # without the shaped context (no tc / no lines) the term is not added
         c3 = _ctx(tau, c.y, c.y_hi * 100.0)
         assert checks._classical_b(c3, A2)["value"] == pytest.approx(base, rel=1e-12)
+    # HDEV: the shaped terms in that statistic's form (the Gauss-Markov one needs the sample interval)
+    lines = ((0.03, 1.0),)
+    for col, kw, shape in ((ALL_TERMS.index("M"), {"tc_s": 10.0}, markov_shape(grid, 10.0, "hdev", 0.01)),
+                           (IS, {"lines": lines}, periodic_shape(grid, lines, 0.01, "hdev"))):
+        A2 = np.zeros(len(ALL_TERMS))
+        A2[IN], A2[col] = a, 0.9
+        c2 = _ctx(tau, c.y, c.y_hi * 100.0, statistic="hdev", **kw)
+        var = a * laws_of("hdev")["N"].shape(grid, 0.01) + 0.9 * shape
+        k = int(np.argmin(var))
+        assert checks._classical_b(c2, A2)["value"] == pytest.approx(math.sqrt(var[k]) / B664, rel=1e-9)
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -504,12 +517,12 @@ def test_refused_floor_is_dropped_however_much_worse_the_model_without_it():
 
 
 def _qs_problem(a_q, a_n, nu=1e4):
-    """Exact Q + N + S curve (a 20-Hz line) at octave taus 0.01 .. 10.24 s, EDF ``nu`` at every point."""
+    """Exact Q + N + S curve (a 20-Hz line) at octave taus 0.01 .. 1.28 s, EDF ``nu`` at every point."""
     from fogdrift.noise.engine import ScoreProblem
     from fogdrift.noise.terms import periodic_shape
 
     dt, lines = 0.01, ((20.0, 1.0),)
-    tau = dt * 2.0 ** np.arange(11)
+    tau = dt * 2.0 ** np.arange(8)
     X = np.zeros((tau.size, len(ALL_TERMS)))
     X[:, IQ], X[:, IN], X[:, IS] = tau**-2.0, 1.0 / tau, periodic_shape(tau, lines, dt, "adev")
     y = X @ _a(Q=a_q, N=a_n, S=1.0)
@@ -520,7 +533,7 @@ def _qs_problem(a_q, a_n, nu=1e4):
 
 
 def test_q_above_the_envelope_is_kept_only_if_resolved_at_whole_periods():
-    """Envelope 1 / (20 pi)^2 = 2.5e-4: Q = 1e-3 is above it.  With N = 1e-3 the taus from 0.05 s on (0.08 .. 10.24 s)
+    """Envelope 1 / (20 pi)^2 = 2.5e-4: Q = 1e-3 is above it.  With N = 1e-3 the taus from 0.05 s on (0.08 .. 1.28 s)
     still see Q (1e-3 / tau^2 against 1e-3 / tau): resolved, Q kept; with N = 1e3 (a million times Q's share at
     0.08 s) Q is not resolved from zero there: unresolved, lower bound 0."""
     best = (IQ, IN, IS)
