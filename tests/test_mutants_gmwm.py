@@ -685,3 +685,16 @@ def test_a_degenerate_candidate_listed_first_does_not_hide_the_others_from_the_s
     sel = select_model(wv, ["WN+GM", "WN", "WN+RW"])
     assert [e.level for e in sel.excluded] == [1, 2, 3] and sel.selected == "WN+RW"
     assert all(e.reason.startswith("no candidate explains the scales from ") for e in sel.excluded)
+
+
+def test_j_pvalue_with_one_degree_of_freedom():
+    """Three scales for the two parameters of WN+RW: df = 1 and p = Q(1/2, q/2) (a value, not NaN)."""
+    from scipy import special
+
+    from fogdrift.gmwm import gmwm_fit
+
+    wv = haar_wvar(simulate_latent("WN+RW", [1.0, 1e-5], 2**12, seed=3), 0.01)
+    fit = gmwm_fit(wv, "WN+RW", scales=[1, 2, 3])
+    assert fit.df == 1 and fit.q > 0
+    assert fit.j_pvalue == pytest.approx(float(special.gammaincc(0.5, fit.q / 2.0)), rel=1e-10)
+    assert fit.wic == pytest.approx(fit.q + fit.penalty, rel=1e-12)
