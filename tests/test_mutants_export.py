@@ -865,3 +865,47 @@ def test_json_keeps_the_terms_after_one_the_result_lacks(tmp_path):
     d = json.loads(render("json", build_context([p])))
     assert list(d["channels"][0]["export_values"]) == ["N", "K", "B", "R"]
     assert d["channels"][0]["export_values"]["R"]["how"] == "bound"
+
+
+def _gyro_gm_chan():
+    return _chan("gyro", {"N": (0.15, 0.14, 0.16, "deg/sqrt(h)", "resolved", ""),
+                          "K": (0.5, 0.3, 0.7, "deg/h^1.5", "resolved", "")},
+                 gms=[GaussMarkov(sigma_si=4.0 * DPH, tc_s=100.0)])
+
+
+@pytest.mark.parametrize("what, factor", [("F", 1.001), ("Q", 1.001), ("r", 1.001)])
+def test_check_max_abs_catches_a_disagreement_in_each_part(monkeypatch, what, factor):
+    import dataclasses
+
+    from fogdrift.export import discretize as dz
+
+    real = dz.state_space
+    ch = _gyro_gm_chan()
+    assert dz.discrete_model(ch, 100.0)["check_max_abs"] < 1e-9
+
+    def off(*a, **k):                                        # statespace's closed forms, one part 0.1 % off
+        ss = real(*a, **k)
+        return dataclasses.replace(ss, **{what: getattr(ss, what) * factor})
+
+    monkeypatch.setattr(dz, "state_space", off)
+    check = dz.discrete_model(ch, 100.0)["check_max_abs"]
+    # Phi ~ 1: an absolute 1e-3; Qd and r: relative 1e-3 (Qd of the largest element, values ~1e-13 (rad/s)^2)
+    assert check == pytest.approx(1e-3, rel=2e-2)
+
+
+def test_gyro_gauss_markov_component_in_si_and_quantization_alone():
+    d = discrete_model(_gyro_gm_chan(), 100.0)
+    gm = next(t for t in d["continuous_terms"] if t["kind"] == "gauss_markov")
+    assert gm["sigma"] == pytest.approx(4.0 * DPH, rel=1e-12) and gm["unit"] == "rad/s"
+    comps, _ = channel_components(_gyro_gm_chan())
+    assert next(c for c in comps if c["kind"] == "gauss_markov")["sigma_dph"] == pytest.approx(4.0, rel=1e-12)
+    q_only = _chan("gyro", {"Q": (2.0, 1.0, 3.0, "urad", "resolved", "")})
+    d = discrete_model(q_only, 100.0)
+    assert d["discrete"]["r"] == pytest.approx(2.0 * (2e-6) ** 2 / 0.01 ** 2, rel=1e-9)   # 2 Q^2 / dt^2
+    assert d["check_max_abs"] is not None and d["check_max_abs"] < 1e-9
+
+
+def test_max_flicker_terms_is_passed_on():
+    b = {"B": (2.0, 1.5, 2.5, "deg/h", "resolved", "")}
+    comps, _ = channel_components(_chan("gyro", b, tau=(0.1, 1e4)), max_flicker_terms=2)
+    assert [c["kind"] for c in comps] == ["gauss_markov", "gauss_markov"]
