@@ -180,6 +180,8 @@ def test_horizons_that_exactly_fill_the_record_are_kept_shorter_than_a_sample_dr
     assert str(info.value) == ("no horizon fits: the record has 359 s, a calibration of 300 s plus the shortest "
                                "horizon does not")
     assert info.value.got == 359
+    with pytest.raises(InsufficientDataError, match=r"the record has 179\.5 s, a calibration of 150 s"):
+        heading_errors(r[:359], 0.5, {}, causal_window=128, calib_s=150.0, horizons_s=(30.0,))
 
 
 def test_origins_run_to_the_last_that_fits_the_shortest_horizon_and_longer_ones_are_nan_there():
