@@ -50,6 +50,13 @@ def test_point_limit_is_the_4_sigma_lower_chi2_quantile():
     got = checks._point_limits(y, np.array([2.0, 2.0]))
     np.testing.assert_allclose(got, y * 2.0 / _chi2_2_ppf(3.17e-5), rtol=1e-9)
     assert got[0] == pytest.approx(1.0 / 3.17e-5, rel=1e-4)  # ~31500 y: one point bounds little
+    # an EDF far below 1 (quantile 0) bounds nothing: inf, and no RuntimeWarning, even for y = 0 (0 / 0)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        got = checks._point_limits(np.array([0.0, 1.0]), np.array([1e-9, 1e-9]))
+    assert np.isinf(got[1])
 
 
 def test_points_outside_their_own_95_interval():
