@@ -321,6 +321,8 @@ def test_null_taus_take_the_nearest_sample_multiple_within_the_tolerance():
     returned tau is below sin^4(pi 0.05) ~ 6e-3 of its 1/(pi f tau)^2 envelope."""
     got = null_taus([0.035], 0.01, 0.01, 1.0)
     assert got[0] == pytest.approx(0.07)
+    # at most max_periods periods: with 1, the 2-period null is not searched for
+    assert null_taus([0.035], 0.01, 0.01, 1.0, max_periods=1).size == 0
     cyc = got / 0.035
     assert np.all(np.abs(cyc - np.round(cyc)) <= NULL_TOLERANCE)
     x = math.pi / 0.035 * got
