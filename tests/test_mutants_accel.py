@@ -19,14 +19,20 @@ from fogdrift.io.channel_quantity import (KEY_OF_QUANTITY, QUANTITY_WORDS, check
 G0 = 9.80665
 
 
+def approx(expected, rel=1e-6, abs=0.0):  # noqa: A002
+    """pytest.approx without its default absolute tolerance of 1e-12, which would pass any two SI values below
+    ~1e-10 (K in rad/s^2/sqrt(Hz), Qd in (rad/s)^2): a relative check must be relative."""
+    return pytest.approx(expected, rel=rel, abs=abs)
+
+
 def test_a_parsed_unit_spec_is_the_one_unit():
     spec = units.parse_unit("mg", None)
     c = parse_unit_choice(spec)
     assert c.text == "mg" and c.single is spec and c.by_quantity == {} and c.by_column == {}
-    assert c.for_channel("ax", "f.csv").scale_to_internal() == pytest.approx(G0 * 1e-3, rel=1e-14)
+    assert c.for_channel("ax", "f.csv").scale_to_internal() == approx(G0 * 1e-3, rel=1e-14)
     c = parse_unit_choice(" deg/s ")
     assert c.text == "deg/s" and c.by_quantity == {} and c.by_column == {}
-    assert c.single.scale_to_internal() == pytest.approx(3600.0, rel=1e-14)      # deg/s -> deg/h
+    assert c.single.scale_to_internal() == approx(3600.0, rel=1e-14)      # deg/s -> deg/h
 
 
 @pytest.mark.parametrize("bad", [None, 5, 9.80665, "", "   ", ["g"]])
@@ -51,7 +57,7 @@ def test_the_key_ends_at_the_first_equals_sign():
         parse_unit_choice("ax==g")
     c = parse_unit_choice("gyro = deg/h , accel = ug , ax = m/s^2")
     assert set(c.by_quantity) == {"angular_rate", "specific_force"} and set(c.by_column) == {"ax"}
-    assert c.by_quantity["specific_force"].scale_to_internal() == pytest.approx(G0 * 1e-6, rel=1e-14)
+    assert c.by_quantity["specific_force"].scale_to_internal() == approx(G0 * 1e-6, rel=1e-14)
 
 
 def test_a_column_given_twice_is_refused():
@@ -82,9 +88,9 @@ def test_a_column_entry_is_checked_against_the_name():
                                     "but unit= entry ax=deg/h is an angular-rate (gyro) unit;")
     # a neutral name takes its column entry, whatever the quantity
     c = parse_unit_choice("gyro=deg/s,accel=g,temp_x=mg")
-    assert c.for_channel("temp_x", "f").scale_to_internal() == pytest.approx(G0 * 1e-3, rel=1e-14)
-    assert c.for_channel("gy", "f").scale_to_internal() == pytest.approx(3600.0, rel=1e-14)
-    assert c.for_channel("a_z", "f").scale_to_internal() == pytest.approx(G0, rel=1e-14)
+    assert c.for_channel("temp_x", "f").scale_to_internal() == approx(G0 * 1e-3, rel=1e-14)
+    assert c.for_channel("gy", "f").scale_to_internal() == approx(3600.0, rel=1e-14)
+    assert c.for_channel("a_z", "f").scale_to_internal() == approx(G0, rel=1e-14)
 
 
 def test_per_quantity_option_without_the_quantity_of_a_channel():

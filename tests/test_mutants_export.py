@@ -27,6 +27,12 @@ DPH = D / 3600.0             # rad/s per deg/h
 RRW = D / 216000.0           # rad/s^1.5 per deg/h^1.5  (3600^1.5 = 216000)
 
 
+def approx(expected, rel=1e-6, abs=0.0):  # noqa: A002
+    """pytest.approx without its default absolute tolerance of 1e-12, which would pass any two SI values below
+    ~1e-10 (K in rad/s^2/sqrt(Hz), Qd in (rad/s)^2): a relative check must be relative."""
+    return pytest.approx(expected, rel=rel, abs=abs)
+
+
 # ------------------------------------------------------------------------------------------------------------------
 # GMWM results (noise.json) read into a ChannelModel
 # ------------------------------------------------------------------------------------------------------------------
@@ -80,14 +86,14 @@ def test_gmwm_channel_every_field_by_hand():
     n = ch.terms["N"]
     assert (n.value, n.lo95, n.hi95, n.unit, n.status, n.reason) == (0.3, 0.27, 0.33, "deg/sqrt(h)", "resolved", "")
     assert n.source == "gmwm WN+RW+GM: N (component WN)"
-    assert n.si == pytest.approx(0.3 * D / 60.0, rel=1e-12)
-    assert n.si_lo95 == pytest.approx(0.27 * D / 60.0, rel=1e-12)
-    assert n.si_hi95 == pytest.approx(0.33 * D / 60.0, rel=1e-12)
+    assert n.si == approx(0.3 * D / 60.0, rel=1e-12)
+    assert n.si_lo95 == approx(0.27 * D / 60.0, rel=1e-12)
+    assert n.si_hi95 == approx(0.33 * D / 60.0, rel=1e-12)
     k = ch.terms["K"]                                     # deg/h/sqrt(h) is read as deg/h^1.5
-    assert k.unit == "deg/h^1.5" and k.status == "resolved" and k.si == pytest.approx(2.0 * RRW, rel=1e-12)
+    assert k.unit == "deg/h^1.5" and k.status == "resolved" and k.si == approx(2.0 * RRW, rel=1e-12)
     r = ch.terms["R"]                                     # lo95 = 0: not resolved from zero
     assert (r.status, r.reason) == ("unresolved", "its 95 % interval reaches 0")
-    assert r.si == pytest.approx(1.0 * D / 3600.0 ** 2, rel=1e-12)       # deg/h^2 -> rad/s^2
+    assert r.si == approx(1.0 * D / 3600.0 ** 2, rel=1e-12)       # deg/h^2 -> rad/s^2
     q = ch.terms["Q"]                                     # not in the model, GMWM gives no bound
     assert (q.value, q.lo95, q.hi95, q.unit, q.status) == (None, None, None, "urad", "absent")
     assert q.reason == "not in the GMWM model WN+RW+GM (GMWM gives no upper bound for a term it leaves out)"
@@ -95,12 +101,12 @@ def test_gmwm_channel_every_field_by_hand():
     b = ch.terms["B"]                                     # the headline reading, resolved
     assert (b.value, b.lo95, b.hi95, b.unit, b.status, b.reason) == (1.5, 1.0, 2.0, "deg/h", "resolved", "")
     assert b.source == "gmwm WN+RW+GM: B, min of the model's ADEV / 0.664"
-    assert b.si == pytest.approx(1.5 * DPH, rel=1e-12) and b.si_hi95 == pytest.approx(2.0 * DPH, rel=1e-12)
+    assert b.si == approx(1.5 * DPH, rel=1e-12) and b.si_hi95 == approx(2.0 * DPH, rel=1e-12)
     assert b.has_estimate
     (g,) = ch.gms
-    assert g.sigma_si == pytest.approx(4.0 * DPH, rel=1e-12) and g.tc_s == 100.0
-    assert g.sigma_lo95_si == pytest.approx(2.0 * DPH, rel=1e-12)
-    assert g.sigma_hi95_si == pytest.approx(8.0 * DPH, rel=1e-12)
+    assert g.sigma_si == approx(4.0 * DPH, rel=1e-12) and g.tc_s == 100.0
+    assert g.sigma_lo95_si == approx(2.0 * DPH, rel=1e-12)
+    assert g.sigma_hi95_si == approx(8.0 * DPH, rel=1e-12)
     assert (g.tc_lo95_s, g.tc_hi95_s) == (50.0, 200.0) and g.source == "gmwm WN+RW+GM: GM1"
 
 
@@ -113,16 +119,16 @@ def test_gmwm_channel_defaults_when_fields_are_absent():
     ie["gm"] = [_gm(50.0, 3.0, unit=None, component=None, ci=False)]
     ch = _one(ax, {"fs_hz": None})
     assert ch.fit == "GMWM model WN+GM"                    # no J-test: no p in the words
-    assert ch.rate_hz == pytest.approx(100.0, rel=1e-12)  # 1 / dt_s
+    assert ch.rate_hz == approx(100.0, rel=1e-12)  # 1 / dt_s
     assert ch.sha256 == "" and ch.b_tau_s is None
     assert all(math.isnan(x) for x in ch.tau_range_s)
     assert ch.terms["K"].unit == "deg/h^1.5" and ch.terms["K"].source == "gmwm WN+GM: K (component ?)"
-    assert ch.terms["K"].si == pytest.approx(2.0 * RRW, rel=1e-12)
+    assert ch.terms["K"].si == approx(2.0 * RRW, rel=1e-12)
     b = ch.terms["B"]                                     # no headline: absent, no bound
     assert (b.value, b.lo95, b.hi95, b.unit, b.status) == (None, 0.0, None, "deg/h", "absent")
     assert b.reason == "no bias-instability reading" and b.source == "gmwm WN+GM: B, "
     (g,) = ch.gms                                         # sigma without unit: deg/h; no interval, no name
-    assert g.sigma_si == pytest.approx(3.0 * DPH, rel=1e-12)
+    assert g.sigma_si == approx(3.0 * DPH, rel=1e-12)
     assert (g.sigma_lo95_si, g.sigma_hi95_si, g.tc_lo95_s, g.tc_hi95_s) == (None, None, None, None)
     assert g.source == "gmwm WN+GM: GM"
     ax2 = _full_gmwm_axis()
@@ -138,7 +144,7 @@ def test_gmwm_b_headline_bound_and_flicker_term():
     ch = _one(ax, {"fs_hz": 100.0})
     b = ch.terms["B"]
     assert (b.value, b.lo95, b.hi95, b.status) == (None, 0.0, 9.0, "absent")
-    assert b.si_hi95 == pytest.approx(9.0 * DPH, rel=1e-12) and b.si_lo95 == 0.0
+    assert b.si_hi95 == approx(9.0 * DPH, rel=1e-12) and b.si_lo95 == 0.0
     assert b.reason == "95 % upper bound: no minimum in the range" and not b.has_estimate
     assert b.source == "gmwm WN+RW+GM: B, min of the model's ADEV / 0.664"
     assert ch.b_is_flicker is False and ch.b_tau_s == 800.0
@@ -158,7 +164,7 @@ def test_gmwm_headline_without_label_and_n_without_unit():
     ch = _one(ax)
     assert ch.terms["B"].source == "gmwm WN+RW+GM: B, " and ch.terms["B"].status == "resolved"
     assert ch.quantity == "gyro" and ch.terms["N"].unit == "deg/sqrt(h)"
-    assert ch.terms["N"].si == pytest.approx(0.3 * D / 60.0, rel=1e-12)
+    assert ch.terms["N"].si == approx(0.3 * D / 60.0, rel=1e-12)
     del ie["terms"]["N_dprh"]                                # no N at all: absent, in the gyro's unit
     n = _one(ax).terms["N"]
     assert (n.unit, n.status, n.value, n.hi95) == ("deg/sqrt(h)", "absent", None, None)
@@ -175,13 +181,13 @@ def test_gmwm_accelerometer_defaults_are_specific_force_units():
     assert ch.quantity == "accel"                         # B's bound is read in m/s^2 (not deg/h)
     assert {k: ch.terms[k].unit for k in "NKRQB"} == {"N": "m/s/sqrt(h)", "K": "m/s^2/sqrt(s)", "R": "m/s^3",
                                                       "Q": "m/s", "B": "m/s^2"}
-    assert ch.terms["B"].si_hi95 == pytest.approx(5e-4, rel=1e-12)
-    assert ch.terms["N"].si == pytest.approx(0.06 / 60.0, rel=1e-12)
+    assert ch.terms["B"].si_hi95 == approx(5e-4, rel=1e-12)
+    assert ch.terms["N"].si == approx(0.06 / 60.0, rel=1e-12)
     k = ch.terms["K"]                                     # the wavelet-variance bound is a gyro (deg/h) reading
     assert k.hi95 is None and k.lo95 is None
     assert k.reason.endswith("(GMWM gives no upper bound for a term it leaves out)")
-    assert ch.gms[0].sigma_si == pytest.approx(2e-4, rel=1e-12)
-    assert ch.gms[0].sigma_hi95_si == pytest.approx(4e-4, rel=1e-12)
+    assert ch.gms[0].sigma_si == approx(2e-4, rel=1e-12)
+    assert ch.gms[0].sigma_hi95_si == approx(4e-4, rel=1e-12)
 
 
 def test_gmwm_wavelet_bound_is_for_the_gyro_random_walk_only():
@@ -194,7 +200,7 @@ def test_gmwm_wavelet_bound_is_for_the_gyro_random_walk_only():
     k = ch.terms["K"]
     tau = 32.0                                            # the LAST scale, not the first or the second
     k_bound = 60.0 * math.sqrt(3.0 * 12.0 * tau / (tau * tau + 2.0) / 0.01)
-    assert k.hi95 == pytest.approx(k_bound, rel=1e-12) and k.lo95 == 0.0 and k.status == "absent"
+    assert k.hi95 == approx(k_bound, rel=1e-12) and k.lo95 == 0.0 and k.status == "absent"
     assert k.reason.startswith("not in the GMWM model WN+RW+GM; 95 % upper bound from the wavelet variance")
     assert "longest scale (0.32 s)" in k.reason
     assert ch.terms["Q"].hi95 is None                     # only K gets the wavelet bound
@@ -216,7 +222,7 @@ def test_rw_bound_from_wv_gives_nothing_for_an_unusable_variance(wv):
 def test_rw_bound_from_wv_by_hand(tau, hi, dt):
     # K [deg/h^1.5] = 60 sqrt(hi * 12 tau / ((tau^2 + 2) dt)): Haar WV of a random walk gamma^2 (tau^2 + 2) / (12 tau)
     k, why = _rw_bound_from_wv({"tau_samples": [tau], "ci_hi95_dph2": [hi], "dt_s": dt, "scale_s": [tau * dt]})
-    assert k == pytest.approx(60.0 * math.sqrt(hi * 12.0 * tau / ((tau * tau + 2.0) * dt)), rel=1e-12)
+    assert k == approx(60.0 * math.sqrt(hi * 12.0 * tau / ((tau * tau + 2.0) * dt)), rel=1e-12)
     assert why.startswith("95 % upper bound from the wavelet variance")
 
 
@@ -378,10 +384,10 @@ def test_gauss_markov_comment_by_hand(both):
                   r"(\S+), driving sigma = sigma sqrt\(1 - phi\^2\) = (\S+) rad/s", text)
     assert m, text
     s, lo, hi, t, p, q = (float(v) for v in m.groups())
-    assert s == pytest.approx(sigma, rel=1e-4) and t == pytest.approx(tc, rel=1e-4)
-    assert lo == pytest.approx(1.0760 * 1.5, rel=1e-3) and hi == pytest.approx(1.0760 * 2.5, rel=1e-3)  # deg/h
-    assert p == pytest.approx(math.exp(-0.01 / t), abs=2e-9)            # the identity, on the printed T_c
-    assert q == pytest.approx(sigma * math.sqrt(1 - phi * phi), rel=1e-3)
+    assert s == approx(sigma, rel=1e-4) and t == approx(tc, rel=1e-4)
+    assert lo == approx(1.0760 * 1.5, rel=1e-3) and hi == approx(1.0760 * 2.5, rel=1e-3)  # deg/h
+    assert p == approx(math.exp(-0.01 / t), abs=2e-9)            # the identity, on the printed T_c
+    assert q == approx(sigma * math.sqrt(1 - phi * phi), rel=1e-3)
     assert ("# corrtime: the longest gyroscope correlation time; per axis: gyro 0.0146769, 0.0146769, 0.0146769 h, "
             "accel 0.0146769, 0.0146769, 0.0146769 h") in text        # 52.8369 s = 0.0146769 h
 
@@ -432,14 +438,14 @@ def test_gnss_ins_sim_with_one_quantity(tmp_path):
         err = ns["imu_err"]
         assert sorted(err) == sorted([f"{have}_b", f"{have}_{'arw' if have == 'gyro' else 'vrw'}",
                                       f"{have}_b_stability", f"{have}_b_corr"])
-        assert list(err[f"{have}_b_corr"]) == pytest.approx([100 / 1.8926] * 3, rel=1e-4)
+        assert list(err[f"{have}_b_corr"]) == approx([100 / 1.8926] * 3, rel=1e-4)
 
 
 def test_kfgins_and_matlab_with_one_quantity(tmp_path):
     g = _gyro_only(tmp_path)
     kf = render("kf-gins", g).splitlines()
     assert kf[0] == _HEADERS["kf-gins"]
-    assert yaml.safe_load("\n".join(kf))["imunoise"]["arw"] == pytest.approx([0.15, 0.20, 0.10], rel=1e-5)
+    assert yaml.safe_load("\n".join(kf))["imunoise"]["arw"] == approx([0.15, 0.20, 0.10], rel=1e-5)
     assert "  # vrw: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in kf
     assert "  # abstd: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in kf
     m = render("matlab", g).splitlines()
@@ -504,8 +510,8 @@ def test_gm_comment_gives_the_intervals_it_has(tmp_path):
     assert sig[1].startswith(f"#   sigma = {2.0 * DPH:.6g} rad/s, T_c = 40.0 s; discrete at 100.0 Hz: ")
     assert sig[2].startswith(f"#   sigma = {1.0 * DPH:.6g} rad/s (95 % [0.5, 2.0] deg/h), T_c = 60.0 s; ")
     d = yaml.safe_load("\n".join(text))["imunoise"]
-    assert d["gbstd"] == pytest.approx([4.0, 2.0, 1.0], rel=1e-5)
-    assert d["corrtime"] == pytest.approx(100.0 / 3600.0, rel=1e-5)
+    assert d["gbstd"] == approx([4.0, 2.0, 1.0], rel=1e-5)
+    assert d["corrtime"] == approx(100.0 / 3600.0, rel=1e-5)
 
 
 _TERM_KEYS = {"name", "value", "lo95", "hi95", "unit", "status", "reason", "si", "si_lo95", "si_hi95", "si_unit",
@@ -535,22 +541,22 @@ def test_json_target_fields_by_hand(tmp_path):
     ev = gx["export_values"]
     assert list(ev) == ["N", "K", "B", "Q", "R"]
     n_si = 0.15 * D / 60.0
-    assert ev["N"] == {"si": pytest.approx(n_si, rel=1e-12), "si_unit": "rad/s/sqrt(Hz)", "how": "estimate",
+    assert ev["N"] == {"si": approx(n_si, rel=1e-12), "si_unit": "rad/s/sqrt(Hz)", "how": "estimate",
                        "note": "", "conversion": gx["terms"]["N"]["conversion"],
-                       "discrete_sigma": pytest.approx(n_si * 20.0, rel=1e-12),                 # x sqrt(400)
+                       "discrete_sigma": approx(n_si * 20.0, rel=1e-12),                 # x sqrt(400)
                        "discrete_note": "per-sample 1-sigma = N sqrt(f)"}
     k_si = 0.5 * RRW
-    assert ev["K"]["discrete_sigma"] == pytest.approx(k_si / 20.0, rel=1e-12)               # / sqrt(400)
+    assert ev["K"]["discrete_sigma"] == approx(k_si / 20.0, rel=1e-12)               # / sqrt(400)
     assert ev["K"]["discrete_note"] == "per-sample bias step 1-sigma = K / sqrt(f)"
     assert ev["K"]["si_unit"] == "rad/s^2/sqrt(Hz)"
     assert set(ev["B"]) == {"si", "si_unit", "how", "note", "conversion"}                   # a level: no discrete
-    assert ev["Q"]["how"] == "bound" and ev["Q"]["si"] == pytest.approx(0.3e-6, rel=1e-12)  # 0.3 urad -> rad
+    assert ev["Q"]["how"] == "bound" and ev["Q"]["si"] == approx(0.3e-6, rel=1e-12)  # 0.3 urad -> rad
     assert "95 % upper bound" in ev["Q"]["note"]
     gm = gx["bias_gauss_markov"]
     tc = 100.0 / 1.8926
-    assert gm["tc_s"] == pytest.approx(tc, rel=1e-4) and gm["sigma_si"] == pytest.approx(1.0760 * 2.0 * DPH, rel=1e-4)
-    assert gm["phi"] == pytest.approx(math.exp(-0.0025 / gm["tc_s"]), rel=1e-12)             # dt = 1/400 s
-    assert gm["driving_sigma_si"] == pytest.approx(gm["sigma_si"] * math.sqrt(1 - gm["phi"] ** 2), rel=1e-9)
+    assert gm["tc_s"] == approx(tc, rel=1e-4) and gm["sigma_si"] == approx(1.0760 * 2.0 * DPH, rel=1e-4)
+    assert gm["phi"] == approx(math.exp(-0.0025 / gm["tc_s"]), rel=1e-12)             # dt = 1/400 s
+    assert gm["driving_sigma_si"] == approx(gm["sigma_si"] * math.sqrt(1 - gm["phi"] ** 2), rel=1e-9)
     assert gm["how"].startswith("one GM matched to B (estimate)")
     assert "caveat" not in gx["state_space"]
     ax = d["channels"][3]
@@ -602,25 +608,25 @@ def test_gyro_state_space_by_hand():
     assert d["terms_left_out"] == [{"term": "B", "reason": "not in the model", "hi95": 0.3, "unit": "deg/h"}]
     ct = {t["kind"]: t for t in d["continuous_terms"]}
     assert set(ct) == {"white", "quantization", "random_walk", "ramp"}
-    assert ct["white"]["density"] == pytest.approx(n, rel=1e-9) and ct["white"]["unit"] == "rad/s/sqrt(Hz)"
-    assert ct["quantization"]["q"] == pytest.approx(q, rel=1e-9) and ct["quantization"]["unit"] == "rad"
-    assert ct["random_walk"]["density"] == pytest.approx(k, rel=1e-9)
+    assert ct["white"]["density"] == approx(n, rel=1e-9) and ct["white"]["unit"] == "rad/s/sqrt(Hz)"
+    assert ct["quantization"]["q"] == approx(q, rel=1e-9) and ct["quantization"]["unit"] == "rad"
+    assert ct["random_walk"]["density"] == approx(k, rel=1e-9)
     assert ct["random_walk"]["unit"] == "rad/s/s/sqrt(Hz)"
-    assert ct["ramp"]["slope_sigma"] == pytest.approx(r, rel=1e-9) and ct["ramp"]["unit"] == "rad/s/s"
+    assert ct["ramp"]["slope_sigma"] == approx(r, rel=1e-9) and ct["ramp"]["unit"] == "rad/s/s"
     c = d["continuous"]
     assert c["states"] == ["bias", "random_walk", "ramp", "ramp_slope"]
     assert np.array_equal(c["F"], [[0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1.0], [0, 0, 0, 0]])
     assert np.allclose(c["Qc"], np.diag([0.0, k * k, 0.0, 0.0]), rtol=1e-9, atol=0)
     assert c["H"] == [1.0, 1.0, 1.0, 0.0] and c["Qc_unit"] == "(rad/s)^2/s"
-    assert c["white_density"] == pytest.approx(n, rel=1e-9) and c["white_density_unit"] == "rad/s/sqrt(Hz)"
-    assert c["quantization"] == pytest.approx(q, rel=1e-9) and c["quantization_unit"] == "rad"
-    assert c["ramp_slope_sigma"] == pytest.approx(r, rel=1e-9) and c["ramp_slope_unit"] == "rad/s/s"
+    assert c["white_density"] == approx(n, rel=1e-9) and c["white_density_unit"] == "rad/s/sqrt(Hz)"
+    assert c["quantization"] == approx(q, rel=1e-9) and c["quantization_unit"] == "rad"
+    assert c["ramp_slope_sigma"] == approx(r, rel=1e-9) and c["ramp_slope_unit"] == "rad/s/s"
     z = d["discrete"]
     dt = 0.02
     assert z["rate_hz"] == 50.0 and z["dt_s"] == dt and z["states"] == c["states"] and z["H"] == c["H"]
     assert np.allclose(z["Phi"], [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, dt], [0, 0, 0, 1]], rtol=0, atol=1e-15)
-    assert z["Qd"][1][1] == pytest.approx(k * k * dt, rel=1e-9)
-    assert z["r"] == pytest.approx(n * n / dt + 2.0 * q * q / dt ** 2, rel=1e-9)
+    assert z["Qd"][1][1] == approx(k * k * dt, rel=1e-9)
+    assert z["r"] == approx(n * n / dt + 2.0 * q * q / dt ** 2, rel=1e-9)
     assert (z["Qd_unit"], z["r_unit"]) == ("(rad/s)^2", "(rad/s)^2")
     assert z["method"] == "Van Loan (1978): expm([[-F, Qc], [0, F^T]] dt); r = N^2/dt + 2 Q^2/dt^2"
     assert 0.0 <= d["check_max_abs"] < 1e-9
@@ -636,16 +642,16 @@ def test_accelerometer_state_space_with_a_gauss_markov_by_hand():
     assert d["components_note"] == ("statespace components (fogdrift.models.statespace) in m/s^2 in place of deg/h "
                                     "(its formulas are linear in the rate unit)")
     gm = next(t for t in d["continuous_terms"] if t["kind"] == "gauss_markov")
-    assert gm == {"kind": "gauss_markov", "sigma": pytest.approx(2e-4, rel=1e-12), "unit": "m/s^2", "tc_s": 300.0}
+    assert gm == {"kind": "gauss_markov", "sigma": approx(2e-4, rel=1e-12), "unit": "m/s^2", "tc_s": 300.0}
     white = next(t for t in d["continuous_terms"] if t["kind"] == "white")
-    assert white["density"] == pytest.approx(0.001, rel=1e-9) and white["unit"] == "m/s^2/sqrt(Hz)"
+    assert white["density"] == approx(0.001, rel=1e-9) and white["unit"] == "m/s^2/sqrt(Hz)"
     c, z = d["continuous"], d["discrete"]
     assert c["states"] == ["bias", "gm_300s"] and c["quantization_unit"] == "m/s" and c["Qc_unit"] == "(m/s^2)^2/s"
-    assert c["F"][1][1] == pytest.approx(-1.0 / 300.0, rel=1e-12)
-    assert c["Qc"][1][1] == pytest.approx(2.0 * 4e-8 / 300.0, rel=1e-12)       # 2 sigma^2 / T
-    assert z["Phi"][1][1] == pytest.approx(math.exp(-0.1 / 300.0), rel=1e-12)  # Van Loan for a 1-state GM
-    assert z["Qd"][1][1] == pytest.approx(4e-8 * (1.0 - math.exp(-0.2 / 300.0)), rel=1e-9)
-    assert z["r"] == pytest.approx(1e-6 / 0.1, rel=1e-9) and z["r_unit"] == "(m/s^2)^2"
+    assert c["F"][1][1] == approx(-1.0 / 300.0, rel=1e-12)
+    assert c["Qc"][1][1] == approx(2.0 * 4e-8 / 300.0, rel=1e-12)       # 2 sigma^2 / T
+    assert z["Phi"][1][1] == approx(math.exp(-0.1 / 300.0), rel=1e-12)  # Van Loan for a 1-state GM
+    assert z["Qd"][1][1] == approx(4e-8 * (1.0 - math.exp(-0.2 / 300.0)), rel=1e-9)
+    assert z["r"] == approx(1e-6 / 0.1, rel=1e-9) and z["r_unit"] == "(m/s^2)^2"
     assert d["check_max_abs"] < 1e-9
 
 
@@ -704,7 +710,7 @@ def test_allan_channel_fields_by_hand():
     assert (r.status, r.value, r.hi95) == ("absent", None, 0.3) and not r.has_estimate
     # no fs_hz: the rate is 1 / dt_s
     (ch,) = channels_from_result(_allan_doc(ax, {}), "a.json")
-    assert ch.rate_hz == pytest.approx(100.0, rel=1e-12) and ch.sha256 == ""
+    assert ch.rate_hz == approx(100.0, rel=1e-12) and ch.sha256 == ""
 
 
 def test_allan_no_fit_reason_and_status():
@@ -729,9 +735,9 @@ def test_allan_b_min_reading_when_the_model_has_no_flicker():
     assert b.source == "allan fit: B_min, min of the fitted ADEV / 0.664"
     assert ch.b_is_flicker is False and ch.b_tau_s == 80.0
     g, how = bias_gm(ch, "bound")                            # one GM matched to the B reading at tau_B = 80 s
-    assert g.sigma_si == pytest.approx(1.0760 * 1.2 * DPH, rel=1e-4) and g.tc_s == pytest.approx(80 / 1.8926, rel=1e-4)
-    assert g.sigma_lo95_si == pytest.approx(1.0760 * 1.0 * DPH, rel=1e-4)
-    assert g.sigma_hi95_si == pytest.approx(1.0760 * 1.5 * DPH, rel=1e-4)
+    assert g.sigma_si == approx(1.0760 * 1.2 * DPH, rel=1e-4) and g.tc_s == approx(80 / 1.8926, rel=1e-4)
+    assert g.sigma_lo95_si == approx(1.0760 * 1.0 * DPH, rel=1e-4)
+    assert g.sigma_hi95_si == approx(1.0760 * 1.5 * DPH, rel=1e-4)
     assert g.source == "from B at tau = 80 s"
     assert how == ("one GM matched to B (estimate): sigma = 1.0760 B, T_c = tau_B/1.8926 with tau_B = 80 s "
                    "(its Allan peak equals the flicker floor 0.664 B there)")
@@ -741,7 +747,7 @@ def test_allan_b_min_reading_when_the_model_has_no_flicker():
     b = ch.terms["B"]
     assert (b.value, b.hi95, b.status, b.reason) == (None, 3.0, "absent", "no minimum: a bound")
     g, how = bias_gm(ch, "bound")
-    assert g.sigma_si == pytest.approx(1.0760 * 3.0 * DPH, rel=1e-4)
+    assert g.sigma_si == approx(1.0760 * 3.0 * DPH, rel=1e-4)
     assert g.sigma_lo95_si is None and g.sigma_hi95_si is None
     assert how.startswith("one GM matched to B (bound: B is its 95 % upper bound 3 deg/h, not an estimate")
     # no fit: the b_min reading is not used
@@ -759,7 +765,7 @@ def test_allan_markov_term_becomes_a_gauss_markov():
                                    "q_unit": "deg/h/sqrt(s)"}}
     (ch,) = channels_from_result(_allan_doc(ax), "a.json")
     (g,) = ch.gms
-    assert g.sigma_si == pytest.approx(0.6 * DPH, rel=1e-12) and g.tc_s == 30.0
+    assert g.sigma_si == approx(0.6 * DPH, rel=1e-12) and g.tc_s == 30.0
     assert (g.tc_lo95_s, g.tc_hi95_s) == (20.0, 45.0)
     assert g.source == "allan fit: M (exponentially correlated, IEEE-952 C.6)"
     for cut in ("tc_lo95_s", "tc_hi95_s"):                   # a T_c without its interval is not used
@@ -811,7 +817,7 @@ def test_resolve_messages_by_hand(tmp_path):
     ax = _allan_axis("gz", {"N": (0.1, 0.0, 0.2, "unresolved"), "B": (1.0, 0.5, 1.5, "resolved")}, selected=("N", "B"))
     (ch,) = channels_from_result(_allan_doc(ax), "g.json")
     r = resolve(ch, "N", "refuse")                           # an estimate is written under every policy
-    assert (r.how, r.si) == ("estimate", pytest.approx(0.1 * D / 60, rel=1e-12))
+    assert (r.how, r.si) == ("estimate", approx(0.1 * D / 60, rel=1e-12))
     assert r.note == "N = 0.1 deg/sqrt(h) is the estimate, not resolved from zero: its 95 % interval reaches 0"
     assert resolve(ch, "B", "zero").note == "" and resolve(ch, "B", "zero").how == "estimate"
     r = resolve(ch, "K", "zero")
@@ -890,18 +896,18 @@ def test_check_max_abs_catches_a_disagreement_in_each_part(monkeypatch, what, fa
     monkeypatch.setattr(dz, "state_space", off)
     check = dz.discrete_model(ch, 100.0)["check_max_abs"]
     # Phi ~ 1: an absolute 1e-3; Qd and r: relative 1e-3 (Qd of the largest element, values ~1e-13 (rad/s)^2)
-    assert check == pytest.approx(1e-3, rel=2e-2)
+    assert check == approx(1e-3, rel=2e-2)
 
 
 def test_gyro_gauss_markov_component_in_si_and_quantization_alone():
     d = discrete_model(_gyro_gm_chan(), 100.0)
     gm = next(t for t in d["continuous_terms"] if t["kind"] == "gauss_markov")
-    assert gm["sigma"] == pytest.approx(4.0 * DPH, rel=1e-12) and gm["unit"] == "rad/s"
+    assert gm["sigma"] == approx(4.0 * DPH, rel=1e-12) and gm["unit"] == "rad/s"
     comps, _ = channel_components(_gyro_gm_chan())
-    assert next(c for c in comps if c["kind"] == "gauss_markov")["sigma_dph"] == pytest.approx(4.0, rel=1e-12)
+    assert next(c for c in comps if c["kind"] == "gauss_markov")["sigma_dph"] == approx(4.0, rel=1e-12)
     q_only = _chan("gyro", {"Q": (2.0, 1.0, 3.0, "urad", "resolved", "")})
     d = discrete_model(q_only, 100.0)
-    assert d["discrete"]["r"] == pytest.approx(2.0 * (2e-6) ** 2 / 0.01 ** 2, rel=1e-9)   # 2 Q^2 / dt^2
+    assert d["discrete"]["r"] == approx(2.0 * (2e-6) ** 2 / 0.01 ** 2, rel=1e-9)   # 2 Q^2 / dt^2
     assert d["check_max_abs"] is not None and d["check_max_abs"] < 1e-9
 
 
