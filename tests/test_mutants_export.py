@@ -638,6 +638,13 @@ def test_accelerometer_state_space_with_a_gauss_markov_by_hand():
     ch = _chan("accel", {"N": (0.06, 0.05, 0.07, "m/s/sqrt(h)", "resolved", "")},
                gms=[GaussMarkov(sigma_si=2e-4, tc_s=300.0)])
     d = discrete_model(ch, 10.0)
+    assert set(d) == {"rate_unit", "continuous_terms", "components", "components_rate_unit", "components_note",
+                      "terms_left_out", "continuous", "discrete", "check_max_abs", "check_note"}
+    assert [c["kind"] for c in d["components"]] == ["white", "gauss_markov"]
+    assert d["components"][1]["sigma_dph"] == approx(2e-4, rel=1e-12)     # statespace units: m/s^2 for deg/h
+    q = _chan("accel", {"Q": (3e-4, 2e-4, 4e-4, "m/s", "resolved", "")})
+    qt = discrete_model(q, 10.0)["continuous_terms"]
+    assert qt == [{"kind": "quantization", "q": approx(3e-4, rel=1e-9), "unit": "m/s"}]
     assert d["rate_unit"] == "m/s^2" and d["components_rate_unit"] == "m/s^2"
     assert d["components_note"] == ("statespace components (fogdrift.models.statespace) in m/s^2 in place of deg/h "
                                     "(its formulas are linear in the rate unit)")
