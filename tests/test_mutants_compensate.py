@@ -787,3 +787,33 @@ def test_a_failure_while_writing_the_test_block_leaves_no_file(tmp_path, monkeyp
     with pytest.raises(KeyboardInterrupt):
         write_compensated_test_block([_model_axis()], tmp_path)
     assert os.listdir(tmp_path) == []
+
+
+def test_bias_window_ending_in_the_last_short_segment_gets_the_prediction_after_the_log():
+    """11 samples at factor 2 (5 intervals and 1 sample), bias window 4 s: the one (final, held) segment completes
+    the window; the last native sample gets the prediction after the log, (z[3] + z[4]) / 2."""
+    x = _log(11, 8)
+    eng = _engine([_axis(bias=3.0)], factor=2, bias=4.0)
+    out = _run(eng, x, None)
+    means = x[:10].reshape(5, 2).mean(axis=1)
+    z = means - means[:4].mean()
+    assert_allclose(out["drift_dph"][10, 0], 0.5 * (z[3] + z[4]), rtol=1e-12)
+    assert_array_equal(out["drift_dph"][:8, 0], 0.0)
+    assert_allclose(out["drift_dph"][8:10, 0], 0.5 * (z[2] + z[3]), rtol=1e-12)
+
+
+def test_a_full_segment_is_processed_as_soon_as_it_is_complete():
+    eng = _engine([_axis()], factor=2, segment=2)  # 4 native samples per segment
+    out = eng.push(np.arange(4.0), np.ones((4, 1)))
+    assert [b.t_s.tolist() for b in out] == [[0.0, 1.0, 2.0, 3.0]] and eng.n_out == 4
+    assert eng.finish() == []
+
+
+def test_integer_input_is_read_as_float():
+    x = np.arange(10)
+    a = _engine([_axis(bias=1.5)], factor=2)
+    blocks = a.push(np.arange(10.0), x.reshape(-1, 1)) + a.finish()
+    comp = np.concatenate([b.compensated_dph for b in blocks])[:, 0]
+    assert comp.dtype == np.float64
+    assert_allclose(comp, _run(_engine([_axis(bias=1.5)], factor=2), x.astype(float), None)["compensated_dph"][:, 0])
+    assert comp[0] == -1.5
