@@ -654,6 +654,7 @@ def test_accelerometer_state_space_with_a_gauss_markov_by_hand():
     assert white["density"] == approx(0.001, rel=1e-9) and white["unit"] == "m/s^2/sqrt(Hz)"
     c, z = d["continuous"], d["discrete"]
     assert c["states"] == ["bias", "gm_300s"] and c["quantization_unit"] == "m/s" and c["Qc_unit"] == "(m/s^2)^2/s"
+    assert (c["ramp_slope_sigma"], c["quantization"], c["ramp_slope_unit"]) == (0.0, 0.0, "m/s^2/s")   # no R, no Q
     assert c["F"][1][1] == approx(-1.0 / 300.0, rel=1e-12)
     assert c["Qc"][1][1] == approx(2.0 * 4e-8 / 300.0, rel=1e-12)       # 2 sigma^2 / T
     assert z["Phi"][1][1] == approx(math.exp(-0.1 / 300.0), rel=1e-12)  # Van Loan for a 1-state GM
