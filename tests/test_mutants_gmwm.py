@@ -698,3 +698,32 @@ def test_j_pvalue_with_one_degree_of_freedom():
     assert fit.df == 1 and fit.q > 0
     assert fit.j_pvalue == pytest.approx(float(special.gammaincc(0.5, fit.q / 2.0)), rel=1e-10)
     assert fit.wic == pytest.approx(fit.q + fit.penalty, rel=1e-12)
+
+
+def test_wic_penalty_and_standard_errors_do_not_depend_on_the_scale_of_v():
+    """Omega = V^-1: multiplying V by 1e8 leaves the estimate and the penalty 2p unchanged and multiplies the
+    standard errors by 1e4 (Cov(z) = (A^T V^-1 A)^-1).  The whitened Jacobian's singular values are then below 1,
+    which a relative rank cut-off must not confuse with a rank deficiency."""
+    from fogdrift.gmwm import gmwm_fit
+
+    wv = haar_wvar(simulate_latent("WN+RW", [1.0, 1e-5], 2**13, seed=3), 0.01)
+    ref = gmwm_fit(wv, "WN+RW")
+    big = gmwm_fit(wv, "WN+RW", V=1e8 * ref.V)
+    np.testing.assert_allclose(big.theta, ref.theta, rtol=1e-4)
+    assert big.penalty == pytest.approx(4.0, rel=1e-6) and ref.penalty == pytest.approx(4.0, rel=1e-6)
+    np.testing.assert_allclose(big.se_z, 1e4 * ref.se_z, rtol=1e-3)
+    assert big.q == pytest.approx(ref.q / 1e8, rel=1e-3)
+
+
+def test_step1_of_each_candidate_is_fitted_on_the_scales_kept():
+    """After the scan, every candidate's step-1 fit (its recorded q_step1) is the step-1 GMWM on the kept scales,
+    not on the excluded ones too."""
+    from fogdrift.gmwm import gmwm_fit
+
+    wv = _filtered(2**13, 4)
+    sel = select_model(wv, ["WN", "WN+RW"], max_excluded=4)
+    kept = [int(v) for v in sel.levels_used]
+    assert kept[0] == 4
+    for c in sel.candidates:
+        own = gmwm_fit(wv, c.model, scales=kept, steps=1)
+        assert c.fit.q_step1 == pytest.approx(own.q, rel=1e-3), c.model
