@@ -223,9 +223,10 @@ def test_classical_b_includes_the_shaped_terms_of_the_printed_model():
     for col, kw, shape in ((ALL_TERMS.index("M"), {"tc_s": 10.0}, markov_shape(grid, 10.0, "hdev", 0.01)),
                            (IS, {"lines": lines}, periodic_shape(grid, lines, 0.01, "hdev"))):
         A2 = np.zeros(len(ALL_TERMS))
-        A2[IN], A2[col] = a, 0.9
+        A2[IN], A2[IK], A2[col] = a, b, 0.9
         c2 = _ctx(tau, c.y, c.y_hi * 100.0, statistic="hdev", **kw)
-        var = a * laws_of("hdev")["N"].shape(grid, 0.01) + 0.9 * shape
+        law = laws_of("hdev")
+        var = a * law["N"].shape(grid, 0.01) + b * law["K"].shape(grid, 0.01) + 0.9 * shape
         k = int(np.argmin(var))
         assert checks._classical_b(c2, A2)["value"] == pytest.approx(math.sqrt(var[k]) / B664, rel=1e-9)
 
@@ -374,6 +375,9 @@ def test_periodic_content_attributes_and_defaults():
     pc = periodic_content({"lines": [_line(5.0, 3.0)], "components": [{"fundamental_hz": 5.0, "lines": [
         _line(5.0, 3.0)]}]})
     assert pc.periods_s == pytest.approx((0.2,)) and len(pc.lines) == 1
+    # a component with a period but no fundamental frequency: its period as given
+    pc = periodic_content({"lines": [_line(5.0, 3.0)], "components": [{"fundamental_hz": 0.0, "period_s": 0.5}]})
+    assert pc.periods_s == pytest.approx((0.5, 0.2))
     # a component with no line: its amplitude is unknown
     pc = periodic_content({"lines": [_line(5.0, 3.0)], "components": [{"fundamental_hz": 2.0, "period_s": 0.5}]})
     assert pc.descriptions[0] == "spectral line at 2 Hz, nan deg/h" and pc.periods_s == pytest.approx((0.5, 0.2))
