@@ -83,3 +83,28 @@ def test_allan_command_loads_no_gmwm(small_npy, tmp_path):
     mods = _modules("from fogdrift.cli import main\nmain()", argv)
     assert "fogdrift.cli.allan" in mods
     assert _gmwm(mods) == []
+
+
+def test_run_freezes_the_imported_objects_only_while_the_command_runs(tmp_path):
+    """cli._app.run freezes the objects that exist when a command starts out of the cyclic GC (full collections
+    during the command skip the imported modules) and unfreezes them when it ends, normally or on an error."""
+    import gc
+    from pathlib import Path
+
+    import typer
+
+    from fogdrift.cli._app import run
+    from fogdrift.errors import ConfigError
+
+    gc.unfreeze()
+    with run("allan", tmp_path / "a", default_out=Path("out/allan")):
+        assert gc.get_freeze_count() > 1000
+        garbage = []
+        garbage.append(garbage)  # a cycle made during the command is still collected there
+        del garbage
+        assert gc.collect() >= 1
+    assert gc.get_freeze_count() == 0
+    with pytest.raises(typer.Exit):
+        with run("allan", tmp_path / "b", default_out=Path("out/allan")):
+            raise ConfigError("bad setting")
+    assert gc.get_freeze_count() == 0

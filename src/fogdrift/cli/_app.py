@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import gc
 import inspect
 import math
 import os
@@ -417,23 +418,33 @@ def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool
     ``--out`` is validated first, so a bad folder is refused before the file is read or anything computed.
     ``out_class``: an :class:`~fogdrift.output.OutputDir` subclass whose ``summary()`` says more on Ctrl-C
     (``batch``: which files' folders are finished).
+
+    While the command runs, the objects that exist when it starts (the imported modules: scipy, numba, the
+    analysis stack, about 10^6 objects) are frozen out of the cyclic garbage collector (:func:`gc.freeze`), and
+    given back to it at the end: every full collection during the command used to walk them all (``fogdrift
+    allan`` on ADIS imu1: 0.20 s of garbage collection, 0.07 s frozen).  What the command allocates is collected
+    as before.
     """
     _configure(json_out)
     _state["finish"] = threading.Lock()
     outdir = None
-    with errors(), _warning_lines():
-        outdir = out_class(out, command=command, create_parents=Path(out) == Path(default_out),
-                           protect=[p for p in inputs if p is not None])
-        outdir.expect(*expect)
-        try:
-            with outdir:
-                yield Run(outdir, bool(json_out))
-        except BaseException as exc:
-            if isinstance(exc, typer.Exit) and not interrupt.requested():
+    gc.freeze()
+    try:
+        with errors(), _warning_lines():
+            outdir = out_class(out, command=command, create_parents=Path(out) == Path(default_out),
+                               protect=[p for p in inputs if p is not None])
+            outdir.expect(*expect)
+            try:
+                with outdir:
+                    yield Run(outdir, bool(json_out))
+            except BaseException as exc:
+                if isinstance(exc, typer.Exit) and not interrupt.requested():
+                    raise
+                if interrupt.requested() or isinstance(exc, KeyboardInterrupt):
+                    _interrupted(outdir)
                 raise
-            if interrupt.requested() or isinstance(exc, KeyboardInterrupt):
-                _interrupted(outdir)
-            raise
+    finally:
+        gc.unfreeze()
 
 
 # -- what was read --------------------------------------------------------------------------------------------
