@@ -666,10 +666,11 @@ def test_a_candidate_with_more_parameters_than_scales_allow_is_scored_as_not_fit
 
 
 def test_the_scan_always_keeps_enough_scales_for_the_largest_candidate():
-    """A 32-tap moving average lowers every octave up to ~0.3 s: the scan excludes leading scales while no candidate
-    explains them, but never leaves fewer than (largest n_params) + 2 = 4 scales."""
+    """A 64-tap moving average lowers every octave up to ~0.6 s: the scan excludes leading scales while no candidate
+    explains them, but never leaves fewer than (largest n_params) + 2 = 4 scales (the fifth scale from the end is
+    still unexplained when the scan stops)."""
     y = simulate_latent("WN+RW", [1.0, 1e-5], 2**11, seed=8)
-    wv = haar_wvar(np.convolve(y, np.ones(32) / 32, mode="valid"), 0.01)
+    wv = haar_wvar(np.convolve(y, np.ones(64) / 64, mode="valid"), 0.01)
     assert len(wv.level) == 9
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FogdriftWarning)
