@@ -375,6 +375,11 @@ def test_periodic_content_attributes_and_defaults():
     pc = periodic_content({"lines": [_line(5.0, 3.0)], "components": [{"fundamental_hz": 5.0, "lines": [
         _line(5.0, 3.0)]}]})
     assert pc.periods_s == pytest.approx((0.2,)) and len(pc.lines) == 1
+    # components by power, strongest first; one without a power counts as power 0 (last)
+    pc = periodic_content({"lines": [_line(5.0, 3.0)], "components": [
+        {"fundamental_hz": 2.0, "lines": [_line(2.0, 1.0)]},
+        {"fundamental_hz": 4.0, "power_dph2": 0.5, "lines": [_line(4.0, 1.0)]}]})
+    assert pc.periods_s == pytest.approx((0.25, 0.5, 0.2))
     # a component with a period but no fundamental frequency: its period as given
     pc = periodic_content({"lines": [_line(5.0, 3.0)], "components": [{"fundamental_hz": 0.0, "period_s": 0.5}]})
     assert pc.periods_s == pytest.approx((0.5, 0.2))
