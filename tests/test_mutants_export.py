@@ -923,3 +923,46 @@ def test_max_flicker_terms_is_passed_on():
     b = {"B": (2.0, 1.5, 2.5, "deg/h", "resolved", "")}
     comps, _ = channel_components(_chan("gyro", b, tau=(0.1, 1e4)), max_flicker_terms=2)
     assert [c["kind"] for c in comps] == ["gauss_markov", "gauss_markov"]
+
+
+def test_header_names_the_files_and_their_hashes(tmp_path):
+    g, a = _gyro_result(tmp_path), _accel_result(tmp_path)
+    lines = render("kalibr", build_context([g], [a])).splitlines()
+    assert lines[1] == f"# from {a}, {g} (input SHA-256 {'ab' * 8}...)"        # sorted; the accel file has none
+    assert render("kalibr", build_context(accel=[a])).splitlines()[1] == f"# from {a}"
+
+
+def test_scalar_targets_say_which_axis_was_written(tmp_path):
+    lines = render("kalibr", build_context([_gyro_result(tmp_path)])).splitlines()
+    assert ("# written: the largest of the 3 axes (gy) in rad/s/sqrt(Hz): this format takes one value for all axes"
+            in lines)
+    assert ("# written: the largest of the 3 axes (gx) in rad/s^2/sqrt(Hz): this format takes one value for all "
+            "axes") in lines
+    doc = json.loads(_gyro_result(tmp_path).read_text())
+    for keep, want in ((2, "# written: the largest of the 2 axes (gy) in rad/s/sqrt(Hz): this format takes one value "
+                           "for all axes"), (1, "# written in rad/s/sqrt(Hz)")):
+        p = tmp_path / f"g{keep}.json"
+        p.write_text(json.dumps({**doc, "axes": doc["axes"][:keep]}))
+        lines = render("kalibr", build_context([p])).splitlines()
+        assert want in lines
+        assert "None" not in "\n".join(lines)
+
+
+def test_continuous_comment_says_how_the_value_was_chosen(tmp_path):
+    g = _gyro_result(tmp_path)
+    text = render("kalibr", build_context([g]))
+    assert "#   continuous 5.81776e-05 rad/s/sqrt(Hz) (the estimate; x 0.000290888 (deg/sqrt(h) -> rad/s/sqrt(Hz))); " \
+           "discrete 0.000581776 rad/s per sample at 100.0 Hz (x sqrt(f))" in text
+    zero = render("kalibr", build_context([g], missing="zero"))
+    assert "#   continuous 0.0 rad/s^2/sqrt(Hz) (0 (--missing zero); x 8.08023e-08 (deg/h^1.5 -> rad/s^2/sqrt(Hz))); " \
+           "discrete 0.0 rad/s per-sample bias step at 100.0 Hz (/ sqrt(f))" in zero
+    assert "#   continuous 2.42407e-08 rad/s^2/sqrt(Hz) (its 95 % upper bound (--missing bound); x 8.08023e-08 " \
+           "(deg/h^1.5 -> rad/s^2/sqrt(Hz))); discrete 2.42407e-09 rad/s per-sample bias step at 100.0 Hz " \
+           "(/ sqrt(f))" in text                               # 0.3 deg/h^1.5 x 8.08023e-08, / sqrt(100)
+
+
+def test_fmt_writes_non_finite_values_as_numbers_not_a_dash():
+    from fogdrift.export.writers import fmt
+
+    assert (fmt(math.inf), fmt(-math.inf), fmt(math.nan)) == ("inf", "-inf", "nan")
+    assert (fmt(1e-5), fmt(0.0), fmt(2.5), fmt(123456789.0), fmt(3)) == ("1.0e-05", "0.0", "2.5", "1.23457e+08", "3.0")
