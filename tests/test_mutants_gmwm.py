@@ -728,3 +728,20 @@ def test_step1_of_each_candidate_is_fitted_on_the_scales_kept():
     for c in sel.candidates:
         own = gmwm_fit(wv, c.model, scales=kept, steps=1)
         assert c.fit.q_step1 == pytest.approx(own.q, rel=1e-3), c.model
+
+
+def test_a_collapsed_component_has_an_infinite_standard_error_and_no_penalty():
+    """WN+RW fitted to white noise: the RW variance collapses to its lower bound, where the WV does not depend on it
+    (a zero column of the Jacobian): its SE is infinite (not identified), the WN's is that of the WN-only fit, and
+    the penalty counts the identified direction only (2 x 1)."""
+    from fogdrift.gmwm import gmwm_fit
+
+    wv = haar_wvar(simulate_latent("WN", [1.0], 2**12, seed=1), 0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        both = gmwm_fit(wv, "WN+RW")
+    wn = gmwm_fit(wv, "WN")
+    assert both.at_bound == ("RW.gamma2",)
+    assert math.isinf(both.se_z[1]) and math.isfinite(both.se_z[0])
+    assert both.se_z[0] == pytest.approx(wn.se_z[0], rel=1e-6) and both.theta[0] == pytest.approx(wn.theta[0], rel=1e-6)
+    assert both.penalty == pytest.approx(2.0, rel=1e-6)
