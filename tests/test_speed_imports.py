@@ -76,8 +76,6 @@ def test_allan_command_loads_gmwm_only_through_the_report_package(small_npy, tmp
     assert gm == [] or "fogdrift.gmwm.compare" in gm, gm  # never through the pipeline (see the test above)
 
 
-@pytest.mark.xfail(strict=True, reason="report/__init__ -> report.html -> report.summary imports gmwm.compare at module "
-                                       "level (requested: defer it to summary._allan_check); remove this mark then")
 def test_allan_command_loads_no_gmwm(small_npy, tmp_path):
     argv = ["fogdrift", "allan", str(small_npy), "--rate", "100", "--unit", "deg/h", "--out", str(tmp_path / "a")]
     mods = _modules("from fogdrift.cli import main\nmain()", argv)

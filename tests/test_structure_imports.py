@@ -197,6 +197,9 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
                           "pipeline imports no model module); GMWM (gmwm.estimator: scipy.optimize's least squares, "
                           "gmwm.simulate: scipy.signal) only for noise_method='gmwm', so allan, separate and model "
                           "never load it (test_speed_imports)", ("fogdrift.models.grey", "fogdrift.gmwm.analysis")),
+    "fogdrift.report.summary": ("GMWM's comparison with the Allan fit (gmwm.compare -> gmwm.estimator: scipy.optimize) "
+                                "only for an axis that has a GMWM fit, so allan and separate never load gmwm "
+                                "(test_speed_imports)", ("fogdrift.gmwm.compare",)),
     "fogdrift.io.load": ("optional readers: the reader registry imports a reader module on first use", (
         "fogdrift.io.registry",)),
     "fogdrift.lifting._kernels": (NUMBA, ("fogdrift.lifting._numba",)),

@@ -12,7 +12,6 @@ from pathlib import Path
 import numpy as np
 
 from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
-from ..gmwm.compare import compare_with_allan
 from ..noise import TERM_TABLE
 from ..noise.terms import DISPLAY_UNITS, TERMS
 from ..spec import B_COMPARED, compare, judgement_line, readings_from_gmwm, readings_from_noise_fit
@@ -143,6 +142,8 @@ def _allan_check(ax) -> dict:
     """The GMWM axis's comparison with the Allan fit of the same record (made once, kept on the GMWM axis)."""
 
     if ax.gmwm.allan_check is None:
+        from ..gmwm.compare import compare_with_allan  # GMWM only for a GMWM axis: allan/separate never load it
+
         ax.gmwm.allan_check = compare_with_allan(ax.gmwm, ax.original.noise)
     return ax.gmwm.allan_check
 
