@@ -448,7 +448,8 @@ def test_gaps_split_compensates_the_longest_segment_and_says_so(tmp_path):
         "(lines 12-36), after a gap of 21 s)"]
     assert src.n_samples == 25 and src.t0_s == 30.0
     t_, x_ = _all(src, 7)
-    assert_array_equal(t_, 30.0 + np.arange(25.0)) and assert_array_equal(x_[:, 0], np.arange(10.0, 35.0))
+    assert_array_equal(t_, 30.0 + np.arange(25.0))
+    assert_array_equal(x_[:, 0], np.arange(10.0, 35.0))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         src = open_log(_csv(tmp_path / "ok.csv", "t_s,gz[deg/h]", np.arange(9.0)), gaps="split")  # one: no warning
@@ -594,7 +595,8 @@ def test_npz_writer_assembles_the_archive_from_member_files(tmp_path, with_sigma
         with zf.open("compensated.npy") as fh:
             assert np.lib.format.read_magic(fh) == (2, 0)
     with np.load(tmp_path / name, allow_pickle=False) as z:
-        assert_array_equal(z["t_s"], t) and assert_array_equal(z["compensated"], comp)
+        assert_array_equal(z["t_s"], t)
+        assert_array_equal(z["compensated"], comp)
         assert_array_equal(z["drift_estimate"], drift)
         assert z["compensated"].dtype == np.float64 and z["compensated"].shape == (5, 2)
         assert z["axis_names"].tolist() == ["gx", "gz"] and str(z["unit"]) == "deg/s"
@@ -645,9 +647,11 @@ def test_allan_accumulator_block_means_by_hand(chunk):
     for lo in range(0, 10, step):
         acc.add(x[lo:lo + step], -x[lo:lo + step])
     before, after = acc.series()
-    assert_allclose(before, [[1.5, 101.5], [5.5, 105.5]]) and assert_allclose(after, -before)
+    assert_allclose(before, [[1.5, 101.5], [5.5, 105.5]])
+    assert_allclose(after, -before)
     assert_allclose(acc.series(1)[0], [[5.5, 105.5]])  # from native sample 1: the next whole block
-    assert_allclose(acc.series(4)[0], [[5.5, 105.5]]) and acc.series(5)[0].shape == (0, 2)
+    assert_allclose(acc.series(4)[0], [[5.5, 105.5]])
+    assert acc.series(5)[0].shape == (0, 2)
     assert acc.series(8)[1].shape == (0, 2)
 
 
@@ -686,13 +690,15 @@ def test_plot_before_after_draws_what_it_says(monkeypatch, tmp_path):
                                                                         "compensated: " + literal("AR$x$")]
     before, after = axs[0].containers
     line = before.lines[0]
-    assert_array_equal(line.get_xdata(), [2.0, 4.0]) and assert_array_equal(line.get_ydata(), [2.0, 1.0])
+    assert_array_equal(line.get_xdata(), [2.0, 4.0])
+    assert_array_equal(line.get_ydata(), [2.0, 1.0])
     assert line.get_color() == "k" and line.get_marker() == "o" and line.get_linestyle() == "-"
     assert line.get_markersize() == 3 and line.get_linewidth() == 0.8
     assert after.lines[0].get_color() == "C3"
     assert_array_equal(after.lines[0].get_xdata(), [1, 2, 4])
     segs = before.lines[2][0].get_segments()  # yerr: adev - lo68 below, hi68 - adev above
-    assert_allclose([s[0][1] for s in segs], [1.0, 0.5]) and assert_allclose([s[1][1] for s in segs], [2.5, 1.25])
+    assert_allclose([s[0][1] for s in segs], [1.0, 0.5])
+    assert_allclose([s[1][1] for s in segs], [2.5, 1.25])
     assert axs[1].containers[0].lines[0].get_xdata().size == 0
     [text] = axs[0].texts
     assert text.get_position() == (0.0, -0.17) and text.get_transform() == axs[0].transAxes
@@ -709,6 +715,9 @@ def test_plot_before_after_draws_what_it_says(monkeypatch, tmp_path):
         outputs._plt().close(saved["fig"])
     outputs.plot_before_after(curves[:1], tmp_path / "g.png", "t", {"gx": "x not checked"})
     assert saved["fig"].axes[0].texts[0].get_color() == "C3"
+    outputs._plt().close(saved["fig"])
+    outputs.plot_before_after(curves[:1], tmp_path / "g.png", "t", {"gx": "a" * 40 + " " + "b" * 40})  # 81 chars
+    assert saved["fig"].axes[0].texts[0].get_text() == "a" * 40 + "\n" + "b" * 40  # wrapped at 80
     outputs._plt().close(saved["fig"])
 
 
@@ -817,3 +826,18 @@ def test_integer_input_is_read_as_float():
     assert comp.dtype == np.float64
     assert_allclose(comp, _run(_engine([_axis(bias=1.5)], factor=2), x.astype(float), None)["compensated_dph"][:, 0])
     assert comp[0] == -1.5
+
+
+def test_npz_members_over_the_zip64_limit_are_written(tmp_path, monkeypatch):
+    """A compensated log over 2 GiB needs ZIP64 members; the limit is lowered to 300 bytes here to check it."""
+    import zipfile
+
+    from fogdrift.compensate.outputs import NpzWriter
+
+    monkeypatch.setattr(zipfile, "ZIP64_LIMIT", 300)  # the 40-row members (448 bytes) are over it
+    w = NpzWriter(tmp_path / "big.npz", 40, ["gz"], "deg/h", 1.0, False)
+    w.write(np.arange(40.0), np.ones((40, 1)), np.zeros((40, 1)), None)
+    w.close()
+    monkeypatch.undo()
+    with np.load(tmp_path / "big.npz") as z:
+        assert_array_equal(z["t_s"], np.arange(40.0))
