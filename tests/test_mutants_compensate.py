@@ -841,3 +841,15 @@ def test_npz_members_over_the_zip64_limit_are_written(tmp_path, monkeypatch):
     monkeypatch.undo()
     with np.load(tmp_path / "big.npz") as z:
         assert_array_equal(z["t_s"], np.arange(40.0))
+
+
+def test_npz_writer_stores_float64_whatever_it_is_given(tmp_path):
+    from fogdrift.compensate.outputs import NpzWriter
+
+    w = NpzWriter(tmp_path / "i.npz", 3, ["gz"], "deg/h", 1.0, False)
+    w.write(np.arange(3), np.arange(3, dtype=np.float32).reshape(3, 1) + 0.5, np.array([[1], [2], [3]]), None)
+    w.close()
+    with np.load(tmp_path / "i.npz") as z:
+        assert_array_equal(z["t_s"], [0.0, 1.0, 2.0])
+        assert_array_equal(z["compensated"][:, 0], [0.5, 1.5, 2.5])
+        assert_array_equal(z["drift_estimate"][:, 0], [1.0, 2.0, 3.0])
