@@ -241,6 +241,9 @@ def test_b_line_values_agree_or_differ_by_height():
         is False
     assert compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {"value": 0.65, "hi95": 0.7, "tau_s": 1}))["b_agree"] \
         is False
+    # the Allan interval, not its value, decides: a value outside GMWM's range whose interval reaches into it agrees
+    for a in ({"value": 0.35, "lo95": 0.3, "hi95": 0.45}, {"value": 0.65, "lo95": 0.55, "hi95": 0.7}):
+        assert compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {**a, "tau_s": 1.0}))["b_agree"] is True, a
     g_point = _bi(0.5, None, None, 10.0)
     assert compare_with_allan(_gaxis(G_N, g_point), _afit(G_N, B_A))["b_agree"] is True  # 0.5 touches [0.5, 0.6]
     c = compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {**B_A, "value": 0.8, "lo95": 0.7, "hi95": 0.9}))
