@@ -966,3 +966,24 @@ def test_fmt_writes_non_finite_values_as_numbers_not_a_dash():
 
     assert (fmt(math.inf), fmt(-math.inf), fmt(math.nan)) == ("inf", "-inf", "nan")
     assert (fmt(1e-5), fmt(0.0), fmt(2.5), fmt(123456789.0), fmt(3)) == ("1.0e-05", "0.0", "2.5", "1.23457e+08", "3.0")
+
+
+def test_allan_defaults_of_missing_fields():
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved"), "K": (0.5, 0.0, 0.7, "unresolved")}, selected=())
+    del ax["noise"]["terms"]["N"]["reason"], ax["noise"]["terms"]["R"]["status"]
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    assert ch.fit == "model none (chi2_red 1.1, good)"
+    assert ch.terms["N"].source == "allan fit: N (selected model none, fit good)" and ch.terms["N"].reason == ""
+    assert ch.terms["R"].status == "absent"
+    # no fit: resolved AND unresolved terms become no_fit; no reason of its own: nothing appended; no chi2: nan
+    ax["noise"]["no_fit"] = {"best_candidate": "N"}
+    del ax["noise"]["fit"]["chi2_red"]
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    assert ch.terms["K"].status == "no_fit" and ch.terms["N"].status == "no_fit"
+    assert ch.terms["N"].reason == ("no model fits the record (best candidate none, chi2_red nan): the coefficient is "
+                                    "no result")
+    assert ch.terms["R"].status == "absent"
+    del ax["noise"]["terms"]["N"]["unit"]                     # a term without its unit is refused, naming it
+    with pytest.raises(DataFormatError, match=r"axis 'gx' is not a complete fogdrift allan result \(ConfigError: "
+                                              r"unit '' of term N is not one fogdrift can convert"):
+        channels_from_result(_allan_doc(ax), "a.json")
