@@ -399,3 +399,17 @@ def test_a_compensator_that_never_predicts_is_refused_with_one_line():
     res = artefact_check(z, 1.0, {"late": MovingFraction(0.0, 596)}, causal_window=128, step_delays_s=())
     assert res.frequencies_hz == [0.5]  # Nyquist: 2 periods in 4 samples
     assert res.row("late").ramp_survival == pytest.approx(1.0, rel=1e-9)
+
+
+def test_flag_thresholds_are_strict():
+    """A claim exactly at claim_ratio is no claim, a gain exactly at 1 - removal removes no more than allowed.
+    Thresholds set to the values measured at 0.01 Hz (1 - (1 - g) == g exactly for g in [0.5, 1], Sterbenz):
+    only 0.001 Hz (strictly below both) stays flagged."""
+    z, models, freqs = _flag_case()
+    res = artefact_check(z, 1.0, models, causal_window=128, frequencies_hz=freqs)
+    g, v = res.row("half").gains[0.01], res.row("half + noise").adev_ratio[0.01]
+    assert 0.5 <= g <= 1.0 and 1.0 - (1.0 - g) == g
+    res = artefact_check(z, 1.0, models, causal_window=128, frequencies_hz=freqs, removal=1.0 - g)
+    assert res.row("half").flagged_hz == (0.001,)
+    res = artefact_check(z, 1.0, models, causal_window=128, frequencies_hz=freqs, claim_ratio=v)
+    assert res.row("half + noise").flagged_hz == (0.001,)
