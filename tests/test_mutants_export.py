@@ -987,3 +987,15 @@ def test_allan_defaults_of_missing_fields():
     with pytest.raises(DataFormatError, match=r"axis 'gx' is not a complete fogdrift allan result \(ConfigError: "
                                               r"unit '' of term N is not one fogdrift can convert"):
         channels_from_result(_allan_doc(ax), "a.json")
+
+
+def test_gm_from_b_without_its_tau_uses_the_end_of_the_fitted_range():
+    ax = _full_gmwm_axis()
+    ie = ax["selection"]["ieee"]
+    ie["gm"] = []
+    del ie["b_headline"]["tau_s"]                            # B read, but not where: the longest fitted tau, 500 s
+    ch = _one(ax, {"fs_hz": 100.0})
+    assert ch.b_tau_s is None
+    g, how = bias_gm(ch, "bound")
+    assert g.tc_s == approx(500.0 / 1.8926, rel=1e-4) and g.sigma_si == approx(1.0760 * 1.5 * DPH, rel=1e-4)
+    assert g.source == "from B at tau = 500 s" and "with tau_B = 500 s" in how
