@@ -168,8 +168,8 @@ def test_quiet_and_noisy_messages_name_the_axes_and_levels():
     found = check_record(from_array(x, dt_s=0.01, unit="deg/h", axis_names=("a", "b")))
     assert [f.rule for f in found] == ["white-noise"] and found[0].axes == ("a",)
     msg = found[0].message
-    assert msg.startswith("white-noise floor N <= a 1.67e-08 deg/√h with the rate read as deg/h: ") or \
-        msg.startswith("white-noise floor N <= a 1.6")
+    assert msg.startswith("white-noise floor N <= a ") and " deg/√h with the rate read as deg/h: " in msg
+    assert float(msg.split("N <= a ")[1].split(" ")[0]) == pytest.approx(1e-5 * 0.1 / 60.0, rel=0.15)  # 1.7e-8
     assert "the class of metre-scale ring lasers" in msg
     assert found[0].likely_units == ()  # every candidate breaks a rule on one axis or the other
     assert msg.endswith("; check {opt:unit}")
