@@ -563,3 +563,98 @@ def test_q_above_the_envelope_is_kept_only_if_resolved_at_whole_periods():
         assert (out["Q"].status == "estimated") == resolved
         if not resolved:
             assert out["Q"].lo95 == 0.0 and "whole periods of the periodic error (tau >= 0.05 s)" in out["Q"].reason
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# notes: the words of the fit, on hand-built curves
+
+from fogdrift.noise import notes  # noqa: E402
+
+
+def test_tau_span_and_slope():
+    assert notes._tau_span(0.64, 0.64) == "0.64" and notes._tau_span(0.64, 5.12) == "0.64-5.12"
+    assert notes._tau_span(1.0001, 1.0002) == "1"  # equal to 3 digits
+    tau = np.array([1.0, 10.0, 100.0])
+    assert notes._slope(tau, 4.0 / tau) == pytest.approx(-0.5)  # white noise: ADEV ~ tau^-1/2
+    assert notes._slope(tau, 4.0 * tau**2) == pytest.approx(1.0)  # a ramp
+    assert math.isnan(notes._slope(np.array([1.0]), np.array([1.0])))
+
+
+def test_worst_region_is_the_run_of_largest_square_sum():
+    z = np.array([0.0, 3.0, 3.0, 0.0, -5.0, 1.0, 2.5])
+    assert notes._worst_region(None, z) == (4, 4)  # 25 > 18 > 6.25
+    assert notes._worst_region(None, np.array([3.0, 3.0, 0.0, -4.0])) == (0, 1)  # 18 > 16
+    assert notes._worst_region(None, np.array([0.0, 2.5, 3.0])) == (1, 2)  # a run at the end
+    assert notes._worst_region(None, np.array([0.5, -1.9, 1.0])) == (1, 1)  # none beyond 2: the largest |z|
+    assert notes._worst_region(None, np.array([])) is None
+
+
+def test_misfit_note_names_the_side_and_size():
+    tau = np.array([1.0, 2.0, 4.0, 8.0])
+    y = np.array([1.0, 1.0, 1.21, 1.44])
+    mu = np.ones(4)
+    z = np.array([0.0, 0.0, 3.0, 4.0])
+    (note,) = notes._misfit_note(tau, y, mu, z, "poor", 3.456, 0.0123)
+    assert note.startswith("fit poor: chi2_red = 3.46 (p = 0.012); the model misses the curve most at tau = 4-8 s, "
+                           "where the measured deviation is above the model by up to 20 %; local ADEV slope there")
+    assert notes._slope(tau[2:], y[2:]) == pytest.approx(math.log(1.2 / 1.1) / math.log(2.0))
+    (note,) = notes._misfit_note(tau, 1.0 / y, mu, z, "poor", 3.0, 0.01)
+    assert "below the model by up to 17 %; the curve falls faster than the fitted terms allow" in note
+
+
+def test_no_fit_names_the_points_outside_their_intervals():
+    tau = np.array([1.0, 10.0, 100.0])
+    y = np.ones(3)
+    mu = np.array([1.0, 0.2, 50.0])  # nu = 2: [0.271, 39.5]: the last two outside
+    no_fit, note = notes._no_fit(tau, y, mu, np.full(3, 2.0), (IN, IK), 7.0)
+    assert no_fit == {"tau_min_s": 1.0, "tau_max_s": 100.0, "miss_tau_s": [10.0, 100.0], "best_candidate": "N+K"}
+    assert note == ("no model fits tau 1-100 s: the best candidate (N+K, chi2_red 7) misses the measured curve outside "
+                    "its 95 % intervals at tau = 10, 100 s; the coefficients are not a result (the table shows their "
+                    "upper bounds only)")
+    assert notes._no_fit(tau, y, np.ones(3), np.full(3, 2.0), (IN,), 1.0) == (None, None)
+
+
+def test_largest_gap_note_at_twice_either_way():
+    tau = np.array([1.0, 10.0, 100.0])
+    y = np.ones(3)
+    assert notes._largest_gap_note(tau, y, np.array([1.0, 1.0, 3.99]), np.full(3, 2.0)) == []  # 1.997x
+    (note,) = notes._largest_gap_note(tau, y, np.array([1.0, 1.0, 4.0]), np.full(3, 2.0))
+    # nu = 2: measured/true in [0.0253, 3.689]; 1 / 2^2 = 0.25 inside
+    assert note.startswith("largest gap: at tau = 100 s the model's deviation is 2.00x the measured one (above it; "
+                           "~2 degrees of freedom), inside that point's own 95 % interval")
+    (note,) = notes._largest_gap_note(tau, y, np.array([1.0, 0.25, 1.0]), np.full(3, 1000.0))
+    assert "at tau = 10 s the model's deviation is 0.50x the measured one (below it; ~1e+03 degrees" in note
+    assert note.endswith("outside that point's own 95 % interval: the model's shape is wrong there")
+    assert notes._largest_gap_note(tau, y, np.array([1.0, 1.0, 4.0]), np.array([2.0, 2.0, 0.0])) == []
+    assert notes._largest_gap_note(tau, y, np.array([1.0, 1.0, 4.0]), np.array([2.0, 2.0, np.inf])) == []
+
+
+def test_at_bound_note_and_reasons():
+    prob = _prob(_upper())
+    out = {"K": NoiseTerm("K", 207.8, "deg/h^1.5", None, None, "estimated", ""),
+           "N": NoiseTerm("N", 1.0, "deg/sqrt(h)", None, None, "estimated", "")}
+    (note,) = notes._at_bound_notes(prob, _a(N=1.0, K=4.0), (IN, IK), TAU3, out)
+    assert note == ("K = 207.8 deg/h^1.5 sits at its data bound: a larger K alone would exceed the measured curve's "
+                    "~4-sigma upper limit at tau = 100 s, so that one point sets the value, not the fit as a whole; "
+                    "read it as the largest K the data allow")
+    assert notes._at_bound_notes(prob, _a(N=1.0, K=3.99), (IN, IK), TAU3, out) == []
+    out["K"] = NoiseTerm("K", None, "deg/h^1.5", None, 207.8, "not_estimable", "")
+    assert notes._at_bound_notes(prob, _a(N=1.0, K=4.0), (IN, IK), TAU3, out) == []
+    res = {(IN,): {"ic": 11.3}}
+    assert notes._unresolved_reason("K", [(IN,)], None, res, 10.0) == ("not resolved from zero: the model N without K "
+                                                                     "describes the curve about as well (IC +1.3)")
+    assert notes._unresolved_reason("K", [], None, res, 10.0) == "not resolved from zero: its 95 % interval reaches 0"
+
+
+def test_absent_reason_says_where_the_term_would_dominate():
+    """N = 1 (A / tau) measured on 1..100 s: a K at A_K tau dominates beyond tau = sqrt(1 / A_K); a Q at A_Q / tau^2
+    below tau = A_Q."""
+    c = _ctx([1.0, 10.0, 100.0], [1.0, 0.1, 0.01], [2.0, 0.2, 0.02])
+    A = _a(N=1.0)
+    assert notes._absent_reason(c, "K", A, 1e-6) == (
+        "not in the model: at its upper bound it would dominate only beyond tau = 1e+03 s (longest fitted tau 100 s); "
+        "a longer record can resolve it")
+    assert notes._absent_reason(c, "Q", A, 1e-3) == ("not in the model: at its upper bound it would dominate only "
+                                                     "below the fitted range (tau < 1 s)")
+    assert notes._absent_reason(c, "K", A, 1.0) == "not in the model: the curve shows no sign of it in the fitted range"
+    assert "beyond the record" in notes._absent_reason(c, "B", _a(N=1e9), 1e-9)
