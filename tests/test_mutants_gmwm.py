@@ -748,3 +748,14 @@ def test_a_collapsed_component_has_an_infinite_standard_error_and_no_penalty():
     assert math.isinf(both.se_z[1]) and math.isfinite(both.se_z[0])
     assert both.se_z[0] == pytest.approx(wn.se_z[0], rel=1e-6) and both.theta[0] == pytest.approx(wn.theta[0], rel=1e-6)
     assert both.penalty == pytest.approx(2.0, rel=1e-6)
+
+
+def test_when_nothing_passes_under_the_pilots_v_the_next_pilot_supplies_v():
+    """2^12 samples of WN+RW whose RW (gamma2 1e-5) is not detectable: under the V of the first pilot no candidate
+    passes its checks; under the next pilot's V the WN model passes and is chosen (the module docstring, step 2)."""
+    wv = haar_wvar(simulate_latent("WN+RW", [1.0, 1e-5], 2**12, seed=1), 0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FogdriftWarning)  # no "no candidate passed" fallback
+        sel = select_model(wv, ["WN", "WN+GM", "WN+RW+GM"], exclude_short=False)
+    _assert_selection_rules(sel, wv)
+    assert sel.selected == "WN" and sel.passed_checks
