@@ -658,3 +658,62 @@ def test_absent_reason_says_where_the_term_would_dominate():
                                                      "below the fitted range (tau < 1 s)")
     assert notes._absent_reason(c, "K", A, 1.0) == "not in the model: the curve shows no sign of it in the fitted range"
     assert "beyond the record" in notes._absent_reason(c, "B", _a(N=1e9), 1e-9)
+
+
+def _excl(y_short):
+    """Fit from tau = 0.16 s on with N alone (ADEV^2 = 0.01 / tau); the left-out taus 0.01 .. 0.08 s hold
+    ``y_short``."""
+    tau = np.array([0.01, 0.02, 0.04, 0.08, 0.16])
+    X = np.zeros((5, len(ALL_TERMS)))
+    X[:, IN] = 1.0 / tau
+    model = 0.01 / tau
+    y = np.r_[np.asarray(y_short, float), model[4]]
+    ctx = SimpleNamespace(tau=tau, y=y, y_hi=1.1 * y, X=X)
+    return ctx, {"best": (IN,), "res": {(IN,): {"a": _a(N=0.01)}}}, model
+
+
+def test_describe_excluded_below_the_model_and_flat():
+    tau = np.array([0.01, 0.02, 0.04, 0.08])
+    ctx, sel, _ = _excl(0.05 * (tau / 0.01) ** 0.2)  # ADEV slope +0.1, below the model at every left-out tau
+    head = "ADEV below the model with a slope of +0.10 (flatter than white noise's -0.5): "
+    assert notes._describe_excluded(ctx, 4, sel) == (
+        head + "correlated samples (no spectrum of the series was given to say more), not a noise term")
+    assert notes._describe_excluded(ctx, 4, sel, spectrum_given=True) == (
+        head + "correlated samples (the spectrum shows no roll-off), not a noise term")
+    assert notes._describe_excluded(ctx, 4, sel, spectrum_given=True, rolloff_hz=30.0) == (
+        head + "an output low-pass / anti-alias filter (the spectrum rolls off above 30 Hz), not a noise term")
+
+
+def test_describe_excluded_steeper_than_quantization_and_other_shapes():
+    tau = np.array([0.01, 0.02, 0.04, 0.08])
+    ctx, sel, model = _excl((tau / 0.01) ** -3.0)  # ADEV ~ tau^-1.5
+    assert notes._describe_excluded(ctx, 4, sel) == "a slope of -1.50, steeper than quantization's -1: not an " \
+                                                    "IEEE-952 term"
+    ctx, sel, model = _excl(1.44 * 0.01 / tau)  # 20 % above the model, same slope
+    assert notes._describe_excluded(ctx, 4, sel) == ("a shape no IEEE-952 term describes: the ADEV is above the "
+                                                     "model by up to 20 %, many times its statistical error there")
+    y = 0.01 / tau
+    y[0] *= 0.64  # 20 % below at the first point only
+    ctx, sel, model = _excl(y)
+    assert "the ADEV is below the model by up to 20 %" in notes._describe_excluded(ctx, 4, sel)
+
+
+def test_describe_excluded_names_a_bump_or_the_line_that_shapes_the_curve():
+    tau = np.array([0.01, 0.02, 0.04, 0.08])
+    y = 0.01 / tau
+    y[2] *= 4.0  # ADEV sqrt(tau) twice the flat level at 0.04 s
+    ctx, sel, _ = _excl(y)
+    assert notes._describe_excluded(ctx, 4, sel) == ("a bump in the curve near tau = 0.04 s (an oscillation or "
+                                                     "vibration; its frequency needs the spectrum of the series, not "
+                                                     "the tau of the bump)")
+    assert notes._describe_excluded(ctx, 4, sel, spectrum_given=True) == (
+        "a bump in the curve near tau = 0.04 s (an oscillation, but the spectrum shows no line: not a noise term)")
+    # a 20-Hz line of 1 deg/h: its ADEV^2 at 0.01 s is sin^4(0.2 pi) / (0.2 pi)^2 = 0.30 of y there (>= 0.1)
+    pc = SimpleNamespace(lines=((20.0, 1.0),), ref_amplitude_dph=1.0)
+    assert notes._describe_excluded(ctx, 4, sel, periodic=pc) == (
+        "spectral line at 20 Hz, 1 deg/h (periodic content the fitted terms do not describe there), not a noise term")
+    # 0.1 deg/h: its largest share is 0.52 x 0.01 / 0.5 = 0.010 (at 0.02 s): not named
+    assert notes._lines_that_matter(SimpleNamespace(lines=((20.0, 1.0),), ref_amplitude_dph=0.1), tau, y) == []
+    assert notes._lines_that_matter(SimpleNamespace(lines=((20.0, 1.0), (40.0, 0.0025)), ref_amplitude_dph=2.0), tau,
+                                    y) == ["spectral line at 20 Hz, 2 deg/h"]
+    assert notes._lines_that_matter(None, tau, y) == [] and notes._lines_that_matter(pc, [], []) == []
