@@ -983,6 +983,10 @@ def test_allan_defaults_of_missing_fields():
     assert ch.terms["N"].reason == ("no model fits the record (best candidate none, chi2_red nan): the coefficient is "
                                     "no result")
     assert ch.terms["R"].status == "absent"
+    del ax["noise"]["fit"]["quality"]
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    assert ch.terms["N"].source == "allan fit: N (selected model none, fit ?)"
+    assert ch.fit == "no model fits; best candidate none (chi2_red nan, ?)"
     del ax["noise"]["terms"]["N"]["unit"]                     # a term without its unit is refused, naming it
     with pytest.raises(DataFormatError, match=r"axis 'gx' is not a complete fogdrift allan result \(ConfigError: "
                                               r"unit '' of term N is not one fogdrift can convert"):
