@@ -336,7 +336,7 @@ def test_open_log_reads_the_declared_unit_and_chunks_any_size(tmp_path):
     assert (src.unit, src.unit_given, src.declared_unit, src.scale_to_dph) == ("deg/s", False, "deg/s", 3600.0)
     assert src.axis_names == ("gz",) and src.dt_s == 0.5 and src.t0_s == 5.0 and src.n_samples == 23
     assert src.path == tmp_path / "s.csv" and len(src.sha256) == 64
-    assert not any("read in chunks" in n for n in src.notes)
+    assert not any("read in chunks" in n for n in src.notes) and "unit 'deg/s' declared in the file" in src.notes
     for chunk in (1, 7, 64, DEFAULT_CHUNK):
         t, x = _all(src, chunk)
         assert_allclose(t, 5.0 + 0.5 * np.arange(23), rtol=1e-15)
@@ -422,6 +422,11 @@ def test_accelerometer_channels_are_refused_naming_them(tmp_path):
         open_log(two)
     assert str(info.value) == (f"{two}: compensate applies a gyro drift model; ax, ay are accelerometer channels "
                                "(specific force, from its unit): leave them out with columns=")
+    mixed = _csv(tmp_path / "m.csv", "t_s,gz[deg/s],ax[m/s^2]", np.ones((5, 2)))  # refused, naming the file
+    with pytest.raises(DataFormatError) as info:
+        open_log(mixed)
+    assert str(info.value) == (f"{mixed}: rate columns declare different units ['deg/s', 'm/s^2']; expected one unit "
+                               "(choose columns with columns=)")
 
 
 def test_one_declared_unit_for_every_rate_column():
@@ -446,7 +451,12 @@ def test_gaps_split_compensates_the_longest_segment_and_says_so(tmp_path):
     assert [str(w.message) for w in rec] == [
         f"{log}: 2 segments between gaps; compensating the longest (25 samples, segment 2 of 2: samples 10-34 "
         "(lines 12-36), after a gap of 21 s)"]
+    import linecache
+
+    line = linecache.getline(rec[0].filename, rec[0].lineno)  # stacklevel: not fogdrift's own warn call
+    assert line.strip() and "warn(" not in line and "FogdriftWarning" not in line and "samples, " not in line
     assert src.n_samples == 25 and src.t0_s == 30.0
+    assert src.notes[-1] == "segment 2 of 2: samples 10-34 (lines 12-36), after a gap of 21 s"
     t_, x_ = _all(src, 7)
     assert_array_equal(t_, 30.0 + np.arange(25.0))
     assert_array_equal(x_[:, 0], np.arange(10.0, 35.0))
