@@ -32,10 +32,12 @@ test: $(STAMP)
 
 # Mutation testing (mutmut, config in pyproject.toml [tool.mutmut]; docs/testing.md). Not part of `make test`.
 # One module: make mutation MUTANTS='fogdrift.metrics.*'   (names as `mutmut results` prints them)
+# NUMBA_THREADING_LAYER=workqueue: numba's OpenMP pool SIGTERMs a child forked after the parent ran a parallel kernel
+# (mutmut forks its workers from the process that ran the clean tests); those mutants ended 'exit -15', undecided.
 MUTANTS ?=
 mutation: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[test,mutation]'
-	$(BIN)/mutmut run --max-children 2 $(MUTANTS)
+	NUMBA_THREADING_LAYER=workqueue $(BIN)/mutmut run --max-children 2 $(MUTANTS)
 	$(BIN)/mutmut results
 
 bench: $(STAMP)
