@@ -782,3 +782,21 @@ def test_a_scale_explained_only_by_an_unresolved_fast_gm_is_excluded():
         assert e.reason.startswith(head) and e.reason.endswith(tail), e.reason
         tc = float(e.reason[len(head):-len(tail)])
         assert 3.785 * tc < 2.0 * e.scale_s and e.best_model == "WN+GM" and e.best_abs_z <= 3.0
+
+
+def test_when_nothing_passes_the_fallback_is_scored_under_the_pilots_v():
+    """Nothing passes under any V (2-tap filtered record, no exclusion allowed): the result is the first pass, scored
+    under the V of the pilot, the candidate with the smallest step-1 Q + 2p (docstring, step 2)."""
+    from fogdrift.gmwm import gmwm_fit
+
+    wv = _filtered(2**13, 2, seed=1)
+    cands = ["WN", "WN+GM", "WN+RW+GM"]
+    with pytest.warns(FogdriftWarning, match="no candidate passed"):
+        sel = select_model(wv, cands, exclude_short=False)
+    assert not sel.passed_checks
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        score = {m: gmwm_fit(wv, m, steps=1, n_starts=4).q + 2.0 * sel.candidate(m).n_params for m in cands}
+    pilot = min(score, key=score.get)
+    assert sorted(score.values())[1] - score[pilot] > 1.0  # a clear pilot
+    assert sel.omega_source == f"common: V at the iterated fit of {pilot}"
