@@ -657,6 +657,8 @@ def test_absent_reason_says_where_the_term_would_dominate():
     assert notes._absent_reason(c, "Q", A, 1e-3) == ("not in the model: at its upper bound it would dominate only "
                                                      "below the fitted range (tau < 1 s)")
     assert notes._absent_reason(c, "K", A, 1.0) == "not in the model: the curve shows no sign of it in the fitted range"
+    # a Q dominating up to 3 s (3 / tau^2 >= 1 / tau) reaches into the fitted range
+    assert notes._absent_reason(c, "Q", A, 3.0) == "not in the model: the curve shows no sign of it in the fitted range"
     assert "beyond the record" in notes._absent_reason(c, "B", _a(N=1e9), 1e-9)
 
 
@@ -696,6 +698,9 @@ def test_describe_excluded_steeper_than_quantization_and_other_shapes():
     y[0] *= 0.64  # 20 % below at the first point only
     ctx, sel, model = _excl(y)
     assert "the ADEV is below the model by up to 20 %" in notes._describe_excluded(ctx, 4, sel)
+    # below the model except just above it (2 %) at the last left-out tau: not "below the model", another shape
+    ctx, sel, model = _excl([0.05, 0.05, 0.05, 0.13])
+    assert notes._describe_excluded(ctx, 4, sel).startswith("a shape no IEEE-952 term describes: the ADEV is below")
 
 
 def test_describe_excluded_names_a_bump_or_the_line_that_shapes_the_curve():
