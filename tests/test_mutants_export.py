@@ -1003,3 +1003,35 @@ def test_gm_from_b_without_its_tau_uses_the_end_of_the_fitted_range():
     g, how = bias_gm(ch, "bound")
     assert g.tc_s == approx(500.0 / 1.8926, rel=1e-4) and g.sigma_si == approx(1.0760 * 1.5 * DPH, rel=1e-4)
     assert g.source == "from B at tau = 500 s" and "with tau_B = 500 s" in how
+
+
+def test_allan_b_min_defaults_and_markov_unit_fallback():
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")}, selected=("N",))
+    ax["noise"]["b_min"].update(value=1.2, lo95=1.0, hi95=1.5, tau_s=80.0)
+    del ax["noise"]["b_min"]["unit"], ax["noise"]["b_min"]["rule"]      # B's own unit; the rule's default words
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    b = ch.terms["B"]
+    assert b.unit == "deg/h" and b.si == approx(1.2 * DPH, rel=1e-12)
+    assert b.source == "allan fit: B_min, min of the fitted ADEV / 0.664"
+    ax["noise"]["b_min"].update(bound_only=True, value=2.0, lo95=None, hi95=3.0)
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    assert ch.terms["B"].reason == "" and ch.terms["B"].status == "absent"
+    # M: sigma in the unit of q_c; without q_unit, the M term's unit; with neither, refused
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")}, selected=("N", "M"))
+    ax["noise"]["terms"]["M"] = {"name": "M", "value": 0.5, "unit": "deg/h/sqrt(s)", "lo95": 0.3, "hi95": 0.7,
+                                 "status": "resolved"}
+    ax["noise"]["shaped"] = {"M": {"tc_s": 30.0, "tc_lo95_s": 20.0, "tc_hi95_s": 45.0, "sigma_dph": 0.6}}
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    assert ch.gms[0].sigma_si == approx(0.6 * DPH, rel=1e-12)
+    del ax["noise"]["terms"]["M"]["unit"]
+    with pytest.raises(DataFormatError, match=r"\(ConfigError: unit '' of term "):
+        channels_from_result(_allan_doc(ax), "a.json")
+
+
+def test_allan_units_that_say_two_quantities_are_refused():
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved"), "B": (50.0, 40.0, 60.0, "resolved")},
+                     units={"Q": "urad", "N": "deg/sqrt(h)", "B": "ug", "K": "deg/h^1.5", "R": "deg/h^2"})
+    with pytest.raises(DataFormatError) as ei:
+        channels_from_result(_allan_doc(ax), "a.json")
+    assert str(ei.value).startswith("a.json: axis gx: the terms' units do not say one quantity (gyro or "
+                                    "accelerometer): Q [urad], N [deg/sqrt(h)], B [ug]")
