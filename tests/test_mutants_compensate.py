@@ -434,6 +434,8 @@ def test_one_declared_unit_for_every_rate_column():
 
     assert _one_declared([], "p") is None and _one_declared([None, None], "p") is None
     assert _one_declared(["deg/s", "deg/s"], "p") == "deg/s"
+    with pytest.raises(DataFormatError, match=r"^q: rate columns declare different units \['deg/h', 'deg/s'\];"):
+        _one_declared(["deg/s", "deg/h"], "q")
     with pytest.raises(DataFormatError) as info:
         _one_declared(["deg/s", "deg/h", None], "p.csv")
     assert str(info.value) == ("p.csv: rate columns declare different units ['None', 'deg/h', 'deg/s']; expected one "
