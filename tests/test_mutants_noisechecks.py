@@ -698,6 +698,13 @@ def test_describe_excluded_steeper_than_quantization_and_other_shapes():
     y[0] *= 0.64  # 20 % below at the first point only
     ctx, sel, model = _excl(y)
     assert "the ADEV is below the model by up to 20 %" in notes._describe_excluded(ctx, 4, sel)
+    # one left-out tau (start = 1): its own deviation (10 % above) is reported, not the first fitted point's (40 %)
+    X2 = np.zeros((2, len(ALL_TERMS)))
+    X2[:, IN] = [100.0, 50.0]
+    y2 = np.array([1.21, 0.98])
+    ctx2 = SimpleNamespace(tau=np.array([0.01, 0.02]), y=y2, y_hi=1.1 * y2, X=X2)
+    assert notes._describe_excluded(ctx2, 1, sel).endswith("the ADEV is above the model by up to 10 %, many times "
+                                                           "its statistical error there")
     # below the model except just above it (2 %) at the last left-out tau: not "below the model", another shape
     ctx, sel, model = _excl([0.05, 0.05, 0.05, 0.13])
     assert notes._describe_excluded(ctx, 4, sel).startswith("a shape no IEEE-952 term describes: the ADEV is below")
