@@ -1035,3 +1035,12 @@ def test_allan_units_that_say_two_quantities_are_refused():
         channels_from_result(_allan_doc(ax), "a.json")
     assert str(ei.value).startswith("a.json: axis gx: the terms' units do not say one quantity (gyro or "
                                     "accelerometer): Q [urad], N [deg/sqrt(h)], B [ug]")
+
+
+def test_header_lists_every_input_hash(tmp_path):
+    g, a = _gyro_result(tmp_path), _accel_result(tmp_path)
+    doc = json.loads(a.read_text())
+    doc["record"]["sha256"] = "cd" * 32
+    a.write_text(json.dumps(doc))
+    line = render("kalibr", build_context([g], [a])).splitlines()[1]
+    assert line == f"# from {a}, {g} (input SHA-256 {'ab' * 8}, {'cd' * 8}...)"   # first 16 hex digits of each
