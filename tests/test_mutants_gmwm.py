@@ -683,6 +683,13 @@ def test_the_scan_always_keeps_enough_scales_for_the_largest_candidate():
         sel = select_model(wv, ["WN", "WN+RW"], max_excluded=20)
     assert [e.level for e in sel.excluded] == [1, 2, 3, 4, 5] and list(sel.levels_used) == [6, 7, 8, 9]
     assert sel.scan_note == ""  # stopped by the scales left, not by max_excluded
+    # the same limit holds for the final fit's check (2^10 samples, 32 taps: its first kept scales are unexplained)
+    y = simulate_latent("WN+RW", [1.0, 1e-5], 2**10, seed=8)
+    wv = haar_wvar(np.convolve(y, np.ones(32) / 32, mode="valid"), 0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FogdriftWarning)
+        sel = select_model(wv, ["WN", "WN+RW"], max_excluded=20)
+    assert [e.level for e in sel.excluded] == [1, 2, 3, 4] and list(sel.levels_used) == [5, 6, 7, 8]
 
 
 def test_a_degenerate_candidate_listed_first_does_not_hide_the_others_from_the_scan():
