@@ -366,7 +366,7 @@ def test_npy_is_streamed_from_the_file_and_other_options_load_it(tmp_path, monke
     monkeypatch.setattr(sources, "load_segments", lambda *a, **k: calls.append(k) or real_segments(*a, **k))
     src = sources.open_log(tmp_path / "r.npy", unit="deg/s", rate_hz=2.0)
     assert calls == [] and any("read in chunks" in n for n in src.notes)
-    assert src.axis_names == ("col0", "col1") and src.dt_s == 0.5 and src.declared_unit is None
+    assert src.axis_names == ("col0", "col1") and src.dt_s == 0.5 and src.declared_unit is None and src.t0_s == 0.0
     assert (src.unit, src.unit_given, src.scale_to_dph) == ("deg/s", True, 3600.0)
     for chunk in (1, 3, 64):
         t, x = _all(src, chunk)
@@ -518,6 +518,7 @@ def test_match_log_rates_exactly_at_the_tolerance():
     assert m.factor == 50 and type(m.factor) is int
     assert m.notes[0] == "rate: the log (50 Hz) differs from the training log (10 Hz); block-averaged x50 to the modelling rate"
     assert match_log(_source(dt_s=0.1), b, accept_rate=True).notes[0].startswith("axes")  # same rate: no note
+    assert match_log(_source(dt_s=0.02), _bundle(model_dt_s=0.5), accept_rate=True).factor == 25  # 50 Hz -> 2 Hz
     with pytest.raises(ConfigError) as info:
         match_log(_source(dt_s=0.3), b, accept_rate=True)
     assert str(info.value) == ("log.csv: the log's 3.33333 Hz cannot be block-averaged to the bundle's modelling rate "
