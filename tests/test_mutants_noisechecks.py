@@ -705,6 +705,16 @@ def test_describe_excluded_steeper_than_quantization_and_other_shapes():
     ctx2 = SimpleNamespace(tau=np.array([0.01, 0.02]), y=y2, y_hi=1.1 * y2, X=X2)
     assert notes._describe_excluded(ctx2, 1, sel).endswith("the ADEV is above the model by up to 10 %, many times "
                                                            "its statistical error there")
+    # a line whose share of the one left-out point is below 0.1 is not named (its share of the first fitted one, 0.15,
+    # does not count): 0.30 x 0.5^2 / 1.21 = 0.062
+    y3 = np.array([1.21, 0.5])
+    ctx3 = SimpleNamespace(tau=np.array([0.01, 0.02]), y=y3, y_hi=1.1 * y3, X=X2)
+    pc = SimpleNamespace(lines=((20.0, 1.0),), ref_amplitude_dph=0.5)
+    assert "spectral line" not in notes._describe_excluded(ctx3, 1, sel, periodic=pc)
+    # the largest deviation (20 % below, at 0.04 s), not the first one (10 % below)
+    y = 0.01 / tau * np.array([0.81, 1.01, 0.64, 1.01])
+    ctx, sel, model = _excl(y)
+    assert "the ADEV is below the model by up to 20 %" in notes._describe_excluded(ctx, 4, sel)
     # below the model except just above it (2 %) at the last left-out tau: not "below the model", another shape
     ctx, sel, model = _excl([0.05, 0.05, 0.05, 0.13])
     assert notes._describe_excluded(ctx, 4, sel).startswith("a shape no IEEE-952 term describes: the ADEV is below")
@@ -720,6 +730,10 @@ def test_describe_excluded_names_a_bump_or_the_line_that_shapes_the_curve():
                                                      "the tau of the bump)")
     assert notes._describe_excluded(ctx, 4, sel, spectrum_given=True) == (
         "a bump in the curve near tau = 0.04 s (an oscillation, but the spectrum shows no line: not a noise term)")
+    # two bumps: the larger one (ADEV sqrt(tau) x 1.5 at 0.08 s, the other x 1.2 at 0.02 s) is named
+    y2 = 0.01 / tau * np.array([1.0, 1.44, 1.0, 2.25])
+    ctx2, sel2, _ = _excl(y2)
+    assert notes._describe_excluded(ctx2, 4, sel2).startswith("a bump in the curve near tau = 0.08 s")
     # a 20-Hz line of 1 deg/h: its ADEV^2 at 0.01 s is sin^4(0.2 pi) / (0.2 pi)^2 = 0.30 of y there (>= 0.1)
     pc = SimpleNamespace(lines=((20.0, 1.0),), ref_amplitude_dph=1.0)
     assert notes._describe_excluded(ctx, 4, sel, periodic=pc) == (
