@@ -238,10 +238,20 @@ def _delta(fun, z, cov):
     return v, math.sqrt(max(var, 0.0))
 
 
+def _exp(x: float) -> float:
+    """``exp(x)``, ``inf`` beyond the float range: a log-normal 95 % bound ``v exp(1.96 se)`` with a huge but finite
+    standard error (a fallback model's, se > ~362) is unbounded, not an OverflowError."""
+
+    try:
+        return math.exp(x)
+    except OverflowError:
+        return float("inf")
+
+
 def _value(name, fun, z, cov, component) -> IEEEValue:
     v, se = _delta(fun, z, cov)
-    lo = v * math.exp(-_Z95 * se) if math.isfinite(se) else 0.0
-    hi = v * math.exp(_Z95 * se) if math.isfinite(se) else float("inf")
+    lo = v * _exp(-_Z95 * se) if math.isfinite(se) else 0.0
+    hi = v * _exp(_Z95 * se) if math.isfinite(se) else float("inf")
     return IEEEValue(name, float(v), float(lo), float(hi), _UNITS[name], float(se), component)
 
 
@@ -357,8 +367,8 @@ def _reading(rule, label, avar, z, cov, dt, m, m_lo, m_hi, *, peak) -> BiasInsta
             return math.sqrt(float(np.max(aa) if peak else np.min(aa))) / B_ADEV_FACTOR
 
         val, se = _delta(ext, z, cov)
-        lo = val * math.exp(-_Z95 * se) if math.isfinite(se) else 0.0
-        hi = val * math.exp(_Z95 * se) if math.isfinite(se) else float("inf")
+        lo = val * _exp(-_Z95 * se) if math.isfinite(se) else 0.0
+        hi = val * _exp(_Z95 * se) if math.isfinite(se) else float("inf")
         return BiasInstability(rule, float(val), float(lo), float(hi), mk * dt, None, "", label)
     if peak:
         where = "after the longest" if mk > m_hi else "before the shortest"
@@ -367,7 +377,8 @@ def _reading(rule, label, avar, z, cov, dt, m, m_lo, m_hi, *, peak) -> BiasInsta
                                f"({tau_hi if mk > m_hi else tau_lo:.4g} s)", label)
     end = m_hi if k == m.size - 1 else m_lo
     val, se = _delta(at(end), z, cov)
-    bound = val * math.exp(_Z95 * se) if math.isfinite(se) else None
+    bound = val * _exp(_Z95 * se) if math.isfinite(se) else None
+    bound = bound if bound is not None and math.isfinite(bound) else None  # no finite bound: nothing, not "B < inf"
     how = "still falls at the longest" if end == m_hi else "still rises from the shortest"
     reason = f"the model's ADEV {how} τ the fit used, {end * dt:.4g} s"
     if bound is None:
