@@ -734,6 +734,11 @@ def test_describe_excluded_names_a_bump_or_the_line_that_shapes_the_curve():
     y2 = 0.01 / tau * np.array([1.0, 1.44, 1.0, 2.25])
     ctx2, sel2, _ = _excl(y2)
     assert notes._describe_excluded(ctx2, 4, sel2).startswith("a bump in the curve near tau = 0.08 s")
+    # a bump must clear the fit's start by 2 sd of the ADEV (y_hi = 1.1 y: sd = ln 1.1 / (2 x 1.96) = 0.024): x 1.04
+    # is not a bump, x 1.06 is
+    for factor, bump in ((1.04, False), (1.06, True)):
+        ctx2, sel2, _ = _excl(0.01 / tau * np.array([1.0, 1.0, factor**2, 1.0]))
+        assert notes._describe_excluded(ctx2, 4, sel2).startswith("a bump") == bump
     # a 20-Hz line of 1 deg/h: its ADEV^2 at 0.01 s is sin^4(0.2 pi) / (0.2 pi)^2 = 0.30 of y there (>= 0.1)
     pc = SimpleNamespace(lines=((20.0, 1.0),), ref_amplitude_dph=1.0)
     assert notes._describe_excluded(ctx, 4, sel, periodic=pc) == (
