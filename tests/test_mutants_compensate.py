@@ -866,3 +866,16 @@ def test_npz_writer_stores_float64_whatever_it_is_given(tmp_path):
         assert_array_equal(z["t_s"], [0.0, 1.0, 2.0])
         assert_array_equal(z["compensated"][:, 0], [0.5, 1.5, 2.5])
         assert_array_equal(z["drift_estimate"][:, 0], [1.0, 2.0, 3.0])
+
+
+def test_open_log_hands_every_reading_option_to_the_reader(tmp_path):
+    from fogdrift.compensate.sources import open_log
+
+    log = _csv(tmp_path / "t.csv", "t_s,gz[deg/h],temp[degC]", np.column_stack([np.arange(5.0), 20 + np.arange(5.0)]))
+    assert open_log(log, temperature="temp").axis_names == ("gz",)  # the temperature column is not a rate
+    with pytest.raises(DataFormatError, match="unknown unit 'degC'"):
+        open_log(log)
+    with pytest.raises((ConfigError, DataFormatError)):  # a forced format is used
+        open_log(log, temperature="temp", format="npz")
+    with pytest.raises((ConfigError, DataFormatError)):  # reader options are used (';' splits nothing here)
+        open_log(log, temperature="temp", reader_options={"delimiter": ";"})

@@ -266,6 +266,8 @@ def test_a_long_line_inside_one_chunk_is_found_with_its_line_number(monkeypatch)
             assert isinstance(e, ResourceLimitError) and e.line == line, (data, k, e)
             assert "more than 4 bytes without a line break" in e.reason
     assert _err(b"a\nbbbb\ncccc\ndddd\n" * 3, 64) is None
+    e = _err(b"a\nbbbb\nEEEEE\nc\n", 64)  # a line exactly at the limit before the long one
+    assert isinstance(e, ResourceLimitError) and e.line == 3
     e = _err(b"a\nEEEEE\n", 64)  # two breaks in the chunk: the line between them
     assert isinstance(e, ResourceLimitError) and e.line == 2
     assert _err(b"abcd\nefgh", 64) is None and _err(b"ab\rcd", 64) is None  # one break: nothing inside
