@@ -11,7 +11,7 @@ the parser its project uses (PyYAML, OpenCV FileStorage), and the state-space mo
 
 from __future__ import annotations
 
-import json  # noqa: F401
+import json
 import math
 import re
 
@@ -1044,3 +1044,72 @@ def test_header_lists_every_input_hash(tmp_path):
     a.write_text(json.dumps(doc))
     line = render("kalibr", build_context([g], [a])).splitlines()[1]
     assert line == f"# from {a}, {g} (input SHA-256 {'ab' * 8}, {'cd' * 8}...)"   # first 16 hex digits of each
+
+
+def test_allan_keys_read_as_given_b_min_unit_rule_and_q_unit():
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")}, selected=("N", "M"))
+    ax["noise"]["b_min"].update(value=0.001, lo95=None, hi95=None, tau_s=80.0, unit="deg/s",
+                                rule="min over the fitted range / 0.664")
+    ax["noise"]["terms"]["M"] = {"name": "M", "value": 0.5, "unit": "a unit q_c has not", "lo95": 0.3, "hi95": 0.7,
+                                 "status": "resolved"}
+    ax["noise"]["shaped"] = {"M": {"tc_s": 30.0, "tc_lo95_s": 20.0, "tc_hi95_s": 45.0, "sigma_dph": 0.6,
+                                   "q_unit": "deg/h/sqrt(s)"}}
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    b = ch.terms["B"]                                         # b_min's own unit, not B's deg/h
+    assert b.unit == "deg/s" and b.si == approx(0.001 * D, rel=1e-12)
+    assert b.source == "allan fit: B_min, min over the fitted range / 0.664"
+    assert ch.gms[0].sigma_si == approx(0.6 * DPH, rel=1e-12)   # q_unit, not the M term's unit
+
+
+def test_quantity_is_read_from_terms_with_a_value_or_a_bound():
+    units = {"Q": "urad", "N": "deg/sqrt(h)", "B": "deg/h", "K": "deg/h^1.5", "R": "m/s^3"}   # R: no value, no bound
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")}, units=units)
+    ax["noise"]["terms"]["R"].update(hi95=None, lo95=None)
+    assert channels_from_result(_allan_doc(ax), "a.json")[0].quantity == "gyro"
+    ax["noise"]["terms"]["R"]["hi95"] = 0.3                   # a bound in an accelerometer unit: two quantities
+    with pytest.raises(DataFormatError, match="the terms' units do not say one quantity"):
+        channels_from_result(_allan_doc(ax), "a.json")
+
+
+def test_load_and_channel_messages_name_the_file(tmp_path):
+    missing = tmp_path / "none.json"
+    with pytest.raises(DataFormatError) as ei:
+        load_result(missing)
+    assert str(ei.value) == (f"{missing}: no such result file; expected the allan.json or noise.json of a fogdrift "
+                             "run (or what 'fogdrift allan --json' printed)")
+    p = tmp_path / "bad.json"
+    p.write_text("{\n not json")
+    with pytest.raises(DataFormatError) as ei:
+        load_result(p)
+    assert str(ei.value).startswith(f"{p}: not a JSON file (JSONDecodeError: ") and "\n" not in str(ei.value)
+    p.write_text('{"axes": []}')
+    with pytest.raises(DataFormatError) as ei:
+        load_result(p)
+    assert str(ei.value) == (f"{p}: not a fogdrift allan or noise result: no 'axes' list; expected the allan.json or "
+                             "noise.json of a fogdrift run")
+    p.write_text('{"axes": [{"name": "gx"}]}', encoding="utf-8")
+    assert load_result(p)["axes"][0]["name"] == "gx"
+    with pytest.raises(DataFormatError) as ei:
+        channels_from_result({"axes": ["gx"]})
+    assert str(ei.value) == "result: an entry of 'axes' is not an object"
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")})
+    del ax["noise"]["dt_s"]
+    with pytest.raises(DataFormatError) as ei:
+        channels_from_result(_allan_doc(ax, {}), "a.json")
+    assert str(ei.value).startswith("a.json: axis 'gx' is not a complete fogdrift allan result (")
+    assert str(ei.value).endswith("); expected the allan.json or noise.json of a fogdrift run")
+    g = json.loads(_gyro_result(tmp_path).read_text())
+    with pytest.raises(DataFormatError) as ei:
+        channels_from_result(g, "g.json", expect="accel")
+    assert str(ei.value) == ("g.json: --accel was given a gyro result (axis gx: N in deg/sqrt(h)); pass it as "
+                             "--gyro")
+
+
+def test_method_is_read_from_the_axis_or_its_shape():
+    gm = _full_gmwm_axis()
+    del gm["method"]                                          # no method: 'selection' says GMWM
+    assert _one(gm).method == "gmwm"
+    al = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")})
+    al["selection"] = {"not": "used"}
+    al["method"] = "allan"                                    # an explicit method wins over the shape
+    assert _one(al).method == "allan"
