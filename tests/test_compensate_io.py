@@ -200,7 +200,12 @@ def test_ctrl_c_while_the_csv_is_written_leaves_no_partial_file(bundle, tmp_path
     n = 3_000_000
     np.save(tmp_path / "big.npy", np.full(n, 45.0))
     out = tmp_path / "o"
-    cmd = [sys.executable, "-m", "fogdrift", "compensate", str(bundle), str(tmp_path / "big.npy"), "--rate", "1",
+    # A test run started as a background job of a non-interactive shell has SIGINT ignored and the child inherits
+    # it (the CLI respects that, as a shell asks: the run then finished with exit 0); restore Python's handler
+    # first, as tests/test_cli_safety.py's BOOT does.
+    boot = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); sys.argv[0] = 'fogdrift'; "
+            "from fogdrift.cli import main; main()")
+    cmd = [sys.executable, "-c", boot, "compensate", str(bundle), str(tmp_path / "big.npy"), "--rate", "1",
            "--unit", "deg/h", "--axis-map", "col0=gz", "--model", "bias", "--no-heading", "--no-artefacts",
            "--chunk", "2000", "--out", str(out)]
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "src"))
