@@ -82,19 +82,19 @@ def _accel_result(tmp_path):
 # ------------------------------------------------------------------------------------------------------------------
 def test_arw_density_hand_values():
     # 0.15 deg/sqrt(h) = 0.15 * (pi/180) rad / sqrt(3600 s) = 0.15 * 0.01745329 / 60 = 4.3633e-5 rad/s/sqrt(Hz)
-    assert arw_to_density(0.15) == pytest.approx(4.3633e-5, rel=1e-4)
-    assert density_to_arw(4.3633e-5) == pytest.approx(0.15, rel=1e-4)
-    assert vrw_to_density(0.06) == pytest.approx(0.001, rel=1e-12)          # 0.06 m/s/sqrt(h) / 60
+    assert arw_to_density(0.15) == pytest.approx(4.3633e-5, rel=1e-4, abs=0)
+    assert density_to_arw(4.3633e-5) == pytest.approx(0.15, rel=1e-4, abs=0)
+    assert vrw_to_density(0.06) == pytest.approx(0.001, rel=1e-12, abs=0)          # 0.06 m/s/sqrt(h) / 60
     # 1 deg/h^1.5 = (pi/180) / 3600^1.5 rad/s^1.5 = 0.01745329 / 216000 = 8.0802e-8
-    assert rrw_to_density(1.0) == pytest.approx(8.0802e-8, rel=1e-4)
+    assert rrw_to_density(1.0) == pytest.approx(8.0802e-8, rel=1e-4, abs=0)
 
 
 def test_to_si_units_and_unknown_unit():
-    assert to_si(0.2, "B", "mg")[0] == pytest.approx(0.2e-3 * G, rel=1e-12)
-    assert to_si(50.0, "B", "ug")[0] == pytest.approx(50e-6 * G, rel=1e-12)
-    assert to_si(1.0, "B", "mGal")[0] == pytest.approx(1e-5, rel=1e-12)
-    assert to_si(3.6, "B", "deg/h")[0] == pytest.approx(1e-3 * D, rel=1e-12)   # 3.6 deg/h = 0.001 deg/s
-    assert to_si(2.0, "N", "deg/√h")[0] == pytest.approx(2 * D / 60, rel=1e-12)
+    assert to_si(0.2, "B", "mg")[0] == pytest.approx(0.2e-3 * G, rel=1e-12, abs=0)
+    assert to_si(50.0, "B", "ug")[0] == pytest.approx(50e-6 * G, rel=1e-12, abs=0)
+    assert to_si(1.0, "B", "mGal")[0] == pytest.approx(1e-5, rel=1e-12, abs=0)
+    assert to_si(3.6, "B", "deg/h")[0] == pytest.approx(1e-3 * D, rel=1e-12, abs=0)   # 3.6 deg/h = 0.001 deg/s
+    assert to_si(2.0, "N", "deg/√h")[0] == pytest.approx(2 * D / 60, rel=1e-12, abs=0)
     with pytest.raises(ConfigError, match="not one fogdrift can convert; expected one of"):
         to_si(1.0, "N", "furlong/fortnight")
 
@@ -113,8 +113,8 @@ def test_single_gm_peak_is_the_flicker_floor():
     sigma, tc = single_gm_from_flicker(b, tau_b)
     taus = np.geomspace(tau_b / 10, tau_b * 10, 2001)
     adev = np.sqrt(gm_avar_dph2(taus, tc, sigma))
-    assert adev.max() == pytest.approx(0.664282 * b, rel=1e-4)     # flicker ADEV floor sqrt(2 ln2 / pi) B
-    assert taus[adev.argmax()] == pytest.approx(tau_b, rel=5e-3)
+    assert adev.max() == pytest.approx(0.664282 * b, rel=1e-4, abs=0)     # flicker ADEV floor sqrt(2 ln2 / pi) B
+    assert taus[adev.argmax()] == pytest.approx(tau_b, rel=5e-3, abs=0)
 
 
 # ------------------------------------------------------------------------------------------------------------------
@@ -128,10 +128,10 @@ def ctx(tmp_path):
 def test_kalibr_pyyaml(ctx):
     d = yaml.safe_load(render("kalibr", ctx))
     # one value for all axes: the largest (gy N 0.20 deg/sqrt(h), gx K 0.5 deg/h^1.5; az VRW 0.18, az K 3e-4)
-    assert d["gyroscope_noise_density"] == pytest.approx(0.20 * D / 60, rel=1e-5)
-    assert d["gyroscope_random_walk"] == pytest.approx(0.5 * D / 216000, rel=1e-5)
-    assert d["accelerometer_noise_density"] == pytest.approx(0.18 / 60, rel=1e-5)
-    assert d["accelerometer_random_walk"] == pytest.approx(3e-4, rel=1e-5)
+    assert d["gyroscope_noise_density"] == pytest.approx(0.20 * D / 60, rel=1e-5, abs=0)
+    assert d["gyroscope_random_walk"] == pytest.approx(0.5 * D / 216000, rel=1e-5, abs=0)
+    assert d["accelerometer_noise_density"] == pytest.approx(0.18 / 60, rel=1e-5, abs=0)
+    assert d["accelerometer_random_walk"] == pytest.approx(3e-4, rel=1e-5, abs=0)
     assert d["update_rate"] == 100.0 and d["rostopic"] == "/imu0"
 
 
@@ -147,35 +147,35 @@ def _cv(text, tmp_path, name):
 def test_openvins_vins_orbslam3_read_by_opencv(ctx, tmp_path):
     fs = _cv(render("openvins", ctx), tmp_path, "ov.yaml")
     imu0 = fs.getNode("imu0")
-    assert imu0.getNode("gyroscope_noise_density").real() == pytest.approx(0.20 * D / 60, rel=1e-5)
-    assert imu0.getNode("accelerometer_random_walk").real() == pytest.approx(3e-4, rel=1e-5)
+    assert imu0.getNode("gyroscope_noise_density").real() == pytest.approx(0.20 * D / 60, rel=1e-5, abs=0)
+    assert imu0.getNode("accelerometer_random_walk").real() == pytest.approx(3e-4, rel=1e-5, abs=0)
     assert imu0.getNode("update_rate").real() == 100.0
     assert imu0.getNode("T_i_b").size() == 4
     fs.release()
     fs = _cv(render("vins-fusion", ctx), tmp_path, "vins.yaml")
-    assert fs.getNode("gyr_n").real() == pytest.approx(0.20 * D / 60, rel=1e-5)
-    assert fs.getNode("acc_n").real() == pytest.approx(0.18 / 60, rel=1e-5)
-    assert fs.getNode("gyr_w").real() == pytest.approx(0.5 * D / 216000, rel=1e-5)
-    assert fs.getNode("acc_w").real() == pytest.approx(3e-4, rel=1e-5)
+    assert fs.getNode("gyr_n").real() == pytest.approx(0.20 * D / 60, rel=1e-5, abs=0)
+    assert fs.getNode("acc_n").real() == pytest.approx(0.18 / 60, rel=1e-5, abs=0)
+    assert fs.getNode("gyr_w").real() == pytest.approx(0.5 * D / 216000, rel=1e-5, abs=0)
+    assert fs.getNode("acc_w").real() == pytest.approx(3e-4, rel=1e-5, abs=0)
     fs.release()
     fs = _cv(render("orbslam3", ctx), tmp_path, "orb.yaml")
-    assert fs.getNode("IMU.NoiseGyro").real() == pytest.approx(0.20 * D / 60, rel=1e-5)
-    assert fs.getNode("IMU.NoiseAcc").real() == pytest.approx(0.18 / 60, rel=1e-5)
-    assert fs.getNode("IMU.GyroWalk").real() == pytest.approx(0.5 * D / 216000, rel=1e-5)
-    assert fs.getNode("IMU.AccWalk").real() == pytest.approx(3e-4, rel=1e-5)
+    assert fs.getNode("IMU.NoiseGyro").real() == pytest.approx(0.20 * D / 60, rel=1e-5, abs=0)
+    assert fs.getNode("IMU.NoiseAcc").real() == pytest.approx(0.18 / 60, rel=1e-5, abs=0)
+    assert fs.getNode("IMU.GyroWalk").real() == pytest.approx(0.5 * D / 216000, rel=1e-5, abs=0)
+    assert fs.getNode("IMU.AccWalk").real() == pytest.approx(3e-4, rel=1e-5, abs=0)
     assert fs.getNode("IMU.Frequency").real() == 100.0
     fs.release()
 
 
 def test_kfgins_units(ctx):
     d = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
-    assert d["arw"] == pytest.approx([0.15, 0.20, 0.10], rel=1e-5)            # deg/sqrt(h), per axis
-    assert d["vrw"] == pytest.approx([0.06, 0.12, 0.18], rel=1e-5)            # m/s/sqrt(h)
+    assert d["arw"] == pytest.approx([0.15, 0.20, 0.10], rel=1e-5, abs=0)            # deg/sqrt(h), per axis
+    assert d["vrw"] == pytest.approx([0.06, 0.12, 0.18], rel=1e-5, abs=0)            # m/s/sqrt(h)
     # one GM per bias matched to B: sigma = 1.0760 B [deg/h]; abstd in mGal (1 ug = 0.980665 mGal)
-    assert d["gbstd"] == pytest.approx([1.0760 * 2.0, 1.0760 * 3.0, 1.0760 * 1.0], rel=1e-4)
+    assert d["gbstd"] == pytest.approx([1.0760 * 2.0, 1.0760 * 3.0, 1.0760 * 1.0], rel=1e-4, abs=0)
     assert d["abstd"] == pytest.approx([1.0760 * 50 * 0.980665, 1.0760 * 100 * 0.980665, 1.0760 * 150 * 0.980665],
-                                       rel=1e-4)
-    assert d["corrtime"] == pytest.approx(100.0 / 1.8926 / 3600.0, rel=1e-4)  # hours
+                                       rel=1e-4, abs=0)
+    assert d["corrtime"] == pytest.approx(100.0 / 1.8926 / 3600.0, rel=1e-4, abs=0)  # hours
     assert "gsstd" not in d and "asstd" not in d
 
 
@@ -187,10 +187,10 @@ def test_matlab_name_value_pairs(ctx):
         m = re.search(rf"'{key}', \[([^\]]*)\]", block)
         return [float(v) for v in m.group(1).split()]
 
-    assert vec("gyro", "NoiseDensity") == pytest.approx([0.15 * D / 60, 0.20 * D / 60, 0.10 * D / 60], rel=1e-5)
-    assert vec("gyro", "BiasInstability") == pytest.approx([2.0 * D / 3600, 3.0 * D / 3600, 1.0 * D / 3600], rel=1e-5)
-    assert vec("accel", "BiasInstability") == pytest.approx([50e-6 * G, 100e-6 * G, 150e-6 * G], rel=1e-5)
-    assert vec("accel", "RandomWalk") == pytest.approx([1e-4, 2e-4, 3e-4], rel=1e-5)
+    assert vec("gyro", "NoiseDensity") == pytest.approx([0.15 * D / 60, 0.20 * D / 60, 0.10 * D / 60], rel=1e-5, abs=0)
+    assert vec("gyro", "BiasInstability") == pytest.approx([2.0 * D / 3600, 3.0 * D / 3600, 1.0 * D / 3600], rel=1e-5, abs=0)
+    assert vec("accel", "BiasInstability") == pytest.approx([50e-6 * G, 100e-6 * G, 150e-6 * G], rel=1e-5, abs=0)
+    assert vec("accel", "RandomWalk") == pytest.approx([1e-4, 2e-4, 3e-4], rel=1e-5, abs=0)
     assert "imuSensor('accel-gyro', 'SampleRate', 100.0, 'Gyroscope', gyro, 'Accelerometer', accel)" in text
 
 
@@ -198,11 +198,11 @@ def test_gnss_ins_sim_dictionary(ctx):
     ns = {}
     exec(render("gnss-ins-sim", ctx), ns)  # noqa: S102 - our own generated file
     err = ns["imu_err"]
-    assert err["gyro_arw"] == pytest.approx([0.15, 0.20, 0.10], rel=1e-5)            # deg/sqrt(h)
-    assert err["gyro_b_stability"] == pytest.approx([1.0760 * 2, 1.0760 * 3, 1.0760], rel=1e-4)  # deg/h
-    assert err["gyro_b_corr"] == pytest.approx([100 / 1.8926] * 3, rel=1e-4)          # s
-    assert err["accel_vrw"] == pytest.approx([0.06, 0.12, 0.18], rel=1e-5)
-    assert err["accel_b_stability"][0] == pytest.approx(1.0760 * 50e-6 * G, rel=1e-4)  # m/s^2
+    assert err["gyro_arw"] == pytest.approx([0.15, 0.20, 0.10], rel=1e-5, abs=0)            # deg/sqrt(h)
+    assert err["gyro_b_stability"] == pytest.approx([1.0760 * 2, 1.0760 * 3, 1.0760], rel=1e-4, abs=0)  # deg/h
+    assert err["gyro_b_corr"] == pytest.approx([100 / 1.8926] * 3, rel=1e-4, abs=0)          # s
+    assert err["accel_vrw"] == pytest.approx([0.06, 0.12, 0.18], rel=1e-5, abs=0)
+    assert err["accel_b_stability"][0] == pytest.approx(1.0760 * 50e-6 * G, rel=1e-4, abs=0)  # m/s^2
     assert list(err["gyro_b"]) == [0.0, 0.0, 0.0]
 
 
@@ -219,24 +219,24 @@ def test_every_number_carries_its_provenance(ctx):
 def test_json_has_terms_and_van_loan_state_space(ctx):
     d = json.loads(render("json", ctx))
     gx = next(c for c in d["channels"] if c["name"] == "gx")
-    assert gx["export_values"]["N"]["si"] == pytest.approx(0.15 * D / 60, rel=1e-9)
-    assert gx["export_values"]["N"]["discrete_sigma"] == pytest.approx(0.15 * D / 60 * 10, rel=1e-9)
+    assert gx["export_values"]["N"]["si"] == pytest.approx(0.15 * D / 60, rel=1e-9, abs=0)
+    assert gx["export_values"]["N"]["discrete_sigma"] == pytest.approx(0.15 * D / 60 * 10, rel=1e-9, abs=0)
     ss = gx["state_space"]
     assert ss["check_max_abs"] < 1e-12
     white = next(t for t in ss["continuous_terms"] if t["kind"] == "white")
-    assert white["density"] == pytest.approx(0.15 * D / 60, rel=1e-9) and white["unit"] == "rad/s/sqrt(Hz)"
+    assert white["density"] == pytest.approx(0.15 * D / 60, rel=1e-9, abs=0) and white["unit"] == "rad/s/sqrt(Hz)"
     rw = next(t for t in ss["continuous_terms"] if t["kind"] == "random_walk")
-    assert rw["density"] == pytest.approx(0.5 * D / 216000, rel=1e-9)
+    assert rw["density"] == pytest.approx(0.5 * D / 216000, rel=1e-9, abs=0)
     states = ss["discrete"]["states"]
     assert states[:2] == ["bias", "random_walk"]
     i = states.index("random_walk")
     k = 0.5 * D / 216000                                                     # K in rad/s^2/sqrt(Hz)
-    assert ss["discrete"]["Qd"][i][i] == pytest.approx(k * k * 0.01, rel=1e-9)
-    assert ss["discrete"]["r"] == pytest.approx((0.15 * D / 60) ** 2 / 0.01, rel=1e-9)
+    assert ss["discrete"]["Qd"][i][i] == pytest.approx(k * k * 0.01, rel=1e-9, abs=0)
+    assert ss["discrete"]["r"] == pytest.approx((0.15 * D / 60) ** 2 / 0.01, rel=1e-9, abs=0)
     for j, s in enumerate(states):
         if s.startswith("gm_"):
             tc = -1.0 / ss["continuous"]["F"][j][j]
-            assert ss["discrete"]["Phi"][j][j] == pytest.approx(math.exp(-0.01 / tc), rel=1e-12)
+            assert ss["discrete"]["Phi"][j][j] == pytest.approx(math.exp(-0.01 / tc), rel=1e-12, abs=0)
 
 
 # ------------------------------------------------------------------------------------------------------------------
@@ -329,11 +329,11 @@ def test_six_channel_result_split_by_units(tmp_path):
     ctx = build_context(results=[six])
     assert [c.name for c in ctx.gyro] == ["gx", "gy", "gz"] and [c.name for c in ctx.accel] == ["ax", "ay", "az"]
     d = yaml.safe_load(render("kalibr", ctx))
-    assert d["accelerometer_noise_density"] == pytest.approx(0.18 / 60, rel=1e-5)
+    assert d["accelerometer_noise_density"] == pytest.approx(0.18 / 60, rel=1e-5, abs=0)
     res = runner.invoke(app, ["export", "--result", str(six), "--target", "orbslam3", "--out", str(tmp_path / "o")])
     assert res.exit_code == 0, res.output
     fs = _cv((tmp_path / "o" / "orbslam3_imu.yaml").read_text(), tmp_path, "orb_back.yaml")
-    assert fs.getNode("IMU.NoiseAcc").real() == pytest.approx(0.18 / 60, rel=1e-5)
+    assert fs.getNode("IMU.NoiseAcc").real() == pytest.approx(0.18 / 60, rel=1e-5, abs=0)
     fs.release()
 
 
@@ -361,10 +361,10 @@ def test_gmwm_result_slowest_gm_is_the_bias(tmp_path):
                                       _gmwm_axis("gy", 0.3, None, [(80.0, 3.0)])]}))
     ctx = build_context([p], missing="zero")
     d = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
-    assert d["gbstd"] == pytest.approx([4.0, 3.0], rel=1e-5)          # the slow GM, not the 0.2-s one
-    assert d["corrtime"] == pytest.approx(150.0 / 3600.0, rel=1e-5)
+    assert d["gbstd"] == pytest.approx([4.0, 3.0], rel=1e-5, abs=0)          # the slow GM, not the 0.2-s one
+    assert d["corrtime"] == pytest.approx(150.0 / 3600.0, rel=1e-5, abs=0)
     k = yaml.safe_load(render("kalibr", ctx))["gyroscope_random_walk"]
-    assert k == pytest.approx(2.0 * D / 216000, rel=1e-5)             # gy has no RW: 0 under --missing zero
+    assert k == pytest.approx(2.0 * D / 216000, rel=1e-5, abs=0)             # gy has no RW: 0 under --missing zero
     with pytest.raises(ConfigError, match="gyro gy: K is not resolved by the record: not in the GMWM model"):
         render("kalibr", build_context([p]))                           # no bound from GMWM: refused, not guessed
     # with the wavelet variance in the result, K is bounded by its longest scale: tau = 2^17 samples at dt 0.01 s,
@@ -377,8 +377,8 @@ def test_gmwm_result_slowest_gm_is_the_bias(tmp_path):
     gy = ctx.gyro[1]
     tau = 2.0 ** 17
     k_bound = 60 * math.sqrt(3.0 * 12 * tau / (tau * tau + 2) / 0.01)
-    assert gy.terms["K"].hi95 == pytest.approx(k_bound, rel=1e-12)
-    assert resolve(gy, "K", "bound").si == pytest.approx(k_bound * D / 216000, rel=1e-12)
+    assert gy.terms["K"].hi95 == pytest.approx(k_bound, rel=1e-12, abs=0)
+    assert resolve(gy, "K", "bound").si == pytest.approx(k_bound * D / 216000, rel=1e-12, abs=0)
     assert "longest scale (1311 s)" in gy.terms["K"].reason
 
 
@@ -409,7 +409,7 @@ def test_damaged_results_give_one_line_errors(tmp_path, cut):
     ("Q", "arcsec", "gyro", D / 3600), ("R", "m/s^2/h", "accel", 1 / 3600)])
 def test_unit_spellings(term, unit, quantity, factor):
     v, _, _ = to_si(1.0, term, unit)
-    assert v == pytest.approx(factor, rel=1e-12)
+    assert v == pytest.approx(factor, rel=1e-12, abs=0)
     from fogdrift.export.conversions import quantity_of_unit
 
     assert quantity_of_unit(term, unit) == quantity
@@ -420,9 +420,9 @@ def test_accelerometer_only_and_duplicate_axes(tmp_path):
     for t in parse_targets("all"):
         render(t, ctx)                                                # every target writes without a gyro
     d = yaml.safe_load(render("kalibr", ctx))
-    assert "gyroscope_noise_density" not in d and d["accelerometer_random_walk"] == pytest.approx(3e-4, rel=1e-5)
+    assert "gyroscope_noise_density" not in d and d["accelerometer_random_walk"] == pytest.approx(3e-4, rel=1e-5, abs=0)
     kf = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
-    assert "arw" not in kf and kf["corrtime"] == pytest.approx(100.0 / 1.8926 / 3600.0, rel=1e-4)
+    assert "arw" not in kf and kf["corrtime"] == pytest.approx(100.0 / 1.8926 / 3600.0, rel=1e-4, abs=0)
     g = _gyro_result(tmp_path)
     with pytest.raises(ConfigError, match="two gyro channels are called 'gx'"):
         build_context([g, g])
@@ -440,7 +440,7 @@ def test_bias_gm_is_the_slowest_of_flicker_and_markov(tmp_path):
     gx = channels_from_result(doc, "g")[0]
     assert len(gx.gms) == 1 and gx.gms[0].tc_s == 3.0
     g, how = bias_gm(gx, "bound")                         # flicker GM T_c = 100/1.8926 = 52.8 s > 3 s
-    assert g.tc_s == pytest.approx(100.0 / 1.8926, rel=1e-4) and "matched to B" in how
+    assert g.tc_s == pytest.approx(100.0 / 1.8926, rel=1e-4, abs=0) and "matched to B" in how
     ax["noise"]["shaped"]["M"]["tc_s"] = 500.0
     g, how = bias_gm(channels_from_result(doc, "g")[0], "bound")
     assert g.tc_s == 500.0 and g.sigma_si == pytest.approx(0.6124 * D / 3600) and "slowest" in how
