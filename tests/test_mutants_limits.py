@@ -256,6 +256,35 @@ def test_line_limit_exactly_at_and_one_above(monkeypatch, k):
     assert _err(b"x" * 5000, k) is None
 
 
+def test_survivors_of_the_workqueue_rerun(monkeypatch):
+    """The five non-equivalent mutants the re-run with NUMBA_THREADING_LAYER=workqueue decided as survivors."""
+    import resource
+
+    monkeypatch.setenv(limits.ENV_ROWS, "1E3")  # a plain number takes an upper-case exponent too
+    assert limits.max_rows() == 1000
+    monkeypatch.setenv(limits.ENV_EXPANSION, "2.5E1")
+    assert limits.max_expansion() == 25.0
+    monkeypatch.delenv(limits.ENV_ROWS)
+    monkeypatch.setattr(limits.os, "sysconf", lambda key: {"SC_PHYS_PAGES": 1000, "SC_PAGE_SIZE": 4096}[key])
+    monkeypatch.setattr(resource, "getrlimit", lambda which: (1, resource.RLIM_INFINITY))
+    assert limits._machine_memory() == 1  # a soft limit of one byte is a limit (only 0 means none)
+    monkeypatch.undo()
+    for name in ENVS:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv(limits.ENV_MEMORY, "10")
+    assert GuardedStream(io.BytesIO(b""), "p", bytes_per_row=1).max_lines == 10  # 10 bytes / 1 byte per row
+    monkeypatch.delenv(limits.ENV_MEMORY)
+    monkeypatch.setenv(limits.ENV_LINE, "10")
+    for k in CHUNKS:  # a first line that is empty: no CR came before the first LF
+        e = _err(b"\n" + b"x" * 11 + b"\n", k)
+        assert isinstance(e, ResourceLimitError) and e.line == 2, (k, e)
+        assert _read(b"\n\n", k).lines == 2
+    monkeypatch.setenv(limits.ENV_LINE, "0")  # no line limit, a file with breaks: chunks longer than anything
+    for k in CHUNKS:
+        gs = _read(b"a\n" + b"x" * 5000 + b"\r\nb", k)
+        assert gs.lines == 2 and gs.current == 1 and gs.max_line is None
+
+
 def test_a_long_line_inside_one_chunk_is_found_with_its_line_number(monkeypatch):
     monkeypatch.setenv(limits.ENV_LINE, "4")
     # read whole: the long line (5 bytes) lies between two breaks inside one chunk longer than the limit
