@@ -355,6 +355,32 @@ def test_open_log_reads_the_declared_unit_and_chunks_any_size(tmp_path):
     assert_allclose(_all(given, 7)[1][:, 0], v, rtol=1e-12)
 
 
+@pytest.mark.parametrize("kind", ("npy", "csv"))
+def test_open_log_hands_the_time_unit_on_and_records_the_file(tmp_path, kind):
+    """A time column in ms (10-ms steps from 5 ms): read as such on both paths; the streamed source names its file
+    and its SHA-256 (both go into the outputs' JSON)."""
+    import hashlib
+
+    from fogdrift.compensate.sources import open_log
+
+    t_ms = 5.0 + 10.0 * np.arange(12)
+    gz = np.arange(12.0)
+    if kind == "npy":
+        path = tmp_path / "r.npy"
+        np.save(path, np.column_stack([t_ms, gz]))
+        src = open_log(path, unit="deg/h", time_column="col0", time_unit="ms")
+        assert any("read in chunks" in n for n in src.notes)  # the streamed path
+    else:
+        path = _csv(tmp_path / "r.csv", "stamp,gz[deg/h]", gz, t=t_ms)  # a name that says no unit
+        src = open_log(path, time_column="stamp", time_unit="ms")
+        assert not any("read in chunks" in n for n in src.notes)
+    assert src.dt_s == pytest.approx(0.01, rel=1e-12, abs=0) and src.t0_s == pytest.approx(0.005, rel=1e-12, abs=0)
+    t, x = _all(src, 5)
+    assert_allclose(t, 0.005 + 0.01 * np.arange(12), rtol=1e-12, atol=0)
+    assert_array_equal(x[:, 0], gz)
+    assert src.path == path and src.sha256 == hashlib.sha256(path.read_bytes()).hexdigest()
+
+
 def test_npy_is_streamed_from_the_file_and_other_options_load_it(tmp_path, monkeypatch):
     import fogdrift.compensate.sources as sources
 
@@ -526,6 +552,32 @@ def test_match_log_rates_exactly_at_the_tolerance():
     assert info.value.__cause__ is None
 
 
+def test_match_log_edges_the_workqueue_rerun_found():
+    """Survivors of the full mutmut re-run of sources.py (0 undecided with the workqueue layer)."""
+    from fogdrift.compensate.sources import match_log, parse_axis_map
+
+    # the tolerance is inclusive: 1 s in 1e6 s is a relative difference of exactly 1e-6 in floating point
+    assert abs(1e6 + 1.0 - 1e6) / 1e6 == 1e-6
+    big = _bundle(native_dt_s=1e6, model_dt_s=1e7)
+    assert match_log(_source(dt_s=1e6 + 1.0), big).factor == 10
+    with pytest.raises(ConfigError):
+        match_log(_source(dt_s=1e6 + 2.0), big)
+    # the modelling rate is 1 / model_dt_s in both refusals (2 Hz for 0.5 s, not 0.5)
+    half = _bundle(model_dt_s=0.5, block_average_factor=5)
+    with pytest.raises(ConfigError) as info:
+        match_log(_source(dt_s=0.05), half)
+    assert "(models at 2 Hz)" in str(info.value)
+    with pytest.raises(ConfigError) as info:
+        match_log(_source(dt_s=0.3), half, accept_rate=True)
+    assert str(info.value).endswith("cannot be block-averaged to the bundle's modelling rate 2 Hz by an integer factor")
+    # every missing bundle axis is listed, separated by ", "
+    m = match_log(_source(axis_names=("gz",)), _bundle(axis_names=("gx", "gy", "gz")))
+    assert m.notes == ("axes of the bundle not in the log (not compensated): gx, gy",)
+    # an empty entry between two others is skipped, not the end of the map; an entry splits at its first "="
+    assert parse_axis_map("col0=gz, ,col1=gx") == {"col0": "gz", "col1": "gx"}
+    assert parse_axis_map("col0=g=z") == {"col0": "g=z"}
+
+
 def test_match_log_axes_by_name_and_map():
     from fogdrift.compensate.sources import match_log, parse_axis_map
 
@@ -576,9 +628,11 @@ def test_csv_writer_header_and_rows_by_hand(tmp_path):
         "1,5,6,7,8"]
     w = CsvWriter(tmp_path / "s.csv", ["gz"], "deg/h", with_sigma=True)
     w.write(np.array([2.0]), np.array([[1.0]]), np.array([[-2.0]]), np.array([[0.25]]))
+    w.write(np.array([3.0]), np.array([[1e20]]), np.array([[-2.5e-05]]), np.array([[1e-300]]))  # C's %g exponent
     w.abort()
     assert w._fh.closed
-    assert (tmp_path / "s.csv").read_text() == "t_s,gz[deg/h],gz_drift[deg/h],gz_drift_sigma[deg/h]\n2,1,-2,0.25\n"
+    assert (tmp_path / "s.csv").read_text() == ("t_s,gz[deg/h],gz_drift[deg/h],gz_drift_sigma[deg/h]\n2,1,-2,0.25\n"
+                                                "3,1e+20,-2.5e-05,1e-300\n")
 
 
 @pytest.mark.parametrize("with_sigma", (False, True))
@@ -697,6 +751,7 @@ def test_plot_before_after_draws_what_it_says(monkeypatch, tmp_path):
         assert ax.get_xscale() == "log" and ax.get_xlabel() == "τ [s]" and ax.get_ylabel() == "σ(τ) [deg/h]"
         assert ax.get_title() == literal(f"T$1$: {name}")
         assert ax.xaxis.get_gridlines()[0].get_visible() and ax.xaxis.get_gridlines()[0].get_alpha() == 0.3
+        assert ax.xaxis.get_minor_ticks()[0].gridline.get_visible()  # which="both": the log decades' minor grid
         assert ax.get_legend().get_texts()[0].get_fontsize() == 7
     assert axs[0].get_yscale() == "log" and axs[1].get_yscale() == "linear"  # all-zero ADEVs: a linear axis
     assert [t.get_text() for t in axs[0].get_legend().get_texts()] == ["log (bias removed)",
@@ -839,6 +894,10 @@ def test_integer_input_is_read_as_float():
     assert comp.dtype == np.float64
     assert_allclose(comp, _run(_engine([_axis(bias=1.5)], factor=2), x.astype(float), None)["compensated_dph"][:, 0])
     assert comp[0] == -1.5
+    b = _engine([_axis(bias=1.5)], factor=2)  # integer times too (a log stamped in whole seconds)
+    blocks = b.push(np.arange(10), x.reshape(-1, 1)) + b.finish()
+    assert all(blk.t_s.dtype == np.float64 for blk in blocks)
+    assert_array_equal(np.concatenate([blk.t_s for blk in blocks]), np.arange(10.0))
 
 
 def test_npz_members_over_the_zip64_limit_are_written(tmp_path, monkeypatch):
