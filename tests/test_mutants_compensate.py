@@ -200,6 +200,17 @@ def test_a_log_shorter_than_the_bias_window_is_refused_in_one_line():
     eng = _engine([_axis()], factor=2, bias=5.0, model_dt_s=0.5)  # 10 intervals of 0.5 s
     with pytest.raises(InsufficientDataError, match="needs 5 s of the log; it has only 4.5 s"):
         _run(eng, np.arange(18.0), 4)
+    for bias, first in (("keep", 0), (2.0, 2), (5.0, 5)):  # bias only, several segments: the first sample it acts
+        eng = _engine([_axis()], factor=1, segment=4, model=BIAS_ONLY, bias=bias)  # on stays the first one
+        _run(eng, np.arange(12.0), None)
+        assert eng.first_active() == [first], bias
+    eng = _engine([_axis()], factor=1, segment=4, bias=4.0)  # the window completes with the first segment:
+    assert [b.t_s.size for b in eng.push(np.arange(4.0), np.arange(4.0).reshape(-1, 1))] == [4]  # emitted at once
+    assert eng.re_estimated_bias_dph == [1.5]
+    for chunk in (None, 2):  # the log ends exactly on a segment boundary, short of the window (finish: no rows)
+        eng = _engine([_axis()], factor=1, segment=4, bias=5.0)
+        with pytest.raises(InsufficientDataError, match="needs 5 s of the log; it has only 4 s"):
+            _run(eng, np.arange(4.0), chunk)
     eng = _engine([_axis()], factor=2, bias=6.0)  # exactly the window: fine
     _run(eng, np.arange(12.0), 5)
     assert eng.first_active() == [None]  # never past the window: the model never acts
