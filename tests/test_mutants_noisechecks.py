@@ -748,3 +748,13 @@ def test_describe_excluded_names_a_bump_or_the_line_that_shapes_the_curve():
     assert notes._lines_that_matter(SimpleNamespace(lines=((20.0, 1.0), (40.0, 0.0025)), ref_amplitude_dph=2.0), tau,
                                     y) == ["spectral line at 20 Hz, 2 deg/h"]
     assert notes._lines_that_matter(None, tau, y) == [] and notes._lines_that_matter(pc, [], []) == []
+
+
+def test_median_null_critical_inverts_sf_below_e_too():
+    """``critical`` searches r in [1, 1e4] (log r from 0): a lenient p whose critical ratio is below e is found."""
+    null = _MedianNull(2.0, 3, 1.0)
+    for p in (0.3, 0.1, 1e-3):
+        r = null.critical(p)
+        assert 1.0 <= r < 1e4
+        assert float(null.sf(r)[0]) == pytest.approx(p, rel=1e-3)
+    assert null.critical(0.3) < math.e  # the case a bracket starting at log r = 1 cannot reach

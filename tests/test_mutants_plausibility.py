@@ -338,6 +338,8 @@ def test_log_spaced_count():
     for bad in (0, -1, 100_001):
         with pytest.raises(ConfigError, match=rf"taus as a count must be in \[1, 100000\], got {bad}"):
             tau_grid(400, 1.0, bad)
+    assert tau_grid(400, 1.0, 2).tolist() == [1, 100]  # two: both ends (logspace(0, 2, 2))
+    assert tau_grid(400, 1.0, 100_000).tolist() == list(range(1, 101))  # the limit itself is allowed
 
 
 def test_explicit_taus():
@@ -357,6 +359,10 @@ def test_explicit_taus():
             tau_grid(100, 0.5, bad)
     with pytest.raises(ConfigError, match=r"at most 100000 taus, got 100001"):
         tau_grid(10**6, 1.0, np.ones(100_001))
+    assert tau_grid(10**6, 1.0, np.ones(100_000)).tolist() == [1]  # exactly the limit: allowed
+    # the refusal names the first tau outside [dt, m_top dt], not one at either end of it
+    with pytest.raises(ConfigError, match=r"tau 25.3 s is outside"):
+        tau_grid(100, 0.5, [0.5, 1.0, 25.0, 25.3])
 
 
 def test_max_fraction_and_too_short_records():
