@@ -758,3 +758,20 @@ def test_median_null_critical_inverts_sf_below_e_too():
         assert 1.0 <= r < 1e4
         assert float(null.sf(r)[0]) == pytest.approx(p, rel=1e-3)
     assert null.critical(0.3) < math.e  # the case a bracket starting at log r = 1 cannot reach
+
+
+def test_periodic_content_lists_a_component_once_with_frequencies_that_need_all_nine_digits():
+    """A sawtooth-like component at f0 = 1/3 Hz (0.333333333333...: ten and more digits) with its first harmonic,
+    the same two lines also in the spectrum's line list, no ``period_s`` (1 / f0 then): one component, described
+    once as a periodic error, and a separate line at 0.25 Hz (below 1 Hz, kept)."""
+    f0 = 1.0 / 3.0
+    fund = {"freq_hz": f0, "amplitude_dph": 2.0}
+    harm = {"freq_hz": 2.0 * f0, "amplitude_dph": 0.5}
+    lone = {"freq_hz": 0.25, "amplitude_dph": 1.0}
+    comp = {"fundamental_hz": f0, "lines": [fund, harm], "power_dph2": 4.25}
+    pc = periodic_content({"lines": [fund, harm, lone], "components": [comp]})
+    assert pc.descriptions == ("periodic error, period 3 s (0.3333 Hz and 1 harmonic(s))",
+                               "spectral line at 0.25 Hz, 1 deg/h")
+    assert pc.periods_s == pytest.approx((3.0, 4.0), rel=1e-12, abs=0)
+    assert [f for f, _ in pc.lines] == pytest.approx([f0, 2.0 * f0, 0.25], rel=1e-12, abs=0)
+    assert [r for _, r in pc.lines] == pytest.approx([1.0, 0.0625, 0.25], rel=1e-12, abs=0)  # (a / 2)^2

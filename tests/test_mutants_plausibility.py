@@ -446,3 +446,87 @@ def test_mixed_record_applies_the_gyro_rules_to_the_gyros_and_gravity_to_the_acc
     found = check_record(load(p))
     assert [f.rule for f in found] == ["white-noise", "gravity"]
     assert found[0].axes == AXES and found[1].axes == ("ax", "ay", "az") and found[1].likely_units == ("mg",)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# survivors of the full re-run with the workqueue layer (docs/testing.md)
+
+
+@pytest.mark.parametrize("fs, text", [
+    (0.05, "sample rate 0.05 Hz (interval 20 s) is unusually low for a gyro log; check {opt:time_unit} (a time "
+           "column in ms read as s gives a 1000 times longer step) and {opt:rate_hz}"),
+    (1e6, "sample rate 1e+06 Hz (interval 1e-06 s) is unusually high for a gyro log; check {opt:time_unit} (a time "
+          "column in s read as ms gives a 1000 times shorter step) and {opt:rate_hz}"),
+])
+def test_sample_rate_message_word_for_word(fs, text):
+    found = pl._rate_findings(from_array(np.zeros(64), dt_s=1.0 / fs))
+    assert [f.message for f in found] == [text]
+
+
+def test_range_reads_the_largest_magnitude_of_either_sign_in_deg_s():
+    neg = [f for f in check_record(from_array(np.full(500, -2e4), dt_s=0.01, unit="deg/s")) if f.rule == "range"]
+    assert len(neg) == 1 and "max |rate| axis0 2e+04 deg/s" in neg[0].message  # |-2e4|, a negative log
+    # 12351 deg/s (44 463 600 deg/h) / 3600 = 12351 -> "1.24e+04" at 3 digits (/ 3601 would print 1.23e+04)
+    x = np.column_stack([np.full(500, 12351.0), np.full(500, -3e4)])
+    rng = [f for f in check_record(from_array(x, dt_s=0.01, unit="deg/s", axis_names=("a", "b"))) if f.rule == "range"]
+    assert rng[0].axes == ("a", "b")
+    assert "max |rate| a 1.24e+04 deg/s, b 3e+04 deg/s with the rate read as deg/s" in rng[0].message
+
+
+def test_quiet_finding_lists_every_quiet_axis_with_its_level():
+    rng = np.random.default_rng(4)
+    x = np.column_stack([rng.normal(0.0, 1e-5, 20_000), rng.normal(0.0, 2e-5, 20_000)])
+    found = check_record(from_array(x, dt_s=0.01, unit="deg/h", axis_names=("a", "b")))
+    assert [f.rule for f in found] == ["white-noise"] and found[0].axes == ("a", "b")
+    assert re.match(r"white-noise floor N <= a \S+, b \S+ deg/√h with the rate read as deg/h: ", found[0].message)
+
+
+def test_gravity_like_finding_names_the_three_axes():
+    found = pl.gravity_like_findings(_triad((0.0, 0.0, 9.80665), sd=1e-4, n=2000))
+    assert found[0].axes == AXES
+
+
+def test_mixed_record_sample_rate_once_and_sums_of_its_gyro_axes(tmp_path):
+    """A gyro + accelerometer record at an implausible 0.05 Hz: the sample-rate finding once (not once more from
+    the gyro sub-record), and the gyro axes' Allan sums handed back to the caller."""
+    from fogdrift.io import load
+    from fogdrift.pipeline_sums import AllanSums
+
+    rng = np.random.default_rng(9)
+    n = 400
+    t = np.arange(n) * 20.0
+    g = rng.normal(0.0, 1.0, (n, 3))
+    a = np.column_stack([np.zeros(n), np.zeros(n), np.ones(n)]) + rng.normal(0.0, 1e-4, (n, 3))
+    p = tmp_path / "slow.csv"
+    head = "t_s,gx[deg/h],gy[deg/h],gz[deg/h],ax[g],ay[g],az[g]"
+    np.savetxt(p, np.column_stack([t, g, a]), delimiter=",", header=head, comments="", fmt="%.9g")
+    sums = {}
+    found = check_record(load(p), sums=sums)
+    assert [f.rule for f in found].count("sample-rate") == 1
+    assert set(sums) == set(AXES) and all(isinstance(v, AllanSums) for v in sums.values())
+
+
+def test_noise_floor_keeps_a_tau_with_exactly_40_clusters():
+    """White phase noise, N = 2560 = 40 x 64: m = 64 has exactly 40 clusters and is kept; the floor is read there."""
+    from fogdrift.allan import allan_variance
+
+    x = np.diff(np.random.default_rng(3).normal(0.0, 1.0, 2561))
+    r = allan_variance(x, 1.0)
+    prod = r.adev_dph * np.sqrt(r.tau_s) / 60.0
+    assert 64 in r.m.tolist() and float(prod[r.m == 64][0]) < float(prod[r.m < 64].min())
+    assert pl.noise_floor(x, 1.0).estimate == pytest.approx(float(prod[r.m <= 64].min()), rel=1e-9, abs=0)
+
+
+def test_floor_figure_from_1e4_is_scientific():
+    assert pl._fmt(10000.5) == "1.00e+04" and pl._fmt(9990.0) == "9.99e+03"
+
+
+def test_a_log_exactly_at_1e4_deg_s_breaks_no_range_rule():
+    x = np.full(500, 1e4) + np.random.default_rng(0).normal(0.0, 1e-3, 500)
+    x = np.minimum(x, 1e4)  # the largest |rate| exactly 1e4 deg/s
+    assert "range" not in [f.rule for f in check_record(from_array(x, dt_s=0.01, unit="deg/s"))]
+
+
+def test_accelerometer_only_record_gets_the_gravity_rule_only():
+    found = check_record(_accel((0.0, 0.0, 1000.0), "g"))  # mg read as g
+    assert [f.rule for f in found] == ["gravity"] and found[0].likely_units == ("mg",)
