@@ -507,9 +507,13 @@ def gyro_only(record, command: str) -> None:
                           "leave them out with {opt:columns}")
 
 
-def check_plausible(record) -> None:
-    """Warn (one line each) when the record is implausible for any gyro: a wrong --unit or --time-unit."""
-    for finding in check_record(record):
+def check_plausible(record, *, sums: dict | None = None) -> None:
+    """Warn (one line each) when the record is implausible for any gyro: a wrong --unit or --time-unit.
+
+    ``sums``: a dict that receives the octave Allan sums of the noise floors
+    (:func:`fogdrift.plausibility.check_record`), for a command that reuses them.
+    """
+    for finding in check_record(record, sums=sums):
         warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
 
 

@@ -20,9 +20,8 @@ import typer
 
 from ..errors import ConfigError
 from ..spec import readings_from_gmwm
-from ..plausibility import check_record
-from ._app import (FLAGS, JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run,
-                   say, warn, with_load_options)
+from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run, say,
+                   with_load_options)
 from ._tables import noise_table, print_noise_notes
 # (the --spec helpers live in the light cli._spec; imported here under their old names too)
 from ._spec import SpecOpt, channel_kinds, print_spec_comparison, print_spec_for_allan, read_spec_option  # noqa: F401
@@ -162,11 +161,10 @@ def noise(
                 raise ConfigError("--sensor belongs to --curve")
             record = load.load()
             echo_record(load, record)
-            # the plausibility check (as _app.check_plausible) keeps the octave Allan sums of its noise floors: the
-            # Allan fit of the GMWM-vs-Allan lines reuses them instead of computing that pass again
+            # the plausibility check keeps the octave Allan sums of its noise floors: the Allan fit of the
+            # GMWM-vs-Allan lines reuses them instead of computing that pass again
             sums = {}
-            for finding in check_record(record, sums=sums):
-                warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
+            check_plausible(record, sums=sums)
             with progress("noise", record.axis_names):
                 axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=model, levels=scales, robust=robust)
                         for name in record.axis_names]
