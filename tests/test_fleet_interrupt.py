@@ -120,6 +120,46 @@ def test_a_killed_workers_dead_lock_file_is_removed_a_live_one_kept(tmp_path, mo
         held.release()
 
 
+def test_a_killed_workers_probe_file_above_the_files_folders_is_removed(tmp_path):
+    """A worker killed while it probed the batch folder for writability (its file's folder did not exist yet) left
+    ``.fogdrift-tmp-<pid>-probe...`` there (seen once in CI under load): the batch removes the killed workers'
+    files and dead processes' files from the folders above the files' folders, up to the batch folder, and keeps
+    its own and a live process's (never anything outside the batch folder)."""
+    import subprocess as sp
+
+    from fogdrift.fleet import runner
+    from fogdrift.fleet.tasks import FileTask
+    from fogdrift.output import TMP_PREFIX, remove_stale_temporaries
+
+    out = tmp_path / "out"
+    (out / "sub").mkdir(parents=True)
+    live = sp.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    unreaped = sp.Popen([sys.executable, "-c", "import time; time.sleep(30)"])  # killed, not yet reaped: alive
+    dead = sp.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    try:
+        files = {
+            "killed": out / f"{TMP_PREFIX}{unreaped.pid}-probeabc",  # given as killed: removed although alive
+            "dead": out / "sub" / f"{TMP_PREFIX}{dead.pid}-probexyz",
+            "live": out / f"{TMP_PREFIX}{live.pid}-probe123",
+            "ours": out / f"{TMP_PREFIX}{os.getpid()}-summary.parquet",
+            "other": out / "notes.txt",
+            "outside": tmp_path / f"{TMP_PREFIX}{dead.pid}-probeqq",
+        }
+        for f in files.values():
+            f.write_text("x")
+        tasks = [FileTask(path="a.npy", file="a.npy", out_dir=str(out / "sub" / "a.npy"), rel_out="sub/a.npy",
+                          command="allan", settings={}, settings_sha256="0" * 64, flags={})]
+        runner._remove_temporaries(tasks, killed=[unreaped.pid])
+        assert {k for k, f in files.items() if f.exists()} == {"live", "ours", "other", "outside"}
+        assert remove_stale_temporaries(tmp_path / "missing") == []
+        assert remove_stale_temporaries(tmp_path) == [files["outside"]]
+    finally:
+        for p in (live, unreaped):
+            p.kill()
+            p.wait()
+
+
 BOOT = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); sys.argv[0] = 'fogdrift'; "
         "from fogdrift.cli import main; main()")
 

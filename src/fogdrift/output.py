@@ -46,7 +46,8 @@ try:  # POSIX; elsewhere runs are not serialised (said in the docstring of _Fold
 except ImportError:  # pragma: no cover - not on the supported platforms
     fcntl = None
 
-__all__ = ["MANIFEST", "LOCK", "TMP_PREFIX", "OutputDir", "atomic_path", "check_out_dir", "active"]
+__all__ = ["MANIFEST", "LOCK", "TMP_PREFIX", "OutputDir", "atomic_path", "check_out_dir", "active",
+           "remove_stale_temporaries"]
 
 #: Name of the manifest a run keeps in its output folder.
 MANIFEST = ".fogdrift-manifest.json"
@@ -132,6 +133,26 @@ def _probe(folder: Path, target: Path) -> None:
     os.close(fd)
     with contextlib.suppress(OSError):
         os.unlink(name)
+
+
+def remove_stale_temporaries(folder, killed=()) -> list[Path]:
+    """Remove the temporary files of dead processes directly in ``folder`` (not recursive); return them.
+
+    A temporary file is named ``TMP_PREFIX<pid>-...`` (:func:`atomic_path`, the writability probe of
+    :func:`check_out_dir`); one whose process no longer runs was left by a run that was killed.  ``killed``:
+    process ids the caller has just killed (their files go even before the processes are reaped).  Files of a
+    live process, and anything not named so, are left alone.
+    """
+    folder = Path(folder)
+    killed = {int(p) for p in killed}
+    removed = []
+    for stale in (folder.glob(TMP_PREFIX + "*") if folder.is_dir() else ()):
+        m = _TMP.match(stale.name)
+        if m and stale.is_file() and (int(m.group(1)) in killed or not _pid_alive(int(m.group(1)))):
+            with contextlib.suppress(OSError):
+                stale.unlink()
+                removed.append(stale)
+    return removed
 
 
 def _pid_alive(pid: int) -> bool:
@@ -441,11 +462,7 @@ class OutputDir:
                     target.rmdir()
         folders = [self.path] + [d for d in (self._inside(r) for r in previous.get("dirs", [])) if d is not None]
         for folder in folders:  # not recursive: --out may be a big folder of other things
-            for stale in (folder.glob(TMP_PREFIX + "*") if folder.is_dir() else ()):
-                m = _TMP.match(stale.name)
-                if m and stale.is_file() and not _pid_alive(int(m.group(1))):
-                    with contextlib.suppress(OSError):
-                        stale.unlink()
+            remove_stale_temporaries(folder)
         self._opened = True
         self._write_manifest()
 

@@ -43,7 +43,7 @@ from ..errors import ConfigError
 from ..io import load as load_fn
 from ..io.load import _options
 from ..io.readers.base import require
-from ..output import LOCK, TMP_PREFIX, OutputDir, _FolderLock, active
+from ..output import LOCK, TMP_PREFIX, OutputDir, _FolderLock, active, remove_stale_temporaries
 from .commands import command_spec, spec_from_settings
 from .summary import COLUMNS, write_summary
 from .tasks import MANIFEST, FileTask, run_file
@@ -441,8 +441,7 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
         for name in muted:
             logging.getLogger(name).setLevel(logging.CRITICAL + 1)
         if cluster is not None:                      # our own workers: stop them now, then tidy their folders
-            _kill_workers(cluster)
-            _remove_temporaries(tasks)
+            _remove_temporaries(tasks, killed=_kill_workers(cluster))
         raise
     finally:
         _close(client, cluster, quick=interrupted)
@@ -470,20 +469,31 @@ def _sigint_blocked_for_children():
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
-def _kill_workers(cluster) -> None:
-    """SIGKILL the worker processes of a local cluster (their tasks cannot be stopped any other way)."""
+def _kill_workers(cluster) -> list[int]:
+    """SIGKILL the worker processes of a local cluster (their tasks cannot be stopped any other way); return
+    their process ids."""
     import signal
 
+    killed = []
     for nanny in list(getattr(cluster, "workers", {}).values()):
         with contextlib.suppress(Exception):
-            os.kill(nanny.process.process.pid, signal.SIGKILL)
+            pid = nanny.process.process.pid
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+    return killed
 
 
-def _remove_temporaries(tasks) -> None:
+def _remove_temporaries(tasks, killed=()) -> None:
     """Remove the temporary files killed workers left in the files' folders (never a complete file), and their
     lock files: a worker killed between its folder's last file and the end of its run leaves the (dead) lock
-    file of :class:`fogdrift.output.OutputDir`."""
+    file of :class:`fogdrift.output.OutputDir`.  Also the folders above them up to the batch's folder: a worker
+    checking a file's folder that does not exist yet probes the nearest existing one for writability
+    (:func:`fogdrift.output.check_out_dir`), and a worker killed during that probe leaves its file there
+    (``killed``: the workers' process ids; there, only their files and dead processes' are removed)."""
     deadline = time.monotonic() + STALE_LOCK_WAIT_S
+    above = {Path(t.out_dir).parents[k] for t in tasks for k in range(len(Path(t.rel_out).parts))}
+    for folder in sorted(above):
+        remove_stale_temporaries(folder, killed)
     for task in tasks:
         folder = Path(task.out_dir)
         for tmp in (folder.rglob(TMP_PREFIX + "*") if folder.is_dir() else ()):
