@@ -55,6 +55,7 @@ from scipy import linalg, optimize, stats
 from scipy.linalg import lapack
 
 from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError, NotFittedError
+from ..noise.discrepancy import discrepancy_relcov
 from .covariance import model_wvar_covariance
 from .ieee import to_ieee
 from .processes import LatentModel, parse_model
@@ -479,8 +480,12 @@ def _scale_index(wvar: WvarResult, scales) -> np.ndarray:
 
 
 def _model_V(model: LatentModel, theta, wv: WvarResult, idx) -> np.ndarray:
-    V = model_wvar_covariance(model, theta, wv.tau_samples[idx], wv.n_coef[idx])
-    return V / wv.efficiency
+    """Covariance of the WV estimates at ``idx`` under the model: the sampling covariance plus the
+    model-discrepancy allowance (:mod:`fogdrift.noise.discrepancy`, the same one the Allan fit uses)."""
+    tau = wv.tau_samples[idx]
+    V = model_wvar_covariance(model, theta, tau, wv.n_coef[idx]) / wv.efficiency
+    nu = model.wv(theta, tau.astype(np.float64))
+    return V + discrepancy_relcov(tau) * np.outer(nu, nu)
 
 
 def _best_solution(prob: _Problem, starts, n_keep, screen_nfev=150):

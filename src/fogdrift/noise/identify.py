@@ -42,6 +42,7 @@ from scipy.stats import chi2, t as student_t
 from ..allan.ci import edf_simple_safe
 from ..errors import ConfigError, InsufficientDataError
 from .checks import _check_floor, _classical_b, _drop_rejected, _point_limits, _q_at_whole_periods
+from .discrepancy import discrepancy_relcov
 from .covariance import estimator_covariance, expected_variance, ieee_spectrum, ramp_cross_variance
 from .engine import ScoreProblem, all_subsets, fit_subsets, profile_interval
 from .notes import (_absent_reason, _at_bound_notes, _describe_excluded, _largest_gap_note, _misfit_note, _no_fit,
@@ -147,7 +148,7 @@ class _Context:
         """Squared coefficient of each term in its Allan-law unit, from the law coefficients ``A``."""
         return {t: max(A[_NAMES.index(t)], 0.0) / self.laws[t].scale(self.dt) for t in self.laws}
 
-    def relcov(self, A, exact_ramp=False):
+    def relcov(self, A, exact_ramp=False, allowance=True):
         """Relative covariance of the working points under the model ``A`` (its spectrum, this statistic).
 
         A deterministic rate ramp has no spectrum.  For model *selection* (``exact_ramp=False``) it is given the
@@ -193,8 +194,11 @@ class _Context:
             share = self.X[:, i_s] * A[i_s] / mu
             nu_w = np.array([edf_simple_safe(self.n + 1, float(mm), 0) for mm in self.m])
             C = C + np.diag(share**2 * 2.0 / np.maximum(nu_w, 1.0))
-        # floor: relative s.d. 1e-6 (a noise-free curve, or a term with no spectrum, still has rounding)
-        return C + np.diag(np.full(mu.size, 1e-12))
+        # the model-discrepancy allowance (a real sensor departs from the textbook sum by a few %), and a floor:
+        # relative s.d. 1e-6 (a noise-free curve, or a term with no spectrum, still has rounding)
+        # (``allowance=False``: the sampling error alone, which the fit-range scan uses to see a filter edge)
+        extra = discrepancy_relcov(self.tau) if allowance else 0.0
+        return C + extra + np.diag(np.full(mu.size, 1e-12))
 
 
 def flicker_shape(m, statistic="adev") -> np.ndarray:
@@ -219,8 +223,9 @@ def flicker_shape(m, statistic="adev") -> np.ndarray:
 _FLICKER: dict = {}
 
 
-def _select(ctx: _Context, penalty: float, iters: int = 2, C=None):
-    """Common-covariance model selection on the points of ``ctx`` (``C``: a fixed relative covariance)."""
+def _select(ctx: _Context, penalty: float, iters: int = 2, C=None, allowance=True):
+    """Common-covariance model selection on the points of ``ctx`` (``C``: a fixed relative covariance;
+    ``allowance``: include the model-discrepancy allowance in the model covariance)."""
     from scipy.optimize import nnls
 
     cols = ctx.cols
@@ -245,7 +250,7 @@ def _select(ctx: _Context, penalty: float, iters: int = 2, C=None):
     if not np.any(A > 0):
         A[list(cols)] = ctx.upper[list(cols)] * 1e-3
     for _ in range(iters):
-        C = ctx.relcov(A)
+        C = ctx.relcov(A, allowance=allowance)
         prob = ScoreProblem(ctx.X, ctx.y, C, ctx._upper(C))
         a, _q = prob.fit(cols)
         newA = np.zeros(len(_NAMES))
@@ -293,8 +298,10 @@ def _choose_start(ctx: _Context, penalty: float, max_fraction: float = 0.5, thre
         if white[k:k + 3].all() and k + 3 <= tau.size:
             start0, from_white = k, True
             break
-    # one covariance for the whole scan: that of the full model fitted to every point
-    C_all = _select(ctx, penalty)["C"]
+    # one covariance for the whole scan: that of the full model fitted to every point, from the sampling error
+    # alone -- a filter edge or a bump a few % off the white-noise line is where the fit range stops, whatever
+    # the model-discrepancy allowance later grants the fit inside that range
+    C_all = _select(ctx, penalty, allowance=False)["C"]
     cache = {}
 
     def get(k):
