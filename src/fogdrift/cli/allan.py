@@ -59,8 +59,9 @@ def allan(
             what = "" if quantity == "angular_rate" else "accelerometer (velocity random walk N, bias instability B) "
             console.print(noise_table(f"{load.file.name}: {what}{estimator} {name}, 95 % intervals in brackets "
                                       "(– (< x): not in the selected model, x its upper bound; [0, x]: in the "
-                                      "model but not resolved from zero; B: the flicker floor when fitted, else the "
-                                      "IEEE reading min ADEV/0.664; every cell a bound when no model fits)",
+                                      "model but not resolved from zero; B: the IEEE reading min ADEV/0.664, < x "
+                                      "where the ADEV has no minimum; no model fits: ≈ slope read-outs and the "
+                                      "curve's own bounds)",
                                       [[a.name] + noise_row(a.noise) + [relabel_note(shaped_cell(a.noise), quantity),
                                                                         fit_cell(a.noise)]
                                        for a in group], fit=True, extra=("periodic / Markov",), quantity=quantity))

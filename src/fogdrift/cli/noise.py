@@ -62,11 +62,12 @@ def _interval(lo, hi) -> str:
     return "–" if lo is None or hi is None else f"[{_fmt(lo)}, {_fmt(hi)}]"
 
 
-def print_gmwm(title, axes, quantities=None):
+def print_gmwm(title, axes, quantities=None, details=False):
     """Per axis: IEEE table (one B, by its rule), the other B readings as details, the comparison with the Allan
     fit when one was made, candidates (WIC, why rejected), excluded scales, J with its caveat.  ``quantities``:
     axis name -> quantity; an accelerometer's reading (:func:`fogdrift.gmwm.quantity.express_gmwm`) shows B in
-    ug and its rate levels in m/s^2."""
+    ug and its rate levels in m/s^2.  Without ``details`` the candidate table, J and the reasons for each
+    excluded scale are one summary line per axis."""
     from ..gmwm.analysis import J_CAVEAT, b_detail_lines, ieee_rows
     from ..gmwm.quantity import accel_rows
     from ..noise.quantity import restate_text
@@ -89,14 +90,23 @@ def print_gmwm(title, axes, quantities=None):
             for line in a.allan_check["lines"]:
                 say(f"  {a.name}: GMWM vs Allan fit: {line}",
                     style=None if a.allan_check["agree"] is not False else "yellow")
-        console.print(fitted_table(f"{title} axis {a.name}: candidates (smallest WIC among those passing wins)",
-                                   ["candidate", "WIC", "passed", "why rejected"],
-                                   [[c.model + (" *" if c.model == sel.selected else ""), _fmt(c.wic),
-                                     "yes" if c.passed else "no", "; ".join(c.reasons)] for c in sel.candidates]))
         fit = sel.fit
-        say(f"  {a.name}: J = {_fmt(fit.q)}, df {fit.df}, p = {_fmt(fit.j_pvalue, 2)} ({J_CAVEAT})", style="dim")
-        for x in sel.excluded:
-            say(f"  {a.name}: scale {_fmt(x.scale_s)} s excluded: {x.reason}", style="yellow")
+        if not details:
+            n_pass = sum(c.passed for c in sel.candidates)
+            ex = (f"; short scales {_fmt(sel.excluded[0].scale_s)}-{_fmt(sel.excluded[-1].scale_s)} s left out"
+                  if sel.excluded else "")
+            say(f"  {a.name}: {sel.selected} chosen by WIC from {len(sel.candidates)} candidates ({n_pass} passed "
+                f"every check){ex}; fitted scales {_fmt(fit.scale_s[0])}-{_fmt(fit.scale_s[-1])} s; --details "
+                "lists the candidates, J and every excluded scale", style="dim")
+        else:
+            console.print(fitted_table(f"{title} axis {a.name}: candidates (smallest WIC among those passing wins)",
+                                       ["candidate", "WIC", "passed", "why rejected"],
+                                       [[c.model + (" *" if c.model == sel.selected else ""), _fmt(c.wic),
+                                         "yes" if c.passed else "no", "; ".join(c.reasons)]
+                                        for c in sel.candidates]))
+            say(f"  {a.name}: J = {_fmt(fit.q)}, df {fit.df}, p = {_fmt(fit.j_pvalue, 2)} ({J_CAVEAT})", style="dim")
+            for x in sel.excluded:
+                say(f"  {a.name}: scale {_fmt(x.scale_s)} s excluded: {x.reason}", style="yellow")
         if sel.scan_note:
             say(f"  {a.name}: {sel.scan_note}", style="yellow")
 
@@ -115,6 +125,8 @@ def noise(
     spec: SpecOpt = None,
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
+    details: Annotated[bool, typer.Option("--details", help="Also print each axis's candidate table (WIC, why "
+                                          "rejected), J and the reason for every excluded scale.")] = False,
 ):
     """Noise model of every axis: GMWM model selection (wavelet variance) with the IEEE-952 table and 95 %
     intervals, or the Allan fit; writes noise.json, wvar.csv (gmwm) and noise.png (and spec.json with --spec)."""
@@ -176,7 +188,7 @@ def noise(
             axes = [express_gmwm(a, quantities[a.name]) for a in axes]  # an accelerometer's terms in its units
             source, meta = str(record.source), record.metadata()
             kinds = channel_kinds(record)
-        print_gmwm((curve or load.file).name, axes, None if curve else quantities)
+        print_gmwm((curve or load.file).name, axes, None if curve else quantities, details=details)
         if limits is not None:
             print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_gmwm(a, kinds[a.name]))
                                            for a in axes}, r.out.path, source=spec.name)

@@ -9,6 +9,11 @@ fit with more terms or fields compares the same.
 Rules (95 % intervals; a bound ``B < x`` is the interval ``[0, x]``):
 
 * **N**: GMWM's white-noise N and the Allan fit's N agree when their intervals overlap.
+* **Q, K, R**: one line per term that either model holds: both hold it and the intervals overlap (agree), or
+  one holds it and the other's 95 % bound admits its lower limit (agree in value), else they differ, with why;
+  the terms neither holds are named together.
+* **S, M**: the Allan fit's periodic term against GMWM's treatment of the line's scales; the Allan fit's
+  exponentially correlated term against GMWM's GM correlation times.
 * **B**: GMWM's headline B (:attr:`fogdrift.gmwm.ieee.IEEEResult.b_headline`: the flicker term, else the
   minimum of the model's ADEV) against the Allan fit's IEEE reading ``b_min`` (the minimum of its ADEV,
   or a bound where the curve still falls).  Two bounds agree (neither finds a minimum within the record).
@@ -22,6 +27,7 @@ from __future__ import annotations
 from .._util import fmt_number
 from ..errors import InsufficientDataError
 from ..pipeline import AnalysisConfig, run_allan
+from ..noise.terms import DISPLAY_UNITS, TERM_TABLE
 from .quantity import express_gmwm  # noqa: F401 -- re-exported for the batch worker (one allowed import edge)
 
 __all__ = ["compare_with_allan", "attach_allan_checks"]
@@ -172,8 +178,105 @@ def compare_with_allan(axis, noise_fit) -> dict:
     hump = _hump_line(axis, noise_fit)
     if hump:
         lines.append(hump)
-    known = [v for v in (n_ok, b_ok) if v is not None]
-    return {"agree": (all(known) if known else None), "n_agree": n_ok, "b_agree": b_ok, "lines": lines}
+    term_ok = {}
+    quiet = []
+    for name in ("Q", "K", "R"):
+        ok, line = _power_line(axis, noise_fit, name)
+        term_ok[name] = ok
+        if line is None:
+            quiet.append(name)
+        else:
+            lines.append(line)
+    if quiet:
+        lines.append(f"{', '.join(quiet)} agree{'s' if len(quiet) == 1 else ''}: neither estimator claims "
+                     f"{'it' if len(quiet) == 1 else 'them'}")
+    for name, fn in (("S", _s_line), ("M", _m_line)):
+        ok, line = fn(axis, noise_fit)
+        term_ok[name] = ok
+        if line:
+            lines.append(line)
+    known = [v for v in (n_ok, b_ok, *term_ok.values()) if v is not None]
+    return {"agree": (all(known) if known else None), "n_agree": n_ok, "b_agree": b_ok,
+            "term_agree": term_ok, "lines": lines}
+
+
+def _power_line(axis, fit, name) -> tuple:
+    """Q, K or R of both estimators, in the Allan fit's unit (GMWM's K unit deg/h/sqrt(h) is deg/h^1.5).
+
+    ``(None, None)`` when neither model holds the term; ``(True, line)`` when both do and their 95 % intervals
+    overlap, or when only one does but the other's 95 % bound admits its lower limit (the data allow both
+    readings); ``(False, line)`` otherwise, with the numbers of both sides."""
+    spec = TERM_TABLE[name]
+    g = axis.selection.ieee.terms.get(name + spec.suffix)
+    a = (getattr(fit, "terms", None) or {}).get(name)
+    a_in = a is not None and a.value is not None and a.status in ("resolved", "unresolved")
+    unit = DISPLAY_UNITS[name]
+    if g is None and not a_in:
+        return None, None
+    g_txt = "GMWM " + (f"{_g(g.value, 4)}{_iv(g.lo95, g.hi95)} {unit}" if g is not None else
+                       f"has no {spec.long_name} in {axis.selection.selected}")
+    if a_in:
+        a_txt = f"the Allan fit {_g(a.value, 4)}{_iv(a.lo95, a.hi95)} {unit} ({a.status})"
+    else:
+        why = "no model fits its curve" if getattr(a, "status", "") == "no_fit" else "not in its model"
+        a_txt = (f"the Allan fit {why}" + (f" (95 % bound < {_g(a.hi95)} {unit})" if a is not None
+                                          and a.hi95 is not None else ""))
+    if g is not None and a_in:
+        lo_a = a.lo95 if a.lo95 is not None else a.value
+        hi_a = a.hi95 if a.hi95 is not None else a.value
+        ok = g.lo95 <= hi_a and lo_a <= g.hi95
+        return ok, (f"{name} {'agrees' if ok else 'differs'}: {g_txt}, {a_txt}"
+                    + ("" if ok else " (the 95 % intervals do not overlap)"))
+    if g is not None:  # only GMWM holds it
+        bound = None if a is None else a.hi95
+        ok = bound is not None and g.lo95 <= bound
+        why = (f"the Allan bound admits GMWM's lower limit {_g(g.lo95)} {unit}: the data allow both readings"
+               if ok else "GMWM's 95 % interval lies above the Allan fit's bound: the two models give the curve's "
+               "shape to different terms (see each estimator's notes)")
+        return ok, f"{name} {'agrees in value' if ok else 'differs'}: {g_txt}; {a_txt}; {why}"
+    lo_a = a.lo95 if a.lo95 is not None else 0.0
+    ok = lo_a <= 0.0
+    why = ("its interval reaches 0, so GMWM's model without it is consistent" if ok else
+           "GMWM's model has no such process (its notes say which candidates held one and why they failed)")
+    return ok, f"{name} {'agrees in value' if ok else 'differs'}: {a_txt}; {g_txt}; {why}"
+
+
+def _s_line(axis, fit) -> tuple:
+    """The periodic term S: the Allan fit models spectral lines as S; GMWM has no sinusoid process and leaves the
+    scales a line dominates out of its fit."""
+    a = (getattr(fit, "terms", None) or {}).get("S")
+    if a is None or a.value is None or "S" not in (getattr(fit, "selected", ()) or ()):
+        return None, None
+    sh = (getattr(fit, "shaped", None) or {}).get("S") or {}
+    f = sh.get("freq_hz")
+    excl = [x for x in axis.selection.excluded if "spectral line" in (x.reason or "")]
+    how = (f"GMWM leaves out the {len(excl)} scale(s) it dominates" if excl else
+           "GMWM has no sinusoid process (its WV at the line's scales is part of its fit)")
+    return True, (f"S: the Allan fit models the periodic error as S {_g(a.value)}{_iv(a.lo95, a.hi95)} deg/h at "
+                  f"{_g(f, 4)} Hz; {how}: both keep it out of the noise terms")
+
+
+def _m_line(axis, fit) -> tuple:
+    """The exponentially correlated term: Allan's M against GMWM's GM components, by correlation time."""
+    a = (getattr(fit, "terms", None) or {}).get("M")
+    a_in = a is not None and a.value is not None and "M" in (getattr(fit, "selected", ()) or ())
+    mdl = axis.selection.fit.latent_model
+    gms = [(lab, axis.selection.fit.dt_s / axis.selection.fit.theta[sl.start])
+           for lab, sl, key in zip(mdl.labels, mdl.slices, mdl.components) if key == "GM"]
+    if not a_in and not gms:
+        return None, None
+    g_txt = ("GMWM " + ", ".join(f"{lab} T_c {_g(tc)} s" for lab, tc in gms)) if gms else "GMWM has no GM"
+    if not a_in:
+        return None, (f"M: {g_txt}; the Allan fit has no M (its flicker/power-law terms describe the same part of "
+                      "the curve; a GM is how GMWM and a Kalman filter express bias instability)")
+    sh = (getattr(fit, "shaped", None) or {}).get("M") or {}
+    tc, lo, hi = sh.get("tc_s"), sh.get("tc_lo95_s"), sh.get("tc_hi95_s")
+    a_txt = f"the Allan fit M T_c {_g(tc)} s" + (f" [{_g(lo)}, {_g(hi)}]" if lo and hi else "")
+    if not gms:
+        return False, f"M differs: {a_txt}; {g_txt} (it reads the same part of the curve with other processes)"
+    ok = any((lo or 0.0) <= t <= (hi or float('inf')) for _, t in gms) if tc else None
+    return ok, (f"M {'agrees' if ok else 'differs'}: {a_txt}; {g_txt}"
+                + ("" if ok else " (no GM correlation time inside the Allan fit's T_c interval)"))
 
 
 def attach_allan_checks(record, axes, *, sums=None) -> list:

@@ -191,5 +191,11 @@ def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penal
                    rolloff_hz=None if spectrum is None else getattr(spectrum, "rolloff_hz", None))
     if statistic == "adev":
         fit.readouts = slope_readouts(allan.tau_s, np.sqrt(var), fit)
+        if fit.no_fit:  # a printed bound is never below the measured read-out of the same term
+            for name, ro in fit.readouts.items():
+                t = fit.terms.get(name)
+                if (t is not None and t.status == "no_fit" and ro.value is not None and t.hi95 is not None
+                        and ro.unit == t.unit and ro.value > t.hi95):
+                    fit.terms[name] = NoiseTerm(name, t.value, t.unit, t.lo95, ro.value, t.status, t.reason)
     del laws
     return fit

@@ -577,6 +577,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         no_fit, note = _no_fit(c.tau, c.y, mu, prob.nu, best, chi2_red)
         if no_fit is not None:
             notes.insert(0, note)
+            _no_fit_terms(c, out_terms, laws, dt_s)
     b_min = _classical_b(c, A, floor_refused=out_terms.get("B") is not None and out_terms["B"].status ==
                          "not_estimable" and "contradicted" in (out_terms["B"].reason or "")) \
         if statistic == "adev" else {}
@@ -588,6 +589,30 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         quality=quality, inflation=float(infl), excluded=excluded, notes=notes, b_min=b_min,
         n_samples=int(n_samples), shaped=shaped, no_fit=no_fit,
     )
+
+
+def _no_fit_terms(c: _Context, out_terms: dict, laws, dt_s) -> None:
+    """The terms of a model that misses the curve are no result: every estimated or absent power-law term becomes
+    status ``"no_fit"`` with, as its ``hi95``, the bound the measured curve itself sets.
+
+    IEEE-952 terms add and none is negative, so each alone lies below the measured variance's upper 95 % limit at
+    every fitted tau: ``X <= min_tau sqrt(var_hi95(tau) / shape_X(tau))``.  That bound needs no model, so it is a
+    true bound even where every model fails -- unlike the profile limit of a model that does not fit (which lay
+    below the measured read-out on a real MEMS axis).  The best candidate's value is kept, labelled by the status.
+    """
+    for i, name in enumerate(TERMS):
+        t = out_terms.get(name)
+        if t is None or name not in laws or t.status not in ("resolved", "unresolved", "absent"):
+            continue
+        col = c.X[:, i]
+        pos = col > 0
+        if not np.any(pos):
+            continue
+        conv = TERM_TABLE[name].to_unit / math.sqrt(laws[name].scale(dt_s))
+        bound = conv * math.sqrt(float(np.min(c.y_hi[pos] / col[pos])))
+        why = ("no model fits the curve: the best candidate's value is no result; the bound is the measured "
+               "curve's own (each term alone stays below its upper 95 % limit at every fitted tau)")
+        out_terms[name] = NoiseTerm(name, t.value, t.unit, None, bound, "no_fit", why)
 
 
 def _markov_fits(c: _Context, C, base_cols, tc, penalty):

@@ -43,16 +43,24 @@ class Readout:
     slope: float | None
     dominated: bool | None
     note: str
+    tau_range_s: tuple | None = None
 
     def to_dict(self) -> dict:
-        return dict(self.__dict__)
+        out = dict(self.__dict__)
+        out["tau_range_s"] = None if self.tau_range_s is None else [float(t) for t in self.tau_range_s]
+        return out
 
     def text(self) -> str:
         if self.value is None:
             return f"{self.term}: no {self.term}-slope in the curve"
         where = "its term dominates" if self.dominated else "another term dominates"
         unit = DISPLAY_UNITS.get(self.term, self.unit) if self.unit == TERM_UNITS.get(self.term) else self.unit
-        out = f"{self.term} {self.value:.3g} {unit} (read at tau = {self.tau_s:.3g} s, {where})"
+        if self.tau_range_s is not None:
+            at = (f"median over the {self.slope:+.2f} slope at tau = {self.tau_range_s[0]:.3g}-"
+                  f"{self.tau_range_s[1]:.3g} s")
+        else:
+            at = f"read at tau = {self.tau_s:.3g} s"
+        out = f"{self.term} {self.value:.3g} {unit} ({at}, {where})"
         return out + (f"; {self.note}" if self.note else "")
 
 
@@ -75,6 +83,18 @@ def slope_readouts(tau_s, adev_dph, fit=None) -> dict:
     i_min = int(np.argmin(s))
     for term, (mu, tau_read, fac, unit) in _READ.items():
         side = np.arange(tau.size) <= i_min if mu < 0 else np.arange(tau.size) >= i_min
+        inside = side
+        if fit is not None and len(getattr(fit, "fit_tau_s", ())):  # a run is read where the fit looked
+            inside = side & (tau >= fit.tau_min_s * (1 - 1e-9)) & (tau <= fit.tau_max_s * (1 + 1e-9))
+        run = _slope_run(tau, s, mu, inside)
+        if run is not None:  # the term's own line, held over at least an octave: read it along the whole run
+            a, b = run
+            vals = s[a:b + 1] * (tau_read / tau[a:b + 1]) ** mu * fac
+            k = a + int(np.argsort(vals)[vals.size // 2])  # the median point (an actual measured point)
+            seg = float(np.polyfit(np.log(tau[a:b + 1]), np.log(s[a:b + 1]), 1)[0])
+            ro = _judge(term, float(np.median(vals)), unit, float(tau[k]), seg, fit)
+            out[term] = Readout(**{**ro.__dict__, "tau_range_s": (float(tau[a]), float(tau[b]))})
+            continue
         dist = np.where(side, np.abs(slope - mu), np.inf)
         i = int(np.argmin(dist))
         if dist[i] > 0.2:
@@ -88,6 +108,39 @@ def slope_readouts(tau_s, adev_dph, fit=None) -> dict:
         out["B"] = Readout("B", None, "deg/h", None, None, None,
                            "the ADEV has no interior minimum (still falling or rising at the record's end)")
     return {t: out[t] for t in TERMS}
+
+
+#: A slope run holds when every chord between neighbouring points is within this of the term's slope.
+RUN_SLOPE_TOLERANCE = 0.1
+
+
+def _slope_run(tau, s, mu, side):
+    """``(first, last)`` index of the longest run of at least three points (on ``side``) whose every
+    neighbour-to-neighbour chord has the slope ``mu`` within :data:`RUN_SLOPE_TOLERANCE` and that spans at least
+    an octave of tau; None when there is none.
+
+    Examples
+    --------
+    >>> tau = np.array([1.0, 2, 4, 8, 16, 32])
+    >>> _slope_run(tau, np.array([9.0, 3, 2.1, 1.5, 1.06, 1.1]), -0.5, np.ones(6, bool))
+    (1, 4)
+    """
+    lt, ls = np.log(tau), np.log(s)
+    chord = np.diff(ls) / np.diff(lt)
+    good = (np.abs(chord - mu) <= RUN_SLOPE_TOLERANCE) & side[:-1] & side[1:]
+    best, k = None, 0
+    while k < good.size:
+        if not good[k]:
+            k += 1
+            continue
+        j = k
+        while j + 1 < good.size and good[j + 1]:
+            j += 1
+        a, b = k, j + 1  # points a..b
+        if b - a >= 2 and tau[b] >= 2.0 * tau[a] * (1 - 1e-9) and (best is None or lt[b] - lt[a] > lt[best[1]] - lt[best[0]]):
+            best = (a, b)
+        k = j + 1
+    return best
 
 
 def _judge(term, value, unit, tau, slope, fit) -> Readout:

@@ -13,7 +13,7 @@ from .terms import TERMS, laws_of, markov_shape, periodic_shape, term_table
 __all__ = ["NoiseTerm", "NoiseFit", "TERM_STATUSES"]
 
 #: What a coefficient's ``status`` can be (see :class:`NoiseTerm`).
-TERM_STATUSES = ("resolved", "unresolved", "absent", "not_estimable")
+TERM_STATUSES = ("resolved", "unresolved", "absent", "not_estimable", "no_fit")
 
 
 def _f(x):
@@ -37,7 +37,9 @@ class NoiseTerm:
     status : str
         ``"resolved"`` (in the selected model, every plausible model needs it, lower bound > 0);
         ``"unresolved"`` (in the selected model, but its interval reaches 0); ``"absent"`` (not in the selected
-        model); ``"not_estimable"`` (the data or the statistic cannot support a number; ``hi95`` may bound it).
+        model); ``"not_estimable"`` (the data or the statistic cannot support a number; ``hi95`` may bound it);
+        ``"no_fit"`` (no model fits the curve: ``value`` is the best candidate's, no result; ``hi95`` is the bound
+        the measured curve sets on the term alone).
     reason : str
         Empty for a resolved term; otherwise the real cause, in words.
     """

@@ -93,7 +93,7 @@ def noise_headline(result) -> tuple:
     cells = [dict(zip(TERMS, noise_row(f))) for f in fits]
     rows = []
     for name in HEADLINE_TERMS:
-        label = ("B bias instability: the flicker floor when fitted, else the IEEE reading min ADEV/0.664 [deg/h]"
+        label = ("B bias instability: the IEEE reading min ADEV/0.664 [deg/h]"
                  if name == "B" else _term_label(name))
         rows.append([label] + [c[name] for c in cells])
     rows.append(["periodic / Markov terms (IEEE-952 Annex C)"] + [shaped_cell(f) for f in fits])

@@ -45,33 +45,59 @@ def noise_row(noise) -> list[str]:
     """Five cells Q, N, B, K, R of a NoiseFit (95 % intervals in brackets; – = not in the model, with its upper
     bound; n/e = not estimable).
 
-    One B per row: the flicker coefficient when the model holds it, otherwise the IEEE reading named by its rule
-    (:func:`b_headline`).  When no model fits (``noise.no_fit``) every cell is an upper bound or "–": the
-    coefficients of a model that misses the curve are no result."""
+    One B per row, one definition: the IEEE reading min ADEV / 0.664 (:func:`b_headline`).  When no model fits
+    (``noise.no_fit``) no coefficient of the best candidate is shown: a term whose own slope holds over at least an
+    octave shows its labelled slope read-out (``≈ 2.33 read-out``), and every cell its true bound (the measured
+    curve's own, ``< x``)."""
+    no_fit = getattr(noise, "no_fit", None)
     cells = []
     for name in TERMS:
         t = noise.terms[name]
-        if getattr(noise, "no_fit", None):
-            cells.append("–" if t.hi95 is None else f"– (< {_fmt(t.hi95, 3)})")
-        elif name == "B":
+        if name == "B":
             cells.append(b_headline(noise))
+        elif no_fit:
+            cells.append(_no_fit_cell(noise, name, t))
         else:
             cells.append(term_text(t))
     return cells
 
 
+def _readout(noise, name):
+    """The slope read-out of a term held over at least an octave (a run), or None."""
+    ro = (getattr(noise, "readouts", None) or {}).get(name)
+    if ro is None or ro.value is None or getattr(ro, "tau_range_s", None) is None:
+        return None
+    return ro
+
+
+def _no_fit_cell(noise, name, t) -> str:
+    bound = "–" if t.hi95 is None else f"< {_fmt(t.hi95, 3)}"
+    ro = _readout(noise, name)
+    if ro is None:
+        return "–" if t.hi95 is None else f"– ({bound})"
+    return f"≈ {_fmt(ro.value, 4)} read-out ({bound})"
+
+
 def b_headline(noise) -> str:
-    """The one bias-instability cell of a row, named by its rule: the fitted flicker floor (``0.51 [0.4, 0.6]
-    flicker``) when the selected model holds B, else the IEEE reading min ADEV / 0.664 (``< 1.14 ADEV min/0.664``
-    or ``0.8 ADEV min/0.664 at τ 117 s``), else the B term's own cell."""
+    """The one bias-instability cell of a row: the IEEE reading min ADEV / 0.664 -- ``39.2 [35, 44] at τ 117 s``,
+    ``< 28.3`` where the curve has no minimum (a bound) -- named by its rule in the table's caption.  When no
+    model fits, the minimum of the *measured* ADEV (``≈ 43.9 read-out at τ 82 s``).  Where the statistic has no
+    such reading, the B term's own cell (the flicker coefficient, labelled)."""
     t = noise.terms.get("B")
-    if t is not None and t.value is not None:
-        return term_text(t) + " flicker"
+    if getattr(noise, "no_fit", None):
+        ro = (getattr(noise, "readouts", None) or {}).get("B")
+        if ro is not None and ro.value is not None:
+            return f"≈ {_fmt(ro.value, 3)} read-out at τ {_fmt(ro.tau_s, 3)} s"
+        return "–" if t is None or t.hi95 is None else f"– (< {_fmt(t.hi95, 3)})"
     b = noise.b_min or {}
     if b.get("value") is not None:
         if b.get("bound_only"):
-            return f"< {_fmt(b['value'], 3)} ADEV min/0.664"
-        return f"{_fmt(b['value'], 3)} ADEV min/0.664 at τ {_fmt(b.get('tau_s'), 3)} s"
+            return f"< {_fmt(b['value'], 3)}"
+        iv = (f" [{_fmt(b['lo95'], 3)}, {_fmt(b['hi95'], 3)}]" if b.get("lo95") is not None
+              and b.get("hi95") is not None else "")
+        return f"{_fmt(b['value'], 3)}{iv} at τ {_fmt(b.get('tau_s'), 3)} s"
+    if t is not None and t.value is not None:
+        return term_text(t) + " flicker"
     return term_text(t) if t is not None else "–"
 
 
@@ -172,8 +198,16 @@ def noise_notes(noise) -> list[str]:
             which = "measured" if "measured ADEV" in b.get("rule", "") else "fitted"
             out.append(f"bias instability (IEEE reading, min of the {which} ADEV / 0.664): B_min = {_fmt(b['value'], 3)} "
                        f"deg/h at tau = {_fmt(b['tau_s'], 3)} s")
+    tb = noise.terms.get("B")
+    if tb is not None and tb.value is not None and tb.status in ("resolved", "unresolved") and b.get("value") is not None:
+        out.append(f"B detail (not the headline B): the fitted flicker coefficient is {term_text(tb)} deg/h; the "
+                   "headline B is the IEEE reading min ADEV / 0.664")
+    ros = [ro for n in TERMS if (ro := _readout(noise, n)) is not None]
+    if getattr(noise, "no_fit", None) and ros:
+        out.append("no model fits, so the table shows IEEE-952 slope read-outs (not a model) where a term's own "
+                   "slope holds over at least an octave: " + "; ".join(ro.text() for ro in ros))
     for t in noise.terms.values():
-        if t.reason and t.status != "resolved":
+        if t.reason and t.status not in ("resolved", "no_fit"):
             out.append(f"{t.name}: {t.reason}")
     if noise.outliers and noise.outliers.get("count"):
         o = noise.outliers
