@@ -710,7 +710,7 @@ def test_j_pvalue_with_one_degree_of_freedom():
     wv = haar_wvar(simulate_latent("WN+RW", [1.0, 1e-5], 2**12, seed=3), 0.01)
     fit = gmwm_fit(wv, "WN+RW", scales=[1, 2, 3])
     assert fit.df == 1 and fit.q > 0
-    assert fit.j_pvalue == pytest.approx(float(special.gammaincc(0.5, fit.q / 2.0)), rel=1e-10)
+    assert fit.j_pvalue == pytest.approx(float(special.gammaincc(0.5, fit.j_stat / 2.0)), rel=1e-10)
     assert fit.wic == pytest.approx(fit.q + fit.penalty, rel=1e-12)
 
 

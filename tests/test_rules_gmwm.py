@@ -43,10 +43,17 @@ def test_j_pvalue_is_the_chi2_survival_function_of_q_with_used_scales_minus_para
     J = len(wn_rw.level) if scales is None else len(scales)
     df = J - N_PARAMS[model]
     assert fit.df == df
-    assert_allclose(fit.j_pvalue, _chi2_sf(fit.q, df), rtol=1e-10, atol=1e-300)
-    # Q is the quadratic form of the residuals in the final Omega = V^-1
+    assert_allclose(fit.j_pvalue, _chi2_sf(fit.j_stat, df), rtol=1e-10, atol=1e-300)
+    # Q is the quadratic form of the residuals in the final Omega = V^-1 (V with the model-discrepancy allowance);
+    # J the same form in the sampling covariance alone, which is V less the allowance at the fitted model
     d = fit.nu2_hat - fit.nu2_fit
     assert_allclose(fit.q, d @ np.linalg.solve(fit.V, d), rtol=1e-6)
+    from fogdrift.gmwm.estimator import _model_V
+    from fogdrift.gmwm.processes import parse_model
+    idx = np.flatnonzero(np.isin(wn_rw.level, fit.level))
+    Vs = _model_V(parse_model(model), fit.theta, wn_rw, idx, allowance=False)
+    assert_allclose(fit.j_stat, d @ np.linalg.solve(Vs, d), rtol=1e-6)
+    assert fit.j_stat >= fit.q * (1 - 1e-9)  # the allowance only ever adds variance
 
 
 def test_j_pvalue_is_uniform_for_a_well_specified_model_and_tiny_for_a_misspecified_one():

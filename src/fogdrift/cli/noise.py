@@ -104,7 +104,7 @@ def print_gmwm(title, axes, quantities=None, details=False):
                                        [[c.model + (" *" if c.model == sel.selected else ""), _fmt(c.wic),
                                          "yes" if c.passed else "no", "; ".join(c.reasons)]
                                         for c in sel.candidates]))
-            say(f"  {a.name}: J = {_fmt(fit.q)}, df {fit.df}, p = {_fmt(fit.j_pvalue, 2)} ({J_CAVEAT})", style="dim")
+            say(f"  {a.name}: J = {_fmt(fit.j_stat)}, df {fit.df}, p = {_fmt(fit.j_pvalue, 2)} ({J_CAVEAT})", style="dim")
             for x in sel.excluded:
                 say(f"  {a.name}: scale {_fmt(x.scale_s)} s excluded: {x.reason}", style="yellow")
         if sel.scan_note:

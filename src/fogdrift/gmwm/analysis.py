@@ -93,7 +93,7 @@ class GmwmAxis:
                 "passed_checks": bool(sel.passed_checks),
                 "b_headline_text": sel.ieee.b_headline.text(),
                 **({} if self.allan_check is None else {"allan_check": self.allan_check}),
-                "j_statistic": {"q": float(sel.fit.q), "df": int(sel.fit.df), "p_value": float(sel.fit.j_pvalue),
+                "j_statistic": {"q": float(sel.fit.j_stat), "df": int(sel.fit.df), "p_value": float(sel.fit.j_pvalue),
                                 "caveat": J_CAVEAT},
                 "wvar": self.wvar.to_dict(), "selection": sel.to_dict()}
 

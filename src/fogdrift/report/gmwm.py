@@ -56,7 +56,7 @@ def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
         ax.set_xlabel("scale [s]")
         ax.set_ylabel("wavelet variance [(deg/h)²]")
         ax.set_title(literal(f"{a.name}: {sel.selected}{'' if sel.passed_checks else ' (no candidate passed the checks)'}\n"
-                             f"J = {fit.q:.3g}, df {fit.df}, p = {fit.j_pvalue:.2g}"), fontsize=9)
+                             f"J = {fit.j_stat:.3g}, df {fit.df}, p = {fit.j_pvalue:.2g}"), fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     _place(fig)  # margins measured once (bbox_inches="tight" drew the figure twice)
@@ -106,7 +106,7 @@ def gmwm_noise_html(axis: GmwmAxis) -> str:
             f"{'' if sel.passed_checks else ' (no candidate passed every check)'}</h4>"
             f"<table class='gmwm'><tr>{head}</tr>{body}</table>"
             + (f"<ul class='note'>{details}{check}</ul>" if details or check else "")
-            + f"<p class='note'>J = {fmt(fit.q)} with {fit.df} degrees of freedom, p = {fmt(fit.j_pvalue, 2)}: "
+            + f"<p class='note'>J = {fmt(fit.j_stat)} with {fit.df} degrees of freedom, p = {fmt(fit.j_pvalue, 2)}: "
             f"{e(J_CAVEAT)}.</p>"
             + (f"<ul class='note'>{excl}</ul>" if excl else "")
             + "<table class='gmwm-candidates'><tr><th>candidate</th><th>WIC</th><th>passed</th><th>why rejected</th>"
