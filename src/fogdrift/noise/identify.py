@@ -595,21 +595,22 @@ def _no_fit_terms(c: _Context, out_terms: dict, laws, dt_s) -> None:
     """The terms of a model that misses the curve are no result: every estimated or absent power-law term becomes
     status ``"no_fit"`` with, as its ``hi95``, the bound the measured curve itself sets.
 
-    IEEE-952 terms add and none is negative, so each alone lies below the measured variance's upper 95 % limit at
-    every fitted tau: ``X <= min_tau sqrt(var_hi95(tau) / shape_X(tau))``.  That bound needs no model, so it is a
-    true bound even where every model fails -- unlike the profile limit of a model that does not fit (which lay
-    below the measured read-out on a real MEMS axis).  The best candidate's value is kept, labelled by the status.
+    IEEE-952 terms add and none is negative, so each alone lies below the measured variance at every fitted tau:
+    ``X <= min_tau sqrt(var_hi(tau) / shape_X(tau))``, with ``var_hi`` each point's ~4-sigma upper limit (the
+    95 % limit stretched to 4 sigma, so the minimum over all the fitted taus still holds: a 95 % limit per point
+    is missed by one of twenty points).  That bound needs no model, so it is a true bound even where every model
+    fails -- unlike the profile limit of a model that does not fit (which lay below the measured read-out on a real
+    MEMS axis).  The best candidate's value is kept, labelled by the status.
     """
+    data_bound = c._upper()  # per term, in law units: the ~4-sigma limit of the curve alone, no model
     for i, name in enumerate(TERMS):
         t = out_terms.get(name)
         if t is None or name not in laws or t.status not in ("resolved", "unresolved", "absent"):
             continue
-        col = c.X[:, i]
-        pos = col > 0
-        if not np.any(pos):
+        if not data_bound[i] > 0:
             continue
         conv = TERM_TABLE[name].to_unit / math.sqrt(laws[name].scale(dt_s))
-        bound = conv * math.sqrt(float(np.min(c.y_hi[pos] / col[pos])))
+        bound = conv * math.sqrt(float(data_bound[i]))
         why = ("no model fits the curve: the best candidate's value is no result; the bound is the measured "
                "curve's own (each term alone stays below its upper 95 % limit at every fitted tau)")
         out_terms[name] = NoiseTerm(name, t.value, t.unit, None, bound, "no_fit", why)
