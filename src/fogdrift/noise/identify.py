@@ -246,12 +246,19 @@ def _slope_refusals(c: _Context, prob, res) -> dict:
             i = _NAMES.index(name)
             if i in k and a[i] > 0:
                 mu = c.X @ a if mu is None else mu
-                claim = slope_claim(c.tau, c.y, lo, hi, mu, c.X[:, i] * a[i], SLOPES[name], name=name,
+                claim = slope_claim(c.tau, c.y, lo, hi, mu, _rising_var(c, a, name), SLOPES[name], name=name,
                                     curve=_CURVE.get(c.statistic, c.statistic.upper()))
                 if not claim.ok:
                     out[k] = claim
                     break
     return out
+
+
+def _rising_var(c: _Context, a, name):
+    """The variance the rule weighs for ``name``: K's stretch is the rise of K and R together (a K between a
+    flicker floor and a ramp shapes a sustained rise without ever holding half the variance alone); R's is R's."""
+    cols = ("K", "R") if name == "K" else (name,)
+    return sum(c.X[:, _NAMES.index(t)] * a[_NAMES.index(t)] for t in cols)
 
 
 def _best_claimable(res, refused, fallback=None):
@@ -589,8 +596,8 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             if name in SLOPES:
                 # never resolved without a sustained slope (a fixed model keeps the term, with the reason)
                 lo_m, hi_m = _measured_limits(c, prob.nu)
-                claim = slope_claim(c.tau, c.y, lo_m, hi_m, c.X @ A, c.X[:, i] * A[i], SLOPES[name], name=name,
-                                    curve=_CURVE.get(statistic, statistic.upper()))
+                claim = slope_claim(c.tau, c.y, lo_m, hi_m, c.X @ A, _rising_var(c, A, name), SLOPES[name],
+                                    name=name, curve=_CURVE.get(statistic, statistic.upper()))
                 if not claim.ok:
                     status, reason, lo_v = "unresolved", claim.reason, 0.0
             out_terms[name] = NoiseTerm(name, val, spec_unit, lo_v, hi_v, status, reason)
@@ -598,8 +605,8 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             why = (_absent_reason(c, name, A, max(his)) if name in laws else
                    "not in the model: the curve is described as well without it")
             if name in slope_notes and slope_notes[name][0] <= ic_best + plausible_delta:
-                why = (f"{slope_notes[name][1]}; the model {'+'.join(_NAMES[j] for j in best)} describes the "
-                       "curve instead")
+                why = (f"{why}; {slope_notes[name][1]}; the model {'+'.join(_NAMES[j] for j in best)} describes "
+                       "the curve instead")
             out_terms[name] = NoiseTerm(name, None, spec_unit, 0.0, hi_v, "absent", why)
     if terms is not None and "B" in laws and out_terms.get("B") is not None and out_terms["B"].value is not None:
         _check_floor(out_terms, c, A)  # a fixed model keeps its terms; a floor above the curve is still refused
