@@ -53,6 +53,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError, FogdriftWarning, InsufficientDataError
+from ..noise.rules import SLOPES, slope_claim
 from .covariance import wvar_covariance
 from .estimator import GMWMFit, Whitener, _bounds, _check_wv, _finish, _model_V, _step1
 from .ieee import IEEEResult, to_ieee
@@ -255,7 +256,12 @@ def _longest_run(x) -> int:
 
 
 def _checks(fit: GMWMFit, mdl: LatentModel, *, z_max, se_log_max, run_alpha, share_min, snr_min,
-            whiten) -> list[str]:
+            whiten, lo95=None, hi95=None) -> list[str]:
+    """Why ``fit`` of candidate ``mdl`` is rejected ("hard: ..." / "soft: ..."; empty: it passes).
+
+    ``lo95``/``hi95`` [(deg/h)^2]: the measured WV's 95 % interval at the fitted scales; with them a RW or DR
+    that fails the sustained-slope rule (:func:`fogdrift.noise.rules.slope_claim`) is a hard failure.
+    """
     reasons = []
     if fit.at_bound:
         reasons.append(f"hard: at a bound: {', '.join(param_label(n) for n in fit.at_bound)}")
@@ -270,6 +276,14 @@ def _checks(fit: GMWMFit, mdl: LatentModel, *, z_max, se_log_max, run_alpha, sha
     if not np.all(np.isfinite(fit.se_z)):
         bad = [n for n, s in zip(fit.param_names, fit.se_z) if not np.isfinite(s)]
         reasons.append(f"hard: not identified (singular information): {', '.join(param_label(n) for n in bad)}")
+    if lo95 is not None and hi95 is not None:
+        # a RW (DR) needs a sustained WV slope +1 (+2) over an octave: a hump is a GM, a flat stretch no RW
+        for lab, key, row in zip(mdl.labels, mdl.components, comp):
+            if key in ("RW", "DR"):
+                claim = slope_claim(fit.scale_s, fit.nu2_hat, lo95, hi95, fit.nu2_fit, row, SLOPES[key],
+                                    name=lab, curve="WV")
+                if not claim.ok:
+                    reasons.append(f"hard: {claim.reason}")
     if not fit.converged:
         reasons.append("soft: the optimiser did not report convergence")
     s_min, s_max = float(fit.scale_s[0]), float(fit.scale_s[-1])
@@ -473,7 +487,8 @@ def _choose(wv, models, idx, step1, opts):
                                           False, ("hard: too few scales for this model",)))
                 continue
             fit = _finish(wv, mdl, idx, *step1[mdl], V=V, omega_source=src)
-            reasons = _checks(fit, mdl, whiten=whiten, **opts)
+            reasons = _checks(fit, mdl, whiten=whiten, lo95=wv.ci_lo95_dph2[idx], hi95=wv.ci_hi95_dph2[idx],
+                              **opts)
             out.append(CandidateScore(mdl.name, mdl.n_params, fit.q, fit.penalty, fit.wic, not reasons,
                                       tuple(reasons), fit))
         fitted = [c for c in out if c.fit is not None]

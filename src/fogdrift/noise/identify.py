@@ -48,6 +48,7 @@ from .engine import ScoreProblem, all_subsets, fit_subsets, profile_interval
 from .notes import (_absent_reason, _at_bound_notes, _describe_excluded, _largest_gap_note, _misfit_note, _no_fit,
                     _unresolved_reason)
 from .result import NoiseFit, NoiseTerm
+from .rules import SLOPES, slope_claim
 from .terms import ALL_TERMS, TERM_TABLE, TERMS, UNESTIMABLE, laws_of, markov_shape, periodic_shape
 
 # the checks and words that lived here before the split stay importable from this module
@@ -221,6 +222,53 @@ def flicker_shape(m, statistic="adev") -> np.ndarray:
 
 
 _FLICKER: dict = {}
+
+
+_CURVE = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}
+
+
+def _measured_limits(c: _Context, nu):
+    """The 95 % chi-squared interval ``[y nu / chi2_nu(0.975), y nu / chi2_nu(0.025)]`` of each point (EDF
+    ``nu``)."""
+    nu = np.maximum(np.asarray(nu, dtype=np.float64), 1e-3)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        return c.y * nu / chi2.ppf(0.975, nu), c.y * nu / chi2.ppf(0.025, nu)
+
+
+def _slope_refusals(c: _Context, prob, res) -> dict:
+    """``{subset: SlopeClaim}`` of the candidates of ``res`` whose K or R fails the sustained-slope rule
+    (:func:`fogdrift.noise.rules.slope_claim`: it must dominate over an octave, the curve must rise there as the
+    model says, and the model must meet the longest taus).  Such a candidate is not selectable: a hump is a
+    Gauss-Markov term (M), not a random walk.  The model values use the current columns of ``c`` (the M column at
+    the correlation time being tried)."""
+    lo, hi = _measured_limits(c, prob.nu)
+    out = {}
+    for k, v in res.items():
+        a = v["a"]
+        mu = None
+        for name in ("K", "R"):
+            i = _NAMES.index(name)
+            if i in k and a[i] > 0:
+                mu = c.X @ a if mu is None else mu
+                claim = slope_claim(c.tau, c.y, lo, hi, mu, _rising_var(c, a, name), SLOPES[name], name=name,
+                                    curve=_CURVE.get(c.statistic, c.statistic.upper()))
+                if not claim.ok:
+                    out[k] = claim
+                    break
+    return out
+
+
+def _rising_var(c: _Context, a, name):
+    """The variance the rule weighs for ``name``: K's stretch is the rise of K and R together (a K between a
+    flicker floor and a ramp shapes a sustained rise without ever holding half the variance alone); R's is R's."""
+    cols = ("K", "R") if name == "K" else (name,)
+    return sum(c.X[:, _NAMES.index(t)] * a[_NAMES.index(t)] for t in cols)
+
+
+def _best_claimable(res, refused, fallback=None):
+    """The smallest-IC subset of ``res`` not in ``refused`` (``fallback`` when every one is)."""
+    keep = [k for k in res if k not in refused]
+    return min(keep, key=lambda k: res[k]["ic"]) if keep else fallback
 
 
 def _select(ctx: _Context, penalty: float, iters: int = 2, C=None, allowance=True):
@@ -437,9 +485,13 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         sel["best"] = tuple(_NAMES.index(t) for t in allowed)
     prob, res = sel["prob"], sel["res"]
     best = sel["best"]
-    if terms is None:  # a term at exactly zero is not in the model: use the subset without it
-        nz = tuple(i for i in best if res[best]["a"][i] > 0)
-        if nz and nz != best and nz in res:
+    refused = {}
+    if terms is None:
+        # a K or R without a sustained slope is not selectable (a hump goes to M, or to B/N without it)
+        refused = _slope_refusals(c, prob, res)
+        best = _best_claimable(res, refused, best)
+        nz = tuple(i for i in best if res[best]["a"][i] > 0)  # a term at exactly zero is not in the model
+        if nz and nz != best and nz in res and nz not in refused:
             best = nz
     # the exponentially correlated (Gauss-Markov) term: its correlation time is profiled on the fitted range
     markov_info = None
@@ -449,16 +501,25 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             prob, res, best, markov_info = mk
             if markov_info is not None:
                 allowed = allowed + ("M",)
+            refused = _slope_refusals(c, prob, res)
+            best = _best_claimable(res, refused, best)
     sel_res = res  # the selection stage's fits (one common covariance): what the candidate table reports
+    # every refusal ranked below the chosen model names why its K or R was not claimed
+    slope_notes = {}
+    for k in sorted(refused, key=lambda k: res[k]["ic"]):
+        for name in ("K", "R"):
+            if _NAMES.index(name) in k and refused[k].reason.startswith(name) and name not in slope_notes:
+                slope_notes[name] = (res[k]["ic"], refused[k].reason)
     # a selected model never holds a term its own checks reject: a flat floor above the measured curve or a term at
     # its ~4-sigma data bound is dropped and the model re-selected without it
     dropped = {}
     if terms is None:
-        best, dropped = _drop_rejected(c, prob, res, best, plausible_delta)
+        best, dropped = _drop_rejected(c, prob, {k: v for k, v in res.items() if k not in refused}, best,
+                                       plausible_delta)
     ic_best = res[best]["ic"]
 
     def _ok(k):
-        return not any(i in k for i in dropped)
+        return not any(i in k for i in dropped) and k not in refused
 
     plaus = [best] if terms is not None else [k for k, v in res.items()
                                              if v["ic"] <= ic_best + plausible_delta and _ok(k)]
@@ -539,11 +600,21 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             else:
                 status = "unresolved"
                 reason = _unresolved_reason(name, lacking, plaus, res, ic_best)
+            if name in SLOPES:
+                # never resolved without a sustained slope (a fixed model keeps the term, with the reason)
+                lo_m, hi_m = _measured_limits(c, prob.nu)
+                claim = slope_claim(c.tau, c.y, lo_m, hi_m, c.X @ A, _rising_var(c, A, name), SLOPES[name],
+                                    name=name, curve=_CURVE.get(statistic, statistic.upper()))
+                if not claim.ok:
+                    status, reason, lo_v = "unresolved", claim.reason, 0.0
             out_terms[name] = NoiseTerm(name, val, spec_unit, lo_v, hi_v, status, reason)
         else:
-            out_terms[name] = NoiseTerm(name, None, spec_unit, 0.0, hi_v, "absent",
-                                        _absent_reason(c, name, A, max(his)) if name in laws else
-                                        "not in the model: the curve is described as well without it")
+            why = (_absent_reason(c, name, A, max(his)) if name in laws else
+                   "not in the model: the curve is described as well without it")
+            if name in slope_notes and slope_notes[name][0] <= ic_best + plausible_delta:
+                why = (f"{why}; {slope_notes[name][1]}; the model {'+'.join(_NAMES[j] for j in best)} describes "
+                       "the curve instead")
+            out_terms[name] = NoiseTerm(name, None, spec_unit, 0.0, hi_v, "absent", why)
     if terms is not None and "B" in laws and out_terms.get("B") is not None and out_terms["B"].value is not None:
         _check_floor(out_terms, c, A)  # a fixed model keeps its terms; a floor above the curve is still refused
     iQ, iS = _NAMES.index("Q"), _NAMES.index("S")
@@ -654,18 +725,22 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     grid = np.linspace(lo_t, hi_t, 12)
     ic0 = res[best]["ic"]
     scan = []
-    for lt in grid:
-        _, fits = _markov_fits(c, C, base_cols, math.exp(lt), penalty)
-        k = min(fits, key=lambda s: fits[s]["ic"])
-        scan.append((fits[k]["ic"], lt, k))
-    ic_m, lt_m, sub = min(scan)
+    for g, lt in enumerate(grid):
+        pr, fits = _markov_fits(c, C, base_cols, math.exp(lt), penalty)
+        k = _best_claimable(fits, _slope_refusals(c, pr, fits))  # a K or R read from the hump is no candidate
+        if k is not None:
+            scan.append((fits[k]["ic"], lt, k, g))
+    if not scan:
+        c.X[:, iM] = 0.0
+        c.tc_s = None
+        return None
+    ic_m, lt_m, sub, j = min(scan, key=lambda e: e[0])
     # the correlation time is searched, not given: ask for more than its one-parameter penalty (look-elsewhere)
     if not ic_m < ic0 - MARKOV_IC_GAIN:
         c.set_tc(math.exp(lt_m))
         c.X[:, iM] = 0.0
         c.tc_s = None
         return None
-    j = int(np.argmin([s[0] for s in scan]))
     a, b = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
 
     def q_at(lt, sub=sub):
@@ -688,8 +763,9 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     _, with_m = _markov_fits(c, C2, base_cols, tc, penalty)
     prob = ScoreProblem(c.X, c.y, C2, c._upper(C2))
     res2 = {**non_m, **with_m}
-    best2 = min(res2, key=lambda s: res2[s]["ic"])
-    best_non = min(non_m, key=lambda s: non_m[s]["ic"])
+    refused = _slope_refusals(c, prob, res2)
+    best_non = _best_claimable(non_m, refused, min(non_m, key=lambda s: non_m[s]["ic"]))
+    best2 = _best_claimable(res2, refused, best_non)
     if iM in best2 and not res2[best2]["ic"] < non_m[best_non]["ic"] - MARKOV_IC_GAIN:
         best2 = best_non
     if iM in best2 and res2[best2]["q"] / max(1, c.tau.size - len(best2) - 1) > POOR_CHI2_RED:
