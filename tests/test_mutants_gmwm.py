@@ -230,7 +230,7 @@ def test_b_line_values_agree_or_differ_by_height():
     c = compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, B_A))
     assert c["b_agree"] is True and c["agree"] is True
     assert c["lines"][1] == f"B agrees: {B_G_TEXT}; {B_A_TEXT} (the 95 % ranges overlap)"
-    assert len(c["lines"]) == 2  # no hump
+    assert len(c["lines"]) == 3 and c["lines"][2] == "Q, K, R agree: neither estimator claims them"  # no hump
     # touching ranges agree (both ends)
     for lo, hi in ((0.6, 0.7), (0.3, 0.4)):
         assert compare_with_allan(_gaxis(G_N, B_G), _afit(G_N, {**B_A, "lo95": lo, "hi95": hi}))["b_agree"] is True
@@ -303,9 +303,11 @@ def test_b_line_cannot_compare():
         assert c["b_agree"] is None
         assert c["lines"][1] == f"B cannot be compared: {B_G_TEXT}; the Allan fit has no ADEV-minimum reading"
     c = compare_with_allan(_gaxis(None, _bi(reason="x")), _afit(None, None))
-    assert c == {"agree": None, "n_agree": None, "b_agree": None, "lines": [
+    assert c == {"agree": None, "n_agree": None, "b_agree": None,
+                 "term_agree": {"Q": None, "K": None, "R": None, "S": None, "M": None}, "lines": [
         "N cannot be compared: neither GMWM nor the Allan fit has a white-noise term",
-        "B cannot be compared: GMWM reads no B (x); the Allan fit has no ADEV-minimum reading"]}
+        "B cannot be compared: GMWM reads no B (x); the Allan fit has no ADEV-minimum reading",
+        "Q, K, R agree: neither estimator claims them"]}
 
 
 def test_agree_is_all_comparable_verdicts():
@@ -318,7 +320,7 @@ def test_agree_is_all_comparable_verdicts():
 def test_hump_line_is_a_third_line_read_without_the_allan_interval():
     hump = _bi(0.123456, 0.1, 0.15, 5.0, label="max of a GM's ADEV (GM1, T_c 2.64 s)", rule="gm-max")
     c = compare_with_allan(_gaxis(G_N, B_G, hump), _afit(G_N, B_A))
-    assert len(c["lines"]) == 3
+    assert len(c["lines"]) == 4 and c["lines"][3].startswith("Q, K, R agree")
     assert c["lines"][2] == ("GMWM B 0.1235 deg/h at τ = 5 s is read from a GM hump (GM1, T_c 2.64 s): a detail, not "
                              "a bias-instability floor; the Allan fit's B_min is 0.55 deg/h at τ = 12 s")
     c = compare_with_allan(_gaxis(G_N, B_G, hump), _afit(G_N, {"value": 0.7, "bound_only": True, "rule": ""},
@@ -330,7 +332,8 @@ def test_hump_line_is_a_third_line_read_without_the_allan_interval():
     assert compare_with_allan(_gaxis(G_N, B_G, hump), SimpleNamespace(terms={"N": G_N}))["lines"][2].endswith(
         "floor; the Allan fit has no ADEV-minimum reading")
     # a hump without a value: no third line
-    assert len(compare_with_allan(_gaxis(G_N, B_G, _bi(reason="none")), _afit(G_N, B_A))["lines"]) == 2
+    lines = compare_with_allan(_gaxis(G_N, B_G, _bi(reason="none")), _afit(G_N, B_A))["lines"]
+    assert len(lines) == 3 and not any("hump" in line for line in lines)
 
 
 def test_number_formats_of_the_sentences():
@@ -355,7 +358,7 @@ def test_attach_allan_checks_sets_each_named_axis_and_says_when_the_record_is_to
     other = SimpleNamespace(name="nope", allan_check="untouched", **vars(_gaxis(G_N, B_G)))
     out = attach_allan_checks(rec, [ax, other])
     assert out == [ax, other] and other.allan_check == "untouched"
-    assert set(ax.allan_check) == {"agree", "n_agree", "b_agree", "lines"}
+    assert set(ax.allan_check) == {"agree", "n_agree", "b_agree", "term_agree", "lines"}
     assert ax.allan_check["lines"][0].startswith("N ")
     # both readings in the internal unit (the GMWM's are re-stated afterwards): the Allan fit's N of white noise of
     # 0.1 m/s^2 per sample at 0.01 s is the gyro table's number 0.1 * sqrt(0.01 s) / 60, not its m/s/√h (x 3600)

@@ -36,7 +36,10 @@ def test_rlg_gx_names_N_at_its_data_bound(rlg_fits):
     assert len(notes) == 1 and notes[0].startswith("N = ")
     value = float(re.match(r"N = ([0-9.eE+-]+) deg/√h", notes[0]).group(1))
     assert value == pytest.approx(f.terms["N"].value, rel=1e-3)
-    assert f.terms["N"].value == pytest.approx(f.terms["N"].hi95, rel=1e-3)  # the interval ends at the bound
+    if f.no_fit is None:
+        assert f.terms["N"].value == pytest.approx(f.terms["N"].hi95, rel=1e-3)  # the interval ends at the bound
+    else:  # no model fits: the printed bound is the curve's own, which holds the best candidate's value
+        assert f.terms["N"].status == "no_fit" and f.terms["N"].hi95 >= f.terms["N"].value
     tau = float(re.search(r"at tau = ([0-9.eE+-]+) s", notes[0]).group(1))
     assert tau in np.round(f.fit_tau_s, 2)
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import csv
 import gzip
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -46,6 +47,10 @@ _IEEE_ORDER = (("N_dprh", "N"), ("K_dphrh", "K"), ("R_dph2", "R"), ("Q_urad", "Q
                ("B_dph", "B"))
 
 
+#: Why the terms of a GMWM selection in which no candidate passed its checks are no result.
+NO_PASS_REASON = ("no GMWM candidate passed its checks: the fallback model's values are no result; the bound is the "
+                  "measured WV's own (each process alone stays below it at every used scale)")
+
 #: One IEEE-952 term as a GMWM model implies it: the one IEEE-term value type, :class:`fogdrift.noise.NoiseTerm`
 #: (the name is kept for code that imported it).
 GmwmTerm = NoiseTerm
@@ -61,6 +66,31 @@ class GmwmAxis:
     #: The comparison with the Allan fit of the same record (:func:`fogdrift.gmwm.compare.compare_with_allan`),
     #: when one was made: ``{"agree": bool, "lines": [str, ...], ...}``.
     allan_check: dict | None = None
+
+    def data_bounds(self) -> dict:
+        """The bound the measured WV alone sets on N, Q and K (units of :data:`fogdrift.noise.TERM_UNITS`).
+
+        Latent processes add and none is negative, so each alone stays below the measured WV at every used scale
+        (per sample, ``tau`` the scale in samples; [GMWM]_ §2 and §4 of :mod:`.processes`): WN
+        ``sigma2 / tau`` (N = sqrt(sigma2 dt) / 60), QN ``6 q2 / tau^2`` (Q = sqrt(q2) dt arcsec), RW
+        ``gamma2 (tau^2 + 2) / (12 tau)`` (K = 60 sqrt(gamma2 / dt)).  Each point's 95 % upper limit is stretched
+        to ~4 sigma, so the minimum over all the used scales still holds.  Needs no model: a true bound where no
+        candidate passes its checks.
+        """
+        from ..units import URAD_PER_ARCSEC
+
+        wv, used = self.wvar, np.isin(self.wvar.level, self.selection.levels_used)
+        nu = np.asarray(wv.nu2_dph2, dtype=np.float64)[used]
+        hi = np.asarray(wv.ci_hi95_dph2, dtype=np.float64)[used]
+        tau = np.asarray(wv.tau_samples, dtype=np.float64)[used]
+        ok = (nu > 0) & np.isfinite(hi) & (hi >= nu)
+        if not np.any(ok):
+            return {}
+        top = nu[ok] * (hi[ok] / nu[ok]) ** (4.0 / 1.96)
+        t, dt = tau[ok], float(wv.dt_s)
+        return {"N": math.sqrt(float(np.min(top * t)) * dt) / 60.0,
+                "Q": math.sqrt(float(np.min(top * t**2 / 6.0))) * dt * URAD_PER_ARCSEC,
+                "K": 60.0 * math.sqrt(float(np.min(top * 12.0 * t / (t**2 + 2.0))) / dt)}
 
     def ieee_terms(self) -> dict:
         """The five IEEE-952 terms the selected model implies, as :class:`~fogdrift.noise.NoiseTerm` keyed Q, N, B, K, R.
@@ -85,6 +115,11 @@ class GmwmAxis:
             reason = {"absent": f"not in the selected GMWM model ({self.selection.selected})",
                       "unresolved": "its 95 % interval reaches 0", "resolved": ""}[status]
             out[name] = NoiseTerm(name, value, spec.unit, lo, hi, status, reason)
+        if not self.selection.passed_checks:  # no candidate passed its checks: nothing is a result
+            bounds = self.data_bounds()
+            for name, t in out.items():
+                if t.status in ("resolved", "unresolved") or name in bounds:
+                    out[name] = NoiseTerm(name, t.value, t.unit, None, bounds.get(name), "no_fit", NO_PASS_REASON)
         return out
 
     def to_dict(self) -> dict:
@@ -288,6 +323,22 @@ def ieee_rows(axis: GmwmAxis) -> list[list]:
     """
     ie = axis.selection.ieee
     rows = []
+    if not axis.selection.passed_checks:  # the values of a model that failed its checks are no result
+        from .quantity import GMWM_ACCEL_UNITS
+
+        bounds = axis.data_bounds()
+        n = ie.terms.get("N_dprh")
+        accel = n is not None and n.unit == GMWM_ACCEL_UNITS["N_dprh"][0]  # re-stated by express_gmwm
+        for key, sym in _IEEE_ORDER:
+            if key in ("N_dprh", "Q_urad", "K_dphrh") and (key in ie.terms or sym in bounds):
+                b, unit = bounds.get(sym), TERM_TABLE[sym].unit
+                if accel and b is not None:
+                    unit, f = GMWM_ACCEL_UNITS[key]
+                    b *= f
+                rows.append([sym, "no result" if b is None else f"< {b:.4g}", None, None, unit,
+                             "the measured WV's own bound (no candidate passed its checks)"])
+        rows.append(["B", "no result", None, None, "deg/h", "no candidate passed its checks"])
+        return rows
     for key, sym in _IEEE_ORDER:
         if key in ie.terms and key != "B_dph":
             v = ie.terms[key]
@@ -305,6 +356,9 @@ def b_detail_lines(axis: GmwmAxis) -> list[str]:
     """Lines under the IEEE table: why the headline B is a bound or nothing (when it is), then the B readings that
     are not the headline B (the GM hump's, the min-AVAR reading beside a flicker term), each labelled by its rule."""
     ie = axis.selection.ieee
+    if not axis.selection.passed_checks:
+        return ["no result: no candidate passed its checks, so neither its terms nor its B readings are numbers to "
+                "sign; the table gives the bounds the measured WV itself sets (--details says why each failed)"]
     head = ie.b_headline
     out = [] if head.value_dph is not None else [f"B ({head.label}): {head.text()}"]
     for b in ie.b_details:

@@ -46,10 +46,36 @@ def _iv(lo, hi):
     return "" if lo is None or hi is None else f" [{_g(lo)}, {_g(hi)}]"
 
 
+def _no_result_n_line(axis, fit):
+    """The N line when either side has no result (no GMWM candidate passed / no Allan model fits): their bounds,
+    and whether the other side's value lies inside them."""
+    sel = axis.selection
+    a = (getattr(fit, "terms", None) or {}).get("N")
+    g_pass = getattr(sel, "passed_checks", True)
+    a_fit = getattr(a, "status", None) != "no_fit"
+    gb = axis.data_bounds().get("N") if not g_pass else None
+    g = sel.ieee.terms.get("N_dprh")
+    g_txt = (f"GMWM: no candidate passed its checks (N < {_g(gb, 4)} deg/√h, the WV's own bound)" if not g_pass else
+             f"GMWM {_g(g.value, 4)}{_iv(g.lo95, g.hi95)} deg/√h" if g is not None else "GMWM has no N")
+    a_txt = (f"the Allan fit: no model fits (N < {_g(a.hi95, 4)} deg/√h, the curve's own bound)" if not a_fit else
+             f"the Allan fit {_g(a.value, 4)}{_iv(a.lo95, a.hi95)} deg/√h" if a is not None and a.value is not None
+             else "the Allan fit has no N")
+    if not g_pass and not a_fit:
+        return None, f"N: neither estimator has a result: {g_txt}; {a_txt}"
+    if not g_pass:
+        ok = a is not None and a.value is not None and gb is not None and (a.lo95 or a.value) <= gb
+    else:
+        ok = g is not None and a is not None and a.hi95 is not None and g.lo95 <= a.hi95
+    return (ok, f"N {'is consistent' if ok else 'differs'}: {g_txt}; {a_txt}"
+            + ("" if ok else "; the estimate lies above the other side's bound"))
+
+
 def _n_line(axis, fit) -> tuple:
     sel = axis.selection
     g = sel.ieee.terms.get("N_dprh")
     a = (getattr(fit, "terms", None) or {}).get("N")
+    if not getattr(sel, "passed_checks", True) or getattr(a, "status", None) == "no_fit":
+        return _no_result_n_line(axis, fit)
     a_val = getattr(a, "value", None)
     if g is None and a_val is None:
         return None, "N cannot be compared: neither GMWM nor the Allan fit has a white-noise term"
@@ -104,6 +130,9 @@ def _b_line(axis, fit) -> tuple:
     ie = axis.selection.ieee
     gb = ie.b_headline
     ab = getattr(fit, "b_min", None) or {}
+    if not getattr(axis.selection, "passed_checks", True):
+        a_txt = _allan_b_text(ab, getattr(fit, "tau_max_s", None), interval=True)
+        return None, f"B: GMWM has no result (no candidate passed its checks); {a_txt}"
     tau_max = getattr(fit, "tau_max_s", None)
     g_iv = _b_interval(gb.value_dph, gb.lo95_dph, gb.hi95_dph, gb.bound_dph)
     a_bound = bool(ab.get("bound_only"))
@@ -208,6 +237,8 @@ def _power_line(axis, fit, name) -> tuple:
     readings); ``(False, line)`` otherwise, with the numbers of both sides."""
     spec = TERM_TABLE[name]
     g = axis.selection.ieee.terms.get(name + spec.suffix)
+    if not getattr(axis.selection, "passed_checks", True):
+        g = None  # no candidate passed: the fallback's terms are no claim
     a = (getattr(fit, "terms", None) or {}).get(name)
     a_in = a is not None and a.value is not None and a.status in ("resolved", "unresolved")
     unit = DISPLAY_UNITS[name]
@@ -249,20 +280,28 @@ def _s_line(axis, fit) -> tuple:
         return None, None
     sh = (getattr(fit, "shaped", None) or {}).get("S") or {}
     f = sh.get("freq_hz")
-    excl = [x for x in axis.selection.excluded if "spectral line" in (x.reason or "")]
+    excl = [x for x in axis.selection.excluded if "spectral line" in (getattr(x, "reason", "") or "")]
     how = (f"GMWM leaves out the {len(excl)} scale(s) it dominates" if excl else
            "GMWM has no sinusoid process (its WV at the line's scales is part of its fit)")
     return True, (f"S: the Allan fit models the periodic error as S {_g(a.value)}{_iv(a.lo95, a.hi95)} deg/h at "
                   f"{_g(f, 4)} Hz; {how}: both keep it out of the noise terms")
 
 
+def _gm_times(axis) -> list:
+    """``[(label, T_c [s]), ...]`` of the GM components of the selected GMWM model (none when it has no fit)."""
+    fit = getattr(axis.selection, "fit", None)
+    if not hasattr(fit, "latent_model"):
+        return []
+    mdl = fit.latent_model
+    return [(lab, fit.dt_s / fit.theta[sl.start]) for lab, sl, key in zip(mdl.labels, mdl.slices, mdl.components)
+            if key == "GM"]
+
+
 def _m_line(axis, fit) -> tuple:
     """The exponentially correlated term: Allan's M against GMWM's GM components, by correlation time."""
     a = (getattr(fit, "terms", None) or {}).get("M")
     a_in = a is not None and a.value is not None and "M" in (getattr(fit, "selected", ()) or ())
-    mdl = axis.selection.fit.latent_model
-    gms = [(lab, axis.selection.fit.dt_s / axis.selection.fit.theta[sl.start])
-           for lab, sl, key in zip(mdl.labels, mdl.slices, mdl.components) if key == "GM"]
+    gms = _gm_times(axis)
     if not a_in and not gms:
         return None, None
     g_txt = ("GMWM " + ", ".join(f"{lab} T_c {_g(tc)} s" for lab, tc in gms)) if gms else "GMWM has no GM"

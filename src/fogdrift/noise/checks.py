@@ -191,7 +191,7 @@ def _q_at_whole_periods(c: _Context, prob, best, A, d2, periodic, out_terms) -> 
     if c.tau.size - k0 < len(best) + 1:
         lo = 0.0
     else:
-        sub = ScoreProblem(prob.X[k0:], prob.y[k0:], _sub_cov(prob, k0), prob.upper)
+        sub = ScoreProblem(prob.X[k0:], prob.y[k0:], _sub_cov(prob, k0), prob.upper, prob.extra_var)
         a, q_sub = sub.fit(best)
         full = np.zeros(len(_NAMES))
         full[list(best)] = a

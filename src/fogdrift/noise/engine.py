@@ -100,13 +100,19 @@ class ScoreProblem:
         Relative covariance ``Cov(y_i, y_j) / (mu_i mu_j)`` of the estimates (model based); ``nu_i = 2 / C_ii``.
     upper : ndarray, shape (k,)
         Upper bounds of the coefficients.
+    extra_var : float
+        The part of each diagonal element of ``C`` that is no chi-squared sampling error (the model-discrepancy
+        allowance, :mod:`fogdrift.noise.discrepancy`): it widens the scores but does not shift their centre,
+        ``1 - 2 / (9 nu)`` with ``nu`` the sampling EDF ``2 / (C_ii - extra_var)``.
     """
 
-    def __init__(self, X, y, C, upper):
+    def __init__(self, X, y, C, upper, extra_var=0.0):
         self.X = np.asarray(X, dtype=np.float64)
         self.y = np.asarray(y, dtype=np.float64)
+        self.extra_var = float(extra_var)
         sd = np.sqrt(np.diag(C))
         self.nu = 2.0 / np.diag(C)
+        nu_sampling = 2.0 / np.maximum(np.diag(C) - self.extra_var, 1e-12)
         R = C / np.outer(sd, sd)
         try:
             L = np.linalg.cholesky(R + np.eye(self.y.size) * 1e-10)
@@ -117,7 +123,7 @@ class ScoreProblem:
             d = np.sqrt(np.diag(R))
             L = np.linalg.cholesky(R / np.outer(d, d) + np.eye(self.y.size) * 1e-10)
         self.W = np.linalg.inv(L)  # lower triangular; tiny (n_tau x n_tau)
-        self.c = 1.0 - 2.0 / (9.0 * self.nu)
+        self.c = 1.0 - 2.0 / (9.0 * nu_sampling)
         self.s = np.sqrt(2.0 / (9.0 * self.nu))
         self.y3 = np.cbrt(self.y)
         self.upper = np.asarray(upper, dtype=np.float64)

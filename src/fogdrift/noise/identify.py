@@ -59,6 +59,8 @@ __all__ = ["identify", "thin_taus", "POOR_CHI2_RED"]
 
 _NAMES = ALL_TERMS  # Q N B K R, then the shaped Annex C terms S (periodic) and M (Gauss-Markov)
 _NP = len(TERMS)
+#: The diagonal of the model-discrepancy allowance's relative covariance (no chi-squared error: see ScoreProblem).
+_ALLOW = float(discrepancy_relcov([1.0])[0, 0])
 #: A fit whose reduced chi-squared exceeds this is "poor" (the misfit is several times the statistical error).
 POOR_CHI2_RED = 4.0
 
@@ -278,7 +280,7 @@ def _select(ctx: _Context, penalty: float, iters: int = 2, C=None, allowance=Tru
 
     cols = ctx.cols
     if C is not None:
-        prob = ScoreProblem(ctx.X, ctx.y, C, ctx._upper(C))
+        prob = ScoreProblem(ctx.X, ctx.y, C, ctx._upper(C), _ALLOW if allowance else 0.0)
         res = fit_subsets(prob, all_subsets(cols), penalty)
         best = min(res, key=lambda s: res[s]["ic"])
         return {"best": best, "res": res, "prob": prob, "C": C, "A_full": res[tuple(cols)]["a"]}
@@ -299,7 +301,7 @@ def _select(ctx: _Context, penalty: float, iters: int = 2, C=None, allowance=Tru
         A[list(cols)] = ctx.upper[list(cols)] * 1e-3
     for _ in range(iters):
         C = ctx.relcov(A, allowance=allowance)
-        prob = ScoreProblem(ctx.X, ctx.y, C, ctx._upper(C))
+        prob = ScoreProblem(ctx.X, ctx.y, C, ctx._upper(C), _ALLOW if allowance else 0.0)
         a, _q = prob.fit(cols)
         newA = np.zeros(len(_NAMES))
         newA[list(cols)] = a
@@ -354,7 +356,7 @@ def _choose_start(ctx: _Context, penalty: float, max_fraction: float = 0.5, thre
 
     def get(k):
         if k not in cache:
-            cache[k] = _select(ctx.sub(k), penalty, C=C_all[k:, k:])
+            cache[k] = _select(ctx.sub(k), penalty, C=C_all[k:, k:], allowance=False)
         return cache[k]
 
     s = start0
@@ -529,7 +531,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     views = [(prob, res)]
     if res[best]["a"][_NAMES.index("R")] > 0:
         C_exact = c.relcov(res[best]["a"], exact_ramp=True)
-        prob = ScoreProblem(c.X, c.y, C_exact, c._upper(C_exact))
+        prob = ScoreProblem(c.X, c.y, C_exact, c._upper(C_exact), _ALLOW)
         res = {**res, **fit_subsets(prob, plaus, ic_penalty)}
         views.append((prob, res))
     A = res[best]["a"]
@@ -690,7 +692,7 @@ def _no_fit_terms(c: _Context, out_terms: dict, laws, dt_s) -> None:
 def _markov_fits(c: _Context, C, base_cols, tc, penalty):
     """Fits of every model ``subset + M`` at one correlation time ``tc`` [s] under the fixed relative covariance C."""
     c.set_tc(tc)
-    prob = ScoreProblem(c.X, c.y, C, c._upper(C))
+    prob = ScoreProblem(c.X, c.y, C, c._upper(C), _ALLOW)
     iM = _NAMES.index("M")
     subs = [()] + all_subsets(base_cols)
     out = fit_subsets(prob, [tuple(sorted(s + (iM,))) for s in subs], penalty)
@@ -745,7 +747,7 @@ def _markov_stage(c: _Context, C, res, best, penalty):
 
     def q_at(lt, sub=sub):
         c.set_tc(math.exp(lt))
-        prob = ScoreProblem(c.X, c.y, C, c._upper(C))
+        prob = ScoreProblem(c.X, c.y, C, c._upper(C), _ALLOW)
         return prob.fit(sub)[1]
 
     r = minimize_scalar(q_at, bounds=(a, b), method="bounded", options={"xatol": 1e-3})
@@ -753,15 +755,15 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     tc = math.exp(lt_best)
     # the final covariance: that of the selected M model
     c.set_tc(tc)
-    prob0 = ScoreProblem(c.X, c.y, C, c._upper(C))
+    prob0 = ScoreProblem(c.X, c.y, C, c._upper(C), _ALLOW)
     a_sel, _ = prob0.fit(sub)
     A = np.zeros(len(_NAMES))
     A[list(sub)] = a_sel
     C2 = c.relcov(A)
-    prob = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+    prob = ScoreProblem(c.X, c.y, C2, c._upper(C2), _ALLOW)
     non_m = fit_subsets(prob, all_subsets(base_cols), penalty)
     _, with_m = _markov_fits(c, C2, base_cols, tc, penalty)
-    prob = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+    prob = ScoreProblem(c.X, c.y, C2, c._upper(C2), _ALLOW)
     res2 = {**non_m, **with_m}
     refused = _slope_refusals(c, prob, res2)
     best_non = _best_claimable(non_m, refused, min(non_m, key=lambda s: non_m[s]["ic"]))
@@ -776,7 +778,7 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     if iM not in best2:  # under its own covariance M is no longer needed
         c.X[:, iM] = 0.0
         c.tc_s = None
-        prob = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+        prob = ScoreProblem(c.X, c.y, C2, c._upper(C2), _ALLOW)
         return prob, non_m, best2, None
     # profile-likelihood interval of T_c: {T : min_q(T) <= q_min + t^2 chi2_red}
     q_min = res2[best2]["q"]
@@ -788,7 +790,7 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     def q_prof(lt):
         if lt not in cache:
             c.set_tc(math.exp(lt))
-            pr = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+            pr = ScoreProblem(c.X, c.y, C2, c._upper(C2), _ALLOW)
             cache[lt] = pr.fit(best2)[1]
         return cache[lt]
 
@@ -828,7 +830,7 @@ def _markov_qc_interval(c: _Context, prob, best, info, q_min, d2, lo_v, hi_v):
     for j in ok[:: max(1, ok.size // 6)]:
         tc = float(np.exp(info["grid_log_tc"][j]))
         c.set_tc(tc)
-        pr = ScoreProblem(c.X, c.y, C2, c._upper(C2))
+        pr = ScoreProblem(c.X, c.y, C2, c._upper(C2), _ALLOW)
         a, qq = pr.fit(best)
         full = np.zeros(len(_NAMES))
         full[list(best)] = a
