@@ -240,7 +240,8 @@ def line_name(content, freq_hz, df_hz=None) -> str:
 
     Examples
     --------
-    >>> pc = PeriodicContent(((4.1667, 1.0), (8.3333, 0.25)), 4.1667, 8.0, (0.24,))
+    >>> pc = PeriodicContent(((4.1667, 1.0), (8.3333, 0.25)), 4.1667, 8.0, (0.24,),
+    ...                      ("periodic error, period 0.24 s (4.167 Hz and 1 harmonic(s))",))
     >>> line_name(pc, 8.3333)
     'spectral line at 8.333 Hz (harmonic 2 of the periodic error with period 0.240 s, 4.167 Hz)'
     >>> line_name(pc, 4.1667)
@@ -248,13 +249,10 @@ def line_name(content, freq_hz, df_hz=None) -> str:
     """
     f = float(freq_hz)
     text = f"spectral line at {f:.4g} Hz"
-    for p in content.periods_s:
+    # a harmonic only of a component the spectrum grouped (its description says "periodic error")
+    for p, d in zip(content.periods_s, content.descriptions):
         k = f * float(p)
-        if k > 0.5 and abs(k - round(k)) <= 0.02 * round(k):
-            others = [x for x, _ in content.lines if x != f and abs(x * p - round(x * p)) <= 0.02 * round(x * p)
-                      and round(x * p) >= 1]
-            if not others:
-                break  # a line of its own
+        if d.startswith("periodic error") and k > 0.5 and abs(k - round(k)) <= 0.02 * round(k):
             if round(k) == 1:
                 return text + f" (the fundamental of the periodic error with period {float(p):.3f} s)"
             return text + f" (harmonic {int(round(k))} of the periodic error with period {float(p):.3f} s, " \
