@@ -7,7 +7,8 @@ Every expected value is computed here from a closed form, independently of the m
   of freedom has ``ppf(p) = -2 ln(1 - p)``); the refusal of a flat B floor above the measured minimum and its
   classical bound ``B <= min ADEV / 0.664`` (IEEE Std 952-1997 C.2, 0.664 = sqrt(2 ln 2 / pi)); the minimum of a
   fitted N + K curve, ``sigma^2 = a / tau + b tau`` -> ``2 sqrt(a b)`` at ``tau = sqrt(a / b)``; the quantization
-  versus tone rule (Q is not told apart from a line whose tau^-2 envelope ``Omega^2 / (pi f)^2`` is larger); the
+  versus tone rule (Q is not told apart from lines unless its variance stands Q_OVER_ENVELOPE times above their
+  envelope ``Omega^2 / (m sin(pi f dt))^2``, the IEEE ``Omega^2 / (pi f tau)^2`` of sampled data); the
   sub-covariance rebuilt from a known correlation and EDF.
 * ``noise/periodic.py``: a tone's ADEV ``A^2 sin^4(pi f tau) / (pi f tau)^2`` (IEEE Std 952-1997 C.7) vanishes at
   the taus :func:`null_taus` returns; the relative powers ``(a / a_ref)^2`` and the periods of
@@ -240,18 +241,34 @@ def _q_terms():
 
 
 def test_q_below_the_lines_envelope_is_unresolved():
-    """Lines (20 Hz, power 1) and (40 Hz, power 0.25): envelope A_S (1 / (20 pi)^2 + 0.25 / (40 pi)^2)."""
-    env1 = 1.0 / (math.pi * 20.0) ** 2 + 0.25 / (math.pi * 40.0) ** 2
-    c = _ctx([0.01, 0.1], [1.0, 1.0], [2.0, 2.0], lines=((20.0, 1.0), (40.0, 0.25)))
+    """Lines (20 Hz, power 1) and (40 Hz, power 0.25), A_S = 2: the envelope is A_S sum r / (m sin(pi f dt))^2 (each
+    line's law with sin^4 replaced by 1, noise.periodic.periodic_variance); Q's variance A_Q / tau^2 must stand
+    Q_OVER_ENVELOPE (10) times above it at some fitted tau (the rule the GMWM applies to QN too)."""
+    from fogdrift.noise.periodic import Q_OVER_ENVELOPE
+    from fogdrift.noise.terms import periodic_shape
+
+    lines = ((20.0, 1.0), (40.0, 0.25))
+    tau = np.array([0.01, 0.1])
+    c = _ctx(tau, [1.0, 1.0], [2.0, 2.0], lines=lines)
     periodic = SimpleNamespace(periods_s=(0.05, 0.3))
+    unit_ratio = float(np.max(tau**-2.0 / (2.0 * periodic_shape(tau, lines, 0.01, "adev", envelope=True))))
+    # with dt -> 0 the envelope tends to the IEEE tau^-2 coefficient sum r / (pi f)^2; at 100 Hz it is a little more
+    env1 = 1.0 / (math.pi * 20.0) ** 2 + 0.25 / (math.pi * 40.0) ** 2
+    assert 1.0 / unit_ratio > 2.0 * env1
     A = np.zeros(len(ALL_TERMS))
     A[IS] = 2.0
-    A[IQ] = 2.0 * env1 * 0.999
+    A[IQ] = Q_OVER_ENVELOPE * 0.999 / unit_ratio
     out = _q_terms()
     checks._q_at_whole_periods(c, None, (IQ, IS), A, 1.0, periodic, out)
     t = out["Q"]
     assert t.status == "unresolved" and t.lo95 == 0.0 and t.value == 1.0 and t.hi95 == 2.0 and t.unit == "urad"
-    assert f"{math.sqrt(1 / 0.999):.3g}x Q in deviation" in t.reason and "envelope" in t.reason
+    assert f"at most {Q_OVER_ENVELOPE * 0.999:.3g}x the lines' own envelope" in t.reason
+    assert f"not the {Q_OVER_ENVELOPE:g}x it must stand above it" in t.reason
+    # just above the threshold the envelope rule lets Q through (to the whole-period test, here short of taus)
+    A[IQ] = Q_OVER_ENVELOPE * 1.001 / unit_ratio
+    out = _q_terms()
+    checks._q_at_whole_periods(c, SimpleNamespace(), (IQ, IS), A, 1.0, periodic, out)
+    assert "envelope" not in out["Q"].reason and "whole periods" in out["Q"].reason
     # no periodic content: nothing to tell apart, Q untouched
     out = _q_terms()
     checks._q_at_whole_periods(c, None, (IQ, IS), A, 1.0, None, out)
@@ -551,14 +568,14 @@ def _qs_problem(a_q, a_n, nu=1e4):
 
 
 def test_q_above_the_envelope_is_kept_only_if_resolved_at_whole_periods():
-    """Envelope 1 / (20 pi)^2 = 2.5e-4: Q = 1e-3 is above it.  With N = 1e-3 the taus from 0.05 s on (0.08 .. 1.28 s)
-    still see Q (1e-3 / tau^2 against 1e-3 / tau): resolved, Q kept; with N = 1e3 (a million times Q's share at
-    0.08 s) Q is not resolved from zero there: unresolved, lower bound 0."""
+    """Envelope 1 / (m sin(pi 20 dt))^2 tau^2 ~ 2.9e-4 / tau^2: Q = 1e-2 is 35x above it.  With N = 1e-3 the taus from
+    0.05 s on (0.08 .. 1.28 s) still see Q (1e-2 / tau^2 against 1e-3 / tau): resolved, Q kept; with N = 1e3 (a
+    hundred thousand times Q's share at 0.08 s) Q is not resolved from zero there: unresolved, lower bound 0."""
     best = (IQ, IN, IS)
     for a_n, resolved in ((1e-3, True), (1e3, False)):
-        c, prob = _qs_problem(1e-3, a_n)
+        c, prob = _qs_problem(1e-2, a_n)
         out = _q_terms()
-        checks._q_at_whole_periods(c, prob, best, _a(Q=1e-3, N=a_n, S=1.0), 3.84, SimpleNamespace(periods_s=(0.05,)),
+        checks._q_at_whole_periods(c, prob, best, _a(Q=1e-2, N=a_n, S=1.0), 3.84, SimpleNamespace(periods_s=(0.05,)),
                                    out)
         assert (out["Q"].status == "estimated") == resolved
         if not resolved:

@@ -232,3 +232,65 @@ def test_no_model_fits_is_said_and_cells_are_bounds():
     assert fit_cell(f).startswith("no model fits")
     g = fit_noise(allan_variance(y, dt), markov=True)  # with M the hump is modelled
     assert g.no_fit is None and "M" in g.selected
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the lines' contribution at given scales (noise.periodic), shared by the Allan fit and the GMWM
+def _content(lines_hz_amp):
+    from fogdrift.noise.periodic import PeriodicContent
+
+    ref = max(lines_hz_amp, key=lambda la: la[1])
+    return PeriodicContent(tuple((f, (a / ref[1]) ** 2) for f, a in lines_hz_amp), ref[0], ref[1],
+                           tuple(1.0 / f for f, _ in lines_hz_amp))
+
+
+def test_periodic_wvar_is_the_line_power_times_the_haar_gain():
+    from fogdrift.gmwm.processes import haar_gain2
+    from fogdrift.noise.periodic import periodic_wvar
+
+    dt, tau = 0.01, 2 ** np.arange(1, 12)
+    pc = _content([(20.0, 8.0), (31.7, 2.0)])
+    want = sum(a**2 / 2 * haar_gain2(f * dt, tau / 2) for f, a in [(20.0, 8.0), (31.7, 2.0)])
+    np.testing.assert_allclose(periodic_wvar(pc, tau, dt), want, rtol=1e-12)
+    each = periodic_wvar(pc, tau, dt, per_line=True)
+    assert each.shape == (2, tau.size)
+    np.testing.assert_allclose(each.sum(axis=0), want, rtol=1e-12)
+    # the envelope: sin^4 replaced by 1, never below the law, equal where sin^4(pi f m) = 1 (f dt m = 1/2)
+    env = periodic_wvar(pc, tau, dt, envelope=True)
+    np.testing.assert_allclose(env, sum(a**2 / 2 / ((tau / 2) * np.sin(np.pi * f * dt)) ** 2
+                                        for f, a in [(20.0, 8.0), (31.7, 2.0)]), rtol=1e-12)
+    assert np.all(env >= want * (1 - 1e-12))
+    one = _content([(25.0, 3.0)])  # f dt = 1/4: m = 2 puts f dt m = 1/2
+    assert periodic_wvar(one, [4], dt)[0] == pytest.approx(periodic_wvar(one, [4], dt, envelope=True)[0], rel=1e-12)
+    # Haar WV = AVAR(m dt) / 2, the Allan variance of the same lines
+    from fogdrift.noise.periodic import periodic_variance
+
+    np.testing.assert_allclose(periodic_wvar(pc, tau, dt), periodic_variance(pc, tau / 2 * dt, dt) / 2, rtol=1e-12)
+
+
+@pytest.mark.parametrize("freq_hz", [20.0, 13.7])
+def test_periodic_wvar_equals_the_haar_wvar_of_a_noiseless_sinusoid(freq_hz):
+    """The estimator (gmwm.wvar.haar_wvar) on a pure sampled sinusoid is an independent check of the formula."""
+    from fogdrift.gmwm import haar_wvar
+    from fogdrift.noise.periodic import periodic_wvar
+
+    dt, amp, n = 0.01, 5.0, 2**16
+    y = amp * np.sin(2 * np.pi * freq_hz * np.arange(n) * dt + 0.7)
+    wv = haar_wvar(y, dt, levels=10)
+    law = periodic_wvar(_content([(freq_hz, amp)]), wv.tau_samples, dt)
+    env = periodic_wvar(_content([(freq_hz, amp)]), wv.tau_samples, dt, envelope=True)
+    # the estimator averages sin^2 over a finite record: exact to ~1/(number of cycles) of the envelope
+    np.testing.assert_allclose(wv.nu2_dph2, law, rtol=0, atol=float(np.max(env)) * 2e-3)
+    big = law > 0.05 * env
+    np.testing.assert_allclose(wv.nu2_dph2[big], law[big], rtol=5e-3)
+    assert np.all(wv.nu2_dph2 <= env * 1.002)
+
+
+def test_q_rule_is_one_threshold_for_both_fits():
+    from fogdrift.noise.periodic import Q_OVER_ENVELOPE, q_stands_above_lines
+
+    env = np.array([4.0, 1.0, 0.25])
+    assert q_stands_above_lines(env * Q_OVER_ENVELOPE * 1.001, env)[0]
+    ok, ratio = q_stands_above_lines(env * Q_OVER_ENVELOPE * 0.999, env)
+    assert not ok and ratio == pytest.approx(Q_OVER_ENVELOPE * 0.999)
+    assert q_stands_above_lines([1e-9, 1e-12], [1.0, 0.0]) == (True, float("inf"))  # no line reaches the 2nd tau

@@ -70,6 +70,7 @@ def print_gmwm(title, axes, quantities=None, details=False):
     excluded scale are one summary line per axis."""
     from ..gmwm.analysis import J_CAVEAT, b_detail_lines, ieee_rows
     from ..gmwm.quantity import accel_rows
+    from ..noise.periodic import Q_OVER_ENVELOPE
     from ..noise.quantity import restate_text
 
     quantities = quantities or {}
@@ -86,6 +87,11 @@ def print_gmwm(title, axes, quantities=None, details=False):
                                     for r in rows]))
         for line in b_detail_lines(a):
             say(f"  {a.name}: {restate_text(line, q)}")
+        if a.periodic is not None:
+            n_line = sum(x.line_share is not None for x in sel.excluded)
+            say(f"  {a.name}: spectrum: {restate_text(a.periodic.text(), q)}; not a latent process: "
+                f"{n_line} short scale{'s' if n_line != 1 else ''} it dominates excluded, QN claimed only "
+                f"{Q_OVER_ENVELOPE:g}x above its envelope", style="yellow")
         if a.allan_check is not None:
             for line in a.allan_check["lines"]:
                 say(f"  {a.name}: GMWM vs Allan fit: {line}",

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, DataFormatError
+from ..noise.periodic import PeriodicContent, periodic_content
 from ..noise.result import NoiseTerm
 from ..noise.terms import TERM_TABLE
 from ..units import rate_scale_to_dph
@@ -66,6 +67,9 @@ class GmwmAxis:
     #: The comparison with the Allan fit of the same record (:func:`fogdrift.gmwm.compare.compare_with_allan`),
     #: when one was made: ``{"agree": bool, "lines": [str, ...], ...}``.
     allan_check: dict | None = None
+    #: The spectral lines of the rate (:class:`fogdrift.noise.periodic.PeriodicContent`) the selection took into
+    #: account; None for a curve given as a table or a rate whose spectrum shows no line.
+    periodic: PeriodicContent | None = None
 
     def data_bounds(self) -> dict:
         """The bound the measured WV alone sets on N, Q and K (units of :data:`fogdrift.noise.TERM_UNITS`).
@@ -128,6 +132,7 @@ class GmwmAxis:
                 "passed_checks": bool(sel.passed_checks),
                 "b_headline_text": sel.ieee.b_headline.text(),
                 **({} if self.allan_check is None else {"allan_check": self.allan_check}),
+                "spectral_lines": [] if self.periodic is None else list(self.periodic.descriptions),
                 "j_statistic": {"q": float(sel.fit.j_stat), "df": int(sel.fit.df), "p_value": float(sel.fit.j_pvalue),
                                 "caveat": J_CAVEAT},
                 "wvar": self.wvar.to_dict(), "selection": sel.to_dict()}
@@ -162,15 +167,26 @@ def analyse_wvar(name, wvar: WvarResult, *, model="auto") -> GmwmAxis:
     return GmwmAxis(str(name), wvar, select_model(wvar, candidates_for(model)))
 
 
-def analyse_gmwm(name, rate_dph, dt_s, *, model="auto", levels=None, robust=False) -> GmwmAxis:
+def analyse_gmwm(name, rate_dph, dt_s, *, model="auto", levels=None, robust=False, spectrum="auto") -> GmwmAxis:
     """Haar WV of one rate series (deg/h at ``dt_s`` s) and the GMWM model selection on it.
 
     ``levels`` is the number of scales J (default ``floor(log2 N) - 1``); ``robust`` uses the Huber WV.
+
+    ``spectrum``: the :class:`~fogdrift.noise.spectral.SpectrumSummary` of this rate, ``"auto"`` (default: computed
+    here by :func:`~fogdrift.noise.spectral.analyse_spectrum`, the function the Allan fit uses) or None (no
+    spectrum).  Its lines (:func:`~fogdrift.noise.periodic.periodic_content`) go to
+    :func:`~fogdrift.gmwm.selection.select_model` as ``periodic``: the scales they dominate are excluded and QN is
+    claimed only above their envelope.
     """
     cands = candidates_for(model)  # a bad model string is refused before the WV is computed
-    wv = haar_wvar(np.asarray(rate_dph, dtype=np.float64), dt_s, levels=levels, robust=robust,
-                   axis_names=(str(name),))
-    return GmwmAxis(str(name), wv, select_model(wv, cands))
+    rate = np.asarray(rate_dph, dtype=np.float64)
+    if isinstance(spectrum, str) and spectrum == "auto":
+        from ..noise.spectral import analyse_spectrum
+
+        spectrum = analyse_spectrum(rate, dt_s)
+    content = periodic_content(spectrum)
+    wv = haar_wvar(rate, dt_s, levels=levels, robust=robust, axis_names=(str(name),))
+    return GmwmAxis(str(name), wv, select_model(wv, cands, periodic=content), periodic=content)
 
 
 def _open_text(path: Path):

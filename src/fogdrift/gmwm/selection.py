@@ -2,6 +2,14 @@
 
 Procedure (:func:`select_model`; [GMWM]_ §5):
 
+0. **Spectral lines** (``periodic``: the :class:`~fogdrift.noise.periodic.PeriodicContent` of the same rate,
+   from its spectrum): no latent process models a sinusoid, whose Haar WV falls as ``tau^-2`` above its period
+   exactly like QN's.  The leading scales up to the last one where the lines' WV
+   (:func:`~fogdrift.noise.periodic.periodic_wvar`) exceeds
+   :data:`~fogdrift.noise.periodic.LINE_SHARE_MAX` of the measured WV are excluded first (each reason names the
+   line by its frequency), and a candidate with QN fails a hard check unless its QN WV stands
+   :data:`~fogdrift.noise.periodic.Q_OVER_ENVELOPE` times above the lines' envelope at some used scale
+   (:func:`~fogdrift.noise.periodic.q_stands_above_lines`, the rule the Allan fit applies to Q too).
 1. **Short scales no candidate explains** (output low-pass filter, vibration, sample
    correlation of the electronics: the first octaves of the KVH DSP-1750 and LN-200
    curves) are detected, not hand-picked: starting from the first scale, every candidate
@@ -54,6 +62,7 @@ import numpy as np
 
 from ..errors import ConfigError, FogdriftWarning, InsufficientDataError
 from ..noise.rules import SLOPES, slope_claim
+from ..noise.periodic import LINE_SHARE_MAX, Q_OVER_ENVELOPE, line_name, periodic_wvar, q_stands_above_lines
 from .covariance import wvar_covariance
 from .estimator import GMWMFit, Whitener, _bounds, _check_wv, _finish, _model_V, _step1
 from .ieee import IEEEResult, to_ieee
@@ -63,6 +72,8 @@ __all__ = ["DEFAULT_CANDIDATES", "CandidateScore", "ExcludedScale", "SelectionRe
            "longest_run_pvalue"]
 
 _GM_PEAK = 3.785  # the WV of a GM peaks at scale ~3.785 T_c
+#: The words that open the hard reason of a QN candidate refused beside spectral lines (the fallback skips them).
+_LINES_REASON = "hard: quantization not told apart from the spectral lines"
 
 #: Default candidate set: WN with RW and one or two GMs, plus QN and drift variants.  FLICKER
 #: models (e.g. "WN+FLICKER+RW") can be passed explicitly; they are not in the default set
@@ -124,10 +135,13 @@ class ExcludedScale:
     level : int
     scale_s : float
     best_abs_z : float
-        The smallest max ``|z|`` over the first checked scales that any candidate reached.
+        The smallest max ``|z|`` over the first checked scales that any candidate reached (NaN for a scale
+        excluded for a spectral line: no candidate is fitted there).
     best_model : str
-        The candidate that came closest.
+        The candidate that came closest ("" for a spectral line).
     reason : str
+    line_share : float or None
+        For a scale excluded for spectral lines: the lines' WV over the measured WV there (a fraction); else None.
     """
 
     level: int
@@ -135,10 +149,15 @@ class ExcludedScale:
     best_abs_z: float
     best_model: str
     reason: str
+    line_share: float | None = None
 
     def to_dict(self) -> dict:
-        return {"level": int(self.level), "scale_s": float(self.scale_s), "best_abs_z": float(self.best_abs_z),
-                "best_model": self.best_model, "reason": self.reason}
+        z = float(self.best_abs_z)
+        d = {"level": int(self.level), "scale_s": float(self.scale_s), "best_abs_z": z if np.isfinite(z) else None,
+             "best_model": self.best_model, "reason": self.reason}
+        if self.line_share is not None:
+            d["line_share"] = float(self.line_share)
+        return d
 
 
 @dataclass(frozen=True)
@@ -255,14 +274,35 @@ def _longest_run(x) -> int:
     return best
 
 
+def _lines_reason(fit: GMWMFit, mdl: LatentModel, periodic) -> str | None:
+    """The hard reason of a candidate with QN whose QN WV does not stand above the lines' envelope at any used
+    scale (:func:`fogdrift.noise.periodic.q_stands_above_lines`); None when it does or there is no QN or line."""
+    if periodic is None or "QN" not in mdl.components:
+        return None
+    q_wv = fit.component_wv()[list(mdl.components).index("QN")]
+    env_each = periodic_wvar(periodic, fit.tau_samples, fit.dt_s, envelope=True, per_line=True)
+    above, ratio = q_stands_above_lines(q_wv, env_each.sum(axis=0))
+    if above:
+        return None
+    f_top = periodic.lines[int(np.argmax(env_each[:, 0]))][0]
+    return (f"{_LINES_REASON}: QN's WV is at most {ratio:.2g}x the envelope of the lines' WV (sin^4 replaced by 1) "
+            f"at the used scales {fit.scale_s[0]:.4g}-{fit.scale_s[-1]:.4g} s, not the {Q_OVER_ENVELOPE:g}x it must "
+            f"stand above it; the {line_name(periodic, f_top)} falls as tau^-2 like QN and its wandering amplitude "
+            "and frequency fill its nulls")
+
+
 def _checks(fit: GMWMFit, mdl: LatentModel, *, z_max, se_log_max, run_alpha, share_min, snr_min,
-            whiten, lo95=None, hi95=None) -> list[str]:
+            whiten, lo95=None, hi95=None, periodic=None) -> list[str]:
     """Why ``fit`` of candidate ``mdl`` is rejected ("hard: ..." / "soft: ..."; empty: it passes).
 
     ``lo95``/``hi95`` [(deg/h)^2]: the measured WV's 95 % interval at the fitted scales; with them a RW or DR
-    that fails the sustained-slope rule (:func:`fogdrift.noise.rules.slope_claim`) is a hard failure.
+    that fails the sustained-slope rule (:func:`fogdrift.noise.rules.slope_claim`) is a hard failure;
+    ``periodic``: the record's spectral lines, beside which a QN must stand above their envelope.
     """
     reasons = []
+    by_lines = _lines_reason(fit, mdl, periodic)
+    if by_lines:
+        reasons.append(by_lines)
     if fit.at_bound:
         reasons.append(f"hard: at a bound: {', '.join(param_label(n) for n in fit.at_bound)}")
     comp = fit.component_wv()
@@ -326,8 +366,37 @@ def _fit_step1_all(wv, models, idx, n_starts, prev=None):
     return out
 
 
+def _line_scales(wv, periodic, j_max) -> list:
+    """The leading scales left out for spectral lines: up to the last one where the lines' WV exceeds
+    :data:`~fogdrift.noise.periodic.LINE_SHARE_MAX` of the measured WV, at most ``j_max`` of them."""
+    if periodic is None:
+        return []
+    each = periodic_wvar(periodic, wv.tau_samples, wv.dt_s, per_line=True)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        share = each.sum(axis=0) / wv.nu2_dph2
+    over = np.flatnonzero(share > LINE_SHARE_MAX)
+    if over.size == 0:
+        return []
+    j_end = min(int(over[-1]) + 1, max(int(j_max), 0))
+    last = float(wv.scale_s[over[-1]])
+    out = []
+    for j in range(j_end):
+        name = line_name(periodic, periodic.lines[int(np.argmax(each[:, j]))][0])
+        if share[j] > LINE_SHARE_MAX:
+            why = (f"{name} dominates the wavelet variance here: the lines' WV is {100 * share[j]:.3g} % of the "
+                   f"measured WV (more than {100 * LINE_SHARE_MAX:g} %), and no latent process models a line")
+        else:
+            why = (f"{name} reaches the wavelet variance up to scale {last:.4g} s (more than "
+                   f"{100 * LINE_SHARE_MAX:g} % of the measured WV there; {100 * share[j]:.2g} % at this scale, "
+                   "near a null of the line's Haar gain): the scales below it are left out with it")
+        out.append(ExcludedScale(level=int(wv.level[j]), scale_s=float(wv.scale_s[j]), best_abs_z=float("nan"),
+                                 best_model="", reason=why, line_share=float(share[j])))
+    return out
+
+
 def select_model(wvar, candidates=None, *, exclude_short=True, max_excluded=None, n_check=3, z_max=3.0,
-                 se_log_max=1.0, run_alpha=0.01, share_min=0.01, snr_min=2.0, n_starts=4) -> SelectionResult:
+                 se_log_max=1.0, run_alpha=0.01, share_min=0.01, snr_min=2.0, n_starts=4,
+                 periodic=None) -> SelectionResult:
     """Choose a latent model by WIC with a common Omega, sanity checks and automatic short-scale exclusion.
 
     Parameters
@@ -355,6 +424,10 @@ def select_model(wvar, candidates=None, *, exclude_short=True, max_excluded=None
         scale (otherwise it only lives in the noise of the longest scales).
     n_starts : int
         Starting points per candidate (:func:`~fogdrift.gmwm.estimator.gmwm_fit`).
+    periodic : PeriodicContent, optional
+        Spectral lines of the same rate (:func:`fogdrift.noise.periodic.periodic_content` of its spectrum): the
+        leading scales they dominate are excluded and QN is claimed only above their envelope (step 0 of the
+        module docstring).  None: no lines.
 
     Returns
     -------
@@ -385,9 +458,14 @@ def select_model(wvar, candidates=None, *, exclude_short=True, max_excluded=None
     if J < p_min + 2:
         raise InsufficientDataError(f"{J} scales are too few for any candidate (need {p_min + 2})",
                                     needed=p_min + 2, got=J)
-    max_ex = J // 3 if max_excluded is None else int(max_excluded)
-    opts = dict(z_max=z_max, se_log_max=se_log_max, run_alpha=run_alpha, share_min=share_min, snr_min=snr_min)
-    j0, excluded, step1 = 0, [], None
+    # the scales the lines dominate go first, keeping enough for every candidate; the scan's own limit counts
+    # from there
+    excluded = _line_scales(wv, periodic, J - (p_max + 2))
+    n_lines = len(excluded)
+    max_ex = n_lines + (J // 3 if max_excluded is None else int(max_excluded))
+    opts = dict(z_max=z_max, se_log_max=se_log_max, run_alpha=run_alpha, share_min=share_min, snr_min=snr_min,
+                periodic=periodic)
+    j0, step1 = n_lines, None
     while True:
         j0, step1 = _scan(wv, models, j0, step1, excluded, exclude_short=exclude_short, max_ex=max_ex,
                           n_check=n_check, p_max=p_max, n_starts=n_starts, z_max=z_max, share_min=share_min)
@@ -411,8 +489,9 @@ def select_model(wvar, candidates=None, *, exclude_short=True, max_excluded=None
                                       best_model=chosen.model, reason=why))
         j0 += 1
     note = ""
-    if exclude_short and max_ex > 0 and j0 >= max_ex:
-        note = f"the exclusion scan stopped at its limit of {max_ex} excluded short scales"
+    if exclude_short and max_ex > n_lines and j0 >= max_ex:
+        note = f"the exclusion scan stopped at its limit of {max_ex - n_lines} excluded short scales" + (
+            f" beyond the {n_lines} the spectral lines dominate" if n_lines else "")
         if zfirst > z_max:
             note += (f"; the first kept scales are still not explained (max |z| = {zfirst:.3g}): read the result "
                      "with care")
@@ -495,7 +574,9 @@ def _choose(wv, models, idx, step1, opts):
         passed = [c for c in fitted if c.passed]
         if passed:
             return out, min(passed, key=lambda c: c.wic), True, src
-        pool = [c for c in fitted if not c.hard_failure] or fitted
+        # a candidate refused beside spectral lines is returned only when every candidate is (a QN model asked for)
+        pool = ([c for c in fitted if not c.hard_failure]
+                or [c for c in fitted if not any(r.startswith(_LINES_REASON) for r in c.reasons)] or fitted)
         return out, min(pool, key=lambda c: c.wic), False, src
 
     # pass 1: V of the pilot (smallest Q_1 + 2p under the common eta3 weights); then V of the

@@ -17,6 +17,7 @@ from scipy.stats import chi2
 
 from ..units import B_FACTOR
 from .engine import ScoreProblem, profile_interval
+from .periodic import Q_OVER_ENVELOPE, q_stands_above_lines
 from .result import NoiseTerm
 from .terms import ALL_TERMS, DISPLAY_UNITS, TERM_TABLE, markov_shape, periodic_shape
 
@@ -175,17 +176,20 @@ def _q_at_whole_periods(c: _Context, prob, best, A, d2, periodic, out_terms) -> 
     p_min = min(periodic.periods_s) if periodic is not None and periodic.periods_s else None
     if p_min is None:
         return
-    # a real line is no perfect sinusoid (its amplitude and frequency wander, which fills its nulls): a Q whose
-    # tau^-2 coefficient is no larger than the lines' own tau^-2 envelope (sum Omega_i^2 / (pi f_i)^2) is not told
-    # apart from them at any tau
-    env = A[iS] * sum(r / (math.pi * f) ** 2 for f, r in c.lines)
-    if A[iQ] <= env:
+    # a real line is no perfect sinusoid (its amplitude and frequency wander, which fills its nulls): a Q that does
+    # not stand clearly above the lines' envelope at some fitted tau is not told apart from them at any tau (the one
+    # rule of both noise fits, noise.periodic.q_stands_above_lines)
+    q_var = A[iQ] * c.laws["Q"].shape(c.tau, c.dt)
+    env = A[iS] * periodic_shape(c.tau, c.lines, c.dt, c.statistic, envelope=True)
+    above, ratio = q_stands_above_lines(q_var, env)
+    if not above:
         t = out_terms["Q"]
         out_terms["Q"] = NoiseTerm(
             "Q", t.value, t.unit, 0.0, t.hi95, "unresolved",
-            f"not told apart from the periodic error: its tau^-2 level is below the lines' own envelope "
-            f"(Omega0^2 / (pi f0)^2 over the lines, {math.sqrt(env / max(A[iQ], 1e-300)):.3g}x Q in deviation), and a "
-            "real line's wandering amplitude and frequency fill its nulls; notch the line to read Q")
+            f"not told apart from the periodic error: its variance is at most {ratio:.3g}x the lines' own envelope "
+            f"(each line's law with sin^4 replaced by 1) at the fitted taus, not the {Q_OVER_ENVELOPE:g}x it must "
+            "stand above it, and a real line's wandering amplitude and frequency fill its nulls; notch the line to "
+            "read Q")
         return
     k0 = int(np.searchsorted(c.tau, p_min * (1 - 1e-9)))
     if c.tau.size - k0 < len(best) + 1:

@@ -342,7 +342,7 @@ SHAPED_TERMS = MappingProxyType({
 ALL_TERMS = TERMS + tuple(SHAPED_TERMS)
 
 
-def sinusoid_shape(tau_s, freq_hz, dt_s, statistic="adev") -> np.ndarray:
+def sinusoid_shape(tau_s, freq_hz, dt_s, statistic="adev", *, envelope=False) -> np.ndarray:
     """Variance of a unit-amplitude sinusoid of ``freq_hz`` [Hz] at ``tau_s`` [s] (``A = Omega0^2`` multiplies it).
 
     Derived for sampled data: the ``m``-sample mean of ``sin(2 pi f t_k + phi)`` is a sinusoid of amplitude
@@ -357,15 +357,21 @@ def sinusoid_shape(tau_s, freq_hz, dt_s, statistic="adev") -> np.ndarray:
     ``(sin^2(pi f tau) / (pi f tau))^2``.  Zero at every multiple of the period.  Checked against exact
     discrete computations on noiseless sinusoids in ``tests/test_noise_periodic.py``.
 
+    ``envelope=True``: the same law with ``sin(pi f tau)`` replaced by 1 (``1 / (m sin(pi f dt))^2`` for ``adev``),
+    the upper envelope of the oscillating law: a real line's amplitude and frequency wander, which fills the nulls,
+    and its variance can reach the envelope at any ``tau``.
+
     Examples
     --------
     >>> float(sinusoid_shape(0.05, 20.0, 0.01)[()]) < 1e-30     # a whole period: the sinusoid cancels
     True
+    >>> round(float(sinusoid_shape(0.05, 20.0, 0.01, envelope=True)[()]), 4)   # 1 / (5 sin(0.2 pi))^2
+    0.1158
     """
     t = np.asarray(tau_s, dtype=np.float64)
     f, dt = float(freq_hz), float(dt_s)
     m = np.rint(t / dt)
-    s_tau = np.sin(np.pi * f * m * dt)
+    s_tau = np.ones(t.shape) if envelope else np.sin(np.pi * f * m * dt)
     den = m * np.sin(np.pi * f * dt)
     with np.errstate(divide="ignore", invalid="ignore"):
         if statistic == "adev":
@@ -380,18 +386,19 @@ def sinusoid_shape(tau_s, freq_hz, dt_s, statistic="adev") -> np.ndarray:
     return np.where(np.isfinite(out), out, 0.0)
 
 
-def periodic_shape(tau_s, lines, dt_s, statistic="adev") -> np.ndarray:
+def periodic_shape(tau_s, lines, dt_s, statistic="adev", *, envelope=False) -> np.ndarray:
     """Variance shape of a periodic error made of spectral lines ``[(freq_hz, relative_power), ...]``.
 
     The lines' powers relative to the first (the fundamental, ``relative_power`` 1) are fixed from the spectrum and
     one scale ``A = Omega0^2`` (the fundamental's squared amplitude [(deg/h)^2]) is fitted: the lines of one periodic
     error share its amplitude drift, the spectrum measures their ratios far better than the tau curve could, and one
-    parameter per component keeps the model selection from trading harmonics against Q.
+    parameter per component keeps the model selection from trading harmonics against Q.  ``envelope``: each line's
+    envelope instead of its law (:func:`sinusoid_shape`).
     """
     t = np.asarray(tau_s, dtype=np.float64)
     out = np.zeros(t.shape)
     for f, r in lines:
-        out = out + float(r) * sinusoid_shape(t, f, dt_s, statistic)
+        out = out + float(r) * sinusoid_shape(t, f, dt_s, statistic, envelope=envelope)
     return out
 
 
