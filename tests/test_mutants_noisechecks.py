@@ -240,7 +240,7 @@ def _q_terms():
     return {"Q": NoiseTerm("Q", 1.0, "urad", 0.5, 2.0, "estimated", "")}
 
 
-def test_q_below_the_lines_envelope_is_unresolved():
+def test_q_below_the_lines_envelope_is_not_claimed():
     """Lines (20 Hz, power 1) and (40 Hz, power 0.25), A_S = 2: the envelope is A_S sum r / (m sin(pi f dt))^2 (each
     line's law with sin^4 replaced by 1, noise.periodic.periodic_variance); Q's variance A_Q / tau^2 must stand
     Q_OVER_ENVELOPE (10) times above it at some fitted tau (the rule the GMWM applies to QN too)."""
@@ -261,7 +261,7 @@ def test_q_below_the_lines_envelope_is_unresolved():
     out = _q_terms()
     checks._q_at_whole_periods(c, None, (IQ, IS), A, 1.0, periodic, out)
     t = out["Q"]
-    assert t.status == "unresolved" and t.lo95 == 0.0 and t.value == 1.0 and t.hi95 == 2.0 and t.unit == "urad"
+    assert t.status == "absent" and t.lo95 == 0.0 and t.value is None and t.hi95 == 2.0 and t.unit == "urad"
     assert f"at most {Q_OVER_ENVELOPE * 0.999:.3g}x the lines' own envelope" in t.reason
     assert f"not the {Q_OVER_ENVELOPE:g}x it must stand above it" in t.reason
     # just above the threshold the envelope rule lets Q through (to the whole-period test, here short of taus)

@@ -183,10 +183,10 @@ def _q_at_whole_periods(c: _Context, prob, best, A, d2, periodic, out_terms) -> 
     env = A[iS] * periodic_shape(c.tau, c.lines, c.dt, c.statistic, envelope=True)
     above, ratio = q_stands_above_lines(q_var, env)
     if not above:
-        t = out_terms["Q"]
+        t = out_terms["Q"]  # not claimed at all (no value): beside a line, a Q below its envelope is no Q
         out_terms["Q"] = NoiseTerm(
-            "Q", t.value, t.unit, 0.0, t.hi95, "unresolved",
-            f"not told apart from the periodic error: its variance is at most {ratio:.3g}x the lines' own envelope "
+            "Q", None, t.unit, 0.0, t.hi95, "absent",
+            f"not claimed beside the periodic error: its variance is at most {ratio:.3g}x the lines' own envelope "
             f"(each line's law with sin^4 replaced by 1) at the fitted taus, not the {Q_OVER_ENVELOPE:g}x it must "
             "stand above it, and a real line's wandering amplitude and frequency fill its nulls; notch the line to "
             "read Q")

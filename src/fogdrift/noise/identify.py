@@ -33,6 +33,7 @@ quantization + white + random walk + ramp, the 95 % intervals cover the true coe
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -230,11 +231,33 @@ _CURVE = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}
 
 
 def _measured_limits(c: _Context, nu):
-    """The 95 % chi-squared interval ``[y nu / chi2_nu(0.975), y nu / chi2_nu(0.025)]`` of each point (EDF
-    ``nu``)."""
-    nu = np.maximum(np.asarray(nu, dtype=np.float64), 1e-3)
+    """The 95 % chi-squared interval ``[y nu / chi2_nu(0.975), y nu / chi2_nu(0.025)]`` of each point: with the
+    EDF of the measured curve's own interval (its ``var_hi95``), which the slope rule needs -- the model's EDF at
+    a long tau is that of the model being judged (a K model lends the long taus its own, wider, scatter) --
+    and the model's ``nu`` only where the curve brought no interval."""
+    nu = np.maximum(np.asarray(nu, dtype=np.float64), 1e-3).copy()
+    ratio = c.y_hi / c.y
+    for i, r in enumerate(ratio):
+        if np.isfinite(r) and 1.0 < r < 1e5:
+            nu[i] = _edf_from_upper(float(r))
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         return c.y * nu / chi2.ppf(0.975, nu), c.y * nu / chi2.ppf(0.025, nu)
+
+
+@functools.lru_cache(maxsize=4096)
+def _edf_from_upper(ratio: float) -> float:
+    """EDF ``nu`` of a chi-squared interval whose upper limit is ``ratio`` times the estimate
+    (``nu / chi2_nu(0.025) = ratio``; 0.2-1e7)."""
+    def f(lnu):
+        nu = math.exp(lnu)
+        return math.log(nu / chi2.ppf(0.025, nu)) - math.log(ratio)
+
+    lo, hi = math.log(0.2), math.log(1e7)
+    if f(hi) >= 0:
+        return 1e7
+    if f(lo) <= 0:
+        return 0.2
+    return math.exp(brentq(f, lo, hi, xtol=1e-6))
 
 
 def _slope_refusals(c: _Context, prob, res) -> dict:
@@ -529,11 +552,23 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     # selected model holds a ramp -- the ramp's real (much smaller) covariance, which gives the estimate.  A ramp
     # that really is a random walk in disguise keeps the wide interval; a real ramp gets an unbiased value.
     views = [(prob, res)]
-    if res[best]["a"][_NAMES.index("R")] > 0:
+    iR = _NAMES.index("R")
+    if res[best]["a"][iR] > 0:
         C_exact = c.relcov(res[best]["a"], exact_ramp=True)
-        prob = ScoreProblem(c.X, c.y, C_exact, c._upper(C_exact), _ALLOW)
-        res = {**res, **fit_subsets(prob, plaus, ic_penalty)}
-        views.append((prob, res))
+        p_exact = ScoreProblem(c.X, c.y, C_exact, c._upper(C_exact), _ALLOW)
+        r_exact = {**res, **fit_subsets(p_exact, plaus, ic_penalty)}
+        no_r = tuple(i for i in best if i != iR)
+        n_par_r = len(best) + (1 if _NAMES.index("M") in best else 0)
+        if (terms is None and r_exact[best]["q"] / max(1, c.tau.size - n_par_r) > POOR_CHI2_RED
+                and no_r in res and no_r in plaus):
+            # as a deterministic ramp (its real covariance) the model misses the curve, while the same curve
+            # without R is a plausible fit: the "ramp" was a random walk's long-tau scatter, not a ramp
+            best = no_r
+            plaus = [k for k in plaus if iR not in k] or [best]
+            ic_best = res[best]["ic"]
+        else:
+            prob, res = p_exact, r_exact
+            views.append((prob, res))
     A = res[best]["a"]
     q = res[best]["q"]
     n_par = len(best) + (1 if _NAMES.index("M") in best else 0)
@@ -620,7 +655,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     if terms is not None and "B" in laws and out_terms.get("B") is not None and out_terms["B"].value is not None:
         _check_floor(out_terms, c, A)  # a fixed model keeps its terms; a floor above the curve is still refused
     iQ, iS = _NAMES.index("Q"), _NAMES.index("S")
-    if iQ in best and iS in best and out_terms["Q"].status == "resolved":
+    if iQ in best and iS in best and out_terms["Q"].status in ("resolved", "unresolved"):
         _q_at_whole_periods(c, prob, best, A, d2, periodic, out_terms)
     if "S" in allowed:
         shaped["S"] = {"A": float(A[_NAMES.index("S")]), "lines": [list(x) for x in lines],
