@@ -569,6 +569,11 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         else:
             prob, res = p_exact, r_exact
             views.append((prob, res))
+    # a candidate refused only by the slope rule cannot be claimed, but the data do not exclude it: within the IC
+    # window it still keeps the *other* terms from being resolved when it does without them (a true K whose rise
+    # the record happens not to show must not turn into a resolved flicker floor)
+    alt = [k for k in refused if k in views[0][1] and not any(i in k for i in dropped)
+           and views[0][1][k]["ic"] <= ic_best + plausible_delta and k not in plaus] if terms is None else []
     A = res[best]["a"]
     q = res[best]["q"]
     n_par = len(best) + (1 if _NAMES.index("M") in best else 0)
@@ -614,10 +619,10 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             out_terms[name] = dropped[i]
             continue
         los, his, lacking = [], [], []
-        for mod in plaus:
+        for mod in plaus + alt:
             if i not in mod:
                 lacking.append(mod)
-            for v_prob, v_res in views:
+            for v_prob, v_res in (views if mod in plaus else views[:1]):
                 r = v_res[mod]
                 if i in mod:
                     lo, hi = profile_interval(v_prob, mod, r["a"], i, r["q"], d2)
