@@ -150,3 +150,43 @@ def test_analyze_noise_method_gmwm_end_to_end(bundled_path, tmp_path):
     result = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--models", "persistence",
                                  "--noise-method", "kalman", "--out", str(tmp_path / "bad")])
     assert result.exit_code == 1 and "--noise-method" in result.output
+
+
+def test_candidate_tables_are_behind_details(tmp_path):
+    """The default console is one table per axis and the verdict lines; --details adds the candidate table, J and
+    every excluded scale (white noise, 2^14 samples: a fast, passing fit)."""
+    x = np.random.default_rng(3).standard_normal(2**14)
+    path = tmp_path / "w.csv"
+    np.savetxt(path, np.c_[np.arange(x.size) * 0.01, x], delimiter=",", header="t_s,gz", comments="")
+    plain = _ok(runner.invoke(app, ["noise", str(path), "--unit", "deg/h", "--out", str(tmp_path / "a")]))
+    assert "why rejected" not in plain and "J = " not in plain and "--details lists the candidates" in plain
+    full = _ok(runner.invoke(app, ["noise", str(path), "--unit", "deg/h", "--out", str(tmp_path / "b"), "--details"]))
+    assert "why rejected" in full and "J = " in full and "--details lists" not in full
+    # the files are the same either way
+    a, b = (json.loads((tmp_path / d / "noise.json").read_text())["axes"][0]["selected"] for d in "ab")
+    assert a == b
+
+
+def test_gmwm_without_a_passing_candidate_prints_true_bounds_not_values():
+    """No candidate passes: the table holds no model value, only the bounds the measured WV itself sets, and they
+    hold the truth of a white-noise record with a slow oscillation no candidate describes."""
+    from fogdrift.gmwm.analysis import GmwmAxis, ieee_rows
+    from fogdrift.gmwm import haar_wvar, select_model
+    import warnings
+
+    dt, n_true = 0.01, 0.05  # deg/sqrt(h): white noise of sigma^2 = (60 N)^2 / dt per sample
+    x = np.random.default_rng(1).standard_normal(2**16) * 60.0 * n_true / np.sqrt(dt)
+    x = x + 30.0 * np.sin(np.arange(x.size) * 0.02)  # a slow oscillation (period 3.1 s): no candidate has it
+    wv = haar_wvar(x, dt)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sel = select_model(wv, ["WN", "QN+WN"])
+    ax = GmwmAxis("x", wv, sel)
+    assert not sel.passed_checks
+    rows = {r[0]: r for r in ieee_rows(ax)}
+    assert all(isinstance(r[1], str) and r[2] is None and r[3] is None for r in rows.values())
+    assert rows["B"][1] == "no result"
+    b = ax.data_bounds()
+    assert rows["N"][1] == f"< {b['N']:.4g}" and b["N"] >= n_true
+    terms = ax.ieee_terms()
+    assert terms["N"].status == "no_fit" and terms["N"].hi95 == b["N"]
