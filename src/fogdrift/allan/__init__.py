@@ -10,7 +10,9 @@ One job per module:
   bounds (:func:`chi2_bounds`);
 * :mod:`~fogdrift.allan.result` -- :class:`AllanResult`;
 * :mod:`~fogdrift.allan.core` -- the entry point :func:`allan_variance` (``statistic=`` picks
-  the operator, ``estimator=`` the sampling).
+  the operator, ``estimator=`` the sampling);
+* :mod:`~fogdrift.allan.segments` -- the Allan variance of gap-free segments pooled without
+  bridging a gap (:func:`allan_variance_segments`).
 
 Examples
 --------
@@ -26,11 +28,13 @@ from .ci import P68, chi2_bounds, edf_greenhall, edf_simple
 from .core import FAST_M0, IEEE952_ALPHAS, allan_variance
 from .grid import tau_grid
 from .result import AllanResult
+from .segments import allan_variance_segments
 from .statistics import ESTIMATORS, STATISTICS, Statistic, get_statistic
 
 __all__ = [
     "AllanResult",
     "allan_variance",
+    "allan_variance_segments",
     "tau_grid",
     "edf_simple",
     "edf_greenhall",
