@@ -68,7 +68,8 @@ def test_default_fit_close_to_r6_and_truth_within_3_se(r6):
     fit = gmwm_fit(r6, "WN+RW+GM")
     assert fit.steps >= 2 and fit.omega_source.startswith("model V")
     ref = np.array([1.0023653, 9.118716e-7, -math.log(0.99412666), 1.1670288e-4])
-    assert np.all(np.abs(np.log(fit.theta / ref)) < 0.3 * fit.se_z)  # normalisation differs (module doc)
+    # normalisation differs (module doc), and the model-discrepancy allowance in V re-weights the scales a little
+    assert np.all(np.abs(np.log(fit.theta / ref)) < 0.5 * fit.se_z)
     assert np.all(np.abs(fit.z - np.log(R6_TRUTH)) < 3 * fit.se_z)
     assert 0.0 < fit.j_pvalue < 1.0 and fit.df == 13
     # a perturbed start converges to the same optimum

@@ -596,11 +596,11 @@ def test_selection_excludes_a_scale_the_chosen_models_final_fit_does_not_explain
     wv = _filtered(2**14, 2)
     sel = select_model(wv, ["WN", "WN+RW"])
     _assert_selection_rules(sel, wv)
-    assert [e.level for e in sel.excluded] == [1, 2, 3] and sel.passed_checks
-    last = sel.excluded[2]
-    assert last.best_model == "WN+RW"
-    assert last.reason == (f"the selected model WN+RW leaves max |z| = {last.best_abs_z:.3g} > 3 over the first 3 "
-                           "scales from 0.08 s")
+    # the scan (sampling error alone) leaves out the two filtered octaves; the chosen model's final fit, judged with
+    # the model-discrepancy allowance, explains the first kept scales (before the allowance it also left out 0.08 s)
+    assert [e.level for e in sel.excluded] == [1, 2] and sel.passed_checks
+    assert all(e.reason.startswith("no candidate explains the scales from") for e in sel.excluded)
+    assert float(np.max(np.abs(sel.fit.z_resid[:3]))) <= 3.0
 
 
 def test_scan_checks_n_check_scales():

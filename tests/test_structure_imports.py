@@ -184,7 +184,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.cli.model": (CLI, ("fogdrift.bundle", "fogdrift.cli.separate", "fogdrift.evaluation",
         "fogdrift.pipeline", "fogdrift.report")),
     "fogdrift.cli.noise": (CLI, ("fogdrift.gmwm.analysis", "fogdrift.gmwm.compare",
-        "fogdrift.gmwm.quantity", "fogdrift.noise.quantity", "fogdrift.pipeline", "fogdrift.report",
+        "fogdrift.gmwm.quantity", "fogdrift.noise.periodic", "fogdrift.noise.quantity", "fogdrift.pipeline", "fogdrift.report",
         "fogdrift.report.gmwm")),
     "fogdrift.cli.separate": (CLI, ("fogdrift.pipeline", "fogdrift.report")),
     "fogdrift.fleet.commands": (BATCH, ("fogdrift.bundle", "fogdrift.evaluation", "fogdrift.evaluation.verdicts",

@@ -60,8 +60,8 @@ def allan(
             console.print(noise_table(f"{load.file.name}: {what}{estimator} {name}, 95 % intervals in brackets "
                                       "(– (< x): not in the selected model, x its upper bound; [0, x]: in the "
                                       "model but not resolved from zero; B: the IEEE reading min ADEV/0.664, < x "
-                                      "where the ADEV has no minimum; no model fits: ≈ slope read-outs and the "
-                                      "curve's own bounds)",
+                                      "where the ADEV has no minimum; no model fits: ≈ x a term's read-out along "
+                                      "its own slope, < x the curve's own bound)",
                                       [[a.name] + noise_row(a.noise) + [relabel_note(shaped_cell(a.noise), quantity),
                                                                         fit_cell(a.noise)]
                                        for a in group], fit=True, extra=("periodic / Markov",), quantity=quantity))

@@ -30,8 +30,10 @@ from ..errors import ConfigError, DataFormatError
 from ..noise.periodic import PeriodicContent, periodic_content
 from ..noise.result import NoiseTerm
 from ..noise.terms import TERM_TABLE
-from ..units import rate_scale_to_dph
+from ..noise.spectral import analyse_spectrum
+from ..units import URAD_PER_ARCSEC, rate_scale_to_dph
 from .processes import parse_model
+from .quantity import GMWM_ACCEL_UNITS
 from .selection import SelectionResult, select_model
 from .wvar import WvarResult, from_curve, haar_wvar
 
@@ -81,8 +83,6 @@ class GmwmAxis:
         to ~4 sigma, so the minimum over all the used scales still holds.  Needs no model: a true bound where no
         candidate passes its checks.
         """
-        from ..units import URAD_PER_ARCSEC
-
         wv, used = self.wvar, np.isin(self.wvar.level, self.selection.levels_used)
         nu = np.asarray(wv.nu2_dph2, dtype=np.float64)[used]
         hi = np.asarray(wv.ci_hi95_dph2, dtype=np.float64)[used]
@@ -119,7 +119,7 @@ class GmwmAxis:
             reason = {"absent": f"not in the selected GMWM model ({self.selection.selected})",
                       "unresolved": "its 95 % interval reaches 0", "resolved": ""}[status]
             out[name] = NoiseTerm(name, value, spec.unit, lo, hi, status, reason)
-        if not self.selection.passed_checks:  # no candidate passed its checks: nothing is a result
+        if self.selection.no_result:  # no candidate passed its checks: nothing is a result
             bounds = self.data_bounds()
             for name, t in out.items():
                 if t.status in ("resolved", "unresolved") or name in bounds:
@@ -129,7 +129,7 @@ class GmwmAxis:
     def to_dict(self) -> dict:
         sel = self.selection
         return {"name": self.name, "method": "gmwm", "selected": sel.selected,
-                "passed_checks": bool(sel.passed_checks),
+                "passed_checks": bool(sel.passed_checks), "no_result": bool(sel.no_result),
                 "b_headline_text": sel.ieee.b_headline.text(),
                 **({} if self.allan_check is None else {"allan_check": self.allan_check}),
                 "spectral_lines": [] if self.periodic is None else list(self.periodic.descriptions),
@@ -181,7 +181,6 @@ def analyse_gmwm(name, rate_dph, dt_s, *, model="auto", levels=None, robust=Fals
     cands = candidates_for(model)  # a bad model string is refused before the WV is computed
     rate = np.asarray(rate_dph, dtype=np.float64)
     if isinstance(spectrum, str) and spectrum == "auto":
-        from ..noise.spectral import analyse_spectrum
 
         spectrum = analyse_spectrum(rate, dt_s)
     content = periodic_content(spectrum)
@@ -339,9 +338,7 @@ def ieee_rows(axis: GmwmAxis) -> list[list]:
     """
     ie = axis.selection.ieee
     rows = []
-    if not axis.selection.passed_checks:  # the values of a model that failed its checks are no result
-        from .quantity import GMWM_ACCEL_UNITS
-
+    if axis.selection.no_result:  # the values of a model that failed its checks are no result
         bounds = axis.data_bounds()
         n = ie.terms.get("N_dprh")
         accel = n is not None and n.unit == GMWM_ACCEL_UNITS["N_dprh"][0]  # re-stated by express_gmwm
@@ -372,7 +369,7 @@ def b_detail_lines(axis: GmwmAxis) -> list[str]:
     """Lines under the IEEE table: why the headline B is a bound or nothing (when it is), then the B readings that
     are not the headline B (the GM hump's, the min-AVAR reading beside a flicker term), each labelled by its rule."""
     ie = axis.selection.ieee
-    if not axis.selection.passed_checks:
+    if axis.selection.no_result:
         return ["no result: no candidate passed its checks, so neither its terms nor its B readings are numbers to "
                 "sign; the table gives the bounds the measured WV itself sets (--details says why each failed)"]
     head = ie.b_headline

@@ -51,7 +51,7 @@ def _no_result_n_line(axis, fit):
     and whether the other side's value lies inside them."""
     sel = axis.selection
     a = (getattr(fit, "terms", None) or {}).get("N")
-    g_pass = getattr(sel, "passed_checks", True)
+    g_pass = not getattr(sel, "no_result", False)
     a_fit = getattr(a, "status", None) != "no_fit"
     gb = axis.data_bounds().get("N") if not g_pass else None
     g = sel.ieee.terms.get("N_dprh")
@@ -74,7 +74,7 @@ def _n_line(axis, fit) -> tuple:
     sel = axis.selection
     g = sel.ieee.terms.get("N_dprh")
     a = (getattr(fit, "terms", None) or {}).get("N")
-    if not getattr(sel, "passed_checks", True) or getattr(a, "status", None) == "no_fit":
+    if getattr(sel, "no_result", False) or getattr(a, "status", None) == "no_fit":
         return _no_result_n_line(axis, fit)
     a_val = getattr(a, "value", None)
     if g is None and a_val is None:
@@ -130,7 +130,7 @@ def _b_line(axis, fit) -> tuple:
     ie = axis.selection.ieee
     gb = ie.b_headline
     ab = getattr(fit, "b_min", None) or {}
-    if not getattr(axis.selection, "passed_checks", True):
+    if getattr(axis.selection, "no_result", False):
         a_txt = _allan_b_text(ab, getattr(fit, "tau_max_s", None), interval=True)
         return None, f"B: GMWM has no result (no candidate passed its checks); {a_txt}"
     tau_max = getattr(fit, "tau_max_s", None)
@@ -237,7 +237,7 @@ def _power_line(axis, fit, name) -> tuple:
     readings); ``(False, line)`` otherwise, with the numbers of both sides."""
     spec = TERM_TABLE[name]
     g = axis.selection.ieee.terms.get(name + spec.suffix)
-    if not getattr(axis.selection, "passed_checks", True):
+    if getattr(axis.selection, "no_result", False):
         g = None  # no candidate passed: the fallback's terms are no claim
     a = (getattr(fit, "terms", None) or {}).get(name)
     a_in = a is not None and a.value is not None and a.status in ("resolved", "unresolved")

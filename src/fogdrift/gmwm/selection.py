@@ -195,6 +195,12 @@ class SelectionResult:
     passed_checks: bool
     scan_note: str = ""
 
+    @property
+    def no_result(self) -> bool:
+        """True when the selection has no result to sign: no candidate passed its checks among several (a model the
+        user fixed alone keeps its values, with the warning that it failed)."""
+        return not self.passed_checks and len(self.candidates) > 1
+
     def candidate(self, model) -> CandidateScore:
         """The score of one candidate (by model string)."""
         name = parse_model(model).name

@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .terms import periodic_shape
+
 __all__ = ["PeriodicContent", "periodic_content", "null_taus", "periodic_variance", "periodic_wvar",
            "q_stands_above_lines", "line_name", "Q_OVER_ENVELOPE", "LINE_SHARE_MAX"]
 
@@ -169,8 +171,6 @@ def periodic_variance(content, tau_s, dt_s, statistic="adev", *, envelope=False,
     >>> round(float(periodic_variance(pc, 0.05, 0.01, envelope=True)[()]), 3)          # 64 / (5 sin(0.2 pi))^2
     7.41
     """
-    from .terms import periodic_shape
-
     lines, a2 = _lines_of(content)
     if per_line:
         return a2 * np.array([periodic_shape(tau_s, (ln,), float(dt_s), statistic, envelope=envelope) for ln in lines])

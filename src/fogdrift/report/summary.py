@@ -123,6 +123,7 @@ def _gmwm_headline(axes) -> tuple:
     for name in HEADLINE_TERMS:
         if name == "B":  # one B per axis, named by its rule; a bound or nothing beyond the scales used (gmwm.ieee)
             rows.append(["B bias instability [deg/h]"] + [
+                "no result (no candidate passed its checks)" if ax.gmwm.selection.no_result else
                 f"{ax.gmwm.selection.ieee.b_headline.text(3)}; {ax.gmwm.selection.ieee.b_headline.label}"
                 for ax in axes])
             continue
@@ -131,7 +132,7 @@ def _gmwm_headline(axes) -> tuple:
                                                    + ("checks passed" if ax.gmwm.selection.passed_checks
                                                       else "checks failed: see the axis section") + ")"
                                                    for ax in axes])
-    rows.append(["J test (q, dof, p)"] + [f"{_fmt(ax.gmwm.selection.fit.q, 3)}, {int(ax.gmwm.selection.fit.df)}, "
+    rows.append(["J test (J, dof, p)"] + [f"{_fmt(ax.gmwm.selection.fit.j_stat, 3)}, {int(ax.gmwm.selection.fit.df)}, "
                                            f"p = {ax.gmwm.selection.fit.j_pvalue:.2g}" for ax in axes])
     rows.append(["wavelet scales used [s]"] + [_scales_used(ax.gmwm) for ax in axes])
     rows.append(["cross-check: GMWM vs Allan fit"] + [" ".join(_allan_check(ax)["lines"]) for ax in axes])

@@ -31,7 +31,7 @@ def _fmt(x, digits=4) -> str:
 def term_text(term) -> str:
     """``value [lo95, hi95]`` for a term in the model; ``- (< hi95)`` for one that is not; ``n/e`` when the data
     cannot support a number (the reason is in the notes)."""
-    if term.value is None:
+    if term.value is None or term.status == "no_fit":  # a model that does not fit claims no value
         if term.status == "not_estimable":
             return "n/e" if term.hi95 is None else f"n/e (< {_fmt(term.hi95, 3)})"
         return "–" if term.hi95 is None else f"– (< {_fmt(term.hi95, 3)})"
