@@ -34,7 +34,9 @@ from typing import Callable
 
 import numpy as np
 
-from .allan import ESTIMATORS, STATISTICS
+from .allan import ESTIMATORS, STATISTICS, allan_variance
+from .allan.segments import allan_variance_segments
+from .screen import longest_segment
 from .allan.ci import periodic_alpha
 from .allan.grid import MAX_TAUS
 from .errors import ConfigError, FogdriftWarning, InsufficientDataError
@@ -311,7 +313,8 @@ def library_versions() -> dict:
 
 
 def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False,
-                  spectrum="auto", outliers=None, quantity="angular_rate", sums=None) -> AllanAxis:
+                  spectrum="auto", outliers=None, quantity="angular_rate", sums=None, segments=None,
+                  screen=None) -> AllanAxis:
     """Allan-family variance and noise identification of one 1-D rate series.
 
     The curve is computed on the configured grid (``cfg.taus``) for display; the noise fit always uses an octave
@@ -338,6 +341,9 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     """
     if check_outliers:
         rate_dph, outliers = treat_outliers(rate_dph, cfg.outliers)
+    if segments is not None:
+        return _analyse_segments(name, rate_dph, dt_s, cfg, segments, spectrum=spectrum, outliers=outliers,
+                                 quantity=quantity, screen=screen)
     if isinstance(spectrum, str) and spectrum == "auto":
         spectrum = analyse_spectrum(rate_dph, dt_s)
     content = periodic_content(spectrum)
@@ -376,7 +382,40 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
         noise = express_quantity(noise, quantity)
     if outliers is not None:  # a new, complete NoiseFit carrying the report (the fit's own object is not edited)
         noise = dataclasses.replace(noise, outliers=outliers.to_dict())
-    return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers)
+    return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers, screen=screen)
+
+
+def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, spectrum, outliers, quantity,
+                      screen) -> AllanAxis:
+    """The Allan analysis of the quiet ``segments`` of a disturbed record (``(start, stop)`` samples): the overlapping
+    Allan variance pooled over the segments without bridging a gap (:func:`fogdrift.allan.allan_variance_segments`;
+    other statistics and estimators: the longest segment alone), the spectrum of the longest segment, the noise
+    fit as for a whole record."""
+    segs = sorted((int(a), int(b)) for a, b in segments)
+    longest = max(segs, key=lambda s: s[1] - s[0])
+    if isinstance(spectrum, str) and spectrum == "auto":
+        spectrum = analyse_spectrum(rate_dph[longest[0]:longest[1]], dt_s)
+    content = periodic_content(spectrum)
+    if cfg.statistic == "adev" and cfg.estimator == "overlapping":
+        res = allan_variance_segments(rate_dph, dt_s, segs, taus=cfg.taus)
+        fit_curve = res if cfg.taus == "octave" else allan_variance_segments(rate_dph, dt_s, segs, taus="octave")
+        if content is not None:
+            t = np.asarray(fit_curve.tau_s, dtype=np.float64)
+            extra = null_taus(content.periods_s, dt_s, float(t[0]), float(t[-1]))
+            fit_curve = allan_variance_segments(rate_dph, dt_s, segs, taus=np.union1d(t, extra))
+    else:
+        part = np.asarray(rate_dph[longest[0]:longest[1]], dtype=np.float64)
+        res = allan_variance(part, dt_s, taus=cfg.taus, estimator=cfg.estimator, statistic=cfg.statistic)
+        fit_curve = res if cfg.taus == "octave" else allan_variance(part, dt_s, estimator=cfg.estimator,
+                                                                    statistic=cfg.statistic)
+    lo, hi = cfg.fit_tau_s
+    noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms),
+                      tau_range_s=None if lo is None and hi is None else (lo, hi), spectrum=spectrum, markov=True)
+    if quantity != "angular_rate":
+        noise = express_quantity(noise, quantity)
+    if outliers is not None:
+        noise = dataclasses.replace(noise, outliers=outliers.to_dict())
+    return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers, screen=screen)
 
 
 def _treated_record(record, cfg: AnalysisConfig):
@@ -457,7 +496,8 @@ def _check_earth_axes(record, cfg: AnalysisConfig) -> None:
 
 
 def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | None = None, *,
-              own_units: bool = True, sums: dict | None = None) -> list[AllanAxis]:
+              own_units: bool = True, sums: dict | None = None, segments: dict | None = None,
+              screens: dict | None = None) -> list[AllanAxis]:
     """Allan variance and noise identification of every axis of a record at its native rate.
 
     ``own_units`` (default True): each axis's fit in its quantity's term table (an accelerometer's velocity random
@@ -465,14 +505,18 @@ def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | No
     table's units of the internal unit (for a comparison with a reading made the same way, the GMWM's).
 
     ``sums``: axis name -> :class:`~fogdrift.pipeline_sums.AllanSums` already taken of that axis (the plausibility
-    check's, :func:`fogdrift.plausibility.check_record` ``sums=``), reused where they hold the analysed array."""
+    check's, :func:`fogdrift.plausibility.check_record` ``sums=``), reused where they hold the analysed array.
+
+    ``segments``: axis name -> ``[(start, stop), ...]`` quiet segments to fit instead of the whole record (None or a
+    missing name: the whole record); ``screens``: axis name -> the record screen's dict, kept on the result."""
     cfg = (cfg or AnalysisConfig()).validate()
     out = []
     for name in record.axis_names:
         checkpoint("Allan variance", axis=name)
         out.append(analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True,
                                  quantity=record.signal.channel(name).quantity if own_units else "angular_rate",
-                                 sums=(sums or {}).get(name)))
+                                 sums=(sums or {}).get(name), segments=(segments or {}).get(name),
+                                 screen=(screens or {}).get(name)))
     return out
 
 
@@ -647,7 +691,8 @@ def _table2(ma: ModelAxis, cfg: AnalysisConfig) -> list[CompensatedSignal]:
 def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | None = None, sha256: str | None = None,
                  apply_to=None, progress=None, fitted_from: "AnalysisResult | list | None" = None,
                  factor: int | None = None, apply_to_factor: int | None = None,
-                 sums: dict | None = None) -> AnalysisResult:
+                 sums: dict | None = None, segments: dict | None = None,
+                 screens: dict | None = None) -> AnalysisResult:
     """The whole method on one record (see the module docstring); ``apply_to`` is a second GyroRecord.
 
     ``progress(epoch, n_epochs, train_loss, val_loss)`` is passed to the neural models.
@@ -657,6 +702,8 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
     otherwise, once.  ``sums``: axis name -> :class:`~fogdrift.pipeline_sums.AllanSums` of ``record``'s axes
     already taken (the plausibility check's, :func:`fogdrift.plausibility.check_record` ``sums=``), reused by the
     native-rate Allan analysis where they hold the analysed array (not after outliers were clipped or replaced).
+    ``segments`` / ``screens``: axis name -> the quiet segments the native-rate noise fit uses and the record screen
+    (:func:`fogdrift.screen.plan_segments`; None: the whole record, no screen), as for :func:`run_allan`.
     """
     t_start = time.perf_counter()
     cfg = (cfg or AnalysisConfig()).validate()
@@ -667,14 +714,17 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
     axes = []
     for name in record.axis_names:
         checkpoint("Allan variance (native rate)", axis=name)
+        seg = (segments or {}).get(name)
         original = analyse_allan(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s, cfg,
-                                 outliers=outlier_reports[name], sums=(sums or {}).get(name))
+                                 outliers=outlier_reports[name], sums=(sums or {}).get(name), segments=seg,
+                                 screen=(screens or {}).get(name))
         gmwm = None
         if cfg.noise_method == "gmwm":
             checkpoint("GMWM noise model (native rate)", axis=name)
             from .gmwm.analysis import analyse_gmwm  # deferred: allan/separate/model never load GMWM (scipy.optimize)
 
-            gmwm = analyse_gmwm(name, np.asarray(record.axis(name), dtype=np.float64), record.dt_s)
+            gmwm = analyse_gmwm(name, longest_segment(np.asarray(record.axis(name), dtype=np.float64), seg),
+                                record.dt_s)
         checkpoint("separation", axis=name)
         rate, bias, earth = _prepared_axis(rec_m, name, cfg)
         sep = _separation_axis(name, rate, rec_m.dt_s, cfg)

@@ -36,10 +36,16 @@ class AllanAxis:
     allan: AllanResult
     noise: NoiseFit
     outliers: OutlierReport | None = None
+    #: The record screen of this axis (:meth:`fogdrift.screen.ScreenResult.to_dict` with the segments fitted), when
+    #: one was made.
+    screen: dict | None = None
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict(),
-                "outliers": None if self.outliers is None else self.outliers.to_dict()}
+        out = {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict(),
+               "outliers": None if self.outliers is None else self.outliers.to_dict()}
+        if self.screen is not None:
+            out["screen"] = self.screen
+        return out
 
 
 @dataclass

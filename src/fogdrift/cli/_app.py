@@ -129,6 +129,10 @@ TermsOpt = Annotated[str, typer.Option(
     "--terms", help="Fix the noise model, e.g. N,K (default: the terms are selected from the data).")]
 StatisticOpt = Annotated[str, typer.Option(
     "--statistic", help="adev (Allan), hdev (Hadamard: blind to a rate ramp) or mdev (modified Allan).")]
+SegmentsOpt = Annotated[str, typer.Option(
+    "--segments", help="What the noise fit uses: auto (default: the quiet segments where the record screen finds a "
+                       "disturbance, the whole record when it finds none), whole, or ranges in s such as "
+                       "'0:600,7000:' (pooled without bridging a gap).")]
 OutliersOpt = Annotated[str, typer.Option(
     "--outliers", help="Samples beyond 6 robust sigma: warn (default), clip (to 6 sigma) or replace (by the "
                        "local median).")]

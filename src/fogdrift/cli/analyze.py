@@ -10,7 +10,7 @@ import typer
 
 from ..errors import ConfigError
 from ._app import (gyro_only, EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutliersOpt, OutOpt,
-                   StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_model_rate, check_plausible, console,
+                   SegmentsOpt, StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_model_rate, check_plausible, console,
                    csv_list, echo_record, fitted_table, parse_fit_taus, parse_level, parse_taus, parse_terms,
                    progress, run, say, with_load_options)
 from ._spec import SpecOpt, print_judgements, read_spec_option
@@ -51,6 +51,7 @@ def analyze(
     terms: TermsOpt = "",
     statistic: StatisticOpt = "adev",
     outliers: OutliersOpt = "warn",
+    segments: SegmentsOpt = "auto",
     fit_taus: FitTausOpt = ":",
     train_fraction: Annotated[float, typer.Option("--train-fraction", help="Chronological training share.")] = 0.6,
     val_fraction: Annotated[float, typer.Option("--val-fraction", help="Validation share (early stopping).")] = 0.2,
@@ -131,9 +132,16 @@ def analyze(
             check_plausible(other)
         elif apply_unit or apply_time_unit:
             raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
+        from ..screen import plan_segments, segment_lines
+
+        # the record screen before any fit: what disturbs the record, where, and what the noise fit uses
+        segs, screens = plan_segments(record, segments)
+        for name in record.axis_names:
+            for line in segment_lines(name, screens[name]):
+                say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")
         with progress("analyze", record.axis_names) as (_, epoch_cb):
             result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb, factor=factor,
-                                  apply_to_factor=other_factor)
+                                  apply_to_factor=other_factor, segments=segs, screens=screens)
         evaluations = []
         if heading:  # compensation evidence on the held-out test block, stored in the result (fogdrift.evaluation)
             from ..evaluation import evaluated_analysis, evaluations as evaluations_of

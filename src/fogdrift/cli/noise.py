@@ -20,8 +20,8 @@ import typer
 
 from ..errors import ConfigError
 from ..spec import readings_from_gmwm
-from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run, say,
-                   with_load_options)
+from ._app import (JsonOpt, OutOpt, SegmentsOpt, app, check_plausible, console, echo_record, fitted_table, progress,
+                   run, say, with_load_options)
 from ._tables import noise_table, print_noise_notes
 # (the --spec helpers live in the light cli._spec; imported here under their old names too)
 from ._spec import SpecOpt, channel_kinds, print_spec_comparison, print_spec_for_allan, read_spec_option  # noqa: F401
@@ -131,6 +131,7 @@ def noise(
     spec: SpecOpt = None,
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
+    segments: SegmentsOpt = "auto",
     details: Annotated[bool, typer.Option("--details", help="Also print each axis's candidate table (WIC, why "
                                           "rejected), J and the reason for every excluded scale.")] = False,
 ):
@@ -154,7 +155,7 @@ def noise(
             if curve is not None or model.lower() != "auto" or scales is not None or robust:
                 raise ConfigError("--curve, --model, --scales and --robust belong to --method gmwm; the Allan "
                                   "fit selects its terms itself (use 'fogdrift allan --terms' to fix them)")
-            return _allan(load, r, limits, spec)
+            return _allan(load, r, limits, spec, segments)
         candidates_for(model)  # refuse a bad --model before reading anything
         if scales is not None and scales < 1:
             raise ConfigError(f"{{opt:scales}} must be >= 1; got {scales}")
@@ -183,10 +184,21 @@ def noise(
             # GMWM-vs-Allan lines reuses them instead of computing that pass again
             sums = {}
             check_plausible(record, sums=sums)
+            from ..screen import longest_segment, plan_segments, segment_lines
+
+            # the record screen comes before either fit; GMWM (one wavelet variance) fits the longest quiet
+            # segment of a disturbed axis, the Allan cross-check pools the quiet segments
+            segs, screens = plan_segments(record, segments)
+            for name in record.axis_names:
+                for line in segment_lines(name, screens[name]):
+                    if segs[name] and "pooled" in line:
+                        line += "; GMWM: the longest of them"
+                    say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")
             with progress("noise", record.axis_names):
-                axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=model, levels=scales, robust=robust)
+                axes = [analyse_gmwm(name, longest_segment(record.axis(name), segs[name]), record.dt_s, model=model,
+                                     levels=scales, robust=robust)
                         for name in record.axis_names]
-                attach_allan_checks(record, axes, sums=sums)
+                attach_allan_checks(record, axes, sums=sums, segments=segs, screens=screens)
             del sums
             from ..gmwm.quantity import express_gmwm
 
@@ -203,7 +215,7 @@ def noise(
         r.print_json(files["json"])
 
 
-def _allan(load, r, limits=None, spec_path=None):
+def _allan(load, r, limits=None, spec_path=None, segments="auto"):
     """--method allan: the Allan noise fit of every axis (as 'fogdrift allan'), written as noise.json/noise.png."""
     from ..pipeline import AnalysisConfig, run_allan
     from ..report import noise_row, plot_allan, write_json
@@ -211,8 +223,14 @@ def _allan(load, r, limits=None, spec_path=None):
     record = load.load()
     echo_record(load, record)
     check_plausible(record)
+    from ..screen import plan_segments, segment_lines
+
+    segs, screens = plan_segments(record, segments)
+    for name in record.axis_names:
+        for line in segment_lines(name, screens[name]):
+            say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")
     with progress("noise", record.axis_names) as (allan_cb, _):
-        results = run_allan(record, AnalysisConfig().validate(), progress=allan_cb)
+        results = run_allan(record, AnalysisConfig().validate(), progress=allan_cb, segments=segs, screens=screens)
     console.print(noise_table(f"{load.file.name}: Allan fit, 95 % intervals in brackets",
                               [[a.name] + noise_row(a.noise) for a in results]))
     for a in results:

@@ -126,10 +126,22 @@ def _allan_b_text(ab, tau_max, *, interval) -> str:
     return f"the Allan fit's B_min is {_g(a_val)}{iv} deg/h at τ = {_t(ab.get('tau_s'))} s"
 
 
+def _allan_b(fit) -> dict:
+    """The Allan fit's B reading in ``b_min``'s shape: ``b_min`` (the fitted ADEV's minimum), or -- when no model
+    fits -- the measured ADEV's minimum read-out, with no interval (the table shows the same)."""
+    if getattr(fit, "no_fit", None):
+        ro = (getattr(fit, "readouts", None) or {}).get("B")
+        if ro is not None and ro.value is not None:
+            return {"value": ro.value, "tau_s": ro.tau_s, "bound_only": False, "lo95": None, "hi95": None,
+                    "rule": "measured ADEV minimum / 0.664 (no model fits)"}
+        return {}
+    return getattr(fit, "b_min", None) or {}
+
+
 def _b_line(axis, fit) -> tuple:
     ie = axis.selection.ieee
     gb = ie.b_headline
-    ab = getattr(fit, "b_min", None) or {}
+    ab = _allan_b(fit)
     if getattr(axis.selection, "no_result", False):
         a_txt = _allan_b_text(ab, getattr(fit, "tau_max_s", None), interval=True)
         return None, f"B: GMWM has no result (no candidate passed its checks); {a_txt}"
@@ -168,7 +180,7 @@ def _hump_line(axis, fit):
     b = axis.selection.ieee.b_gm
     if b is None or b.value_dph is None:
         return None
-    ab = getattr(fit, "b_min", None) or {}
+    ab = _allan_b(fit)
     tail = _allan_b_text(ab, getattr(fit, "tau_max_s", None), interval=False)
     return (f"GMWM B {_g(b.value_dph, 4)} deg/h at τ = {_t(b.tau_s)} s is read from a GM hump ({b.label.split('(')[-1]}:"
             f" a detail, not a bias-instability floor; {tail}")
@@ -318,7 +330,7 @@ def _m_line(axis, fit) -> tuple:
                 + ("" if ok else " (no GM correlation time inside the Allan fit's T_c interval)"))
 
 
-def attach_allan_checks(record, axes, *, sums=None) -> list:
+def attach_allan_checks(record, axes, *, sums=None, segments=None, screens=None) -> list:
     """Set ``allan_check`` on each GMWM axis of a record: its comparison with the Allan fit of the same axis (the
     default fit of ``fogdrift allan``, :func:`fogdrift.pipeline.run_allan`).  Used by ``fogdrift noise`` and
     ``fogdrift batch --command noise`` alike; returns ``axes``.
@@ -329,7 +341,8 @@ def attach_allan_checks(record, axes, *, sums=None) -> list:
 
     try:
         # both readings in the units of the internal unit (the GMWM's are re-stated per quantity afterwards)
-        fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate(), own_units=False, sums=sums)}
+        fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate(), own_units=False, sums=sums,
+                                                   segments=segments, screens=screens)}
     except InsufficientDataError as exc:  # too short for the Allan fit: the GMWM result stands, and says so
         for a in axes:
             a.allan_check = {"agree": None, "n_agree": None, "b_agree": None,

@@ -88,7 +88,9 @@ def noise_headline(result) -> tuple:
     axes = list(result.axes)
     if axes and all(getattr(ax, "gmwm", None) is not None for ax in axes):
         return _gmwm_headline(axes)
-    headers = ["whole record, native rate (Allan fit)"] + [f"axis {ax.name}" for ax in axes]
+    cut = [ax.name for ax in axes if (getattr(ax.original, "screen", None) or {}).get("segments_used")]
+    headers = [("native rate (Allan fit); the quiet segments of " + ", ".join(cut) + " (see the screen)") if cut else
+               "whole record, native rate (Allan fit)"] + [f"axis {ax.name}" for ax in axes]
     fits = [ax.original.noise for ax in axes]
     cells = [dict(zip(TERMS, noise_row(f))) for f in fits]
     rows = []
