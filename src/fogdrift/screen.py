@@ -716,8 +716,11 @@ def plan_segments(record, mode="auto") -> tuple[dict, dict]:
     """
     chosen = parse_segments(mode, record.dt_s, record.n_samples) if isinstance(mode, str) else tuple(mode)
     segments, screens = {}, {}
+    # pieces down to 1 % of the record are pooled (the pooled Allan variance takes each at the taus it holds):
+    # a log with short shocks spread over it keeps most of its quiet samples
+    min_quiet_s = max(0.01 * record.n_samples, 100) * record.dt_s
     for name in record.axis_names:
-        r = screen_record(record.axis(name), record.dt_s)
+        r = screen_record(record.axis(name), record.dt_s, min_quiet_s=min_quiet_s)
         dropped = []
         if chosen == "auto":
             use, dropped = (None, []) if r.stationary or not r.quiet_segments else _homogeneous(r)
@@ -780,9 +783,10 @@ def segment_lines(name, screen) -> list[str]:
         what = ("the quiet segment" if len(used) == 1 else "the quiet segments") if screen["mode"] == "auto" else \
             "the segments"
         span = sum(b - a for a, b in used) * dt
-        out.append(f"{name}: the noise fit uses {what} " + ", ".join(f"{a * dt:g}-{b * dt:g} s" for a, b in used)
-                   + f" ({span:g} s of {n * dt:g} s" + (", pooled without bridging a gap" if len(used) > 1 else "")
-                   + "); --segments whole fits it all")
+        where = (", ".join(f"{a * dt:g}-{b * dt:g} s" for a, b in used) if len(used) <= MAX_LISTED else
+                 f"({len(used)} of them, from {used[0][0] * dt:g} s to {used[-1][1] * dt:g} s; each in the JSON)")
+        out.append(f"{name}: the noise fit uses {what} {where} ({span:g} s of {n * dt:g} s"
+                   + (", pooled without bridging a gap" if len(used) > 1 else "") + "); --segments whole fits it all")
     elif not screen["stationary"]:
         out.append(f"{name}: the noise fit uses the whole record (--segments {screen['mode']}); its figures include "
                    "the disturbance")
