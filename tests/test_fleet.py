@@ -63,7 +63,15 @@ def test_done_when_adis_batch_on_local_dask_cluster(tmp_path):
     res = runner.invoke(app, ["allan", files[0], "--unit", "deg/s", "--out", str(single)])
     assert res.exit_code == 0, res.output
     batch_doc = json.loads((out / "adis16405_imu1.csv.gz" / "allan.json").read_text())
-    assert batch_doc == json.loads((single / "allan.json").read_text())
+    single_doc = json.loads((single / "allan.json").read_text())
+    # the record screen's eigen-decompositions round in the last bit differently in a Dask worker's BLAS: its
+    # numbers agree to 1e-12, its decisions (intervals, segments) exactly
+    for a, b in zip(batch_doc["axes"], single_doc["axes"]):
+        sa, sb = a.pop("screen"), b.pop("screen")
+        assert {k: sa[k] for k in ("intervals", "quiet_segments", "segments_used", "stationary")} == \
+            {k: sb[k] for k in ("intervals", "quiet_segments", "segments_used", "stationary")}
+        assert np.allclose(sa["levels"], sb["levels"], rtol=1e-12) and sa["edf"] == pytest.approx(sb["edf"], rel=1e-12)
+    assert batch_doc == single_doc
     page = (out / "fleet.html").read_text()
     assert "<h1>fogdrift fleet: allan over 5 files</h1>" in page and "data:image/png;base64," in page
     assert not re.search(r"(src|href)=\"https?:", page)        # self-contained

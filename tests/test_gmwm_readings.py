@@ -162,7 +162,7 @@ def test_comparison_agrees_on_white_noise_and_names_a_disagreement():
 
 @needs_mtig
 def test_mtig_one_headline_b_and_an_agreement_or_reason_line(tmp_path):
-    out = _ok(runner.invoke(app, ["noise", str(MTIG), "--unit", "rad/s", "--out", str(tmp_path)],
+    out = _ok(runner.invoke(app, ["noise", str(MTIG), "--unit", "rad/s", "--segments", "whole", "--out", str(tmp_path)],
                             env={"COLUMNS": "300"}))  # one table, not folded: the rows are the question here
     b_rows = [ln for ln in out.splitlines() if ln.startswith("│ B ")]
     assert len(b_rows) == 1 and "< " in b_rows[0]  # the ADEV still falls at 655 s: a bound, no interval

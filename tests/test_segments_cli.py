@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 from fogdrift.cli import app
 from fogdrift.errors import ConfigError
-from fogdrift.screen import parse_segments
+from fogdrift.segments import parse_segments
 
 runner = CliRunner()
 ROMY = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "romy_teleseism_1hz" / "romy_teleseism_1hz.csv.gz"

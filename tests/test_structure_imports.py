@@ -168,7 +168,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift": (ROOT, ("fogdrift.errors",)),
     "fogdrift.cli": (CLI + "; main() takes SIGINT over before importing anything (cli/__init__ docstring)", (
         "fogdrift.cli._app", "fogdrift.interrupt")),
-    "fogdrift.cli._app": (CLI, ("fogdrift.pipeline",)),
+    "fogdrift.cli._app": (CLI, ("fogdrift.pipeline", "fogdrift.segments")),
     "fogdrift.cli._spec": (CLI, ("fogdrift.report",)),
     "fogdrift.cli._tables": (CLI, ("fogdrift.noise.terms", "fogdrift.report")),
     "fogdrift.cli.allan": (CLI, ("fogdrift.pipeline", "fogdrift.report")),
@@ -184,12 +184,12 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.cli.model": (CLI, ("fogdrift.bundle", "fogdrift.cli.separate", "fogdrift.evaluation",
         "fogdrift.pipeline", "fogdrift.report")),
     "fogdrift.cli.noise": (CLI, ("fogdrift.gmwm.analysis", "fogdrift.gmwm.compare",
-        "fogdrift.gmwm.quantity", "fogdrift.noise.periodic", "fogdrift.noise.quantity", "fogdrift.pipeline", "fogdrift.report",
+        "fogdrift.gmwm.quantity", "fogdrift.noise.periodic", "fogdrift.noise.quantity", "fogdrift.segments", "fogdrift.pipeline", "fogdrift.report",
         "fogdrift.report.gmwm")),
     "fogdrift.cli.separate": (CLI, ("fogdrift.pipeline", "fogdrift.report")),
     "fogdrift.fleet.commands": (BATCH, ("fogdrift.bundle", "fogdrift.evaluation", "fogdrift.evaluation.verdicts",
         "fogdrift.gmwm.analysis", "fogdrift.gmwm.compare", "fogdrift.pipeline", "fogdrift.report",
-        "fogdrift.report.gmwm", "fogdrift.compensate.holdout")),
+        "fogdrift.report.gmwm", "fogdrift.compensate.holdout", "fogdrift.segments")),
     "fogdrift.fleet.runner": (BATCH, ("fogdrift.fleet.page", "fogdrift.gmwm.analysis", "fogdrift.pipeline")),
     "fogdrift.io.chunked": ("optional readers: the binary/HDF5 readers and the registry load only for the format opened", (
         "fogdrift.io.readers.binary", "fogdrift.io.registry")),

@@ -36,7 +36,7 @@ import numpy as np
 
 from .allan import ESTIMATORS, STATISTICS, allan_variance
 from .allan.segments import allan_variance_segments
-from .screen import longest_segment
+from .segments import longest_segment
 from .allan.ci import periodic_alpha
 from .allan.grid import MAX_TAUS
 from .errors import ConfigError, FogdriftWarning, InsufficientDataError
@@ -343,7 +343,7 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
         rate_dph, outliers = treat_outliers(rate_dph, cfg.outliers)
     if segments is not None:
         return _analyse_segments(name, rate_dph, dt_s, cfg, segments, spectrum=spectrum, outliers=outliers,
-                                 quantity=quantity, screen=screen)
+                                 quantity=quantity, screen=screen, progress=progress)
     if isinstance(spectrum, str) and spectrum == "auto":
         spectrum = analyse_spectrum(rate_dph, dt_s)
     content = periodic_content(spectrum)
@@ -386,7 +386,7 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
 
 
 def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, spectrum, outliers, quantity,
-                      screen) -> AllanAxis:
+                      screen, progress=None) -> AllanAxis:
     """The Allan analysis of the quiet ``segments`` of a disturbed record (``(start, stop)`` samples): the overlapping
     Allan variance pooled over the segments without bridging a gap (:func:`fogdrift.allan.allan_variance_segments`;
     other statistics and estimators: the longest segment alone), the spectrum of the longest segment, the noise
@@ -408,6 +408,8 @@ def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, sp
         res = allan_variance(part, dt_s, taus=cfg.taus, estimator=cfg.estimator, statistic=cfg.statistic)
         fit_curve = res if cfg.taus == "octave" else allan_variance(part, dt_s, estimator=cfg.estimator,
                                                                     statistic=cfg.statistic)
+    if progress is not None:  # the pooled sums are one step: its taus done at once
+        progress(len(res.tau_s), len(res.tau_s))
     lo, hi = cfg.fit_tau_s
     noise = fit_noise(fit_curve, terms=None if cfg.terms is None else tuple(cfg.terms),
                       tau_range_s=None if lo is None and hi is None else (lo, hi), spectrum=spectrum, markov=True)

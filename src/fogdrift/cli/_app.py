@@ -771,3 +771,18 @@ def fitted_table(title, headers, rows) -> Group:
 def print_table(title, headers, rows) -> None:
     """Print :func:`fitted_table` on stdout (nothing under --json)."""
     console.print(fitted_table(title, headers, rows))
+
+
+def screen_record_axes(record, segments, gmwm=False):
+    """The record screen of every axis, printed before any fit (what disturbs it, where, what the fit uses), and
+    the segment plan (:func:`fogdrift.segments.plan_segments`); ``gmwm``: say that GMWM fits the longest segment.
+    Returns ``(segments, screens)`` by axis name."""
+    from ..segments import plan_segments, segment_lines
+
+    segs, screens = plan_segments(record, segments)
+    for name in record.axis_names:
+        for line in segment_lines(name, screens[name]):
+            if gmwm and segs[name] and line.endswith("fits it all") and len(segs[name]) > 1:
+                line += "; GMWM: the longest of them"
+            say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")
+    return segs, screens

@@ -8,7 +8,7 @@ from ..plausibility import check_record
 from ..temperature import summary_line
 from ._app import (FLAGS, EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, SegmentsOpt, StatisticOpt, TausOpt,
                    TermsOpt, app, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, progress,
-                   run, say, warn, with_load_options)
+                   run, screen_record_axes, warn, with_load_options)
 from ._tables import noise_table, print_noise_notes, relabel_note
 from ._spec import SpecOpt, print_spec_for_allan, read_spec_option
 
@@ -49,13 +49,7 @@ def allan(
         sums = {}
         for finding in check_record(record, sums=sums):
             warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
-        from ..screen import plan_segments, segment_lines
-
-        # the record screen comes before any fit: what disturbs it, where, and which samples the fit uses
-        segs, screens = plan_segments(record, segments)
-        for name in record.axis_names:
-            for line in segment_lines(name, screens[name]):
-                say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")
+        segs, screens = screen_record_axes(record, segments)  # the record screen comes before any fit
         with progress("allan", record.axis_names) as (allan_cb, _):
             results = run_allan(record, cfg, progress=allan_cb, sums=sums, segments=segs, screens=screens)
         del sums

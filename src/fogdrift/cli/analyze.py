@@ -12,7 +12,7 @@ from ..errors import ConfigError
 from ._app import (gyro_only, EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutliersOpt, OutOpt,
                    SegmentsOpt, StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_model_rate, check_plausible, console,
                    csv_list, echo_record, fitted_table, parse_fit_taus, parse_level, parse_taus, parse_terms,
-                   progress, run, say, with_load_options)
+                   progress, run, say, screen_record_axes, with_load_options)
 from ._spec import SpecOpt, print_judgements, read_spec_option
 from ._tables import metrics_table, noise_table
 from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt, model_axes_text
@@ -132,13 +132,7 @@ def analyze(
             check_plausible(other)
         elif apply_unit or apply_time_unit:
             raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
-        from ..screen import plan_segments, segment_lines
-
-        # the record screen before any fit: what disturbs the record, where, and what the noise fit uses
-        segs, screens = plan_segments(record, segments)
-        for name in record.axis_names:
-            for line in segment_lines(name, screens[name]):
-                say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")
+        segs, screens = screen_record_axes(record, segments)  # the record screen comes before any fit
         with progress("analyze", record.axis_names) as (_, epoch_cb):
             result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb, factor=factor,
                                   apply_to_factor=other_factor, segments=segs, screens=screens)

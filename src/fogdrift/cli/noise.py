@@ -21,7 +21,7 @@ import typer
 from ..errors import ConfigError
 from ..spec import readings_from_gmwm
 from ._app import (JsonOpt, OutOpt, SegmentsOpt, app, check_plausible, console, echo_record, fitted_table, progress,
-                   run, say, with_load_options)
+                   run, say, screen_record_axes, with_load_options)
 from ._tables import noise_table, print_noise_notes
 # (the --spec helpers live in the light cli._spec; imported here under their old names too)
 from ._spec import SpecOpt, channel_kinds, print_spec_comparison, print_spec_for_allan, read_spec_option  # noqa: F401
@@ -184,16 +184,11 @@ def noise(
             # GMWM-vs-Allan lines reuses them instead of computing that pass again
             sums = {}
             check_plausible(record, sums=sums)
-            from ..screen import longest_segment, plan_segments, segment_lines
+            from ..segments import longest_segment
 
             # the record screen comes before either fit; GMWM (one wavelet variance) fits the longest quiet
             # segment of a disturbed axis, the Allan cross-check pools the quiet segments
-            segs, screens = plan_segments(record, segments)
-            for name in record.axis_names:
-                for line in segment_lines(name, screens[name]):
-                    if segs[name] and "pooled" in line:
-                        line += "; GMWM: the longest of them"
-                    say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")
+            segs, screens = screen_record_axes(record, segments, gmwm=True)
             with progress("noise", record.axis_names):
                 axes = [analyse_gmwm(name, longest_segment(record.axis(name), segs[name]), record.dt_s, model=model,
                                      levels=scales, robust=robust)
@@ -223,12 +218,7 @@ def _allan(load, r, limits=None, spec_path=None, segments="auto"):
     record = load.load()
     echo_record(load, record)
     check_plausible(record)
-    from ..screen import plan_segments, segment_lines
-
-    segs, screens = plan_segments(record, segments)
-    for name in record.axis_names:
-        for line in segment_lines(name, screens[name]):
-            say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")
+    segs, screens = screen_record_axes(record, segments)
     with progress("noise", record.axis_names) as (allan_cb, _):
         results = run_allan(record, AnalysisConfig().validate(), progress=allan_cb, segments=segs, screens=screens)
     console.print(noise_table(f"{load.file.name}: Allan fit, 95 % intervals in brackets",

@@ -182,8 +182,11 @@ def run_allan_command(record, settings: dict, out_dir) -> list[dict]:
     from ..pipeline import run_allan
     from ..report import write_allan_outputs
 
+    from ..segments import plan_segments
+
     limits = spec_from_settings(settings)
-    results = run_allan(record, _config(settings))
+    segs, screens = plan_segments(record, settings.get("segments", "auto"))  # as the command: screen, then fit
+    results = run_allan(record, _config(settings), segments=segs, screens=screens)
     write_allan_outputs(results, record, out_dir)
     return [{"axis": a.name, **record_columns(record), **noise_columns(a.noise),
              **_spec_allan(limits, record, a.name, a.noise)} for a in results]
@@ -200,9 +203,12 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
     from ..evaluation.verdicts import paper_measure_verdict
     from ..report import write_report
 
+    from ..segments import plan_segments
+
     cfg = _config(settings)
     limits = spec_from_settings(settings)
-    result = run_analysis(record, cfg)
+    segs, screens = plan_segments(record, settings.get("segments", "auto"))
+    result = run_analysis(record, cfg, segments=segs, screens=screens)
     result = evaluated_analysis(result)
     evaluations = {ax.name: ax.evaluation for ax in result.axes}
     spec_doc, spec_cols = None, {}
@@ -241,12 +247,17 @@ def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
     from ..gmwm.compare import attach_allan_checks, express_gmwm
     from ..report.gmwm import write_gmwm_outputs
 
+    from ..segments import longest_segment, plan_segments
+
     opts = settings.get("gmwm", {})
     limits = spec_from_settings(settings)
-    axes = [analyse_gmwm(name, record.axis(name), record.dt_s, model=opts.get("model", "auto"),
-                         levels=opts.get("levels"), robust=bool(opts.get("robust", False)))
+    segs, screens = plan_segments(record, settings.get("segments", "auto"))
+    axes = [analyse_gmwm(name, longest_segment(record.axis(name), segs[name]), record.dt_s,
+                         model=opts.get("model", "auto"), levels=opts.get("levels"),
+                         robust=bool(opts.get("robust", False)))
             for name in record.axis_names]
-    attach_allan_checks(record, axes)  # as 'fogdrift noise': N and B against the Allan fit, in noise.json
+    # as 'fogdrift noise': N and B against the Allan fit, in noise.json
+    attach_allan_checks(record, axes, segments=segs, screens=screens)
     # an accelerometer axis's reading in its units (B stays m/s^2 here; the batch row shows it in ug)
     axes = [express_gmwm(a, record.signal.channel(a.name).quantity) for a in axes]
     write_gmwm_outputs(axes, out_dir, source=str(record.source), record=record.metadata())
