@@ -28,7 +28,9 @@ def test_python_m_help():
 
 
 def test_allan_on_bundled_recording(bundled_path, tmp_path):
-    out = _ok(runner.invoke(app, ["allan", str(bundled_path), "--unit", "deg/h", "--out", str(tmp_path)]))
+    # the whole record (the default fits the quiet segments the screen finds: tests/test_segments_cli.py)
+    out = _ok(runner.invoke(app, ["allan", str(bundled_path), "--unit", "deg/h", "--segments", "whole", "--out",
+                                  str(tmp_path)]))
     for unit in ("µrad", "deg/√h", "deg/h^1.5", "deg/h²"):
         assert unit in out
     for axis in ("gx", "gy", "gz"):

@@ -35,7 +35,8 @@ def _csv(path):
 
 def test_noise_gmwm_on_the_bundled_rlg(bundled_path, bundled_record, tmp_path):
     allantools = pytest.importorskip("allantools")
-    _ok(runner.invoke(app, ["noise", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--out", str(tmp_path)]))
+    _ok(runner.invoke(app, ["noise", str(bundled_path), "--unit", "deg/h", "--columns", "gz", "--segments", "whole",
+                            "--out", str(tmp_path)]))  # the whole record, so the WV is that of the whole gz
     assert {p.name for p in tmp_path.iterdir()} >= {"noise.json", "wvar.csv", "noise.png"}
     doc = json.loads((tmp_path / "noise.json").read_text())
     assert doc["method"] == "gmwm" and doc["units"]["wvar"] == "(deg/h)^2"

@@ -71,11 +71,10 @@ def _readout(noise, name):
 
 
 def _no_fit_cell(noise, name, t) -> str:
-    bound = "–" if t.hi95 is None else f"< {_fmt(t.hi95, 3)}"
     ro = _readout(noise, name)
     if ro is None:
-        return "–" if t.hi95 is None else f"– ({bound})"
-    return f"≈ {_fmt(ro.value, 4)} read-out ({bound})"
+        return "–" if t.hi95 is None else f"– (< {_fmt(t.hi95, 3)})"
+    return f"≈ {_fmt(ro.value, 4)} read-out" + ("" if t.hi95 is None else f" (< {_fmt(t.hi95, 4)})")
 
 
 def b_headline(noise) -> str:
@@ -204,8 +203,8 @@ def noise_notes(noise) -> list[str]:
                    "headline B is the IEEE reading min ADEV / 0.664")
     ros = [ro for n in TERMS if (ro := _readout(noise, n)) is not None]
     if getattr(noise, "no_fit", None) and ros:
-        out.append("no model fits, so the table shows IEEE-952 slope read-outs (not a model) where a term's own "
-                   "slope holds over at least an octave: " + "; ".join(ro.text() for ro in ros))
+        out.append("no model fits: the table's ≈ values are IEEE-952 read-outs along a term's own slope, held over "
+                   "at least an octave (not a model): " + "; ".join(ro.text() for ro in ros))
     for t in noise.terms.values():
         if t.reason and t.status not in ("resolved", "no_fit"):
             out.append(f"{t.name}: {t.reason}")
