@@ -76,3 +76,30 @@ def test_romy_quiet_part_agrees_with_the_pre_event_segment_and_the_event_gives_n
         assert all(lo(x) <= y["hi95"] for x in v for y in b)
     tight = whole["status"] == "resolved" and (whole["hi95"] - whole["lo95"]) < 0.1 * whole["value"]
     assert not tight, whole
+
+
+def test_dynamic_adev_of_a_disturbed_record_is_in_the_json_and_drawn(tmp_path):
+    """A white record with a burst of 8x its level: the axis's screen holds the dynamic ADEV (windows of 1/8 of the
+    record, a quarter-window step: 29 windows), its first row is the overlapping ADEV of the first window
+    (independent: allan_variance on that slice), and allan_dynamic.png is written; a stationary record gets none."""
+    from fogdrift.allan import allan_variance
+
+    rng = np.random.default_rng(5)
+    x = rng.standard_normal(2**15)
+    x[20000:23000] *= 8.0
+    path = tmp_path / "b.csv"
+    np.savetxt(path, np.c_[np.arange(x.size) * 0.01, x], delimiter=",", header="t_s,gz", comments="", fmt="%.9g")
+    _ok(runner.invoke(app, ["allan", str(path), "--unit", "deg/h", "--out", str(tmp_path / "o")]))
+    scr = json.loads((tmp_path / "o" / "allan.json").read_text())["axes"][0]["screen"]
+    d = scr["dynamic_adev"]
+    assert not scr["stationary"] and len(d["t_s"]) == 29 and d["window_s"] == pytest.approx(x.size * 0.01 / 8)
+    first = np.loadtxt(path, delimiter=",", skiprows=1)[: x.size // 8, 1]
+    ref = allan_variance(first, 0.01, taus=np.asarray(d["tau_s"]))
+    assert np.allclose(d["adev"][0], ref.dev_dph, rtol=1e-9)
+    png = tmp_path / "o" / "allan_dynamic.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    quiet = tmp_path / "q.csv"
+    np.savetxt(quiet, np.c_[np.arange(x.size) * 0.01, rng.standard_normal(x.size)], delimiter=",",
+               header="t_s,gz", comments="", fmt="%.9g")
+    _ok(runner.invoke(app, ["allan", str(quiet), "--unit", "deg/h", "--out", str(tmp_path / "s")]))
+    assert not (tmp_path / "s" / "allan_dynamic.png").exists()

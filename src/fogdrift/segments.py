@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .errors import ConfigError
-from .screen import ScreenResult, screen_record
+from .screen import ScreenResult, dynamic_adev, screen_record
 
 __all__ = ["SEGMENT_MODES", "parse_segments", "plan_segments", "segment_lines", "longest_segment", "MAX_LISTED"]
 
@@ -85,7 +85,26 @@ def plan_segments(record, mode="auto") -> tuple[dict, dict]:
         screens[name] = {**r.to_dict(), "mode": chosen if isinstance(chosen, str) else "ranges",
                          "segments_used": None if use is None else [[int(a), int(b)] for a, b in use],
                          "segments_dropped": dropped, "text": r.text()}
+        if not r.stationary:
+            screens[name]["dynamic_adev"] = record_dynamic_adev(record.axis(name), record.dt_s)
     return segments, screens
+
+
+#: The dynamic ADEV of a disturbed axis: windows of 1/8 of the record, a quarter-window step, octave taus up to a
+#: quarter of the window.
+DYNAMIC_WINDOWS = 8
+
+
+def record_dynamic_adev(rate, dt_s) -> dict:
+    """The dynamic Allan deviation of a whole record on the default grid (:func:`fogdrift.screen.dynamic_adev`), as
+    JSON-able lists: ``t_s`` (window centres [s]), ``tau_s`` [s], ``adev`` (windows x taus, in the rate's unit)."""
+    n = len(rate)
+    window_s = n * dt_s / DYNAMIC_WINDOWS
+    m_max = max(1, int(window_s / dt_s / 4))
+    taus = dt_s * 2.0 ** np.arange(0, int(math.log2(m_max)) + 1)
+    t, tau, adev = dynamic_adev(rate, dt_s, window_s, window_s / 4.0, taus)
+    return {"t_s": [float(v) for v in t], "tau_s": [float(v) for v in tau],
+            "adev": [[float(v) for v in row] for row in np.asarray(adev)], "window_s": float(window_s)}
 
 
 def _homogeneous(r: ScreenResult) -> tuple:

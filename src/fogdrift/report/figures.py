@@ -465,3 +465,31 @@ def plot_residuals(model_axis, path, fig_no=9) -> Path:
                          "y scales differ between panels; grey: not scored"))
     _place(fig)
     return _save(fig, path)
+
+
+@_styled
+def plot_dynamic_adev(allan_axes, path) -> Path | None:
+    """The dynamic Allan deviation of each disturbed axis (its screen's ``dynamic_adev``: ADEV over sliding windows)
+    as an image over time x tau, the disturbed intervals marked above it; None when no axis has one."""
+    shown = [a for a in allan_axes if (getattr(a, "screen", None) or {}).get("dynamic_adev")]
+    if not shown:
+        return None
+    plt = _plt()
+    fig, axs = plt.subplots(len(shown), 1, figsize=(FIG_WIDTH_IN, 3.4 * len(shown) + 0.6), squeeze=False)
+    for ax, a in zip(axs[:, 0], shown):
+        d = a.screen["dynamic_adev"]
+        t, tau, adev = np.asarray(d["t_s"]), np.asarray(d["tau_s"]), np.asarray(d["adev"], dtype=np.float64)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            img = np.log10(np.where(adev > 0, adev, np.nan))
+        mesh = ax.pcolormesh(t, tau, img.T, shading="nearest", cmap="viridis")
+        ax.set_yscale("log")
+        ax.set_xlabel("window centre t [s]")
+        ax.set_ylabel("τ [s]")
+        unit = "m/s²" if getattr(a.noise, "quantity", "angular_rate") == "specific_force" else "deg/h"
+        fig.colorbar(mesh, ax=ax, label=f"log10 ADEV [{unit}]")
+        for iv in a.screen.get("intervals") or ():
+            ax.axvspan(iv["start_s"], iv["end_s"], ymin=0.96, ymax=1.0, color="red", lw=0)
+        ax.set_title(literal(f"{a.name}: dynamic ADEV (windows of {d['window_s']:.4g} s); red: disturbed intervals"))
+    _place(fig)
+    fig.subplots_adjust(hspace=0.55)  # each panel's title clear of the time ticks above it
+    return _save(fig, path)

@@ -9,7 +9,7 @@ import numpy as np
 from .._util import strict_json
 from ..noise import TERM_TABLE
 from ..output import atomic_path
-from .figures import _safe, plot_allan, plot_models, plot_residuals, plot_separation, plot_separation_allan
+from .figures import _safe, plot_allan, plot_dynamic_adev, plot_models, plot_residuals, plot_separation, plot_separation_allan
 
 __all__ = ["write_json", "write_allan_outputs", "write_separation_outputs", "write_model_outputs"]
 
@@ -78,7 +78,11 @@ def write_allan_outputs(allan_axes, record, out_dir) -> dict:
                      f"{dev}_hi68_{u}", f"{dev}_lo95_{u}", f"{dev}_hi95_{u}"] + (["unit"] if u == "internal" else []),
                     rows)
     plot_allan(allan_axes, out / "allan.png")
-    return {"json": out / "allan.json", "csv": out / "allan.csv", "png": out / "allan.png"}
+    files = {"json": out / "allan.json", "csv": out / "allan.csv", "png": out / "allan.png"}
+    dyn = plot_dynamic_adev(allan_axes, out / "allan_dynamic.png")  # a disturbed axis's ADEV over time
+    if dyn is not None:
+        files["dynamic_png"] = dyn
+    return files
 
 
 def write_separation_outputs(seps, out_dir) -> dict:
