@@ -44,7 +44,7 @@ from .grid import tau_grid
 from .result import AllanResult
 from .statistics import get_statistic
 
-__all__ = ["allan_variance", "result_from_sums", "IEEE952_ALPHAS", "FAST_M0"]
+__all__ = ["allan_variance", "result_from_sums", "choose_alphas", "IEEE952_ALPHAS", "FAST_M0"]
 
 #: ``noise_alpha="auto"`` trusts a phase-noise slope (alpha > 0, white PM: EDF ~ N/2 even at long tau) only
 #: where at least this many averaging intervals m fit in the record; below it the smallest EDF among the
@@ -204,6 +204,34 @@ def allan_variance(
                             noise_alpha=noise_alpha)
 
 
+def choose_alphas(noise_alpha, tau_s, var, stat, edf_of, few_intervals):
+    """The noise type (power-law alpha) and EDF of each tau: ``noise_alpha`` resolved (:func:`resolve_alpha`),
+    ``"conservative"`` the smallest EDF among the IEEE-952 alphas; with ``"auto"``, where ``few_intervals`` (fewer
+    than :data:`AUTO_MIN_INTERVALS` averaging intervals fit in the record) and the slope says phase noise, the
+    smallest EDF too (a bounded disturbance at long tau looks the same).  ``edf_of(i, alpha)`` is the EDF rule.
+    Returns ``(alphas, edf, rule)``."""
+    m_size = len(tau_s)
+    alphas, rule = resolve_alpha(noise_alpha, tau_s, var, slopes=stat.dev_slopes, candidates=IEEE952_ALPHAS)
+    if isinstance(alphas, str):  # conservative
+        cands = np.array([[edf_of(i, a) for a in IEEE952_ALPHAS] for i in range(m_size)]).reshape(m_size, -1)
+        pick = np.argmin(cands, axis=1)
+        return np.asarray(IEEE952_ALPHAS, dtype=np.int64)[pick], cands[np.arange(m_size), pick], rule
+    alphas = np.array(alphas, dtype=np.int64)
+    edf = np.array([edf_of(i, a) for i, a in enumerate(alphas)], dtype=np.float64)
+    if isinstance(noise_alpha, str):  # auto: a phase-noise slope at long tau is not evidence of phase noise
+        few = np.flatnonzero((alphas > 0) & np.asarray(few_intervals, dtype=bool))
+        for i in few:
+            cand = [edf_of(i, a) for a in IEEE952_ALPHAS]
+            k = int(np.nanargmin(cand))
+            if cand[k] < edf[i]:
+                alphas[i], edf[i] = IEEE952_ALPHAS[k], cand[k]
+        if few.size:
+            rule += (f"; where fewer than {AUTO_MIN_INTERVALS} averaging intervals fit in the record and the "
+                     "slope says phase noise (alpha > 0: a bounded disturbance at long tau looks the same), "
+                     "the smallest EDF among the IEEE-952 alphas")
+    return alphas, edf, rule
+
+
 def result_from_sums(sums, n, m, strides, dt_s, *, statistic, estimator, noise_alpha) -> AllanResult:
     """The :class:`AllanResult` (variance, EDF, alpha, bounds, every field) from the operator sums.
 
@@ -242,25 +270,7 @@ def result_from_sums(sums, n, m, strides, dt_s, *, statistic, estimator, noise_a
     tau_s = m * dt
 
     edf_of, cap_of, base = _edf_rule(stat, estimator, n, m, strides)
-    alphas, rule = resolve_alpha(noise_alpha, tau_s, var, slopes=stat.dev_slopes, candidates=IEEE952_ALPHAS)
-    if isinstance(alphas, str):  # conservative
-        cands = np.array([[edf_of(i, a) for a in IEEE952_ALPHAS] for i in range(m.size)]).reshape(m.size, -1)
-        pick = np.argmin(cands, axis=1)
-        alphas = np.asarray(IEEE952_ALPHAS, dtype=np.int64)[pick]
-        edf = cands[np.arange(m.size), pick]
-    else:
-        edf = np.array([edf_of(i, a) for i, a in enumerate(alphas)], dtype=np.float64)
-        if isinstance(noise_alpha, str):  # auto: a phase-noise slope at long tau is not evidence of phase noise
-            few = np.flatnonzero((alphas > 0) & (n < AUTO_MIN_INTERVALS * m))
-            for i in few:
-                cand = [edf_of(i, a) for a in IEEE952_ALPHAS]
-                k = int(np.nanargmin(cand))
-                if cand[k] < edf[i]:
-                    alphas[i], edf[i] = IEEE952_ALPHAS[k], cand[k]
-            if few.size:
-                rule += (f"; where fewer than {AUTO_MIN_INTERVALS} averaging intervals fit in the record and the "
-                         "slope says phase noise (alpha > 0: a bounded disturbance at long tau looks the same), "
-                         "the smallest EDF among the IEEE-952 alphas")
+    alphas, edf, rule = choose_alphas(noise_alpha, tau_s, var, stat, edf_of, n < AUTO_MIN_INTERVALS * m)
     if cap_of is not None:  # a strided (fast) sum cannot have more EDF than the full overlapping one
         edf = np.minimum(edf, [cap_of(i, a) for i, a in enumerate(alphas)])
     edf = np.clip(np.nan_to_num(edf, nan=1.0, posinf=float(n_terms.max())), 1.0, np.maximum(n_terms, 1))

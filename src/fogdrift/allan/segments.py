@@ -31,8 +31,8 @@ from .._util import check_series
 from ..errors import ConfigError, InsufficientDataError
 from ..units import check_dt_s
 from . import _kernels
-from .ci import P68, chi2_bounds, edf_simple_safe, resolve_alpha
-from .core import AUTO_MIN_INTERVALS, IEEE952_ALPHAS
+from .ci import P68, chi2_bounds, edf_simple_safe
+from .core import AUTO_MIN_INTERVALS, choose_alphas
 from .grid import tau_grid
 from .result import AllanResult
 from .statistics import get_statistic
@@ -157,21 +157,8 @@ def allan_variance_segments(rate_dph, dt_s, segments, *, taus="octave", noise_al
         used = lengths[2 * m[i] <= lengths]
         return float(sum(edf_simple_safe(int(n_s) + 1, int(m[i]), a) for n_s in used))
 
-    alphas, rule = resolve_alpha(noise_alpha, tau_s, var, slopes=stat.dev_slopes, candidates=IEEE952_ALPHAS)
-    if isinstance(alphas, str):  # conservative
-        cands = np.array([[edf_of(i, a) for a in IEEE952_ALPHAS] for i in range(m.size)]).reshape(m.size, -1)
-        pick = np.argmin(cands, axis=1)
-        alphas = np.asarray(IEEE952_ALPHAS, dtype=np.int64)[pick]
-        edf = cands[np.arange(m.size), pick]
-    else:
-        alphas = np.array(alphas, dtype=np.int64)
-        edf = np.array([edf_of(i, a) for i, a in enumerate(alphas)], dtype=np.float64)
-        if isinstance(noise_alpha, str):  # auto: the same phase-noise caution as allan_variance
-            for i in np.flatnonzero((alphas > 0) & (n_long < AUTO_MIN_INTERVALS * m)):
-                cand = [edf_of(i, a) for a in IEEE952_ALPHAS]
-                k = int(np.nanargmin(cand))
-                if cand[k] < edf[i]:
-                    alphas[i], edf[i] = IEEE952_ALPHAS[k], cand[k]
+    # the same noise-type and phase-noise caution as allan_variance (the few-intervals rule on the longest segment)
+    alphas, edf, rule = choose_alphas(noise_alpha, tau_s, var, stat, edf_of, n_long < AUTO_MIN_INTERVALS * m)
     edf = np.clip(np.nan_to_num(edf, nan=1.0, posinf=float(terms.max())), 1.0, np.maximum(terms, 1))
 
     lo68, hi68 = chi2_bounds(var, edf, P68)
