@@ -1,6 +1,6 @@
 """Synthetic gyro rate signals with known IEEE-952 noise terms.
 
-Every term is generated so that its Allan variance is the IEEE-952 law (method notes 2.2),
+Each term is drawn by its row's simulator (:mod:`fogdrift.noise.processes`, ``simulate``).  Every term is generated so that its Allan variance is the IEEE-952 law (method notes 2.2),
 with sigma in deg/h and tau in s:
 
 =====  =====================================  ==========================================
@@ -33,6 +33,7 @@ import numpy as np
 
 from ._util import check_count
 from .errors import ConfigError
+from .noise.processes import processes
 from .units import B_FACTOR as B_FLAT_FACTOR  # the flat ADEV of flicker rate noise in units of B
 from .units import URAD_PER_ARCSEC, check_dt_s, earth_rate_projection_dph
 
@@ -49,21 +50,6 @@ def _nonneg(name, value) -> float:
     return v
 
 
-def _flicker(n: int, dt_s: float, b_dph: float, rng: np.random.Generator) -> np.ndarray:
-    """Flicker rate noise with one-sided PSD S(f) = (B^2/pi)/f, shape (n,)."""
-    length = 4 * n if n <= 2**24 else 2 * n
-    nf = length // 2 + 1
-    f_hz = np.arange(nf) / (length * dt_s)
-    # E|X_k|^2 = S(f_k) * length / (2 dt) for 0 < k < length/2 (numpy unnormalised rfft)
-    scale = np.zeros(nf)
-    scale[1:] = np.sqrt(b_dph**2 / (math.pi * f_hz[1:]) * length / (4.0 * dt_s))
-    spec = rng.standard_normal(nf) + 1j * rng.standard_normal(nf)
-    spec *= scale
-    if length % 2 == 0:  # the Nyquist bin is real; keep E|X|^2 equal to the interior rule
-        spec[-1] = spec[-1].real * math.sqrt(2.0)
-    return np.fft.irfft(spec, n=length)[:n]
-
-
 def simulate(
     n_samples,
     dt_s,
@@ -77,6 +63,7 @@ def simulate(
     latitude_deg=None,
     axis="up",
     seed,
+    **more,
 ) -> np.ndarray:
     """Simulate a static gyro's rate output in deg/h.
 
@@ -107,6 +94,9 @@ def simulate(
     seed : int or numpy.random.Generator, keyword-only, required
         Seed.  Each noise term draws from its own child stream (``SeedSequence.spawn``), so
         switching one term on or off leaves the others' realisations unchanged.
+    **more : float, keyword-only
+        The coefficient of a registered process (:func:`fogdrift.noise.processes.register`), by its row's
+        ``sim_kwarg``, in its term's reported unit.
 
     Returns
     -------
@@ -135,43 +125,35 @@ def simulate(
     """
     n = check_count(n_samples)
     dt = check_dt_s(dt_s)
-    q = _nonneg("q_urad", q_urad) / URAD_PER_ARCSEC  # (deg/h) s
-    arw = _nonneg("arw_dprh", arw_dprh) * 60.0  # (deg/h) sqrt(s)
-    b = _nonneg("bias_instability_dph", bias_instability_dph)
-    k = _nonneg("rrw_dphrh", rrw_dphrh) / 60.0  # (deg/h)/sqrt(s)
-    r = _nonneg("ramp_dph2", ramp_dph2) / 3600.0  # (deg/h)/s
+    given = {"q_urad": q_urad, "arw_dprh": arw_dprh, "bias_instability_dph": bias_instability_dph,
+             "rrw_dphrh": rrw_dphrh, "ramp_dph2": ramp_dph2}
+    known = {p.sim_kwarg for p in processes() if p.sim_kwarg and p.simulate is not None}
+    unknown = sorted(set(more) - known)
+    if unknown:
+        raise ConfigError(f"simulate() got unknown term keyword(s) {unknown}; expected {sorted(known)}")
+    given.update(more)
+    rows = [p for p in processes() if p.sim_kwarg in given]
+    # each term's coefficient in the Allan-law units of its row (Q (deg/h) s, N (deg/h) sqrt(s), B deg/h, ...)
+    x = {p.name: _nonneg(p.sim_kwarg, given[p.sim_kwarg]) / p.term.to_unit for p in rows}
     try:
         bias = float(bias_dph)
     except (TypeError, ValueError):
         raise ConfigError(f"bias_dph must be a finite number, got {bias_dph!r}") from None
     if not math.isfinite(bias):
         raise ConfigError(f"bias_dph must be a finite number, got {bias_dph!r}")
+    n_streams = max([4] + [p.sim_stream + 1 for p in rows if p.sim_stream is not None])
     if isinstance(seed, np.random.Generator):
-        streams = seed.spawn(4)
+        streams = seed.spawn(n_streams)
     else:
         try:
-            streams = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(4)]
+            streams = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(n_streams)]
         except (TypeError, ValueError):
             raise ConfigError(f"seed must be a non-negative int or a numpy Generator, got {seed!r}") from None
 
     y = np.full(n, bias, dtype=np.float64)
     if latitude_deg is not None:
         y += earth_rate_projection_dph(latitude_deg, axis)
-    if q > 0:
-        angle = streams[0].standard_normal(n + 1)
-        y += (q / dt) * np.diff(angle)
-    if arw > 0:
-        y += (arw / math.sqrt(dt)) * streams[1].standard_normal(n)
-    if b > 0:
-        y += _flicker(n, dt, b, streams[2])
-    if k > 0:
-        rng = streams[3]
-        w = np.empty(n + 1)
-        w[0] = 0.0
-        np.cumsum(rng.standard_normal(n), out=w[1:])
-        w *= k * math.sqrt(dt)
-        y += 0.5 * (w[:-1] + w[1:])
-        y += (k * math.sqrt(dt / 12.0)) * rng.standard_normal(n)
-    if r > 0:
-        y += r * dt * (np.arange(n) + 0.5)
+    for p in rows:  # each row's simulator, on its own child stream
+        if x[p.name] > 0:
+            y += p.simulate(x[p.name], n, dt, None if p.sim_stream is None else streams[p.sim_stream])
     return y

@@ -29,12 +29,13 @@ from __future__ import annotations
 import math
 
 from ..errors import ConfigError
+from ..noise.processes import process, processes
 
 __all__ = [
     "DEG", "G0", "MGAL", "GM_FLICKER_SIGMA", "GM_PEAK_X",
     "arw_to_density", "density_to_arw", "vrw_to_density", "density_to_vrw", "rrw_to_density",
     "white_discrete", "walk_discrete", "gm_discrete", "to_si", "from_si", "quantity_of_unit",
-    "single_gm_from_flicker", "UNIT_TABLE",
+    "single_gm_from_flicker", "UNIT_TABLE", "SI_UNITS", "si_unit",
 ]
 
 DEG = math.pi / 180.0
@@ -227,13 +228,42 @@ UNIT_TABLE: dict[tuple[str, str], tuple[str, float]] = {
     ("q_c", "m/s^2/sqrt(s)"): ("accel", 1.0),
 }
 
-#: SI unit of each (quantity, term kind).
-SI_UNITS = {
-    ("gyro", "N"): "rad/s/sqrt(Hz)", ("gyro", "K"): "rad/s^2/sqrt(Hz)", ("gyro", "B"): "rad/s",
-    ("gyro", "Q"): "rad", ("gyro", "R"): "rad/s^2", ("gyro", "sigma"): "rad/s", ("gyro", "q_c"): "rad/s/sqrt(s)",
-    ("accel", "N"): "m/s^2/sqrt(Hz)", ("accel", "K"): "m/s^3/sqrt(Hz)", ("accel", "B"): "m/s^2",
-    ("accel", "Q"): "m/s", ("accel", "R"): "m/s^3", ("accel", "sigma"): "m/s^2", ("accel", "q_c"): "m/s^2/sqrt(s)",
-}
+#: SI unit of the Markov driving density (IEEE-952 C.6) per quantity; every term's own SI unit is its row's.
+_Q_C_SI = {"gyro": "rad/s/sqrt(s)", "accel": "m/s^2/sqrt(s)"}
+
+
+def si_unit(quantity: str, term: str) -> str:
+    """SI unit of ``term`` (a letter of :mod:`fogdrift.noise.processes`, ``sigma`` or ``q_c``) for ``"gyro"`` or
+    ``"accel"``: the row's ``si`` (``sigma``: the Gauss-Markov row's).
+
+    Examples
+    --------
+    >>> si_unit("gyro", "K"), si_unit("accel", "N"), si_unit("gyro", "sigma")
+    ('rad/s^2/sqrt(Hz)', 'm/s^2/sqrt(Hz)', 'rad/s')
+    """
+    if term == "q_c":
+        return _Q_C_SI[quantity]
+    return process("M" if term == "sigma" else term).si[quantity][0]
+
+
+def _registered_units() -> dict:
+    """(term, reported unit) -> (quantity, factor) of every row's own reported unit (registered rows included)."""
+    out = {}
+    for p in processes():
+        for quantity, spec in (("gyro", p.term), ("accel", p.accel_term)):
+            if spec is not None and quantity in p.si:
+                out[(p.name, _normalise(spec.unit))] = (quantity, p.si[quantity][1])
+    return out
+
+
+def _lookup(term: str, unit: str):
+    key = (_kind(term), _normalise(unit))
+    hit = UNIT_TABLE.get(key)
+    return hit if hit is not None else _registered_units().get(key)
+
+
+#: SI unit of each (quantity, term kind), from the rows of :mod:`fogdrift.noise.processes`.
+SI_UNITS = {(q, t): si_unit(q, t) for q in ("gyro", "accel") for t in ("N", "K", "B", "Q", "R", "sigma", "q_c")}
 
 _REPLACE = (("µ", "u"), ("μ", "u"), (" ", ""), ("(m/s^2)", "m/s^2"), ("(rad/s)", "rad/s"), ("(deg/h)", "deg/h"),
             ("(deg/s)", "deg/s"), ("·", "*"), ("√", "sqrt"), ("sqrt(hr)", "sqrt(h)"), ("/hr", "/h"),
@@ -261,7 +291,7 @@ def quantity_of_unit(term: str, unit: str) -> str | None:
     >>> quantity_of_unit("N", "deg/√h"), quantity_of_unit("N", "m/s/sqrt(h)"), quantity_of_unit("N", "furlong")
     ('gyro', 'accel', None)
     """
-    hit = UNIT_TABLE.get((_kind(term), _normalise(unit)))
+    hit = _lookup(term, unit)
     return None if hit is None else hit[0]
 
 
@@ -282,15 +312,15 @@ def to_si(value, term: str, unit: str) -> tuple[float | None, str, str]:
     >>> round(v, 9), u
     (0.00196133, 'm/s^2')
     """
-    hit = UNIT_TABLE.get((_kind(term), _normalise(unit)))
+    hit = _lookup(term, unit)
     if hit is None:
-        known = sorted({u for (k, u) in UNIT_TABLE if k == _kind(term)})
+        known = sorted({u for (k, u) in {**UNIT_TABLE, **_registered_units()} if k == _kind(term)})
         raise ConfigError(f"unit {unit!r} of term {term} is not one fogdrift can convert; expected one of "
                           f"{', '.join(known)}")
     quantity, factor = hit
-    si_unit = SI_UNITS[(quantity, term if term in ("sigma", "q_c") else _kind(term))]
-    how = f"x {factor:.6g} ({unit} -> {si_unit})"
-    return (None if value is None else float(value) * factor), si_unit, how
+    unit_si = si_unit(quantity, term if term in ("sigma", "q_c") else _kind(term))
+    how = f"x {factor:.6g} ({unit} -> {unit_si})"
+    return (None if value is None else float(value) * factor), unit_si, how
 
 
 def from_si(value_si: float, term: str, unit: str) -> float:
@@ -303,7 +333,7 @@ def from_si(value_si: float, term: str, unit: str) -> float:
     >>> round(from_si(4.3633231e-5, "N", "deg/sqrt(h)"), 6)
     0.15
     """
-    hit = UNIT_TABLE.get((_kind(term), _normalise(unit)))
+    hit = _lookup(term, unit)
     if hit is None:
         raise ConfigError(f"unit {unit!r} of term {term} is not one fogdrift can convert")
     return float(value_si) / hit[1]

@@ -45,7 +45,6 @@ References
 
 from __future__ import annotations
 
-import itertools
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -60,13 +59,13 @@ from .covariance import model_wvar_covariance
 from .ieee import to_ieee
 from .processes import LatentModel, parse_model
 from .simulate import simulate_latent
+from .starts import bounds as _bounds
+from .starts import starts as _starts
 from .wvar import WvarResult, haar_wvar
 
 __all__ = ["GMWMFit", "GMWM", "gmwm_fit", "Whitener"]
 
 _Z95 = 1.959963984540054
-_GM_PEAK_TAU = 3.785  # WV peak of a GM at tau ~ 3.785 / beta (samples)
-_GM_PEAK_HEIGHT = 0.1906  # times the process variance
 
 
 # ----------------------------------------------------------------------------------------
@@ -322,106 +321,6 @@ class _Problem:
     def clipped(self, z0) -> np.ndarray:
         """The start :meth:`solve` really uses: ``z0`` moved 1e-6 inside the bounds."""
         return np.clip(np.asarray(z0, dtype=np.float64), self.lo + 1e-6, self.hi - 1e-6)
-
-
-def _refs(model: LatentModel, nu_hat, tau):
-    """Reference magnitude of each natural parameter: the value at which the component alone
-    reaches the largest observed WV at some scale (bounds are placed around it)."""
-    t = tau
-    ref_wn = np.max(t * nu_hat)
-    ref_rw = np.max(12.0 * nu_hat * t / (t * t + 2.0))
-    refs = []
-    for key in model.components:
-        if key == "WN":
-            refs.append([ref_wn])
-        elif key == "QN":
-            refs.append([np.max(t * t * nu_hat / 6.0)])
-        elif key == "RW":
-            refs.append([ref_rw])
-        elif key == "DR":
-            refs.append([np.max(4.0 * np.sqrt(nu_hat) / t)])
-        elif key == "FLICKER":
-            refs.append([np.max(nu_hat) / 0.22])
-        elif key == "GM":
-            refs.append([1.0, max(ref_wn, ref_rw)])
-    return np.concatenate(refs)
-
-
-def _bounds(model: LatentModel, nu_hat, tau):
-    ref = np.log(_refs(model, nu_hat, tau))
-    lo = ref - 45.0
-    hi = ref + 5.0
-    for key, sl in zip(model.components, model.slices):
-        if key == "GM":
-            lo[sl.start] = math.log(1e-3 / tau.max())  # T_c up to 1000 x the largest scale
-            hi[sl.start] = math.log(30.0)  # phi = e^-30: white
-    return lo, hi
-
-
-def _starts(model: LatentModel, nu_hat, tau, weights) -> list[np.ndarray]:
-    """Deterministic heuristic starting points (natural parameters), best first by step-1 Q."""
-    J = tau.size
-    base = {}
-    if model.has("QN"):
-        low = slice(0, max(1, J // 2))
-        base["WN"] = float(np.min(tau[low] * nu_hat[low]))
-        q2 = (nu_hat[0] - base["WN"] / tau[0]) * tau[0] ** 2 / 6.0
-        base["QN"] = q2 if q2 > 0 else 0.1 * nu_hat[0] * tau[0] ** 2 / 6.0
-    else:
-        base["WN"] = float(tau[0] * nu_hat[0])
-    if model.has("RW"):
-        base["RW"] = float(12.0 * nu_hat[-1] / tau[-1])
-    if model.has("DR"):
-        base["DR"] = float(2.0 * math.sqrt(nu_hat[-1]) / tau[-1])
-    if model.has("FLICKER"):
-        base["FLICKER"] = float(np.min(nu_hat) / 0.22 * 0.5)
-    fixed_keys = [k for k in model.components if k != "GM"]
-    k_gm = model.n_gm
-
-    def assemble(vals: dict, gms):
-        th = []
-        it = iter(gms)
-        for key in model.components:
-            th.extend(next(it) if key == "GM" else [vals[key]])
-        return np.asarray(th, dtype=np.float64)
-
-    def partial(vals):
-        tmp = parse_model("+".join(fixed_keys)) if fixed_keys else None
-        if tmp is None:
-            return np.zeros(J)
-        return tmp.wv([vals[k] for k in tmp.components], tau)
-
-    variants = [base]
-    if model.has("RW") or model.has("QN") or model.has("FLICKER"):
-        shrunk = dict(base)
-        for k in ("RW", "QN", "FLICKER"):
-            if k in shrunk:
-                shrunk[k] *= 0.3
-        variants.append(shrunk)
-    cands = []
-    for vals in variants:
-        if k_gm == 0:
-            cands.append(assemble(vals, []))
-            continue
-        resid = nu_hat - partial(vals)
-        for placement in itertools.combinations(range(J), k_gm):
-            gms = []
-            for j in placement:
-                beta = _GM_PEAK_TAU / tau[j]
-                h = resid[j] if resid[j] > 0 else 0.1 * nu_hat[j]
-                sp2 = h / (_GM_PEAK_HEIGHT * k_gm)
-                u = -math.expm1(-beta)
-                gms.append([beta, sp2 * u * (2.0 - u)])
-            cands.append(assemble(vals, gms))
-    w = np.sqrt(weights)
-    scored = []
-    ev = model.evaluator(tau)  # the values of model.wv(th, tau), without its per-call overhead (hundreds of starts)
-    with np.errstate(over="ignore", invalid="ignore"):
-        for th in cands:
-            r = w * (nu_hat - ev.wv(th))
-            scored.append((float(r @ r), th))
-    scored.sort(key=lambda s: s[0])
-    return [th for _, th in scored]
 
 
 def _sandwich(A, whitener: Whitener, V):

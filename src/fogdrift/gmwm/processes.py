@@ -1,4 +1,9 @@
-"""Latent error processes of a gyro and the composite models built from them (a registry).
+"""Latent error processes of a gyro and the composite models built from them.
+
+The processes are the ``latent`` parts of the rows of :mod:`fogdrift.noise.processes` (one home per process:
+per-sample definition, Haar WV, SDF, IEEE reading, simulator); this module composes them into models, evaluates
+their WV and Jacobian (a compiled kernel for the built-in rows, the rows' own ``wv`` for a registered one) and
+parses model strings.
 
 Each process is defined per sample (interval ``dt_s``) with its rate in deg/h, so its
 variances are in (deg/h)^2 ([GMWM]_ §2).  ``tau`` is the Haar scale in samples (filter
@@ -38,16 +43,17 @@ References
 
 from __future__ import annotations
 
-import functools
 import math
 import re
-from dataclasses import dataclass
+from collections.abc import Mapping
 from typing import Callable
 
 import numpy as np
 
 from ..errors import ConfigError
-from ..units import B_FACTOR
+from ..noise.processes import LatentSpec, latent_processes
+from ..noise.processes.flicker import B_FLAT_WV, flicker_wv_factor
+from ..noise.processes.gauss_markov import ar1_wv
 
 __all__ = [
     "Process",
@@ -62,11 +68,6 @@ __all__ = [
     "B_FLAT_WV",
 ]
 
-#: Flat Haar WV of flicker noise in units of B^2: ln2 / pi = (2 ln2 / pi) B^2 / 2 (half the flat Allan variance,
-#: :data:`fogdrift.units.B_FACTOR` squared).
-B_FLAT_WV = B_FACTOR**2 / 2.0
-
-_SQRT_H = 60.0  # sqrt(3600 s / h)
 
 
 # ----------------------------------------------------------------------------------------
@@ -88,78 +89,6 @@ def haar_gain2(f, m):
     with np.errstate(divide="ignore", invalid="ignore"):
         g = np.sin(np.pi * f * m) ** 4 / (m * m * s * s)
     return np.where(s == 0.0, 0.0, g)
-
-
-# ----------------------------------------------------------------------------------------
-# AR(1) in beta (stable form)
-# ----------------------------------------------------------------------------------------
-def ar1_wv(beta, sigma2, tau):
-    """Haar WV of an AR(1) with ``phi = exp(-beta)`` and innovation variance ``sigma2``.
-
-    Parameters
-    ----------
-    beta : float or ndarray
-        ``-ln phi`` (> 0), per sample.
-    sigma2 : float or ndarray
-        Innovation variance (rate^2).
-    tau : array_like
-        Haar scales in samples (even integers >= 2).
-
-    Returns
-    -------
-    ndarray
-        ``nu2(tau)`` in rate^2, broadcast over the inputs.
-
-    Notes
-    -----
-    The textbook form ``sigma2 [m(1-phi^2) - 3phi + 4phi^(m+1) - phi^(2m+1)] /
-    [2 m^2 (1-phi)^2 (1-phi^2)]`` loses all digits when ``1 - phi`` is small ([GMWM]_ §2,
-    "numerical trap").  With ``u = -expm1(-beta) = 1 - phi`` and ``v = -expm1(-m beta)``::
-
-        nu2 / sigma2 = [m u (2-u) - (1-u) v (2+v)] / [2 m^2 u^3 (2-u)]
-
-    and for ``m beta < 1e-3`` the series ``(2m^2+1)/(12m) - beta (3m^3-4m^2-2)/(24m)
-    + beta^2 (m-1)(7m^3-8m^2-3m-3)/(120m)``.  Relative error below 1e-9 over
-    ``beta = 1e-7..50`` and ``tau = 2..2^24`` (tested against 50-digit decimal arithmetic).
-
-    Examples
-    --------
-    >>> [round(float(v), 10) for v in ar1_wv(-math.log(0.9), 1.0, [2, 8, 64, 1024])]
-    [0.2631578947, 0.5680840625, 0.9001211711, 0.0949458072]
-    """
-    m = np.asarray(tau, dtype=np.float64) / 2.0
-    if np.ndim(beta) == 0 and np.ndim(sigma2) == 0:  # fast path: one process, many scales
-        b = float(beta)
-        u = -math.expm1(-b)
-        mb = m * b
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            v = -np.expm1(-mb)
-            out = (m * u * (2.0 - u) - (1.0 - u) * v * (2.0 + v)) / (2.0 * m * m * u**3 * (2.0 - u))
-        small = mb < 1e-3
-        if np.any(small):
-            ms = m[small] if np.ndim(m) else m
-            ser = _ar1_series(ms, b)
-            if np.ndim(out):
-                out[small] = ser
-            else:
-                out = ser
-        return float(sigma2) * out
-    beta = np.asarray(beta, dtype=np.float64)
-    sigma2 = np.asarray(sigma2, dtype=np.float64)
-    beta, sigma2, m = np.broadcast_arrays(beta, sigma2, m)
-    mb = m * beta
-    u = -np.expm1(-beta)
-    v = -np.expm1(-mb)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        closed = (m * u * (2.0 - u) - (1.0 - u) * v * (2.0 + v)) / (2.0 * m * m * u**3 * (2.0 - u))
-    return sigma2 * np.where(mb < 1e-3, _ar1_series(m, beta), closed)
-
-
-def _ar1_series(m, beta):
-    """Small-(m beta) expansion of the AR(1) WV per unit innovation variance ([GMWM]_ §2)."""
-    return ((2.0 * m * m + 1.0) / (12.0 * m)
-            - beta * (3.0 * m**3 - 4.0 * m * m - 2.0) / (24.0 * m)
-            + beta * beta * (m - 1.0) * (7.0 * m**3 - 8.0 * m * m - 3.0 * m - 3.0) / (120.0 * m))
 
 
 # ----------------------------------------------------------------------------------------
@@ -246,175 +175,32 @@ def _wv_kernel():
 
 
 # ----------------------------------------------------------------------------------------
-# Flicker (1/f) WV factor
+# Registry: the latent forms of the rows of fogdrift.noise.processes
 # ----------------------------------------------------------------------------------------
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
-_K_EXACT = 64  # periods integrated exactly before the averaged tail
+#: One latent process (parameters, Haar WV, SDF, IEEE reading, simulator): the ``latent`` part of a row of
+#: :mod:`fogdrift.noise.processes`.
+Process = LatentSpec
 
 
-def _gl_panels(a: float, b: float, n: int):
-    """Nodes and weights of n equal Gauss-Legendre(16) panels on [a, b]."""
-    edges = np.linspace(a, b, n + 1)
-    h = np.diff(edges)[:, None] / 2.0
-    c = (edges[:-1] + edges[1:])[:, None] / 2.0
-    return (c + h * _GL_X).ravel(), (h * _GL_W).ravel()
+class _LatentView(Mapping):
+    """GMWM name -> :class:`Process`, from the rows of :mod:`fogdrift.noise.processes` (live)."""
+
+    def __getitem__(self, key):
+        return latent_processes()[key]
+
+    def __iter__(self):
+        return iter(latent_processes())
+
+    def __len__(self):
+        return len(latent_processes())
+
+    def __repr__(self):
+        return f"PROCESSES({list(self)})"
 
 
-def _g_minus_third_over_v(v):
-    """(1/sin^2(pi v) - 1/(pi v)^2 - 1/3) / v, stable near 0 (series below 0.05)."""
-    x = np.pi * v
-    with np.errstate(divide="ignore", invalid="ignore"):
-        direct = (1.0 / np.sin(x) ** 2 - 1.0 / (x * x) - 1.0 / 3.0) / v
-    series = np.pi * x * (1.0 / 15.0 + x * x * (2.0 / 189.0 + x * x / 675.0))
-    return np.where(v < 0.05, series, direct)
+#: GMWM name (``"WN"``, ``"QN"``, ``"RW"``, ``"DR"``, ``"FLICKER"``, ``"GM"``, and any registered row's) -> Process.
+PROCESSES = _LatentView()
 
-
-@functools.lru_cache(maxsize=4096)
-def _flicker_c(m: int) -> float:
-    """c(m) = (1/pi) int_0^{1/2} sin^4(pi f m) / (m^2 sin^2(pi f) f) df (see flicker_wv_factor)."""
-    def env(u):  # E(u) = 1 / (m^2 sin^2(pi u / m) u)
-        return 1.0 / (m * m * np.sin(np.pi * u / m) ** 2 * u)
-
-    if m <= 2 * _K_EXACT:
-        half = m / 2.0
-        n_full = int(math.floor(half))
-        x, w = _gl_panels(0.0, float(n_full), max(n_full, 1)) if n_full else (np.empty(0), np.empty(0))
-        if half > n_full:
-            x2, w2 = _gl_panels(float(n_full), half, 1)
-            x, w = np.concatenate([x, x2]), np.concatenate([w, w2])
-        return float(np.dot(w, np.sin(np.pi * x) ** 4 * env(x))) / math.pi
-    K = _K_EXACT
-    x, w = _gl_panels(0.0, float(K), K)
-    exact = float(np.dot(w, np.sin(np.pi * x) ** 4 * env(x)))
-    a = K / m
-    xv, wv = _gl_panels(a, 0.5, 4)
-    smooth = float(np.dot(wv, _g_minus_third_over_v(xv)))
-    tail = (0.375 / (m * m)) * ((m * m / (K * K) - 4.0) / (2.0 * math.pi**2)
-                                 + math.log(m / (2.0 * K)) / 3.0 + smooth)
-    return (exact + tail) / math.pi
-
-
-def flicker_wv_factor(tau):
-    """Haar WV of flicker noise per unit ``B^2``: ``nu2(tau) = B^2 c(tau/2)``.
-
-    Flicker (bias-instability) noise is taken as the discrete-time process with two-sided
-    SDF ``B^2 / (2 pi |f|)`` on ``|f| <= 1/2`` (cycles/sample), i.e. one-sided PSD
-    ``B^2 / (pi f_hz)`` in (deg/h)^2/Hz whatever the sample rate, which is how
-    :func:`fogdrift.simulate.simulate` generates it.  Then ([PW2000]_ eq. 296)::
-
-        nu2(tau) = int |H(f)|^2 S(f) df = (B^2 / pi) int_0^{1/2} sin^4(pi f m) / (m^2 sin^2(pi f) f) df
-
-    which converges without a low-frequency cutoff (the Haar filter removes the mean) and
-    tends to the flat ``(ln 2 / pi) B^2 = 0.2206 B^2`` for large ``m``.  The integral is
-    evaluated by Gauss-Legendre quadrature over whole periods of ``sin^4`` (all of them
-    for ``m <= 128``; the first 64 periods plus the period-averaged tail, integrated in
-    closed form up to a smooth remainder, beyond; error < 1e-9).
-
-    Examples
-    --------
-    >>> [round(float(c), 5) for c in flicker_wv_factor([2, 4, 2**20])]
-    [0.26233, 0.2402, 0.22064]
-    """
-    t = np.asarray(tau, dtype=np.float64)
-    m = t / 2.0
-    if np.any(m < 1) or np.any(m != np.round(m)):
-        raise ConfigError("flicker WV needs even integer scales tau >= 2")
-    flat = np.ravel(m)
-    out = np.array([_flicker_c(int(v)) for v in flat])
-    return out.reshape(t.shape)
-
-
-# ----------------------------------------------------------------------------------------
-# Registry
-# ----------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Process:
-    """One latent process: parameters, theoretical WV, SDF and IEEE mapping.
-
-    Attributes
-    ----------
-    name : str
-        Registry key (``"WN"``, ``"QN"``, ``"RW"``, ``"DR"``, ``"FLICKER"``, ``"GM"``).
-    long_name : str
-    params : tuple of str
-        Natural parameters, all > 0 (free parameters are their logarithms).
-    param_units : tuple of str
-        Units of ``params`` (``rate`` is deg/h, per sample).
-    wv : callable
-        ``wv(theta, tau) -> nu2`` with ``theta`` of shape ``(len(params),)``.
-    sdf : callable or None
-        ``sdf(theta, f) -> S(f)`` two-sided in rate^2 per cycle/sample, ``|f| <= 1/2``;
-        None for a deterministic process (drift).
-    ieee : callable
-        ``ieee(theta, dt_s) -> {quantity: value}`` (keys carry units).
-    excess_kurtosis : float
-        Excess kurtosis of the iid innovations (0: Gaussian; QN: -1.2, uniform rounding);
-        enters the fourth-cumulant term of the WV covariance.
-    """
-
-    name: str
-    long_name: str
-    params: tuple
-    param_units: tuple
-    wv: Callable
-    sdf: Callable | None
-    ieee: Callable
-    excess_kurtosis: float = 0.0
-
-
-def _gm_ieee(th, dt):
-    beta, s2 = th
-    u = -math.expm1(-beta)
-    return {"tc_s": dt / beta, "sigma_gm_dph": math.sqrt(s2 / (u * (2.0 - u)))}
-
-
-def _gm_sdf(th, f):
-    beta, s2 = th
-    u = -math.expm1(-beta)
-    return s2 / (u * u + 4.0 * (1.0 - u) * np.sin(np.pi * f) ** 2)
-
-
-PROCESSES: dict[str, Process] = {
-    "QN": Process(
-        "QN", "quantization noise", ("q2",), ("rate^2",),
-        wv=lambda th, tau: 6.0 * th[0] / np.asarray(tau, dtype=np.float64) ** 2,
-        sdf=lambda th, f: 4.0 * th[0] * np.sin(np.pi * f) ** 2,
-        ieee=lambda th, dt: {"Q_arcsec": math.sqrt(th[0]) * dt,
-                             "Q_urad": math.sqrt(th[0]) * dt * 1e6 * math.pi / 648000.0},
-        excess_kurtosis=-1.2,
-    ),
-    "WN": Process(
-        "WN", "white noise (angle random walk)", ("sigma2",), ("rate^2",),
-        wv=lambda th, tau: th[0] / np.asarray(tau, dtype=np.float64),
-        sdf=lambda th, f: np.full(np.shape(f), th[0]),
-        ieee=lambda th, dt: {"N_dprh": math.sqrt(th[0] * dt) / _SQRT_H},
-    ),
-    "RW": Process(
-        "RW", "random walk (rate random walk)", ("gamma2",), ("rate^2",),
-        wv=lambda th, tau: th[0] * (np.asarray(tau, dtype=np.float64) ** 2 + 2.0)
-        / (12.0 * np.asarray(tau, dtype=np.float64)),
-        sdf=lambda th, f: th[0] / (4.0 * np.sin(np.pi * f) ** 2),
-        ieee=lambda th, dt: {"K_dphrh": math.sqrt(th[0] / dt) * _SQRT_H},
-    ),
-    "DR": Process(
-        "DR", "drift (rate ramp)", ("omega",), ("rate per sample",),
-        wv=lambda th, tau: th[0] ** 2 * np.asarray(tau, dtype=np.float64) ** 2 / 16.0,
-        sdf=None,
-        ieee=lambda th, dt: {"R_dph2": th[0] / dt * 3600.0},
-    ),
-    "FLICKER": Process(
-        "FLICKER", "flicker noise (bias instability)", ("b2",), ("rate^2",),
-        wv=lambda th, tau: th[0] * flicker_wv_factor(tau),
-        sdf=lambda th, f: th[0] / (2.0 * np.pi * np.abs(f)),
-        ieee=lambda th, dt: {"B_dph": math.sqrt(th[0])},
-    ),
-    "GM": Process(
-        "GM", "Gauss-Markov / AR(1)", ("beta", "sigma2"), ("1/sample", "rate^2"),
-        wv=lambda th, tau: ar1_wv(th[0], th[1], tau),
-        sdf=_gm_sdf,
-        ieee=_gm_ieee,
-    ),
-}
 
 #: A natural parameter in words, as shown to the user (``"RW.gamma2"`` -> ``"RW variance"``).
 _PARAM_WORDS = {"q2": "variance", "sigma2": "variance", "gamma2": "variance", "omega": "slope",
@@ -434,11 +220,33 @@ def param_label(name: str) -> str:
     return f"{comp} {_PARAM_WORDS.get(par, par)}" if par else comp
 
 
-#: Accepted spellings in model strings (upper-cased) -> registry key.
-ALIASES = {"GM": "GM", "AR1": "GM", "AR(1)": "GM", "GAUSSMARKOV": "GM", "WN": "WN", "ARW": "WN",
-           "QN": "QN", "RW": "RW", "RRW": "RW", "DR": "DR", "RAMP": "DR", "FLICKER": "FLICKER",
-           "BI": "FLICKER"}
-_ORDER = ("QN", "WN", "RW", "DR", "FLICKER", "GM")
+
+
+class _AliasView(Mapping):
+    """Accepted spellings in model strings (upper-cased) -> registry key: each latent form's name and aliases."""
+
+    def _rows(self):
+        return {a: p.name for p in latent_processes().values() for a in (p.name, *p.aliases)}
+
+    def __getitem__(self, key):
+        return self._rows()[key]
+
+    def __iter__(self):
+        return iter(self._rows())
+
+    def __len__(self):
+        return len(self._rows())
+
+
+#: Accepted spellings in model strings (upper-cased) -> registry key (GM = AR1, WN = ARW, RW = RRW, DR = RAMP, ...).
+ALIASES = _AliasView()
+_BUILTIN_ORDER = ("QN", "WN", "RW", "DR", "FLICKER", "GM")
+
+
+def _order() -> tuple:
+    """Canonical component order of a model: QN, WN, RW, DR, FLICKER, then registered processes, GM last."""
+    extra = tuple(k for k in latent_processes() if k not in _BUILTIN_ORDER)
+    return _BUILTIN_ORDER[:-1] + extra + ("GM",)
 _MAX_GM = 6
 
 
@@ -476,7 +284,7 @@ class LatentModel:
         n_gm = comps.count("GM")
         self.n_gm = n_gm
         parts = []
-        for key in _ORDER:
+        for key in _order():
             k = comps.count(key)
             if k:
                 parts.append(key if k == 1 else f"{k}{key}")
@@ -498,7 +306,8 @@ class LatentModel:
         self.param_names = tuple(names)
         self.slices = tuple(slices)
         self.n_params = i
-        self._codes = np.array([_CODE[k] for k in comps], dtype=np.int64)
+        self._compiled_ok = all(k in _CODE for k in comps)  # a registered process has no kernel code: NumPy path
+        self._codes = np.array([_CODE.get(k, -1) for k in comps], dtype=np.int64)
         self._starts = np.array([sl.start for sl in slices], dtype=np.int64)
         self._has_flicker = "FLICKER" in comps
         self._dr = slices[comps.index("DR")].start if "DR" in comps else -1
@@ -538,8 +347,40 @@ class LatentModel:
             self._flick[key] = flick
         return flick
 
+    def _numpy(self, theta, tau, want_jac):
+        """As :meth:`_compiled`, by the rows' ``wv`` (a model with a registered process the kernel does not know)."""
+        th = self._theta(theta)
+        t = np.asarray(tau, dtype=np.float64)
+        comps = np.stack([np.broadcast_to(PROCESSES[k].wv(th[sl], t), t.shape)
+                          for k, sl in zip(self.components, self.slices)])
+        jac = self._jacobian_numpy(th, t.ravel()) if want_jac else np.empty((0, 0))
+        return comps, comps.sum(axis=0), jac
+
+    def _jacobian_numpy(self, th, t):
+        cols = []
+        for key, sl in zip(self.components, self.slices):
+            p = th[sl]
+            if key == "GM":
+                h = 1e-3
+                d_beta = (ar1_wv(p[0] * math.exp(h), p[1], t) - ar1_wv(p[0] * math.exp(-h), p[1], t)) / (2.0 * h)
+                cols.extend([d_beta, ar1_wv(p[0], p[1], t)])
+            elif key == "DR":
+                cols.append(2.0 * PROCESSES[key].wv(p, t))
+            elif key in _CODE:
+                cols.append(PROCESSES[key].wv(p, t))
+            else:  # a registered process: central differences in the log of each parameter
+                h = _JAC_H
+                for j in range(p.size):
+                    up, dn = p.copy(), p.copy()
+                    up[j] *= math.exp(h)
+                    dn[j] *= math.exp(-h)
+                    cols.append((PROCESSES[key].wv(up, t) - PROCESSES[key].wv(dn, t)) / (2.0 * h))
+        return np.column_stack(cols)
+
     def _compiled(self, theta, tau, want_jac):
         """Components, total and (if ``want_jac``) Jacobian in one compiled call (see :func:`_wv_kernel`)."""
+        if not self._compiled_ok:
+            return self._numpy(theta, tau, want_jac)
         th = self._theta(theta)
         t = np.asarray(tau, dtype=np.float64)
         shape = t.shape
@@ -587,19 +428,7 @@ class LatentModel:
         t = np.asarray(tau, dtype=np.float64)
         if t.ndim == 1:
             return self._compiled(theta, t, True)[2]
-        th = self._theta(theta)
-        cols = []
-        for key, sl in zip(self.components, self.slices):
-            p = th[sl]
-            if key == "GM":
-                h = 1e-3
-                d_beta = (ar1_wv(p[0] * math.exp(h), p[1], t) - ar1_wv(p[0] * math.exp(-h), p[1], t)) / (2.0 * h)
-                cols.extend([d_beta, ar1_wv(p[0], p[1], t)])
-            elif key == "DR":
-                cols.append(2.0 * PROCESSES[key].wv(p, t))
-            else:
-                cols.append(PROCESSES[key].wv(p, t))
-        return np.column_stack(cols)
+        return self._jacobian_numpy(self._theta(theta), t)
 
     def avar(self, theta, m) -> np.ndarray:
         """Theoretical Allan variance at averaging factors ``m`` (integers >= 1): ``2 nu2(2m)``."""
@@ -758,10 +587,10 @@ def parse_model(model) -> LatentModel:
         if count < 1:
             raise ConfigError(f"component count must be >= 1 in {term.strip()!r}")
         comps.extend([key] * count)
-    for key in _ORDER:
+    for key in _order():
         if key != "GM" and comps.count(key) > 1:
             raise ConfigError(f"model {model!r} repeats {key}; only GM may appear more than once")
     if comps.count("GM") > _MAX_GM:
         raise ConfigError(f"at most {_MAX_GM} GMs per model, got {comps.count('GM')} in {model!r}")
-    comps.sort(key=_ORDER.index)
+    comps.sort(key=_order().index)
     return LatentModel(comps)

@@ -1,6 +1,6 @@
 """Simulate sums of the latent processes of :mod:`fogdrift.gmwm.processes` (per-sample definitions).
 
-Each component draws from its own child stream of ``numpy.random.SeedSequence(seed)``, so
+Each component is drawn by its row's simulator (:mod:`fogdrift.noise.processes`, ``latent.simulate``).  Each component draws from its own child stream of ``numpy.random.SeedSequence(seed)``, so
 the realisation of one component does not depend on the others.  Definitions ([GMWM]_ §2):
 
 * QN: ``x_t = sqrt(12 q2) (U_t - U_{t-1})``, ``U ~ U(0, 1)`` (``n + 1`` uniforms).
@@ -20,29 +20,13 @@ References
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-from scipy.signal import lfilter
 
 from .._util import check_count
 from ..errors import ConfigError
-from .processes import parse_model
+from .processes import PROCESSES, parse_model
 
 __all__ = ["simulate_latent"]
-
-
-def _flicker(n: int, b2: float, rng: np.random.Generator) -> np.ndarray:
-    length = 4 * n if n <= 2**24 else 2 * n
-    nf = length // 2 + 1
-    f = np.arange(nf) / length
-    scale = np.zeros(nf)
-    # E|X_k|^2 = length * S(f_k) for the unnormalised DFT; split over real and imaginary parts
-    scale[1:] = np.sqrt(length * b2 / (2.0 * np.pi * f[1:]) / 2.0)
-    spec = (rng.standard_normal(nf) + 1j * rng.standard_normal(nf)) * scale
-    if length % 2 == 0:
-        spec[-1] = spec[-1].real * math.sqrt(2.0)
-    return np.fft.irfft(spec, n=length)[:n]
 
 
 def simulate_latent(model, theta, n_samples, *, seed) -> np.ndarray:
@@ -81,24 +65,8 @@ def simulate_latent(model, theta, n_samples, *, seed) -> np.ndarray:
     rngs = [np.random.default_rng(s) for s in ss.spawn(len(mdl.components))]
     x = np.zeros(n)
     for key, sl, rng in zip(mdl.components, mdl.slices, rngs):
-        p = th[sl]
-        if key == "WN":
-            x += math.sqrt(p[0]) * rng.standard_normal(n)
-        elif key == "QN":
-            u = rng.random(n + 1)
-            x += math.sqrt(12.0 * p[0]) * np.diff(u)
-        elif key == "RW":
-            x += np.cumsum(math.sqrt(p[0]) * rng.standard_normal(n))
-        elif key == "DR":
-            x += p[0] * np.arange(n, dtype=np.float64)
-        elif key == "FLICKER":
-            x += _flicker(n, p[0], rng)
-        elif key == "GM":
-            beta, s2 = p
-            phi = math.exp(-beta)
-            u = -math.expm1(-beta)
-            e = math.sqrt(s2) * rng.standard_normal(n)
-            x0 = math.sqrt(s2 / (u * (2.0 - u))) * rng.standard_normal()
-            e[0] = x0
-            x += lfilter([1.0], [1.0, -phi], e)
+        sim = PROCESSES[key].simulate
+        if sim is None:
+            raise ConfigError(f"process {key} has no simulator (its row in fogdrift.noise.processes gives none)")
+        x += sim(th[sl], n, rng)
     return x

@@ -31,6 +31,7 @@ import math
 import numpy as np
 
 from ..errors import ConfigError
+from ..noise.processes import processes
 from .statespace import check_components, components_from_allan, flicker_as_gauss_markov
 
 __all__ = ["components_from_noise_fit", "components_from_gmwm", "gmwm_ieee"]
@@ -54,11 +55,14 @@ def components_from_noise_fit(noise) -> tuple[list[dict], list[str]]:
         raise ConfigError(f"the consistency check needs an Allan-variance fit; this one is of {noise.statistic!r}")
     A = np.clip(np.asarray(noise.A, dtype=np.float64)[:5], 0.0, None)
     comps = components_from_allan(A, tau_range_s=(noise.tau_min_s, noise.tau_max_s))
-    m = (noise.shaped or {}).get("M") or {}
-    if "M" in noise.selected and m.get("tc_s") and m.get("sigma_dph"):
-        comps.append({"kind": "gauss_markov", "tc_s": float(m["tc_s"]), "sigma_dph": float(m["sigma_dph"])})
-    if "S" in noise.selected:
-        notes.append("periodic term S left out (it integrates to a bounded angle)")
+    for p in processes():  # the shaped terms selected: each row's own components, or a note why none
+        if p.power_law or p.name not in noise.selected:
+            continue
+        if p.to_components is not None:
+            comps.extend(p.to_components((noise.shaped or {}).get(p.name) or {}, {}))
+        else:
+            notes.append("periodic term S left out (it integrates to a bounded angle)" if p.name == "S"
+                         else f"{p.long_name} {p.name} left out (no state-space form)")
     if noise.no_fit:
         notes.append("no model fits this record's Allan curve: the components are the best candidate's")
     return check_components(comps), notes

@@ -47,13 +47,16 @@ R. E. Kalman, "A new approach to linear filtering and prediction problems", J. B
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ConfigError
-from ..noise.terms import TERM_TABLE, TERMS
-from ..units import URAD_PER_ARCSEC
+from ..noise.processes import component_specs, power_law_names, processes
+from ..noise.processes.flicker import flicker_as_gauss_markov
+from ..noise.processes.gauss_markov import gm_avar_dph2
+from ..noise.terms import TERMS
 
 __all__ = [
     "COMPONENT_KINDS",
@@ -68,17 +71,25 @@ __all__ = [
     "forecast_uncertainty",
 ]
 
-#: Flat Allan variance of flicker rate noise in units of B^2: 2 ln 2 / pi (the B row of the term table).
-_B_AVAR = TERM_TABLE["B"].avar_coefficient
+class _KindView(Mapping):
+    """Component kind -> (parameter keys in order, one-line description with units), from the rows'
+    :class:`~fogdrift.noise.processes.ComponentSpec` (live)."""
 
-#: Component kinds -> (parameter keys in order, one-line description with units). Data, not code.
-COMPONENT_KINDS: dict[str, tuple[tuple[str, ...], str]] = {
-    "white": (("arw_dprh",), "white rate noise (angle random walk N [deg/sqrt(h)]), measurement noise"),
-    "quantization": (("q_urad",), "quantization noise Q [urad], treated as white measurement noise"),
-    "random_walk": (("rrw_dphrh",), "rate random walk K [deg/h^1.5], one random-walk state"),
-    "gauss_markov": (("tc_s", "sigma_dph"), "first-order Gauss-Markov state: correlation time [s], 1-sigma [deg/h]"),
-    "ramp": (("ramp_dph2",), "rate ramp R [deg/h^2]: a ramp state with a random constant slope of 1-sigma R"),
-}
+    def _rows(self):
+        return {k: (c.keys, c.description) for k, c in component_specs().items()}
+
+    def __getitem__(self, key):
+        return self._rows()[key]
+
+    def __iter__(self):
+        return iter(self._rows())
+
+    def __len__(self):
+        return len(self._rows())
+
+
+#: Component kinds -> (parameter keys in order, one-line description with units): the rows' components.
+COMPONENT_KINDS = _KindView()
 
 
 def check_components(components) -> list[dict]:
@@ -131,76 +142,6 @@ def check_components(components) -> list[dict]:
 # ---------------------------------------------------------------------------------------------------
 # Allan coefficients -> components
 # ---------------------------------------------------------------------------------------------------
-def gm_avar_dph2(tau_s, tc_s: float, sigma_dph: float) -> np.ndarray:
-    """Allan variance [(deg/h)^2] of a first-order Gauss-Markov rate with correlation time ``tc_s`` and 1-sigma.
-
-    AVAR(tau) = sigma^2 (T/tau)^2 (2x - 3 + 4 e^-x - e^-2x), x = tau/T (continuous-time process;
-    IEEE Std 952 Annex C, method notes §9.4); maximum 0.3811 sigma^2 at tau = 1.893 T.  A series in
-    x is used for x < 1e-2 (the closed form cancels catastrophically there).
-
-    Examples
-    --------
-    >>> round(float(gm_avar_dph2(1.893, 1.0, 1.0)), 4)
-    0.3811
-    """
-    x = np.asarray(tau_s, dtype=np.float64) / float(tc_s)
-    small = x < 1e-2
-    xs = np.where(small, 1.0, x)
-    closed = (2.0 * xs - 3.0 + 4.0 * np.exp(-xs) - np.exp(-2.0 * xs)) / xs**2
-    series = (2.0 / 3.0) * x - 0.5 * x**2 + (7.0 / 30.0) * x**3
-    return float(sigma_dph) ** 2 * np.where(small, series, closed)
-
-
-def flicker_as_gauss_markov(b_dph: float, tau_min_s: float, tau_max_s: float, *, max_terms: int = 4) -> list[dict]:
-    """Gauss-Markov terms whose summed Allan variance is flat at 0.4413 B^2 over ``[tau_min_s, tau_max_s]``.
-
-    Correlation times are log-spaced from ``tau_min_s/1.893`` to ``tau_max_s/1.893`` (where each
-    term's AVAR peaks), about one per decade and at most ``max_terms``; the variances are fitted by
-    non-negative least squares in relative error on 40 log-spaced taus (method notes §9.7: terms one
-    decade apart give an AVAR ripple of about +-4 %).
-
-    Parameters
-    ----------
-    b_dph : float
-        Bias instability B [deg/h] (flat ADEV 0.6643 B).
-    tau_min_s, tau_max_s : float
-        Tau range [s] over which the flat Allan variance is matched (e.g. the range of the fit
-        that identified B); beyond ``tau_max_s`` the terms decay like white noise.
-    max_terms : int
-        Most terms kept.
-
-    Returns
-    -------
-    list of dict
-        ``{"kind": "gauss_markov", "tc_s": ..., "sigma_dph": ...}``; empty when ``b_dph`` is 0.
-
-    Examples
-    --------
-    >>> gms = flicker_as_gauss_markov(1.0, 1.0, 1000.0)
-    >>> tau = np.geomspace(3.0, 300.0, 9)
-    >>> avar = sum(gm_avar_dph2(tau, g["tc_s"], g["sigma_dph"]) for g in gms)
-    >>> bool(np.all(np.abs(avar / 0.4413 - 1) < 0.2))
-    True
-    """
-    from scipy.optimize import nnls
-
-    b = float(b_dph)
-    lo, hi = float(tau_min_s), float(tau_max_s)
-    if not (math.isfinite(b) and b >= 0):
-        raise ConfigError(f"b_dph must be a finite number >= 0; got {b_dph!r}")
-    if not (0 < lo < hi and math.isfinite(hi)):
-        raise ConfigError(f"flicker tau range must satisfy 0 < tau_min_s < tau_max_s; got {tau_min_s!r}, {tau_max_s!r}")
-    if b == 0:
-        return []
-    n_tc = max(1, min(int(max_terms), int(math.ceil(math.log10(hi / lo))) + 1))
-    tcs = np.geomspace(lo / 1.893, hi / 1.893, n_tc)
-    taus = np.geomspace(lo, hi, 40)
-    design = np.column_stack([gm_avar_dph2(taus, t, 1.0) for t in tcs]) / (_B_AVAR * b * b)
-    var, _ = nnls(design, np.ones(taus.size))
-    return [{"kind": "gauss_markov", "tc_s": float(t), "sigma_dph": float(math.sqrt(v))}
-            for t, v in zip(tcs, var) if v > 0]
-
-
 def components_from_allan(A, *, tau_range_s, terms=TERMS, ramp="random_walk",
                           max_flicker_terms: int = 4) -> list[dict]:
     """Noise components from Allan-law coefficients A_-2..A_2 ((deg/h)^2, tau in s).
@@ -237,8 +178,10 @@ def components_from_allan(A, *, tau_range_s, terms=TERMS, ramp="random_walk",
     [('white', 0.1), ('random_walk', 0.6)]
     """
     a = np.asarray(A, dtype=np.float64)
-    if a.shape != (5,) or not np.all(np.isfinite(a)) or np.any(a < 0):
-        raise ConfigError(f"A must be 5 finite non-negative numbers A_-2..A_2; got {A!r}")
+    n_power = len(power_law_names())
+    if a.shape not in ((5,), (n_power,)) or not np.all(np.isfinite(a)) or np.any(a < 0):
+        raise ConfigError(f"A must be {n_power} finite non-negative numbers (A_-2..A_2 of Q, N, B, K, R, then any "
+                          f"registered power-law process's); got {A!r}")
     terms = tuple(terms)
     if ramp not in ("random_walk", "state"):
         raise ConfigError(f"ramp must be 'random_walk' or 'state'; got {ramp!r}")
@@ -246,20 +189,14 @@ def components_from_allan(A, *, tau_range_s, terms=TERMS, ramp="random_walk",
         a = a.copy()
         a[3] += a[4] * float(tau_range_s[1])
         terms = tuple(t for t in terms if t != "R") + (("K",) if "K" not in terms and a[3] > 0 else ())
+    ctx = {"tau_range_s": tau_range_s, "A_white": a[1], "max_flicker_terms": max_flicker_terms}
+    rows = sorted((p for p in processes() if p.name in terms and p.power_law and p.to_components is not None),
+                  key=lambda p: p.component_rank)
+    index = {name: i for i, name in enumerate(power_law_names()) if i < a.size}
     out = []
-    if "N" in terms and a[1] > 0:
-        out.append({"kind": "white", "arw_dprh": math.sqrt(a[1]) / 60.0})
-    if "Q" in terms and a[0] > 0:
-        out.append({"kind": "quantization", "q_urad": math.sqrt(a[0] / 3.0) * URAD_PER_ARCSEC})
-    if "K" in terms and a[3] > 0:
-        out.append({"kind": "random_walk", "rrw_dphrh": 60.0 * math.sqrt(3.0 * a[3])})
-    if "B" in terms and a[2] > 0:
-        lo, hi = (float(t) for t in tau_range_s)
-        if a[1] > 0:  # below the white/flicker crossover N^2/tau = A_0 the white noise dominates
-            lo = max(lo, min(a[1] / a[2], hi / 10.0))
-        out.extend(flicker_as_gauss_markov(math.sqrt(a[2] / _B_AVAR), lo, hi, max_terms=max_flicker_terms))
-    if "R" in terms and a[4] > 0:
-        out.append({"kind": "ramp", "ramp_dph2": 3600.0 * math.sqrt(2.0 * a[4])})
+    for p in rows:
+        if p.name in index:
+            out.extend(p.to_components(float(a[index[p.name]]), ctx))
     return out
 
 
@@ -318,19 +255,9 @@ def component_densities(components) -> dict:
     (36.0, 1.0, 0.0001, True, [0.01])
     """
     out = {"white2": 0.0, "quant2": 0.0, "rw2": 0.0, "random_walk": False, "gms": [], "ramps": []}
+    specs = component_specs()
     for c in components:
-        kind = c["kind"]
-        if kind == "white":
-            out["white2"] += (60.0 * c["arw_dprh"]) ** 2
-        elif kind == "quantization":
-            out["quant2"] += (c["q_urad"] / URAD_PER_ARCSEC) ** 2
-        elif kind == "random_walk":
-            out["random_walk"] = True
-            out["rw2"] += (c["rrw_dphrh"] / 60.0) ** 2
-        elif kind == "gauss_markov":
-            out["gms"].append((c["tc_s"], c["sigma_dph"]))
-        elif kind == "ramp":
-            out["ramps"].append(c["ramp_dph2"] / 3600.0)
+        specs[c["kind"]].densities(c, out)  # each row's component adds its densities
     return out
 
 
