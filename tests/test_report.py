@@ -125,7 +125,7 @@ const p=g.getImageData(0,0,c.width,c.height).data;let n=0,s=0,q=0;
 for(let k=0;k<p.length;k+=4*7){const y=p[k]+p[k+1]+p[k+2];n++;s+=y;q+=y*y;}v=q/n-(s/n)*(s/n);}catch(e){v=-2;}
 const r=i.getBoundingClientRect();
 return {ok:i.complete,nw:i.naturalWidth,nh:i.naturalHeight,w:+i.getAttribute('width'),h:+i.getAttribute('height'),
-var:v,shown:r.width,top:r.top+scrollY};});
+var:v,shown:r.width,top:r.top+scrollY,insum:!!i.closest('#summary')};});
 const sm=document.getElementById('summary').getBoundingClientRect();
 document.body.setAttribute('data-probe',JSON.stringify({sw:document.documentElement.scrollWidth,iw:innerWidth,
 images:im,summary_bottom:sm.bottom+scrollY,tables:document.querySelectorAll('table').length}));});</script>"""
@@ -133,7 +133,8 @@ images:im,summary_bottom:sm.bottom+scrollY,tables:document.querySelectorAll('tab
 
 def test_report_layout_at_1280_px(report_dir, tmp_path):
     """At 1280 px: no horizontal scroll, every figure decoded at its own size (1200 px wide), not blank and not
-    wider than the window, and the summary (recording, noise, verdicts, limits) above the first figure."""
+    wider than the window, and the summary (recording, noise, screen, verdicts, limits) above the first figure
+    outside it (the summary holds one: the dynamic ADEV of the disturbed axis)."""
     from fogdrift.report.figures import DPI, FIG_WIDTH_IN
 
     browser = _browser_or_skip()
@@ -157,7 +158,10 @@ def test_report_layout_at_1280_px(report_dir, tmp_path):
         assert img["nw"] == round(FIG_WIDTH_IN * DPI), (i, img)  # full width of the report column
         assert img["var"] > 0, (i, img)  # not blank (a canvas read that failed gives -2)
         assert 0 < img["shown"] <= info["iw"], (i, img)
-    assert info["summary_bottom"] <= min(img["top"] for img in images), info
+    # the summary comes before every figure but its own: the dynamic ADEV of a disturbed axis (the bundled gz is
+    # disturbed throughout), which belongs to the first screen
+    assert sum(img["insum"] for img in images) == 1, info
+    assert info["summary_bottom"] <= min(img["top"] for img in images if not img["insum"]), info
 
 
 def test_pdf_is_written_with_the_report(report_dir):
@@ -221,10 +225,11 @@ def test_pipeline_blocks_do_not_leak(bundled_record):
 
 
 def test_report_files_have_deterministic_names(report_dir):
-    """Figure names carry the figure number and the axis; the applied section's start "apply_to_" (no _0/_2)."""
+    """Figure names carry the figure number and the axis; the applied section's start "apply_to_" (no _0/_2); the
+    first screen's dynamic ADEV (the bundled gz is disturbed) is fig_dynamic_adev."""
     out, _ = report_dir
     figs = sorted(p.name for p in (out / "figures").iterdir())
-    assert figs == sorted(["fig1_signal.png", "fig2_spectrum.png", "fig3_allan_gz.png", "fig5_drift_noise_gz.png",
+    assert figs == sorted(["fig_dynamic_adev.png", "fig1_signal.png", "fig2_spectrum.png", "fig3_allan_gz.png", "fig5_drift_noise_gz.png",
                            "fig6_allan_gz.png", "fig8_models_gz.png", "fig9_residual_gz.png",
                            "apply_to_fig3_allan_gz.png", "apply_to_fig5_drift_noise_gz.png",
                            "apply_to_fig6_allan_gz.png", "apply_to_fig10_models_gz.png",

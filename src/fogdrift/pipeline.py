@@ -417,7 +417,9 @@ def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, sp
         noise = express_quantity(noise, quantity)
     if outliers is not None:
         noise = dataclasses.replace(noise, outliers=outliers.to_dict())
-    return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers, screen=screen)
+    # what the whole record gives (``--segments whole``), kept beside the segments' fit for the output and the report
+    whole = analyse_allan(name, rate_dph, dt_s, cfg, outliers=outliers, quantity=quantity).noise
+    return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers, screen=screen, whole_noise=whole)
 
 
 def _treated_record(record, cfg: AnalysisConfig):

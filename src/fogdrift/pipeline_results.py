@@ -39,12 +39,17 @@ class AllanAxis:
     #: The record screen of this axis (:meth:`fogdrift.screen.ScreenResult.to_dict` with the segments fitted), when
     #: one was made.
     screen: dict | None = None
+    #: The noise fit of the whole record when ``noise`` is the fit of the quiet segments (``--segments auto`` on a
+    #: disturbed axis, or explicit ranges): what ``--segments whole`` would have given.  None otherwise.
+    whole_noise: NoiseFit | None = None
 
     def to_dict(self) -> dict:
         out = {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict(),
                "outliers": None if self.outliers is None else self.outliers.to_dict()}
         if self.screen is not None:
             out["screen"] = self.screen
+        if self.whole_noise is not None:
+            out["whole_record_noise"] = self.whole_noise.to_dict()
         return out
 
 

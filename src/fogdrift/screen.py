@@ -64,17 +64,25 @@ interval gets a character:
     the excess energy of the interval lies mostly (> 50 %) in at most 1 % of its samples (or
     8 samples) and its largest sample lies beyond the Sidak normal quantile for N samples
     (what quiet Gaussian noise reaches once per record): a few-sample spike train;
+``vibration burst``
+    a level interval whose excess power is band-limited (>= 60 % within one octave) and steady (no window's
+    excess above 3x the interval's median): :func:`fogdrift.screen_kinds.is_vibration_burst`;
+``warm-up``
+    disturbances at the record start that an exponential settling of the window means explains better than one
+    step, merged from the first sample to where the settling falls to one window mean's scatter
+    (:func:`fogdrift.screen_kinds.warm_up_end`);
 ``transient``
     otherwise: the level rises and returns.
+
+The characters only name what the two detectors found (no new detection): the false-alarm rate is theirs.
 
 Quiet segments are the complement of the intervals, each interval widened by ``guard``
 windows on both sides (the edge windows may hold the onset or the coda of the disturbance),
 dropping pieces shorter than ``min_quiet_s`` (default: 5 % of the record, at least 100 samples;
 shorter ones give an Allan deviation only to taus of ~1 % of the record).
 
-Not done: vibration bursts (short-tau variance up while long-tau not) and warm-up drifts are
-not named separately; a warm-up shows as a ``transient`` or a ``level step`` at the start only
-when it changes the window levels or means beyond the thresholds.
+A warm-up is seen only when it moves the window means beyond the step threshold (on white + flicker noise at
+2^16 samples: a settling of 3x the sample deviation with a time constant of 2-8 % of the record is).
 """
 
 from __future__ import annotations
@@ -87,6 +95,7 @@ import numpy as np
 from ._util import check_series
 from .allan import allan_variance, tau_grid
 from .errors import ConfigError, InsufficientDataError
+from .screen_kinds import is_vibration_burst, warm_up_end, welch_windows
 from .units import check_dt_s
 
 __all__ = ["screen_record", "ScreenResult", "Disturbance", "dynamic_adev", "default_window",
@@ -137,7 +146,7 @@ class Disturbance:
     Attributes
     ----------
     kind : str
-        ``"transient"``, ``"level step"`` or ``"shock"`` (module docstring).
+        ``"transient"``, ``"level step"``, ``"shock"``, ``"vibration burst"`` or ``"warm-up"`` (module docstring).
     start, stop : int
         Sample indices, stop exclusive (a step found by the mean test alone: the step sample,
         ``stop = start + 1``).
@@ -421,12 +430,36 @@ def _step_time(y: np.ndarray, a: int, b: int) -> int:
     return a + 1 + int(np.argmax(stat))
 
 
+def _warm_up(intervals: list, ratio, mu, edges, scale, a_pair: float, L: int, dt: float, head: int) -> list:
+    """The disturbances at the record start merged into one ``warm-up`` interval when an exponential settling of the
+    window means explains them (:func:`fogdrift.screen_kinds.warm_up_end`); ``intervals`` unchanged otherwise."""
+    sig, dof = scale
+    M = mu.size
+    centres = (edges[:-1] + edges[1:]) / 2.0 * dt
+    use = np.ones(M, dtype=bool)
+    for d in intervals:
+        if d.start > head:  # a later disturbance: its windows (and one on each side) are not the warm-up's
+            use[max(0, d.start // L - 1):min(M, -(-d.stop // L) + 1)] = False
+    found = warm_up_end(mu, centres, use, sig, _t_isf(a_pair, dof) if sig > 0 else math.inf, L * dt)
+    if found is None:
+        return intervals
+    end_s, change = found
+    j_end = min(M, int(math.ceil(end_s / dt / L)))
+    stop = int(edges[j_end])
+    inside = [d for d in intervals if d.start < stop]
+    stop = max([stop] + [d.stop for d in inside])
+    j_stop = min(M, int(math.ceil(stop / L)))
+    peak = math.sqrt(max(1.0, float(np.max(ratio[:max(1, j_stop)]))))
+    warm = Disturbance("warm-up", 0, stop, 0.0, stop * dt, peak, float(change), abs(change) / sig)
+    return [warm] + [d for d in intervals if d.start >= stop]
+
+
 # ----------------------------------------------------------------------------------------
 # Entry points
 # ----------------------------------------------------------------------------------------
 def screen_record(rate, dt_s, *, window_s=None, false_alarm=0.05, min_quiet_s=None, guard=1,
                   merge_windows=None) -> ScreenResult:
-    """Find disturbed intervals (transients, level steps, shocks) in one axis of a rate record.
+    """Find disturbed intervals (transients, level steps, shocks, vibration bursts, warm-ups) in one axis of a record.
 
     Parameters
     ----------
@@ -558,6 +591,7 @@ def screen_record(rate, dt_s, *, window_s=None, false_alarm=0.05, min_quiet_s=No
 
     z_sample = float(ndtri(1.0 - _sidak(a_half, n) / 2.0))  # one Gaussian sample this far out: by chance
     intervals = []
+    quiet_psd = None
     for j0, j1 in _runs(flag, int(merge_windows)):
         a, b = int(edges[j0]), int(edges[j1 + 1])
         peak = math.sqrt(float(ratio[j0:j1 + 1].max()))
@@ -582,12 +616,20 @@ def screen_record(rate, dt_s, *, window_s=None, false_alarm=0.05, min_quiet_s=No
             if (excess > 0 and float(e_top.sum()) - s_ref * top > 0.5 * excess
                     and float(e_top[-1]) > z_sample**2 * s_ref):
                 kind = "shock"
+            else:
+                if quiet_psd is None:
+                    quiet_psd = welch_windows(y, edges[:-1][ok], L)
+                if is_vibration_burst(y, a, b, L, quiet_psd, ratio[j0:j1 + 1]):
+                    kind = "vibration burst"
         intervals.append(Disturbance(kind, a, b, a * dt, b * dt, peak, step, sig_step))
     for p, d, k in steps:
         if any(iv.start - L <= p <= iv.stop + L for iv in intervals):
             continue  # inside or next to a level interval: judged there
         intervals.append(Disturbance("level step", p, p + 1, p * dt, p * dt, 1.0, d, k))
     intervals.sort(key=lambda d: d.start)
+    head = max(4 * L, int(0.05 * n))  # a disturbance found this close to the start may be a warm-up
+    if intervals and intervals[0].start <= head:
+        intervals = _warm_up(intervals, ratio, mu, edges, scales[1], a_pair, L, dt, head)
 
     cuts = [(max(0, d.start - guard * L), min(n, d.stop + guard * L)) for d in intervals]
     quiet = []

@@ -20,8 +20,8 @@ from ..evaluation.verdicts import CONSTANT_BIAS_LABEL, judge, table2_marks
 from ..models.registry import MODELS
 from ..output import atomic_path
 from ..temperature import summary_line, temperature_summary
-from .figures import (_safe, plot_allan, plot_models, plot_residuals, plot_separation, plot_separation_allan,
-                      plot_signal, plot_spectrum)
+from .figures import (_safe, plot_allan, plot_dynamic_adev, plot_models, plot_residuals, plot_separation,
+                      plot_separation_allan, plot_signal, plot_spectrum)
 from .files import write_json
 from .glossary import glossary_entries
 from .settings import settings_rows
@@ -30,6 +30,7 @@ from .summary import (OUTCOME_LABELS, SPEC_LABELS, cannot_support, noise_headlin
 from .tables import (METRICS_HEADERS, NOISE_HEADERS, _fmt, causal_metrics_rows, fit_cell, metrics_rows, noise_notes, noise_row,
                      readout_text, verdict)
 from .pdf import write_pdf
+from .screen import screen_summary
 from .sections import sections
 from .temperature import plot_rate_and_temperature
 
@@ -52,7 +53,7 @@ table{border-collapse:collapse;margin:0.5em 0 0.8em;font-size:0.86em}
 th,td{border:1px solid #c4c4c4;padding:3px 7px;text-align:right;vertical-align:top;overflow-wrap:normal;
  word-break:normal;hyphens:manual}
 th{background:#eee}td:first-child,th:first-child{text-align:left}
-table.kv td{text-align:left}table.limits td{text-align:left}table.heading td:nth-child(-n+2),table.heading th:nth-child(-n+2){white-space:nowrap;
+table.kv td{text-align:left}table.screen td,table.intervals td:nth-child(2){text-align:left}table.limits td{text-align:left}table.heading td:nth-child(-n+2),table.heading th:nth-child(-n+2){white-space:nowrap;
  overflow-wrap:normal}table.heading td:nth-child(2){text-align:left}table.limits td:first-child{white-space:nowrap}table.kv td:first-child{white-space:nowrap;color:#444}
 table.settings td{text-align:left}table.settings tr.group th{text-align:left;background:#dde6ef}
 table.settings td:first-child{width:28%}
@@ -166,14 +167,42 @@ def _spec_block(spec: dict) -> str:
     return "\n".join(parts)
 
 
-def _summary_section(result, sensor, evaluated, spec=None) -> str:
+def _screen_block(result, fig_dir) -> str:
+    """The record screen on the first screen (:func:`fogdrift.report.screen.screen_summary`): per axis what disturbs
+    it and what the noise fit used against the whole record, the disturbed intervals, and the dynamic ADEV figure
+    of the disturbed axes (the values the screen holds; nothing recomputed)."""
+    scr = screen_summary(result)
+    if scr is None:
+        return ""
+    parts = ["<h3>Is the record stationary? The screen before the noise fit</h3>"]
+    if not scr["disturbed"]:
+        parts.append(f'<p class="note">No disturbed interval on any axis (false-alarm rate {scr["false_alarm"]:g} per '
+                     "axis): the noise fit uses the whole record.</p>")
+        return "\n".join(parts)
+    parts.append(_table(scr["axes"]["headers"], scr["axes"]["rows"], "screen"))
+    parts.append("<h4>Disturbed intervals (times from the first sample)</h4>")
+    parts.append(_table(scr["intervals"]["headers"], scr["intervals"]["rows"], "intervals"))
+    parts.append('<p class="note">A disturbance only adds to the sensor\'s own noise: the figures of the fit used '
+                 "are the gyro's under the quiet part; the whole record's include the disturbance. Method and "
+                 "characters (transient, level step, shock, vibration burst, warm-up): docs/disturbed-records.md.</p>")
+    fig = plot_dynamic_adev([ax.original for ax in result.axes], Path(fig_dir) / "fig_dynamic_adev.png")
+    if fig is not None:
+        parts.append(_img(fig, "Dynamic Allan deviation of each disturbed axis: ADEV over sliding windows (1/8 of "
+                               "the record, quarter-window steps) against time and τ; red above: the disturbed "
+                               "intervals."))
+    return "\n".join(parts)
+
+
+def _summary_section(result, sensor, evaluated, spec=None, fig_dir=None) -> str:
     parts = ['<section class="summary" id="summary"><h2>Summary</h2>']
     parts.append(_table(["recording", ""], recording_rows(result, sensor), "kv"))
     headers, rows = noise_headline(result)
-    parts.append("<h3>How noisy is this gyro? (whole record, native rate; value [95 % interval])</h3>")
+    parts.append("<h3>How noisy is this gyro? (native rate; value [95 % interval])</h3>")
     parts.append(_table(headers, rows, "noise"))
     parts.append('<p class="note">“– (&lt; x)”: not in the selected model, x = 95 % upper bound; “n/e”: not '
                  'estimable (why: below). Definitions in the <a href="#glossary">glossary</a>.</p>')
+    if fig_dir is not None:
+        parts.append(_screen_block(result, fig_dir))
     if spec is not None:
         parts.append(_spec_block(spec))
     parts.append("<h3>Did drift compensation help? Heading error after a static calibration, against "
@@ -420,7 +449,7 @@ def render_report(result, record, fig_dir, *, sensor=None, evaluated=True, gener
     body = [f"<h1>fogdrift report: {_e(src)}</h1>",
             f'<p class="meta">{_e(generated)} · fogdrift {_e(result.versions.get("fogdrift", "?"))} · rates in '
             "deg/h, τ in s</p>",
-            _summary_section(result, sensor, evaluated, spec), f"<nav>{''.join(nav)}</nav>",
+            _summary_section(result, sensor, evaluated, spec, fig_dir), f"<nav>{''.join(nav)}</nav>",
             _settings_section(result, generated),
             '<section id="recording"><h2>Recording</h2>',
             '<p class="note">Method: Tang et al., Chinese J. Lasers 39(10) 2012, with the corrected IEEE-952 '

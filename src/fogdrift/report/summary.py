@@ -15,6 +15,7 @@ from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
 from ..noise import TERM_TABLE
 from ..noise.terms import DISPLAY_UNITS, TERMS
 from ..spec import B_COMPARED, compare, judgement_line, readings_from_gmwm, readings_from_noise_fit
+from .screen import screen_summary
 from .tables import _fmt, noise_row, shaped_cell, term_text
 
 __all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "SPEC_LABELS", "SPEC_OUTCOMES", "recording_rows", "noise_headline",
@@ -290,6 +291,9 @@ def summary_dict(result, sensor: str | None = None, *, evaluated: bool = True, s
     headers, rows = noise_headline(result)
     out = {"recording": dict(recording_rows(result, sensor)), "noise": {"headers": headers, "rows": rows},
            "verdicts": verdict_items(result, evaluated=evaluated), "cannot_support": cannot_support(result)}
+    screen = screen_summary(result)
+    if screen is not None:
+        out["screen"] = screen
     if spec is not None:
         out["spec"] = spec
     if getattr(result, "apply_to", None) is not None:
