@@ -16,12 +16,14 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from fogdrift.allan import allan_variance
 from fogdrift.errors import ConfigError
 from fogdrift.export.conversions import UNIT_TABLE, si_unit, to_si
 from fogdrift.gmwm import gmwm_fit, haar_wvar, parse_model
 from fogdrift.gmwm.processes import PROCESSES, haar_gain2
 from fogdrift.gmwm.simulate import simulate_latent
 from fogdrift.models.statespace import COMPONENT_KINDS, component_densities, components_from_allan
+from fogdrift.noise import fit_noise
 from fogdrift.noise.processes import (LatentSpec, NoiseProcess, TermLaw, TermSpec, power_law_names, process,
                                       processes, registered)
 from fogdrift.noise.terms import TERM_TABLE, VARIANCE_LAWS
@@ -161,7 +163,7 @@ TOY = NoiseProcess(
 )
 
 
-def test_a_process_added_from_a_test_file_reaches_gmwm_the_simulators_the_laws_and_the_exports():
+def test_a_process_added_from_a_test_file_reaches_both_estimators_the_simulators_and_the_exports():
     assert "X" not in TERM_TABLE and "FRAC" not in PROCESSES
     with registered(TOY):
         # the Allan-law views and the lookup see it
@@ -187,6 +189,14 @@ def test_a_process_added_from_a_test_file_reaches_gmwm_the_simulators_the_laws_a
         t2, ad, err, _ = allantools.oadev(y, rate=1.0 / dt, data_type="freq", taus=taus)
         want = TOY.laws["adev"].scale(dt) * xval**2 * t2**-0.5
         assert np.all(np.abs(ad**2 / want - 1.0) < 0.15), (ad**2 / want)
+        # the Allan fit: its law is a column of the design, its spectrum enters the covariance; selected by default
+        for seed in (0, 1):
+            av = allan_variance(simulate(2**18, dt, arw_dprh=0.01, frac_dphs4=1.0, seed=seed), dt)
+            fit = fit_noise(av)
+            x_term = fit.terms["X"]
+            assert "X" in fit.selected and x_term.status == "resolved" and x_term.unit == "deg/h*s^(1/4)"
+            assert x_term.lo95 < 1.0 < x_term.hi95, x_term
+            assert fit.terms["N"].lo95 < 0.01 < fit.terms["N"].hi95
         # the exports convert its reported unit to SI through its row
         v, unit, _ = to_si(2.0, "X", "deg/h*s^(1/4)")
         assert unit == "rad/s*s^(1/4)" and v == pytest.approx(2.0 * math.pi / 180.0 / 3600.0)

@@ -41,6 +41,7 @@ from .terms import (
     TermSpec,
     default_terms,
     laws_of,
+    power_terms,
     term_spec,
 )
 from ..units import B_FACTOR
@@ -171,10 +172,11 @@ def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penal
         if isinstance(terms, str):
             terms = tuple(t for t in terms.replace("+", ",").split(",") if t.strip())
         terms = tuple(str(t).strip().upper() for t in terms)
-        bad = [t for t in terms if t not in TERMS]
+        names = power_terms()
+        bad = [t for t in terms if t not in names]
         if bad or not terms or len(set(terms)) != len(terms):
-            raise ConfigError(f"terms must be distinct names from {TERMS}, got {terms!r} (option {{opt:terms}})")
-        terms = tuple(t for t in TERMS if t in terms)
+            raise ConfigError(f"terms must be distinct names from {names}, got {terms!r} (option {{opt:terms}})")
+        terms = tuple(t for t in names if t in terms)
     var = np.asarray(allan.var_dph2, dtype=np.float64)
     hi = np.asarray(allan.dev_hi95_dph, dtype=np.float64) ** 2
 

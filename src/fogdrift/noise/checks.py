@@ -19,12 +19,12 @@ from ..units import B_FACTOR
 from .engine import ScoreProblem, profile_interval
 from .periodic import Q_OVER_ENVELOPE, q_stands_above_lines
 from .result import NoiseTerm
-from .terms import ALL_TERMS, DISPLAY_UNITS, TERM_TABLE, markov_shape, periodic_shape
+from .terms import DISPLAY_UNITS, TERM_TABLE, all_terms, markov_shape, periodic_shape
 
 if TYPE_CHECKING:
     from .identify import _Context
 
-_NAMES = ALL_TERMS  # Q N B K R, then the shaped Annex C terms S (periodic) and M (Gauss-Markov)
+_names = all_terms  # the fit's columns: Q N B K R (then any registered power-law term), S, M
 
 
 def _point_limits(y, nu) -> np.ndarray:
@@ -45,7 +45,7 @@ def _points_outside(y, mu, nu) -> np.ndarray:
 
 def _check_floor(terms, c: _Context, A) -> None:
     """Refuse a flat B floor above the measured curve's minimum (its 95 % upper bound): the data fall below it."""
-    i = _NAMES.index("B")
+    i = _names().index("B")
     floor_var = A[i]
     k = int(np.argmin(c.y))
     if floor_var > c.y_hi[k]:
@@ -75,8 +75,8 @@ def _classical_b(c: _Context, A, floor_refused: bool = False) -> dict:
                 "rule": "min of the measured ADEV / 0.664 (IEEE Std 952-1997 C.2), an upper bound: the fitted flat "
                         "floor lies above the measured curve"}
     grid = np.logspace(math.log10(c.tau[0]), math.log10(c.tau[-1]), 400)
-    var = sum(A[i] * c.laws[n].shape(grid, c.dt) for i, n in enumerate(_NAMES) if n in c.laws)
-    iS, iM = _NAMES.index("S"), _NAMES.index("M")
+    var = sum(A[i] * c.laws[n].shape(grid, c.dt) for i, n in enumerate(_names()) if n in c.laws)
+    iS, iM = _names().index("S"), _names().index("M")
     if A[iM] > 0 and c.tc_s is not None:  # the printed model: its shaped terms too
         var = var + A[iM] * markov_shape(grid, c.tc_s, c.statistic, c.dt)
     if A[iS] > 0 and c.lines:
@@ -118,10 +118,10 @@ def _drop_rejected(c: _Context, prob, res, best, plausible_delta=6.0):
     """
     dropped = {}
     ic_now = res[best]["ic"]
-    for _ in range(len(_NAMES)):
+    for _ in range(len(_names())):
         a = res[best]["a"]
         bad = None
-        iB = _NAMES.index("B")
+        iB = _names().index("B")
         if iB in best and "B" in c.laws:
             tmp = {}
             _check_floor(tmp, c, a)
@@ -131,7 +131,7 @@ def _drop_rejected(c: _Context, prob, res, best, plausible_delta=6.0):
             for i in best:
                 u = float(prob.upper[i])
                 if u > 0 and a[i] >= (1.0 - 1e-3) * u and len(best) > 1:
-                    name = _NAMES[i]
+                    name = _names()[i]
                     ub_pt = _point_limits(prob.y, prob.nu)
                     k = int(np.nanargmin(np.where(prob.X[:, i] > 0, ub_pt / np.where(prob.X[:, i] > 0, prob.X[:, i], 1),
                                                   np.inf)))
@@ -156,7 +156,7 @@ def _drop_rejected(c: _Context, prob, res, best, plausible_delta=6.0):
         if not keep:
             break
         alt = min(keep, key=lambda k: res[k]["ic"])
-        if _NAMES[i] != "B" and res[alt]["ic"] > ic_now + plausible_delta:
+        if _names()[i] != "B" and res[alt]["ic"] > ic_now + plausible_delta:
             break  # the data need the term: it stays at its bound (noted)
         dropped[i] = term
         best = alt
@@ -172,7 +172,7 @@ def _q_at_whole_periods(c: _Context, prob, best, A, d2, periodic, out_terms) -> 
     (where every line of a component vanishes at its whole periods) tell them apart.  A Q the fit resolves is kept
     resolved only if it is still resolved from zero on those taus alone; otherwise it is reported unresolved with
     that reason (lower bound 0)."""
-    iQ, iS = _NAMES.index("Q"), _NAMES.index("S")
+    iQ, iS = _names().index("Q"), _names().index("S")
     p_min = min(periodic.periods_s) if periodic is not None and periodic.periods_s else None
     if p_min is None:
         return
@@ -197,7 +197,7 @@ def _q_at_whole_periods(c: _Context, prob, best, A, d2, periodic, out_terms) -> 
     else:
         sub = ScoreProblem(prob.X[k0:], prob.y[k0:], _sub_cov(prob, k0), prob.upper, prob.extra_var)
         a, q_sub = sub.fit(best)
-        full = np.zeros(len(_NAMES))
+        full = np.zeros(len(_names()))
         full[list(best)] = a
         lo = profile_interval(sub, best, full, iQ, q_sub, d2)[0] if full[iQ] > 0 else 0.0
     if lo > 0:

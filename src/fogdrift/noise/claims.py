@@ -20,12 +20,12 @@ from scipy.stats import chi2
 
 from .result import NoiseTerm
 from .rules import SLOPES, slope_claim
-from .terms import ALL_TERMS, TERM_TABLE, TERMS
+from .terms import TERM_TABLE, all_terms, power_terms
 
 if TYPE_CHECKING:
     from .identify import _Context
 
-_NAMES = ALL_TERMS  # Q N B K R, then the shaped Annex C terms S (periodic) and M (Gauss-Markov)
+_names = all_terms  # the fit's columns: Q N B K R (then any registered power-law term), S, M
 
 
 _CURVE = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}
@@ -73,7 +73,7 @@ def _slope_refusals(c: _Context, prob, res) -> dict:
         a = v["a"]
         mu = None
         for name in ("K", "R"):
-            i = _NAMES.index(name)
+            i = _names().index(name)
             if i in k and a[i] > 0:
                 mu = c.X @ a if mu is None else mu
                 claim = slope_claim(c.tau, c.y, lo, hi, mu, _rising_var(c, a, name), SLOPES[name], name=name,
@@ -88,7 +88,7 @@ def _rising_var(c: _Context, a, name):
     """The variance the rule weighs for ``name``: K's stretch is the rise of K and R together (a K between a
     flicker floor and a ramp shapes a sustained rise without ever holding half the variance alone); R's is R's."""
     cols = ("K", "R") if name == "K" else (name,)
-    return sum(c.X[:, _NAMES.index(t)] * a[_NAMES.index(t)] for t in cols)
+    return sum(c.X[:, _names().index(t)] * a[_names().index(t)] for t in cols)
 
 
 def _best_claimable(res, refused, fallback=None):
@@ -109,7 +109,7 @@ def _no_fit_terms(c: _Context, out_terms: dict, laws, dt_s) -> None:
     MEMS axis).  The best candidate's value is kept, labelled by the status.
     """
     data_bound = c._upper()  # per term, in law units: the ~4-sigma limit of the curve alone, no model
-    for i, name in enumerate(TERMS):
+    for i, name in enumerate(power_terms()):
         t = out_terms.get(name)
         if t is None or name not in laws or t.status not in ("resolved", "unresolved", "absent"):
             continue

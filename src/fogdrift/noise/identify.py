@@ -50,7 +50,8 @@ from .notes import (_absent_reason, _at_bound_notes, _describe_excluded, _larges
 from .result import NoiseFit, NoiseTerm
 from .claims import _CURVE, _best_claimable, _measured_limits, _no_fit_terms, _rising_var, _slope_refusals
 from .rules import SLOPES, slope_claim
-from .terms import ALL_TERMS, TERM_TABLE, TERMS, UNESTIMABLE, laws_of, markov_shape, periodic_shape
+from .processes import power_law_sdf
+from .terms import TERM_TABLE, UNESTIMABLE, all_terms, laws_of, markov_shape, periodic_shape, power_terms
 
 # the checks and words that lived here before the split stay importable from this module
 from .checks import _points_outside, _sub_cov  # noqa: F401
@@ -58,8 +59,8 @@ from .notes import GAP_NOTE_RATIO, _shape_hint, _slope, _tau_span, _worst_region
 
 __all__ = ["identify", "thin_taus", "POOR_CHI2_RED"]
 
-_NAMES = ALL_TERMS  # Q N B K R, then the shaped Annex C terms S (periodic) and M (Gauss-Markov)
-_NP = len(TERMS)
+_names = all_terms  # the fit's columns: Q N B K R (then any registered power-law term), S, M
+
 #: The diagonal of the model-discrepancy allowance's relative covariance (no chi-squared error: see ScoreProblem).
 _ALLOW = float(discrepancy_relcov([1.0])[0, 0])
 #: A fit whose reduced chi-squared exceeds this is "poor" (the misfit is several times the statistical error).
@@ -101,25 +102,25 @@ class _Context:
         self.strides = np.ones(tau.size) if strides is None else strides
         self.n, self.dt, self.statistic = n, dt, statistic
         self.laws = laws_of(statistic)
-        self.names = names  # allowed terms, in TERMS order
-        self.cols = tuple(_NAMES.index(t) for t in names)
+        self.names = names  # allowed terms, in the order of the fit's columns
+        self.cols = tuple(_names().index(t) for t in names)
         # design column of each term (the law's tau shape; its constant is part of the fitted A)
-        self.X = np.stack([self.laws[t].shape(tau, dt) if t in self.laws else np.zeros_like(tau) for t in TERMS]
+        self.X = np.stack([self.laws[t].shape(tau, dt) if t in self.laws else np.zeros_like(tau) for t in power_terms()]
                           + [np.zeros_like(tau), np.zeros_like(tau)], axis=1)
         self.lines = tuple(lines)  # [(freq_hz, relative power)] of the periodic error (S), from the spectrum
         self.tc_s = None
         if self.lines:
-            self.X[:, _NAMES.index("S")] = periodic_shape(tau, self.lines, dt, statistic)
+            self.X[:, _names().index("S")] = periodic_shape(tau, self.lines, dt, statistic)
         if tc_s is not None:
             self.set_tc(tc_s)
         if "B" in self.laws:  # flicker: the sampled process is not flat at small m (+19 % at m = 1 for ADEV)
-            self.X[:, _NAMES.index("B")] *= flicker_shape(m, statistic)
+            self.X[:, _names().index("B")] *= flicker_shape(m, statistic)
         self.upper = self._upper()
 
     def set_tc(self, tc_s):
         """Set the Gauss-Markov correlation time [s] of the M column (the column of the shape at ``tc_s``)."""
         self.tc_s = float(tc_s)
-        self.X[:, _NAMES.index("M")] = markov_shape(self.tau, self.tc_s, self.statistic, self.dt)
+        self.X[:, _names().index("M")] = markov_shape(self.tau, self.tc_s, self.statistic, self.dt)
 
     def _upper(self, C=None):
         """Largest coefficient of each term that keeps it, alone, below every point's ~4-sigma upper bound.
@@ -133,10 +134,10 @@ class _Context:
             ub_pt = self.y * (self.y_hi / self.y) ** (4.0 / 1.96)
         else:
             ub_pt = _point_limits(self.y, 2.0 / np.diag(C))
-        out = np.array([np.min(ub_pt / self.X[:, i]) if np.all(self.X[:, i] > 0) else 0.0 for i in range(_NP)])
+        out = np.array([np.min(ub_pt / self.X[:, i]) if np.all(self.X[:, i] > 0) else 0.0 for i in range(len(power_terms()))])
         # a shaped column can vanish at single taus (S at multiples of its period): bound it where it is non-zero
         shaped = [np.min(ub_pt[self.X[:, i] > 0] / self.X[self.X[:, i] > 0, i]) if np.any(self.X[:, i] > 0) else 0.0
-                  for i in range(_NP, len(_NAMES))]
+                  for i in range(len(power_terms()), len(_names()))]
         return np.concatenate([out, shaped])
 
     def sub(self, start):
@@ -150,7 +151,7 @@ class _Context:
 
     def x2(self, A):
         """Squared coefficient of each term in its Allan-law unit, from the law coefficients ``A``."""
-        return {t: max(A[_NAMES.index(t)], 0.0) / self.laws[t].scale(self.dt) for t in self.laws}
+        return {t: max(A[_names().index(t)], 0.0) / self.laws[t].scale(self.dt) for t in self.laws}
 
     def relcov(self, A, exact_ramp=False, allowance=True):
         """Relative covariance of the working points under the model ``A`` (its spectrum, this statistic).
@@ -162,7 +163,7 @@ class _Context:
         (:func:`~fogdrift.noise.covariance.ramp_cross_variance`), which keeps the ramp estimate unbiased.
         """
         x2 = self.x2(A)
-        a_allan = [TERM_TABLE[t].avar_coefficient * x2.get(t, 0.0) for t in TERMS]
+        a_allan = [TERM_TABLE[t].avar_coefficient * x2.get(t, 0.0) for t in power_terms()]
         mu = self.X @ A
         if not exact_ramp and a_allan[4] > 0:
             extra = 1.5 * a_allan[4] * float(self.tau[-1])
@@ -172,11 +173,17 @@ class _Context:
                 # scatter; dividing its variance by the (much smaller, short-tau) ramp mean instead made every
                 # estimate look like ~0.1 EDF, so that any model -- even 10^5 x the data -- "fitted"
                 # (the mean of the spectrum actually used: the ramp's own part replaced by the stand-in's)
-                ir = _NAMES.index("R")
-                mu = mu - self.X[:, ir] * A[ir] + self.X[:, _NAMES.index("K")] * (
+                ir = _names().index("R")
+                mu = mu - self.X[:, ir] * A[ir] + self.X[:, _names().index("K")] * (
                     extra / TERM_TABLE["K"].avar_coefficient * self.laws["K"].scale(self.dt))
-        spec = ieee_spectrum(a_allan, self.dt)
-        i_m = _NAMES.index("M")
+        spec = ieee_spectrum(a_allan[:5], self.dt)
+        extra_rows = [(t, a) for t, a in zip(power_terms()[5:], a_allan[5:]) if a > 0]
+        if extra_rows:  # a registered power-law process: its row's per-sample spectrum at this Allan coefficient
+            base0 = spec
+
+            def spec(f, base0=base0, extra_rows=extra_rows, dt=self.dt):
+                return base0(f) + sum(power_law_sdf(t, a, dt)(f) for t, a in extra_rows)
+        i_m = _names().index("M")
         if A[i_m] > 0 and self.tc_s is not None:  # exact spectrum of the sampled Gauss-Markov process (AR(1))
             phi, s2 = math.exp(-self.dt / self.tc_s), A[i_m] / (2.0 * self.tc_s)
             base = spec
@@ -189,7 +196,7 @@ class _Context:
             V = V + np.diag(self.strides * ramp_cross_variance(self.m, self.n, spec, a_allan[4] * self.dt**2))
         s = np.sqrt(self.inflation)
         C = V * np.outer(s, s) / np.outer(mu, mu)
-        i_s = _NAMES.index("S")
+        i_s = _names().index("S")
         if A[i_s] > 0 and self.lines:
             # a periodic error's share of each estimate gets the white-FM EDF of that tau (independent between
             # taus): a line's amplitude wanders, and as a deterministic sinusoid it would lend the points it
@@ -249,7 +256,7 @@ def _select(ctx: _Context, penalty: float, iters: int = 2, C=None, allowance=Tru
         from scipy.optimize import lsq_linear
 
         a = lsq_linear(Xw / sc, ctx.y * w, bounds=(0.0, np.inf)).x
-    A = np.zeros(len(_NAMES))
+    A = np.zeros(len(_names()))
     A[list(cols)] = np.minimum(a / sc, ctx.upper[list(cols)])
     if not np.any(A > 0):
         A[list(cols)] = ctx.upper[list(cols)] * 1e-3
@@ -257,7 +264,7 @@ def _select(ctx: _Context, penalty: float, iters: int = 2, C=None, allowance=Tru
         C = ctx.relcov(A, allowance=allowance)
         prob = ScoreProblem(ctx.X, ctx.y, C, ctx._upper(C), _ALLOW if allowance else 0.0)
         a, _q = prob.fit(cols)
-        newA = np.zeros(len(_NAMES))
+        newA = np.zeros(len(_names()))
         newA[list(cols)] = a
         done = np.allclose(newA, A, rtol=2e-2, atol=0.0)
         A = newA
@@ -324,9 +331,9 @@ def _choose_start(ctx: _Context, penalty: float, max_fraction: float = 0.5, thre
         # rebalance around it (N down, B up).  Such a point is judged by its score against that line, no refit.
         # (Only when the current fit is not poor: a poor fit's N is no reliable anchor.)
         a_here = here["res"][here["best"]]["a"]
-        i_n = _NAMES.index("N")
+        i_n = _names().index("N")
         if from_white and a_here[i_n] > 0 and _reduced(here, tau.size - s) <= POOR_CHI2_RED:
-            white = np.zeros(len(_NAMES))
+            white = np.zeros(len(_names()))
             white[i_n] = a_here[i_n]
             line = float(ctx.X[s - 1] @ white)
             if ctx.y[s - 1] < line:
@@ -411,7 +418,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         near = np.any(np.abs(tau[:, None] / kt[None, :] - 1.0) < 1e-9, axis=1)
         idx = np.union1d(idx, np.flatnonzero(near)).astype(np.int64)
     tau, y, y_hi, mm, infl_pt, strd = tau[idx], y[idx], y_hi[idx], mm[idx], infl_pt[idx], strd[idx]
-    allowed = tuple(t for t in TERMS if t in laws) if terms is None else tuple(terms)
+    allowed = tuple(t for t in power_terms() if t in laws) if terms is None else tuple(terms)
     bad = [t for t in allowed if t not in laws]
     if bad:
         why = "; ".join(UNESTIMABLE.get((statistic, t), f"{statistic} has no law for {t}") for t in bad)
@@ -438,7 +445,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
                          "reason": _describe_excluded(ctx, start, sel, periodic, spectrum_given, rolloff_hz)})
     c = ctx.sub(start)
     if terms is not None:
-        sel["best"] = tuple(_NAMES.index(t) for t in allowed)
+        sel["best"] = tuple(_names().index(t) for t in allowed)
     prob, res = sel["prob"], sel["res"]
     best = sel["best"]
     refused = {}
@@ -464,7 +471,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     slope_notes = {}
     for k in sorted(refused, key=lambda k: res[k]["ic"]):
         for name in ("K", "R"):
-            if _NAMES.index(name) in k and refused[k].reason.startswith(name) and name not in slope_notes:
+            if _names().index(name) in k and refused[k].reason.startswith(name) and name not in slope_notes:
                 slope_notes[name] = (res[k]["ic"], refused[k].reason)
     # a selected model never holds a term its own checks reject: a flat floor above the measured curve or a term at
     # its ~4-sigma data bound is dropped and the model re-selected without it
@@ -483,13 +490,13 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     # selected model holds a ramp -- the ramp's real (much smaller) covariance, which gives the estimate.  A ramp
     # that really is a random walk in disguise keeps the wide interval; a real ramp gets an unbiased value.
     views = [(prob, res)]
-    iR = _NAMES.index("R")
+    iR = _names().index("R")
     if res[best]["a"][iR] > 0:
         C_exact = c.relcov(res[best]["a"], exact_ramp=True)
         p_exact = ScoreProblem(c.X, c.y, C_exact, c._upper(C_exact), _ALLOW)
         r_exact = {**res, **fit_subsets(p_exact, plaus, ic_penalty)}
         no_r = tuple(i for i in best if i != iR)
-        n_par_r = len(best) + (1 if _NAMES.index("M") in best else 0)
+        n_par_r = len(best) + (1 if _names().index("M") in best else 0)
         if (terms is None and r_exact[best]["q"] / max(1, c.tau.size - n_par_r) > POOR_CHI2_RED
                 and no_r in res and no_r in plaus):
             # as a deterministic ramp (its real covariance) the model misses the curve, while the same curve
@@ -507,7 +514,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
            and views[0][1][k]["ic"] <= ic_best + plausible_delta and k not in plaus] if terms is None else []
     A = res[best]["a"]
     q = res[best]["q"]
-    n_par = len(best) + (1 if _NAMES.index("M") in best else 0)
+    n_par = len(best) + (1 if _names().index("M") in best else 0)
     dof = max(1, c.tau.size - n_par)
     chi2_red = q / dof
     p = float(chi2.sf(q, dof))
@@ -518,13 +525,13 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     mu = c.X @ A
     z = prob.scores(mu)
 
-    candidates = [{"terms": [_NAMES[i] for i in k], "chi2": float(v["q"]), "ic": float(v["ic"]),
+    candidates = [{"terms": [_names()[i] for i in k], "chi2": float(v["q"]), "ic": float(v["ic"]),
                    "delta_ic": float(v["ic"] - sel_res[best]["ic"]), "plausible": k in plaus}
                   for k, v in sorted(sel_res.items(), key=lambda kv: kv[1]["ic"])]
 
     out_terms = {}
     shaped = {}
-    for i, name in enumerate(_NAMES):
+    for i, name in enumerate(_names()):
         if name in ("S", "M"):
             if name not in allowed:
                 continue
@@ -585,16 +592,16 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             why = (_absent_reason(c, name, A, max(his)) if name in laws else
                    "not in the model: the curve is described as well without it")
             if name in slope_notes and slope_notes[name][0] <= ic_best + plausible_delta:
-                why = (f"{why}; {slope_notes[name][1]}; the model {'+'.join(_NAMES[j] for j in best)} describes "
+                why = (f"{why}; {slope_notes[name][1]}; the model {'+'.join(_names()[j] for j in best)} describes "
                        "the curve instead")
             out_terms[name] = NoiseTerm(name, None, spec_unit, 0.0, hi_v, "absent", why)
     if terms is not None and "B" in laws and out_terms.get("B") is not None and out_terms["B"].value is not None:
         _check_floor(out_terms, c, A)  # a fixed model keeps its terms; a floor above the curve is still refused
-    iQ, iS = _NAMES.index("Q"), _NAMES.index("S")
+    iQ, iS = _names().index("Q"), _names().index("S")
     if iQ in best and iS in best and out_terms["Q"].status in ("resolved", "unresolved"):
         _q_at_whole_periods(c, prob, best, A, d2, periodic, out_terms)
     if "S" in allowed:
-        shaped["S"] = {"A": float(A[_NAMES.index("S")]), "lines": [list(x) for x in lines],
+        shaped["S"] = {"A": float(A[_names().index("S")]), "lines": [list(x) for x in lines],
                        "freq_hz": float(periodic.ref_freq_hz), "spectrum_amplitude_dph": periodic.ref_amplitude_dph,
                        "description": periodic.text()}
         t_s = out_terms["S"]
@@ -602,7 +609,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
             f"modelled as S, amplitude {t_s.value:.3g} deg/h at {periodic.ref_freq_hz:.4g} Hz" if t_s.value else
             "not needed by the model in the fitted range (S absent)"))
     if markov_info is not None:
-        iM = _NAMES.index("M")
+        iM = _names().index("M")
         tc = markov_info["tc_s"]
         shaped["M"] = {"A": float(A[iM]), "tc_s": tc, "tc_lo95_s": markov_info["tc_lo95_s"],
                        "tc_hi95_s": markov_info["tc_hi95_s"],
@@ -625,10 +632,10 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     b_min = _classical_b(c, A, floor_refused=out_terms.get("B") is not None and out_terms["B"].status ==
                          "not_estimable" and "contradicted" in (out_terms["B"].reason or "")) \
         if statistic == "adev" else {}
-    A5 = np.asarray(A[:_NP], dtype=np.float64)
+    A5 = np.asarray(A[:len(power_terms())], dtype=np.float64)
     return NoiseFit(
-        statistic=statistic, dt_s=float(dt_s), terms=out_terms, selected=tuple(_NAMES[i] for i in best), A=A5,
-        candidates=candidates, plausible=["+".join(_NAMES[i] for i in k) for k in plaus], fit_tau_s=c.tau,
+        statistic=statistic, dt_s=float(dt_s), terms=out_terms, selected=tuple(_names()[i] for i in best), A=A5,
+        candidates=candidates, plausible=["+".join(_names()[i] for i in k) for k in plaus], fit_tau_s=c.tau,
         fit_var=c.y, model_var=mu, z=z, chi2=float(q), dof=int(dof), chi2_red=float(chi2_red), p_value=p,
         quality=quality, inflation=float(infl), excluded=excluded, notes=notes, b_min=b_min,
         n_samples=int(n_samples), shaped=shaped, no_fit=no_fit,
@@ -639,7 +646,7 @@ def _markov_fits(c: _Context, C, base_cols, tc, penalty):
     """Fits of every model ``subset + M`` at one correlation time ``tc`` [s] under the fixed relative covariance C."""
     c.set_tc(tc)
     prob = ScoreProblem(c.X, c.y, C, c._upper(C), _ALLOW)
-    iM = _NAMES.index("M")
+    iM = _names().index("M")
     subs = [()] + all_subsets(base_cols)
     out = fit_subsets(prob, [tuple(sorted(s + (iM,))) for s in subs], penalty)
     for v in out.values():
@@ -661,9 +668,9 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     """
     from scipy.optimize import minimize_scalar
 
-    if "M" in _NAMES and c.statistic not in ("adev", "hdev", "mdev"):
+    if "M" in _names() and c.statistic not in ("adev", "hdev", "mdev"):
         return None
-    iM = _NAMES.index("M")
+    iM = _names().index("M")
     base_cols = tuple(i for i in c.cols if i != iM)
     # T_c inside the fitted range (2 tau_min .. tau_max / 2): the Gauss-Markov hump (ADEV maximum at ~1.9 T_c)
     # must lie within it, or the term only imitates a filter edge (short T_c) or a random walk (long T_c)
@@ -703,7 +710,7 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     c.set_tc(tc)
     prob0 = ScoreProblem(c.X, c.y, C, c._upper(C), _ALLOW)
     a_sel, _ = prob0.fit(sub)
-    A = np.zeros(len(_NAMES))
+    A = np.zeros(len(_names()))
     A[list(sub)] = a_sel
     C2 = c.relcov(A)
     prob = ScoreProblem(c.X, c.y, C2, c._upper(C2), _ALLOW)
@@ -768,7 +775,7 @@ def _markov_stage(c: _Context, C, res, best, penalty):
 def _markov_qc_interval(c: _Context, prob, best, info, q_min, d2, lo_v, hi_v):
     """``q_c = sqrt(A_M) / T_c`` 95 % interval: the union over the T_c values inside the T_c interval of the
     profile interval of ``A_M`` at each (threshold: the global minimum plus the same ``d2``)."""
-    iM = _NAMES.index("M")
+    iM = _names().index("M")
     C2 = info["C"]
     tc0 = c.tc_s
     los, his = [lo_v], [hi_v]
@@ -778,7 +785,7 @@ def _markov_qc_interval(c: _Context, prob, best, info, q_min, d2, lo_v, hi_v):
         c.set_tc(tc)
         pr = ScoreProblem(c.X, c.y, C2, c._upper(C2), _ALLOW)
         a, qq = pr.fit(best)
-        full = np.zeros(len(_NAMES))
+        full = np.zeros(len(_names()))
         full[list(best)] = a
         if full[iM] <= 0:
             continue

@@ -15,12 +15,12 @@ from scipy.stats import chi2
 
 from .checks import _point_limits, _points_outside
 from .spectral import sinusoid_avar
-from .terms import ALL_TERMS, DISPLAY_UNITS
+from .terms import DISPLAY_UNITS, all_terms
 
 if TYPE_CHECKING:
     from .identify import _Context
 
-_NAMES = ALL_TERMS  # Q N B K R, then the shaped Annex C terms S (periodic) and M (Gauss-Markov)
+_names = all_terms  # the fit's columns: Q N B K R (then any registered power-law term), S, M
 
 
 def _tau_span(lo: float, hi: float) -> str:
@@ -144,7 +144,7 @@ def _no_fit(tau, y, mu, nu, best, chi2_red):
         return None, None
     no_fit = {"tau_min_s": float(tau[0]), "tau_max_s": float(tau[-1]),
               "miss_tau_s": [float(t) for t in tau[miss]],
-              "best_candidate": "+".join(_NAMES[i] for i in best)}
+              "best_candidate": "+".join(_names()[i] for i in best)}
     note = (f"no model fits tau {tau[0]:.3g}-{tau[-1]:.3g} s: the best candidate "
             f"({no_fit['best_candidate']}, chi2_red {chi2_red:.3g}) misses the measured curve outside "
             f"its 95 % intervals at tau = {', '.join(f'{t:.3g}' for t in tau[miss])} s; the "
@@ -186,7 +186,7 @@ def _at_bound_notes(prob, A, best, tau, out_terms) -> list:
         u = float(prob.upper[i])
         if not (u > 0 and A[i] >= (1.0 - 1e-3) * u):
             continue
-        name = _NAMES[i]
+        name = _names()[i]
         t = out_terms[name]
         if t.value is None:  # refused afterwards (a floor above the measured curve): its reason says why
             continue
@@ -209,7 +209,7 @@ def _shape_hint(tau, y, dev) -> str:
 
 def _unresolved_reason(name, lacking, plaus, res, ic_best) -> str:
     if lacking:
-        alt = "+".join(_NAMES[i] for i in lacking[0])
+        alt = "+".join(_names()[i] for i in lacking[0])
         return (f"not resolved from zero: the model {alt} without {name} describes the curve about as well "
                 f"(IC {res[lacking[0]]['ic'] - ic_best:+.1f})")
     return "not resolved from zero: its 95 % interval reaches 0"
@@ -218,9 +218,9 @@ def _unresolved_reason(name, lacking, plaus, res, ic_best) -> str:
 def _absent_reason(c: _Context, name, A, hi_a) -> str:
     """Why a term is not in the model: where would it show at its upper bound?"""
     law = c.laws[name]
-    i = _NAMES.index(name)
+    i = _names().index(name)
     grid = np.logspace(math.log10(c.tau[0]) - 4, math.log10(c.tau[-1]) + 4, 801)
-    rest = sum(A[j] * c.laws[n].shape(grid, c.dt) for j, n in enumerate(_NAMES) if n in c.laws and j != i)
+    rest = sum(A[j] * c.laws[n].shape(grid, c.dt) for j, n in enumerate(_names()) if n in c.laws and j != i)
     dom = grid[hi_a * law.shape(grid, c.dt) >= rest]
     if law.power >= 0 and (dom.size == 0 or dom.min() > c.tau[-1]):
         where = "beyond the record" if dom.size == 0 else f"only beyond tau = {dom.min():.3g} s"

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .terms import TERMS, laws_of, markov_shape, periodic_shape, term_table
+from .terms import laws_of, markov_shape, periodic_shape, power_terms, term_table
 
 __all__ = ["NoiseTerm", "NoiseFit", "TERM_STATUSES"]
 
@@ -170,7 +170,10 @@ class NoiseFit:
         law = laws_of(self.statistic).get(name)
         if law is None:
             return 0.0
-        return float(self.A[TERMS.index(name)]) / law.scale(self.dt_s)
+        names = power_terms()
+        if name not in names or names.index(name) >= len(self.A):
+            return 0.0
+        return float(self.A[names.index(name)]) / law.scale(self.dt_s)
 
     def _term_var(self, name, tau_s, statistic) -> np.ndarray:
         law = laws_of(statistic).get(name)
@@ -193,7 +196,7 @@ class NoiseFit:
         """Fitted deviation [deg/h] of ``statistic`` (default: the fitted one) at ``tau_s`` [s]: every selected term,
         the shaped S and M included (the curve of the printed model)."""
         st = statistic or self.statistic
-        return np.sqrt(sum(self._term_var(n, tau_s, st) for n in TERMS)
+        return np.sqrt(sum(self._term_var(n, tau_s, st) for n in power_terms())
                        + self._shaped_var("S", tau_s, st) + self._shaped_var("M", tau_s, st))
 
     def term_dev_dph(self, name, tau_s, statistic=None) -> np.ndarray:

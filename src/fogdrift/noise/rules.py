@@ -47,6 +47,8 @@ from scipy.optimize import brentq
 from scipy.special import polygamma, psi
 from scipy.stats import chi2
 
+from .processes import processes as _processes
+
 __all__ = ["SlopeClaim", "slope_claim", "DOMINANCE", "Z_SLOPE", "N_LAST", "SLOPES"]
 
 #: Share of the model variance a term must hold at every point of its stretch (criterion (a)).
@@ -62,8 +64,10 @@ N_LAST = 2
 #: ... and judges each against its interval at this level: a right model misses one of two 95 % intervals one
 #: time in ten, which refused true K's; a K read from a hump misses by far more.
 LAST_LEVEL = 0.99
-#: Variance slope against tau of the rising terms: Allan fit names and GMWM process keys.
-SLOPES = {"K": 1.0, "R": 2.0, "RW": 1.0, "DR": 2.0}
+#: Variance slope against tau of the rising terms claimed only from a sustained slope (the rows of
+#: :mod:`fogdrift.noise.processes` with ``slope_rule``): Allan fit names and GMWM process keys.
+SLOPES = {name: float(p.term.avar_power) for p in _processes() if p.slope_rule
+          for name in (p.name, p.latent.name if p.latent is not None else p.name)}
 
 _WORDS = {1.0: "a rate random walk (variance slope +1, deviation slope +1/2)",
           2.0: "a rate ramp (variance slope +2, deviation slope +1)"}

@@ -23,7 +23,9 @@ from types import MappingProxyType
 
 from ..errors import ConfigError
 from .processes import gauss_markov, sinusoid
+from .processes import power_law_names as _power_law_names
 from .processes import processes as _processes
+from .processes import shaped_names as _shaped_names
 from .processes import version as _version
 from .processes.base import TermLaw, TermSpec
 from .processes.gauss_markov import markov_shape
@@ -48,6 +50,8 @@ __all__ = [
     "default_terms",
     "SHAPED_TERMS",
     "ALL_TERMS",
+    "power_terms",
+    "all_terms",
     "sinusoid_shape",
     "periodic_shape",
     "markov_shape",
@@ -234,3 +238,15 @@ def default_terms(statistic="adev") -> tuple:
 SHAPED_TERMS = MappingProxyType({"S": sinusoid.SHAPED, "M": gauss_markov.SHAPED})
 #: Every term the noise fit can select: the five power-law terms, then S and M.
 ALL_TERMS = TERMS + tuple(SHAPED_TERMS)
+
+
+def power_terms() -> tuple:
+    """The power-law terms now in the table: Q, N, B, K, R, then any registered one (live; :data:`TERMS` is the
+    built-in five)."""
+    return _power_law_names()
+
+
+def all_terms() -> tuple:
+    """Every term the Allan fit can select now: :func:`power_terms`, then S and M (live; :data:`ALL_TERMS` is the
+    built-in seven).  The position of a term in this tuple is its column in the fit."""
+    return _power_law_names() + _shaped_names()

@@ -39,6 +39,8 @@ from __future__ import annotations
 from contextlib import contextmanager
 from types import MappingProxyType
 
+import numpy as np
+
 from ...errors import ConfigError
 from . import flicker, gauss_markov, quantization, ramp, random_walk, sinusoid, white
 from .base import ComponentSpec, LatentSpec, NoiseProcess, TermLaw, TermSpec
@@ -46,7 +48,7 @@ from .base import ComponentSpec, LatentSpec, NoiseProcess, TermLaw, TermSpec
 __all__ = [
     "NoiseProcess", "TermSpec", "TermLaw", "LatentSpec", "ComponentSpec",
     "PROCESSES", "process", "processes", "power_law_names", "shaped_names", "register", "unregister", "registered",
-    "latent_processes", "component_specs", "version",
+    "latent_processes", "component_specs", "version", "power_law_sdf",
 ]
 
 #: The rows, in the order of the Allan-fit columns: the power-law terms by their power of tau, then S and M.
@@ -127,6 +129,30 @@ def component_specs() -> dict:
     """Component kind -> :class:`ComponentSpec` of every row that becomes a Kalman component."""
     return {p.component.kind: p.component for p in sorted(_TABLE.values(), key=lambda p: p.component_rank)
             if p.component is not None}
+
+
+def power_law_sdf(name, A, dt_s):
+    """Per-sample two-sided rate spectrum (rate^2 per cycle/sample, ``|f| <= 1/2``) of the power-law row ``name`` whose
+    Allan law has the coefficient ``A`` [(deg/h)^2 s^-power]: its GMWM form (``latent.sdf``) at the parameters that
+    give that Allan coefficient (the first parameter scaled linearly; the Allan fit's covariance of a registered
+    process).
+
+    Examples
+    --------
+    >>> s = power_law_sdf("N", 4.0, 0.01)            # white noise: A = N^2 = sigma2 dt
+    >>> float(s(0.25))
+    400.0
+    """
+    p = process(name)
+    if p.latent is None or p.latent.sdf is None or p.term is None:
+        raise ConfigError(f"noise process {p.name!r} has no per-sample spectrum (its row gives no latent sdf)")
+    n_par = len(p.latent.params)
+    unit = np.ones(n_par)
+    reading = p.latent.ieee(unit, float(dt_s))
+    a_unit = p.term.to_A(reading[p.name + p.term.suffix])
+    theta = unit.copy()
+    theta[0] = float(A) / a_unit
+    return lambda f: p.latent.sdf(theta, np.asarray(f, dtype=np.float64))
 
 
 def register(p: NoiseProcess) -> NoiseProcess:
