@@ -47,7 +47,7 @@ import numpy as np
 
 from ..errors import ConfigError
 
-__all__ = ["FilterSpec", "FILTERS", "estimator_covariance", "expected_variance", "ieee_spectrum", "n_terms",
+__all__ = ["FilterSpec", "FILTERS", "estimator_covariance", "expected_variance", "n_terms",
            "ramp_cross_variance"]
 
 
@@ -151,7 +151,7 @@ def estimator_covariance(m, n_samples, spectrum, *, statistic="adev", per_octave
     n_samples : int
         Number of rate samples ``N``.
     spectrum : callable
-        Two-sided per-sample rate spectrum ``S(f)`` for ``0 < f <= 1/2`` (vectorised), e.g. :func:`ieee_spectrum`.
+        Two-sided per-sample rate spectrum ``S(f)`` for ``0 < f <= 1/2`` (vectorised), e.g. :func:`fogdrift.noise.processes.model_sdf`.
     statistic : {"adev", "hdev", "mdev"}
     per_octave : int
         Quadrature cells per octave of frequency.
@@ -244,32 +244,3 @@ def ramp_cross_variance(m, n_samples, spectrum, a_ramp, *, per_octave=16) -> np.
         osc = np.where(mk * (b - a) < 0.1, np.sin(np.pi * fm * mk) ** 4, osc)
         out[k] = 2.0 * (osc @ slow)  # both signs of f
     return 4.0 * float(a_ramp) * out / M**2
-
-
-def ieee_spectrum(A, dt_s, *, tau_max_s=None):
-    """Per-sample rate spectrum whose Allan variance is ``sum_n A_n tau^n`` (IEEE-952 terms, deg/h and s).
-
-    ``A = (A_-2, A_-1, A_0, A_1, A_2)``: quantization (white angle noise, ``S = 4 Qs^2 sin^2(pi f)``,
-    ``Qs^2 = A_-2/(3 dt^2)``), white rate noise (``S = A_-1/dt``), flicker (``S = A_0/(4 ln2 |f|)``) and random
-    walk (``S = 3 A_1 dt / (4 sin^2(pi f))``).  A rate ramp is deterministic and has no spectrum (its effect on
-    the estimates' variance is :func:`ramp_cross_variance`); ``A_2`` is ignored here.
-
-    Examples
-    --------
-    >>> S = ieee_spectrum([0, 4.0, 0, 0, 0], 0.01)
-    >>> float(S(np.array([0.25]))[0])
-    400.0
-    """
-    Aq, An, Ab, Ak, _ = (float(v) for v in A)
-    dt = float(dt_s)
-    qs2 = Aq / (3.0 * dt * dt)
-    s2 = An / dt
-    h = Ab / (4.0 * math.log(2.0))
-    g2 = 3.0 * Ak * dt
-
-    def spectrum(f):
-        f = np.asarray(f, dtype=np.float64)
-        sf2 = np.sin(np.pi * f) ** 2
-        return 4.0 * qs2 * sf2 + s2 + h / np.abs(f) + g2 / (4.0 * sf2)
-
-    return spectrum

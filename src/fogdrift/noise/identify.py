@@ -43,14 +43,14 @@ from ..allan.ci import edf_simple_safe
 from ..errors import ConfigError, InsufficientDataError
 from .checks import _check_floor, _classical_b, _drop_rejected, _point_limits, _q_at_whole_periods
 from .discrepancy import discrepancy_relcov
-from .covariance import estimator_covariance, expected_variance, ieee_spectrum, ramp_cross_variance
+from .covariance import estimator_covariance, expected_variance, ramp_cross_variance
 from .engine import ScoreProblem, all_subsets, fit_subsets, profile_interval
 from .notes import (_absent_reason, _at_bound_notes, _describe_excluded, _largest_gap_note, _misfit_note, _no_fit,
                     _unresolved_reason)
 from .result import NoiseFit, NoiseTerm
 from .claims import _CURVE, _best_claimable, _measured_limits, _no_fit_terms, _rising_var, _slope_refusals
 from .rules import SLOPES, slope_claim
-from .processes import power_law_sdf
+from .processes import model_sdf
 from .terms import TERM_TABLE, UNESTIMABLE, all_terms, laws_of, markov_shape, periodic_shape, power_terms
 
 # the checks and words that lived here before the split stay importable from this module
@@ -176,13 +176,7 @@ class _Context:
                 ir = _names().index("R")
                 mu = mu - self.X[:, ir] * A[ir] + self.X[:, _names().index("K")] * (
                     extra / TERM_TABLE["K"].avar_coefficient * self.laws["K"].scale(self.dt))
-        spec = ieee_spectrum(a_allan[:5], self.dt)
-        extra_rows = [(t, a) for t, a in zip(power_terms()[5:], a_allan[5:]) if a > 0]
-        if extra_rows:  # a registered power-law process: its row's per-sample spectrum at this Allan coefficient
-            base0 = spec
-
-            def spec(f, base0=base0, extra_rows=extra_rows, dt=self.dt):
-                return base0(f) + sum(power_law_sdf(t, a, dt)(f) for t, a in extra_rows)
+        spec = model_sdf(a_allan, self.dt)  # the rows' per-sample spectra at these Allan coefficients
         i_m = _names().index("M")
         if A[i_m] > 0 and self.tc_s is not None:  # exact spectrum of the sampled Gauss-Markov process (AR(1))
             phi, s2 = math.exp(-self.dt / self.tc_s), A[i_m] / (2.0 * self.tc_s)

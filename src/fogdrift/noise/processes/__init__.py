@@ -48,7 +48,7 @@ from .base import ComponentSpec, LatentSpec, NoiseProcess, TermLaw, TermSpec
 __all__ = [
     "NoiseProcess", "TermSpec", "TermLaw", "LatentSpec", "ComponentSpec",
     "PROCESSES", "process", "processes", "power_law_names", "shaped_names", "register", "unregister", "registered",
-    "latent_processes", "component_specs", "version", "power_law_sdf",
+    "latent_processes", "component_specs", "version", "power_law_sdf", "model_sdf",
 ]
 
 #: The rows, in the order of the Allan-fit columns: the power-law terms by their power of tau, then S and M.
@@ -153,6 +153,34 @@ def power_law_sdf(name, A, dt_s):
     theta = unit.copy()
     theta[0] = float(A) / a_unit
     return lambda f: p.latent.sdf(theta, np.asarray(f, dtype=np.float64))
+
+
+def model_sdf(A, dt_s):
+    """Per-sample two-sided rate spectrum of a sum of power-law terms with Allan-law coefficients ``A`` (one per
+    :func:`power_law_names`, deg/h and s): the sum of each row's GMWM spectral density (:func:`power_law_sdf`).  A
+    process without a spectrum (the deterministic ramp R) adds nothing; its effect on the estimates' variance is
+    :func:`fogdrift.noise.covariance.ramp_cross_variance`.
+
+    For the built-in rows: quantization ``4 Qs^2 sin^2(pi f)`` with ``Qs^2 = A_-2 / (3 dt^2)``, white ``A_-1 / dt``,
+    flicker ``A_0 / (4 ln2 |f|)``, random walk ``3 A_1 dt / (4 sin^2(pi f))``.
+
+    Examples
+    --------
+    >>> S = model_sdf([0, 4.0, 0, 0, 0], 0.01)
+    >>> float(S(np.array([0.25]))[0])
+    400.0
+    """
+    parts = [power_law_sdf(name, a, dt_s) for name, a in zip(power_law_names(), A)
+             if float(a) > 0 and process(name).latent is not None and process(name).latent.sdf is not None]
+
+    def spectrum(f):
+        f = np.asarray(f, dtype=np.float64)
+        out = np.zeros(f.shape)
+        for s in parts:
+            out = out + s(f)
+        return out
+
+    return spectrum
 
 
 def register(p: NoiseProcess) -> NoiseProcess:
