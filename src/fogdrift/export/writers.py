@@ -208,7 +208,7 @@ def _kalibr_body(ctx, target, keys, indent="", factor=None, written=_CONTINUOUS)
 def write_kalibr(ctx: ExportContext) -> str:
     lines = _header(ctx, "kalibr", "# ", "Kalibr imu.yaml (continuous-time densities; Kalibr discretises at update_rate)")
     lines += _kalibr_body(ctx, "kalibr", _KALIBR_KEYS)
-    lines += [f"rostopic: {ctx.topic}  # the IMU's ROS topic: set yours (--rostopic)",
+    lines += ["# rostopic: the IMU's ROS topic: set yours (--rostopic)", f"rostopic: {json.dumps(ctx.topic)}",
               f"update_rate: {fmt(ctx.rate_hz)}  # [Hz] the IMU rate Kalibr discretises at (--update-rate)"]
     ctx.fill("kalibr", "continuous-time densities (Kalibr ConfigReader: discrete = density / sqrt(1/update_rate))",
              [f"rostopic (written {ctx.topic})", f"update_rate (written {fmt(ctx.rate_hz)} Hz)"])
@@ -231,7 +231,8 @@ def write_openvins(ctx: ExportContext) -> str:
     lines += ["  # T_i_b: NOT MEASURED: identity (fogdrift does not calibrate extrinsics; Kalibr's multi-IMU pose)",
               "  T_i_b:"] + [f"    - [{', '.join('1.0' if i == j else '0.0' for j in range(4))}]" for i in range(4)]
     lines += _kalibr_body(ctx, "openvins", _KALIBR_KEYS, indent="  ")
-    lines += [f"  rostopic: {ctx.topic}  # the IMU's ROS topic: set yours (--rostopic)", "  time_offset: 0.0  # [s]",
+    lines += ["  # rostopic: the IMU's ROS topic: set yours (--rostopic); quoted, as cv::FileStorage keeps a comment "
+              "after an unquoted string", f"  rostopic: {json.dumps(ctx.topic)}", "  time_offset: 0.0  # [s]",
               f"  update_rate: {fmt(ctx.rate_hz)}  # [Hz]",
               '  model: "kalibr"  # VioManagerOptions / StateOptions read kalibr, calibrated or rpng']
     why = ("NOT MEASURED: fogdrift does not calibrate IMU intrinsics; OpenVINS's neutral value (its own default in "
@@ -265,7 +266,8 @@ def write_vins(ctx: ExportContext) -> str:
               f"{fmt(vins_walk(1.0, f))}",
               "# (continuous densities here would make VINS over-confident by sqrt(2 f) and sqrt(f)).  These values hold",
               f"# at {fmt(f)} Hz only: re-export with --update-rate for another IMU rate.",
-              "imu: 1  # use the IMU", f'imu_topic: "{ctx.topic}"  # the IMU\'s ROS topic: set yours (--rostopic)']
+              "imu: 1  # use the IMU", "# imu_topic: the IMU's ROS topic: set yours (--rostopic)",
+              f"imu_topic: {json.dumps(ctx.topic)}"]
     lines += _kalibr_body(ctx, "vins-fusion", _VINS_KEYS, factor=_vins_factor, written=f"per IMU step at {fmt(f)} Hz")
     lines += ["# g_norm: NOT MEASURED: standard gravity (CGPM 1901); put your local gravity magnitude",
               "g_norm: 9.80665  # [m/s^2]"]
