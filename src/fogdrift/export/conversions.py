@@ -30,6 +30,7 @@ import math
 
 from ..errors import ConfigError
 from ..noise.processes import process, processes
+from ..noise.processes.gauss_markov import gm_avar_dph2
 
 __all__ = [
     "DEG", "G0", "MGAL", "GM_FLICKER_SIGMA", "GM_PEAK_X",
@@ -194,8 +195,6 @@ def gm_rematch(sigma: float, tc_s: float, tc_common_s: float) -> float:
     """
     if tc_s == tc_common_s:
         return float(sigma)
-    from ..noise.processes.gauss_markov import gm_avar_dph2  # the Allan law of the process table (linear in units)
-
     peak_tau = GM_PEAK_X * float(tc_s)
     ratio = float(gm_avar_dph2(peak_tau, tc_s, 1.0)) / float(gm_avar_dph2(peak_tau, tc_common_s, 1.0))
     return float(sigma) * math.sqrt(ratio)
