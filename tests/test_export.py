@@ -153,10 +153,11 @@ def test_openvins_vins_orbslam3_read_by_opencv(ctx, tmp_path):
     assert imu0.getNode("T_i_b").size() == 4
     fs.release()
     fs = _cv(render("vins-fusion", ctx), tmp_path, "vins.yaml")
-    assert fs.getNode("gyr_n").real() == pytest.approx(0.20 * D / 60, rel=1e-5, abs=0)
-    assert fs.getNode("acc_n").real() == pytest.approx(0.18 / 60, rel=1e-5, abs=0)
-    assert fs.getNode("gyr_w").real() == pytest.approx(0.5 * D / 216000, rel=1e-5, abs=0)
-    assert fs.getNode("acc_w").real() == pytest.approx(3e-4, rel=1e-5, abs=0)
+    # per IMU step at 100 Hz (integration_base.h): white x sqrt(2 f) = x sqrt(200), walk x sqrt(f) = x 10
+    assert fs.getNode("gyr_n").real() == pytest.approx(0.20 * D / 60 * math.sqrt(200), rel=1e-5, abs=0)
+    assert fs.getNode("acc_n").real() == pytest.approx(0.18 / 60 * math.sqrt(200), rel=1e-5, abs=0)
+    assert fs.getNode("gyr_w").real() == pytest.approx(0.5 * D / 216000 * 10, rel=1e-5, abs=0)
+    assert fs.getNode("acc_w").real() == pytest.approx(3e-4 * 10, rel=1e-5, abs=0)
     fs.release()
     fs = _cv(render("orbslam3", ctx), tmp_path, "orb.yaml")
     assert fs.getNode("IMU.NoiseGyro").real() == pytest.approx(0.20 * D / 60, rel=1e-5, abs=0)
@@ -176,7 +177,7 @@ def test_kfgins_units(ctx):
     assert d["abstd"] == pytest.approx([1.0760 * 50 * 0.980665, 1.0760 * 100 * 0.980665, 1.0760 * 150 * 0.980665],
                                        rel=1e-4, abs=0)
     assert d["corrtime"] == pytest.approx(100.0 / 1.8926 / 3600.0, rel=1e-4, abs=0)  # hours
-    assert "gsstd" not in d and "asstd" not in d
+    assert d["gsstd"] == [300.0] * 3 and d["asstd"] == [300.0] * 3          # not measured: KF-GINS's example value
 
 
 def test_matlab_name_value_pairs(ctx):
@@ -257,13 +258,17 @@ def test_missing_policies(tmp_path):
     assert any("gz: K written as 0" in n for n in ctx.notes)
 
 
-def test_no_accel_result_leaves_the_keys_out(tmp_path):
+def test_no_accel_result_writes_the_programs_default_said_as_not_measured(tmp_path):
     ctx = build_context([_gyro_result(tmp_path)])
     text = render("kalibr", ctx)
     d = yaml.safe_load(text)
-    assert "accelerometer_noise_density" not in d and "accelerometer_random_walk" not in d
-    assert "not written: no accelerometer result was given" in text
-    assert any("no accelerometer result given" in n for n in ctx.notes)
+    # Kalibr requires both accelerometer keys (> 0): OpenVINS's own default is written, said as NOT MEASURED
+    assert d["accelerometer_noise_density"] == 2.0e-3 and d["accelerometer_random_walk"] == 3.0e-3
+    assert "NOT MEASURED: no accelerometer result was given" in text
+    assert any("no accelerometer result given" in n and "NOT MEASURED" in n for n in ctx.notes)
+    assert "no accelerometer result" in "; ".join(ctx.todo["kalibr"][1])
+    text = render("matlab", ctx)          # MATLAB's imuSensor has an ideal default: the object is left out
+    assert "accelparams(" not in text and "ideal default" in text
 
 
 def test_no_model_fits_makes_every_term_missing(tmp_path):
@@ -361,8 +366,18 @@ def test_gmwm_result_slowest_gm_is_the_bias(tmp_path):
                                       _gmwm_axis("gy", 0.3, None, [(80.0, 3.0)])]}))
     ctx = build_context([p], missing="zero")
     d = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
-    assert d["gbstd"] == pytest.approx([4.0, 3.0], rel=1e-5, abs=0)          # the slow GM, not the 0.2-s one
-    assert d["corrtime"] == pytest.approx(150.0 / 3600.0, rel=1e-5, abs=0)
+    # the slow GMs (gx 4 deg/h at 150 s, not the 0.2-s one; gy 3 deg/h at 80 s); KF-GINS takes ONE corrtime: the
+    # geometric mean sqrt(150 * 80) s, each sigma re-matched so that its Allan variance at its own peak
+    # (tau = 1.8926 T_c) is kept: sigma' = sigma sqrt(g(1.8926) / g(1.8926 T_c / T)), g(x) = (2x-3+4e^-x-e^-2x)/x^2
+    tc = math.sqrt(150.0 * 80.0)
+
+    def g(x):
+        return (2 * x - 3 + 4 * math.exp(-x) - math.exp(-2 * x)) / x ** 2
+
+    hand = [s * math.sqrt(g(1.8926) / g(1.8926 * t / tc)) for s, t in ((4.0, 150.0), (3.0, 80.0))]
+    assert d["gbstd"][:2] == pytest.approx(hand, rel=1e-4, abs=0)
+    assert d["gbstd"][2] == d["gbstd"][0]                                  # two axes: the third copies the largest
+    assert d["corrtime"] == pytest.approx(tc / 3600.0, rel=1e-5, abs=0)
     k = yaml.safe_load(render("kalibr", ctx))["gyroscope_random_walk"]
     assert k == pytest.approx(2.0 * D / 216000, rel=1e-5, abs=0)             # gy has no RW: 0 under --missing zero
     with pytest.raises(ConfigError, match="gyro gy: K is not resolved by the record: not in the GMWM model"):
@@ -420,9 +435,10 @@ def test_accelerometer_only_and_duplicate_axes(tmp_path):
     for t in parse_targets("all"):
         render(t, ctx)                                                # every target writes without a gyro
     d = yaml.safe_load(render("kalibr", ctx))
-    assert "gyroscope_noise_density" not in d and d["accelerometer_random_walk"] == pytest.approx(3e-4, rel=1e-5, abs=0)
+    assert d["gyroscope_noise_density"] == 1.6968e-4                      # not measured: the default, said so
+    assert d["accelerometer_random_walk"] == pytest.approx(3e-4, rel=1e-5, abs=0)
     kf = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
-    assert "arw" not in kf and kf["corrtime"] == pytest.approx(100.0 / 1.8926 / 3600.0, rel=1e-4, abs=0)
+    assert kf["arw"] == [0.003] * 3 and kf["corrtime"] == pytest.approx(100.0 / 1.8926 / 3600.0, rel=1e-4, abs=0)
     g = _gyro_result(tmp_path)
     with pytest.raises(ConfigError, match="two gyro channels are called 'gx'"):
         build_context([g, g])
@@ -456,4 +472,4 @@ def test_gmwm_accelerometer_result(tmp_path):
     ctx = build_context(accel=[p], missing="zero")
     assert ctx.accel[0].quantity == "accel"
     d = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
-    assert d["vrw"] == pytest.approx([0.1]) and d["abstd"] == pytest.approx([2e-4 / 1e-5])   # mGal
+    assert d["vrw"] == pytest.approx([0.1] * 3) and d["abstd"] == pytest.approx([2e-4 / 1e-5] * 3)   # mGal

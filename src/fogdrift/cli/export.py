@@ -90,6 +90,9 @@ def export(
                 Path(tmp).write_text(text, encoding="utf-8")
         chans = ", ".join(f"{c.label} ({c.method})" for c in ctx.gyro + ctx.accel)
         say(f"exported {chans} at {ctx.rate_hz:g} Hz, --missing {ctx.missing}")
+        for n in chosen:  # per target: the time convention written, and what the user must still fill in
+            conv, items = ctx.todo.get(n, ("", []))
+            say(f"{n} ({TARGETS[n].filename}): time convention: {conv}; fill in: {'; '.join(items) or 'nothing'}")
         for line in ctx.notes:
             warn(line)
         r.wrote()

@@ -30,12 +30,13 @@ import math
 
 from ..errors import ConfigError
 from ..noise.processes import process, processes
+from ..noise.processes.gauss_markov import gm_avar_dph2
 
 __all__ = [
     "DEG", "G0", "MGAL", "GM_FLICKER_SIGMA", "GM_PEAK_X",
     "arw_to_density", "density_to_arw", "vrw_to_density", "density_to_vrw", "rrw_to_density",
     "white_discrete", "walk_discrete", "gm_discrete", "to_si", "from_si", "quantity_of_unit",
-    "single_gm_from_flicker", "UNIT_TABLE", "SI_UNITS", "si_unit",
+    "single_gm_from_flicker", "UNIT_TABLE", "SI_UNITS", "si_unit", "vins_white", "vins_walk", "gm_rematch",
 ]
 
 DEG = math.pi / 180.0
@@ -146,6 +147,57 @@ def gm_discrete(sigma: float, tc_s: float, rate_hz: float) -> tuple[float, float
         raise ConfigError(f"Gauss-Markov correlation time must be a finite number > 0 s; got {tc_s!r}")
     phi = math.exp(-dt / tc_s)
     return phi, float(sigma) * math.sqrt(-math.expm1(-2.0 * dt / tc_s))
+
+
+def vins_white(density: float, rate_hz: float) -> float:
+    """VINS-Fusion's ``acc_n`` / ``gyr_n`` for a white density N at the IMU rate f: N sqrt(2 f).
+
+    VINS-Fusion's ``IntegrationBase::midPointIntegration`` (vins_estimator/src/factor/integration_base.h) adds
+    ``V noise V^T`` per IMU step, the rotation row of V holding 0.5 dt for the noise of each of the two samples it
+    averages and ``noise`` holding ``gyr_n^2`` for each: 2 (0.5 dt)^2 gyr_n^2 = 0.5 dt^2 gyr_n^2 per step.  A white
+    rate density N gives N^2 dt per step; equal when gyr_n = N sqrt(2/dt) (likewise for the velocity row and
+    ``acc_n``).
+
+    Examples
+    --------
+    >>> f"{vins_white(1e-4, 100.0):.6g}"   # 1e-4 * sqrt(200)
+    '0.00141421'
+    """
+    return float(density) * math.sqrt(2.0 * _rate(rate_hz))
+
+
+def vins_walk(density: float, rate_hz: float) -> float:
+    """VINS-Fusion's ``acc_w`` / ``gyr_w`` for a random-walk density K at the IMU rate f: K sqrt(f).
+
+    ``midPointIntegration``'s V maps ``gyr_w`` to the bias row with dt: dt^2 gyr_w^2 per step; a random walk of
+    density K grows by K^2 dt per step; equal when gyr_w = K / sqrt(dt).
+
+    Examples
+    --------
+    >>> f"{vins_walk(1e-6, 100.0):.6g}"    # 1e-6 * sqrt(100)
+    '1e-05'
+    """
+    return float(density) * math.sqrt(_rate(rate_hz))
+
+
+def gm_rematch(sigma: float, tc_s: float, tc_common_s: float) -> float:
+    """The 1-sigma of a Gauss-Markov process of correlation time ``tc_common_s`` whose Allan variance at the
+    original's peak (tau = 1.8926 ``tc_s``) equals the original's there (the Gauss-Markov Allan law of
+    :mod:`fogdrift.noise.processes.gauss_markov`) (for formats with one correlation time
+    for all axes: KF-GINS's ``corrtime``).
+
+    Examples
+    --------
+    >>> gm_rematch(2.0, 50.0, 50.0)          # the same T_c: unchanged
+    2.0
+    >>> round(gm_rematch(1.0, 10.0, 100.0), 4)   # a longer T_c needs a larger sigma for the same ADEV at 18.9 s
+    1.8636
+    """
+    if tc_s == tc_common_s:
+        return float(sigma)
+    peak_tau = GM_PEAK_X * float(tc_s)
+    ratio = float(gm_avar_dph2(peak_tau, tc_s, 1.0)) / float(gm_avar_dph2(peak_tau, tc_common_s, 1.0))
+    return float(sigma) * math.sqrt(ratio)
 
 
 def single_gm_from_flicker(b: float, tau_b_s: float) -> tuple[float, float]:

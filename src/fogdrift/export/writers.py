@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 from .._util import fmt_number
 from ..errors import FogdriftError
-from .conversions import DEG, MGAL, gm_discrete, walk_discrete, white_discrete
+from .conversions import DEG, MGAL, gm_discrete, gm_rematch, vins_walk, vins_white, walk_discrete, white_discrete
 from .discretize import discrete_model
 from .model import ChannelModel, bias_gm, describe, resolve
 
@@ -39,6 +39,8 @@ class ExportContext:
         ROS topic written where a target has one.
     notes : list of str
         Lines for the console (bounds, zeros, unresolved estimates, left-out keys), filled by the writers.
+    todo : dict
+        Target -> (time convention, what the user must still fill in), one console line per target.
     """
 
     gyro: list
@@ -47,6 +49,7 @@ class ExportContext:
     missing: str = "bound"
     topic: str = "/imu0"
     notes: list = field(default_factory=list)
+    todo: dict = field(default_factory=dict)
 
     def channels(self, quantity: str) -> list:
         return self.gyro if quantity == "gyro" else self.accel
@@ -54,6 +57,11 @@ class ExportContext:
     def note(self, text: str) -> None:
         if text not in self.notes:
             self.notes.append(text)
+
+    def fill(self, target: str, convention: str, items) -> None:
+        """Record ``target``'s time convention and what its user must still fill in (extrinsics, rates)."""
+        conv, old = self.todo.get(target, ("", []))
+        self.todo[target] = (convention or conv, old + [i for i in items if i not in old])
 
 
 def fmt(x: float) -> str:
@@ -115,10 +123,10 @@ def _scalar(ctx, quantity, name, prefix, out_unit, out_factor, kind):
 
 
 def _missing_quantity(ctx, target: str, quantity: str, keys, prefix: str) -> list[str]:
-    ctx.note(f"no {_QWORD[quantity]} result given (--{quantity} FILE): the {_QWORD[quantity]} fields of every target "
-             "are left out (each file says which)")
+    ctx.note(f"{target}: no {_QWORD[quantity]} result given (--{quantity} FILE): its {_QWORD[quantity]} is left "
+             "at the program's ideal default")
     return [f"{prefix}{', '.join(keys)}: not written: no {_QWORD[quantity]} result was given "
-            f"(fogdrift export --{quantity} RESULT.json); fogdrift never writes a noise figure it did not measure"]
+            f"(fogdrift export --{quantity} RESULT.json); {target} then uses its own ideal default"]
 
 
 def _header(ctx, target, prefix, source) -> list[str]:
@@ -134,57 +142,138 @@ def _header(ctx, target, prefix, source) -> list[str]:
 
 
 # ------------------------------------------------------------------------------------------------------------------
+# values a program requires that fogdrift does not measure
+# ------------------------------------------------------------------------------------------------------------------
+#: A quantity without a result (no --accel file, say) whose keys the program requires: the program's own default
+#: or the value of its shipped example configuration, written with a NOT MEASURED comment (cited in docs/export.md).
+_OPENVINS_DEFAULT = ({"accelerometer_noise_density": 2.0e-3, "accelerometer_random_walk": 3.0e-3,
+                      "gyroscope_noise_density": 1.6968e-4, "gyroscope_random_walk": 1.9393e-5},
+                     "OpenVINS's own default (ov_msckf/src/utils/NoiseManager.h)")
+PLACEHOLDERS = {
+    "kalibr": (_OPENVINS_DEFAULT[0], "OpenVINS's default (ov_msckf/src/utils/NoiseManager.h; Kalibr has none)"),
+    "openvins": _OPENVINS_DEFAULT,
+    "vins-fusion": ({"acc_n": 0.1, "gyr_n": 0.01, "acc_w": 0.001, "gyr_w": 0.0001},
+                    "VINS-Fusion's config/euroc/euroc_mono_imu_config.yaml"),
+    "orbslam3": ({"IMU.NoiseGyro": 1.7e-4, "IMU.NoiseAcc": 2.0e-3, "IMU.GyroWalk": 1.9393e-5, "IMU.AccWalk": 3.0e-3},
+                 "ORB-SLAM3's Examples/Monocular-Inertial/EuRoC.yaml"),
+    "kf-gins": ({"arw": 0.003, "vrw": 0.03, "gbstd": 0.027, "abstd": 15.0, "gsstd": 300.0, "asstd": 300.0,
+                 "corrtime": 4.0}, "KF-GINS's dataset/kf-gins.yaml"),
+    "gnss-ins-sim": ({"gyro_arw": 0.75, "gyro_b_stability": 10.0, "gyro_b_corr": 100.0, "accel_vrw": 0.05,
+                      "accel_b_stability": 2.0e-4, "accel_b_corr": 100.0},
+                     "gnss-ins-sim's default profile 'low-accuracy' (gnss_ins_sim/sim/imu_model.py)"),
+}
+
+
+def _placeholder(ctx, target, quantity, keys, prefix, indent=""):
+    """The program's default for ``keys`` of a quantity fogdrift has no result for, said as NOT MEASURED."""
+    vals, src = PLACEHOLDERS[target]
+    ctx.note(f"{target}: no {_QWORD[quantity]} result given (--{quantity} FILE): {', '.join(keys)} written as "
+             f"{src} values, NOT MEASURED")
+    ctx.fill(target, "", [f"{', '.join(keys)} (no {_QWORD[quantity]} result: {src} values written)"])
+    return ([f"{prefix}{', '.join(keys)}: NOT MEASURED: no {_QWORD[quantity]} result was given (fogdrift export "
+             f"--{quantity} RESULT.json); the program requires them, so {src} values are written: replace them "
+             f"with your {_QWORD[quantity]}'s"], {k: vals[k] for k in keys})
+
+
+# ------------------------------------------------------------------------------------------------------------------
 # Kalibr-family: one white density and one random-walk density per sensor
 # ------------------------------------------------------------------------------------------------------------------
 _KALIBR_KEYS = (("accel", "N", "accelerometer_noise_density", "m/s^2/sqrt(Hz)", "white"),
                 ("accel", "K", "accelerometer_random_walk", "m/s^3/sqrt(Hz)", "walk"),
                 ("gyro", "N", "gyroscope_noise_density", "rad/s/sqrt(Hz)", "white"),
                 ("gyro", "K", "gyroscope_random_walk", "rad/s^2/sqrt(Hz)", "walk"))
+_CONTINUOUS = "continuous time"
 
 
-def _kalibr_body(ctx, target, keys, indent="") -> list[str]:
+def _kalibr_body(ctx, target, keys, indent="", factor=None, written=_CONTINUOUS) -> list[str]:
+    """The lines of ``keys`` (quantity, term, key, unit, kind); ``factor(kind, rate)`` scales the continuous SI
+    value into the program's convention (None: continuous)."""
     out = []
     done = set()
     for quantity, name, key, unit, kind in keys:
         if not ctx.channels(quantity):
             if quantity not in done:
-                out += _missing_quantity(ctx, target, quantity, [k[2] for k in keys if k[0] == quantity], indent + "# ")
+                qkeys = [k[2] for k in keys if k[0] == quantity]
+                lines, vals = _placeholder(ctx, target, quantity, qkeys, indent + "# ")
+                out += lines + [f"{indent}{k}: {fmt(vals[k])}  # [{u}] NOT MEASURED ({written})"
+                                for (q, _n, k, u, _k) in keys if q == quantity]
                 done.add(quantity)
             continue
-        v, lines = _scalar(ctx, quantity, name, indent + "# ", unit, 1.0, kind)
-        out += lines + [f"{indent}{key}: {fmt(v)}  # [{unit}] continuous time"]
+        f = 1.0 if factor is None else factor(kind, ctx.rate_hz)
+        v, lines = _scalar(ctx, quantity, name, indent + "# ", unit, f, kind)
+        out += lines + [f"{indent}{key}: {fmt(v)}  # [{unit}] {written}"]
     return out
 
 
 def write_kalibr(ctx: ExportContext) -> str:
     lines = _header(ctx, "kalibr", "# ", "Kalibr imu.yaml (continuous-time densities; Kalibr discretises at update_rate)")
     lines += _kalibr_body(ctx, "kalibr", _KALIBR_KEYS)
-    lines += [f"rostopic: {ctx.topic}", f"update_rate: {fmt(ctx.rate_hz)}  # [Hz]"]
+    lines += ["# rostopic: the IMU's ROS topic: set yours (--rostopic)", f"rostopic: {json.dumps(ctx.topic)}",
+              f"update_rate: {fmt(ctx.rate_hz)}  # [Hz] the IMU rate Kalibr discretises at (--update-rate)"]
+    ctx.fill("kalibr", "continuous-time densities (Kalibr ConfigReader: discrete = density / sqrt(1/update_rate))",
+             [f"rostopic (written {ctx.topic})", f"update_rate (written {fmt(ctx.rate_hz)} Hz)"])
     return "\n".join(lines) + "\n"
+
+
+def _matrix(name, rows, indent, why) -> list[str]:
+    return ([f"{indent}# {name}: {why}", f"{indent}{name}:"]
+            + [f"{indent}  - [{', '.join(fmt(v) for v in r)}]" for r in rows])
+
+
+_I3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+_Z3 = ((0.0, 0.0, 0.0),) * 3
 
 
 def write_openvins(ctx: ExportContext) -> str:
     lines = ["%YAML:1.0", ""] + _header(ctx, "openvins", "# ", "OpenVINS kalibr_imu_chain.yaml (read with cv::FileStorage)")
-    lines += ["# T_i_b is the identity: fogdrift does not calibrate extrinsics", "imu0:", "  T_i_b:"]
-    lines += [f"    - [{', '.join('1.0' if i == j else '0.0' for j in range(4))}]" for i in range(4)]
+    lines += ["# OpenVINS reads continuous-time densities and discretises itself (ov_msckf Propagator: sigma^2 / dt for",
+              "# the white noises, sigma_b^2 dt for the bias walks per IMU step)", "imu0:"]
+    lines += ["  # T_i_b: NOT MEASURED: identity (fogdrift does not calibrate extrinsics; Kalibr's multi-IMU pose)",
+              "  T_i_b:"] + [f"    - [{', '.join('1.0' if i == j else '0.0' for j in range(4))}]" for i in range(4)]
     lines += _kalibr_body(ctx, "openvins", _KALIBR_KEYS, indent="  ")
-    lines += [f"  rostopic: {ctx.topic}", "  time_offset: 0.0", f"  update_rate: {fmt(ctx.rate_hz)}  # [Hz]",
-              '  model: "kalibr"']
+    lines += ["  # rostopic: the IMU's ROS topic: set yours (--rostopic); quoted, as cv::FileStorage keeps a comment "
+              "after an unquoted string", f"  rostopic: {json.dumps(ctx.topic)}", "  time_offset: 0.0  # [s]",
+              f"  update_rate: {fmt(ctx.rate_hz)}  # [Hz]",
+              '  model: "kalibr"  # VioManagerOptions / StateOptions read kalibr, calibrated or rpng']
+    why = ("NOT MEASURED: fogdrift does not calibrate IMU intrinsics; OpenVINS's neutral value (its own default in "
+           "VioManagerOptions.h: an ideal IMU)")
+    for name, rows in (("Tw", _I3), ("R_IMUtoGYRO", _I3), ("Ta", _I3), ("R_IMUtoACC", _I3), ("Tg", _Z3)):
+        lines += _matrix(name, rows, "  ", why)
+    ctx.fill("openvins", "continuous-time densities (OpenVINS Propagator discretises with the IMU dt)",
+             ["Tw, R_IMUtoGYRO, Ta, R_IMUtoACC (identity), Tg (zero), T_i_b (identity): IMU intrinsics / extrinsics "
+              "not measured", f"rostopic (written {ctx.topic})", "cameras: kalibr_imucam_chain.yaml"])
     return "\n".join(lines) + "\n"
 
 
-_VINS_KEYS = (("accel", "N", "acc_n", "m/s^2/sqrt(Hz)", "white"), ("gyro", "N", "gyr_n", "rad/s/sqrt(Hz)", "white"),
-              ("accel", "K", "acc_w", "m/s^3/sqrt(Hz)", "walk"), ("gyro", "K", "gyr_w", "rad/s^2/sqrt(Hz)", "walk"))
+_VINS_KEYS = (("accel", "N", "acc_n", "m/s^2", "white"), ("gyro", "N", "gyr_n", "rad/s", "white"),
+              ("accel", "K", "acc_w", "m/s^3", "walk"), ("gyro", "K", "gyr_w", "rad/s^2", "walk"))
+
+
+def _vins_factor(kind, rate):
+    return vins_white(1.0, rate) if kind == "white" else vins_walk(1.0, rate)
 
 
 def write_vins(ctx: ExportContext) -> str:
-    lines = ["%YAML:1.0", ""] + _header(ctx, "vins-fusion", "# ", "VINS-Fusion config (IMU noise block; cv::FileStorage)")
-    lines += ["# merge these keys into your VINS-Fusion config.  Its comments call them 'measurement noise standard",
-              "# deviation' and 'bias random work noise standard deviation' without saying continuous or discrete time (questions open",
-              "# in VINS-Mono issues #102, #327); written here: the continuous-time densities, the Kalibr values; the",
-              "# per-sample (discrete) values at the update rate are in the comments.  VINS's own EuRoC config uses values",
-              "# 10-100x the EuRoC Kalibr densities (inflated by hand)."]
-    lines += _kalibr_body(ctx, "vins-fusion", _VINS_KEYS)
+    f = ctx.rate_hz
+    lines = ["%YAML:1.0", ""] + _header(ctx, "vins-fusion", "# ", "VINS-Fusion config (IMU block; cv::FileStorage)")
+    lines += ["# merge these keys into your VINS-Fusion config (parameters.cpp readParameters reads imu, imu_topic,",
+              "# acc_n, acc_w, gyr_n, gyr_w, g_norm; a missing number reads as 0 without an error).",
+              f"# TIME CONVENTION: per IMU step at {fmt(f)} Hz, as VINS-Fusion's integration code applies them",
+              "# (vins_estimator/src/factor/integration_base.h, midPointIntegration: covariance += V noise V^T, noise =",
+              "# diag(acc_n^2, gyr_n^2, acc_n^2, gyr_n^2, acc_w^2, gyr_w^2), V = 0.5 dt on each of the two averaged samples",
+              "# and dt on the bias walks): matching the continuous model per step needs",
+              f"#   acc_n, gyr_n = N sqrt(2 f) = N x {fmt(vins_white(1.0, f))};  acc_w, gyr_w = K sqrt(f) = K x "
+              f"{fmt(vins_walk(1.0, f))}",
+              "# (continuous densities here would make VINS over-confident by sqrt(2 f) and sqrt(f)).  These values hold",
+              f"# at {fmt(f)} Hz only: re-export with --update-rate for another IMU rate.",
+              "imu: 1  # use the IMU", "# imu_topic: the IMU's ROS topic: set yours (--rostopic)",
+              f"imu_topic: {json.dumps(ctx.topic)}"]
+    lines += _kalibr_body(ctx, "vins-fusion", _VINS_KEYS, factor=_vins_factor, written=f"per IMU step at {fmt(f)} Hz")
+    lines += ["# g_norm: NOT MEASURED: standard gravity (CGPM 1901); put your local gravity magnitude",
+              "g_norm: 9.80665  # [m/s^2]"]
+    ctx.fill("vins-fusion", f"per IMU step at {fmt(f)} Hz (N sqrt(2f), K sqrt(f): integration_base.h)",
+             ["merge into your config (cameras, body_T_cam0, estimate_extrinsic, td)", "g_norm (written 9.80665 m/s^2)",
+              f"imu_topic (written {ctx.topic})", f"the IMU rate: the values hold at {fmt(f)} Hz only"])
     return "\n".join(lines) + "\n"
 
 
@@ -196,10 +285,19 @@ _ORB_KEYS = (("gyro", "N", "IMU.NoiseGyro", "rad/s/sqrt(Hz)", "white"),
 
 def write_orbslam3(ctx: ExportContext) -> str:
     lines = ["%YAML:1.0", ""] + _header(ctx, "orbslam3", "# ", "ORB-SLAM3 settings (IMU block; cv::FileStorage)")
-    lines += ["# ORB-SLAM3 reads continuous densities and discretises itself: noise x sqrt(IMU.Frequency), "
+    lines += ["# merge into a settings file with File.version: \"1.0\" (System.cc reads Settings only then; Settings::readIMU",
+              "# requires IMU.NoiseGyro, IMU.NoiseAcc, IMU.GyroWalk, IMU.AccWalk, IMU.Frequency (real) and IMU.T_b_c1)",
+              "# ORB-SLAM3 reads continuous densities and discretises itself: noise x sqrt(IMU.Frequency), "
               "walk / sqrt(IMU.Frequency) (Tracking: IMU::Calib(Tbc, Ng*sf, Na*sf, Ngw/sf, Naw/sf), sf = sqrt(freq))"]
     lines += _kalibr_body(ctx, "orbslam3", _ORB_KEYS)
-    lines += [f"IMU.Frequency: {fmt(ctx.rate_hz)}  # [Hz]"]
+    lines += [f"IMU.Frequency: {fmt(ctx.rate_hz)}  # [Hz]",
+              "# IMU.T_b_c1 (camera 1 to IMU body): NOT MEASURED: identity (fogdrift does not calibrate extrinsics); "
+              "put your camera-IMU calibration (Kalibr's T_cam_imu, inverted)",
+              "IMU.T_b_c1: !!opencv-matrix", "   rows: 4", "   cols: 4", "   dt: f",
+              "   data: [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]"]
+    ctx.fill("orbslam3", "continuous-time densities (Tracking multiplies by sqrt(IMU.Frequency))",
+             ["IMU.T_b_c1 (identity written)", "merge into a File.version \"1.0\" settings file (cameras, ORB, viewer)",
+              f"IMU.Frequency (written {fmt(ctx.rate_hz)} Hz)"])
     return "\n".join(lines) + "\n"
 
 
@@ -239,36 +337,85 @@ def _list(vals) -> str:
     return "[" + ", ".join(fmt(v) for v in vals) + "]"
 
 
+def _three(ctx, target, quantity, vals, names, prefix):
+    """Programs that index three axes (KF-GINS, gnss-ins-sim): a result of fewer axes is padded with its largest
+    value, said as NOT MEASURED; more than three is refused."""
+    if len(vals) > 3:
+        raise FogdriftError(f"{target}: takes three {_QWORD[quantity]} axes; the result has {len(vals)} "
+                            f"({', '.join(names)}): export one result of three axes")
+    if len(vals) == 3:
+        return list(vals), []
+    pad = max(vals)
+    ctx.fill(target, "", [f"{_QWORD[quantity]} axes {len(vals) + 1}..3 (NOT MEASURED: the largest measured axis "
+                          "copied)"])
+    return (list(vals) + [pad] * (3 - len(vals)),
+            [f"{prefix}NOT MEASURED: the result has {len(vals)} {_QWORD[quantity]} axis(es) ({', '.join(names)}); "
+             f"the program reads three: axes {len(vals) + 1}..3 copy the largest measured value"])
+
+
+def _geomean(xs) -> float:
+    return math.exp(sum(math.log(x) for x in xs) / len(xs))
+
+
 def write_kfgins(ctx: ExportContext) -> str:
     lines = _header(ctx, "kf-gins", "# ", "KF-GINS imunoise block (merge into kf-gins.yaml)")
-    lines += ["# KF-GINS models each bias as one first-order Gauss-Markov process: gbstd/abstd its 1-sigma,",
-              "# corrtime its correlation time (one value for all biases); a random walk K has no place in it", "imunoise:"]
-    body, values = [], {}
+    lines += ["# KF-GINS (src/kf_gins.cpp, loading the configuration) requires imunoise: arw, vrw, gbstd, abstd, gsstd,",
+              "# asstd (three numbers each) and corrtime; it converts arw x (pi/180)/60, vrw / 60, gbstd x (pi/180)/3600,",
+              "# abstd x 1e-5, gsstd and asstd x 1e-6, corrtime x 3600 and uses them in continuous time",
+              "# (src/kf-gins/gi_engine.cpp: Qc = arw^2, vrw^2 and 2 std^2 / corrtime; F = -1/corrtime for every bias and",
+              "# scale factor): each bias one first-order Gauss-Markov, ONE correlation time for all of them; a random",
+              "# walk K has no place in it", "imunoise:"]
+    body = []
     for quantity, key, factor, unit in (("gyro", "arw", 60.0 / DEG, "deg/sqrt(h)"), ("accel", "vrw", 60.0, "m/s/sqrt(h)")):
         if ctx.channels(quantity):
             vals, ls = _vector(ctx, quantity, "N", "  # ", unit, factor, "white")
-            body += ls + [f"  {key}: {_list(vals)}  # [{unit}]"]
+            vals, pad = _three(ctx, "kf-gins", quantity, vals, [c.name for c in ctx.channels(quantity)], "  # ")
+            body += ls + pad + [f"  {key}: {_list(vals)}  # [{unit}] continuous time"]
         else:
-            body += _missing_quantity(ctx, "kf-gins", quantity, [key], "  # ")
-    tcs_all = {}
-    for quantity, key, factor, unit in (("gyro", "gbstd", 3600.0 / DEG, "deg/h"), ("accel", "abstd", 1.0 / MGAL, "mGal")):
+            ls, d = _placeholder(ctx, "kf-gins", quantity, [key], "  # ")
+            body += ls + [f"  {key}: {_list([d[key]] * 3)}  # [{unit}] NOT MEASURED"]
+    gms = {}
+    for quantity, sigma_unit, sigma_factor in (("gyro", "deg/h", 3600.0 / DEG), ("accel", "mGal", 1.0 / MGAL)):
         if ctx.channels(quantity):
-            sig, tcs, ls = _gm_vectors(ctx, quantity, "  # ", factor, unit, 1.0 / 3600.0, "h")
-            tcs_all[quantity] = tcs
-            body += ls + [f"  {key}: {_list(sig)}  # [{unit}]"]
-        else:
-            body += _missing_quantity(ctx, "kf-gins", quantity, [key], "  # ")
-    body += ["  # gsstd, asstd (scale-factor instability [ppm]): not written: a static record does not observe scale "
-             "factors; take them from the datasheet"]
-    ctx.note("kf-gins: gsstd, asstd not written (scale factors are not observable in a static record)")
-    if tcs_all:
-        src = "gyro" if "gyro" in tcs_all else "accel"
-        tc = max(tcs_all[src])
-        other = ", ".join(f"{q} {', '.join(fmt(t) for t in v)} h" for q, v in tcs_all.items())
-        body += [f"  # corrtime: the longest {_QWORD[src]} correlation time; per axis: {other}",
-                 f"  corrtime: {fmt(tc)}  # [h]"]
-        values["corrtime"] = tc
+            _, _, ls = _gm_vectors(ctx, quantity, "  # ", sigma_factor, sigma_unit, 1.0, "s")
+            gms[quantity] = ([bias_gm(ch, ctx.missing)[0] for ch in ctx.channels(quantity)], ls)
+    tcs = [g.tc_s for q in gms for g in gms[q][0]]
+    tc = _geomean(tcs) if tcs else None
+    for quantity, key, unit, factor in (("gyro", "gbstd", "deg/h", 3600.0 / DEG), ("accel", "abstd", "mGal", 1.0 / MGAL)):
+        if quantity not in gms:
+            ls, d = _placeholder(ctx, "kf-gins", quantity, [key], "  # ")
+            body += ls + [f"  {key}: {_list([d[key]] * 3)}  # [{unit}] NOT MEASURED"]
+            continue
+        gs, ls = gms[quantity]
+        vals = []
+        for ch, g in zip(ctx.channels(quantity), gs):
+            s2 = gm_rematch(g.sigma_si, g.tc_s, tc)
+            vals.append(s2 * factor)
+            ls.append(f"  # {ch.name}: for the one corrtime {fmt(tc)} s: sigma = {fmt(s2 * factor)} {unit} (its Allan "
+                      f"variance at 1.8926 x {fmt(g.tc_s)} s, the peak of the axis's own Gauss-Markov, kept)")
+        vals, pad = _three(ctx, "kf-gins", quantity, vals, [c.name for c in ctx.channels(quantity)], "  # ")
+        body += ls + pad + [f"  {key}: {_list(vals)}  # [{unit}] 1-sigma of the Gauss-Markov bias"]
+    d = PLACEHOLDERS["kf-gins"][0]
+    body += ["  # gsstd, asstd (scale-factor instability): NOT MEASURED: a static record does not observe scale factors;",
+             f"  # {PLACEHOLDERS['kf-gins'][1]} values are written: replace them with your datasheet's",
+             f"  gsstd: {_list([d['gsstd']] * 3)}  # [ppm] NOT MEASURED", f"  asstd: {_list([d['asstd']] * 3)}  # [ppm] NOT MEASURED"]
+    ctx.note("kf-gins: gsstd, asstd NOT MEASURED (scale factors are not observable in a static record): KF-GINS's "
+             "example 300 ppm written")
+    if tc is not None:
+        per = "; ".join(f"{_QWORD[q]} " + ", ".join(f"{fmt(g.tc_s)}" for g in gms[q][0]) + " s" for q in gms)
+        body += [f"  # corrtime: KF-GINS takes one correlation time for all six biases (and the scale factors): the "
+                 f"geometric mean of the axes' T_c ({per}), each axis's sigma re-matched to it above",
+                 f"  corrtime: {fmt(tc / 3600.0)}  # [h]"]
+        spread = max(tcs) / min(tcs)
+        if spread > 2.0:
+            ctx.note(f"kf-gins: the axes' bias correlation times span a factor {spread:.3g}; KF-GINS takes one "
+                     f"({fmt(tc)} s): each sigma is re-matched at its own Allan peak")
+    else:
+        body += [f"  # corrtime: NOT MEASURED: {PLACEHOLDERS['kf-gins'][1]} value",
+                 f"  corrtime: {fmt(d['corrtime'])}  # [h] NOT MEASURED"]
     lines += body
+    ctx.fill("kf-gins", "continuous time (arw, vrw densities; biases Gauss-Markov 1-sigma with one corrtime)",
+             ["gsstd, asstd (300 ppm example written)", "merge imunoise into kf-gins.yaml (antlever, initial state)"])
     return "\n".join(lines) + "\n"
 
 
@@ -295,30 +442,46 @@ def write_matlab(ctx: ExportContext) -> str:
                   f"    'BiasInstability', {_list(b).replace(',', '')});     % {si}"]
         objs.append(("Gyroscope" if quantity == "gyro" else "Accelerometer", var))
     args = "".join(f", '{k}', {v}" for k, v in objs)
-    lines += [f"imu = imuSensor('accel-gyro', 'SampleRate', {fmt(ctx.rate_hz)}{args});"]
+    lines += [f"imu = imuSensor('accel-gyro', 'SampleRate', {fmt(ctx.rate_hz)}{args});  % SampleRate [Hz]"]
+    ctx.fill("matlab", "continuous-time densities (imuSensor discretises at SampleRate)",
+             [f"SampleRate (written {fmt(ctx.rate_hz)} Hz)", "the other gyroparams / accelparams properties (range, "
+              "resolution, misalignment) are left at MATLAB's defaults"]
+             + ([] if ctx.accel else ["Accelerometer (no result: MATLAB's ideal default)"])
+             + ([] if ctx.gyro else ["Gyroscope (no result: MATLAB's ideal default)"]))
     return "\n".join(lines) + "\n"
 
 
 def write_gnss_ins_sim(ctx: ExportContext) -> str:
     pre = "# "
     lines = _header(ctx, "gnss-ins-sim", pre, "gnss-ins-sim imu_err dictionary (README 'Step 1.1'; imu_model.IMU)")
-    lines += [f"{pre}b_stability is the 1-sigma of a first-order Gauss-Markov bias with correlation time b_corr "
-              "(gnss-ins-sim's bias_drift)", "import numpy as np", "", "imu_err = {"]
+    lines += [f"{pre}gnss_ins_sim/sim/imu_model.py IMU(accuracy=imu_err) requires gyro_b, gyro_b_stability, gyro_arw, "
+              "accel_b, accel_b_stability, accel_vrw (b_corr optional: infinite = white bias); pathgen.py applies arw and",
+              f"{pre}vrw as continuous densities (per sample / sqrt(dt)); b_stability is the 1-sigma of a first-order "
+              "Gauss-Markov bias with correlation time b_corr (bias_drift)", "import numpy as np", "", "imu_err = {"]
     for quantity, pfx, nunit, nfac, bunit, bfac in (("gyro", "gyro", "deg/sqrt(h)", 60.0 / DEG, "deg/h", 3600.0 / DEG),
                                                     ("accel", "accel", "m/s/sqrt(h)", 60.0, "m/s^2", 1.0)):
+        nkey = f"{pfx}_{'arw' if pfx == 'gyro' else 'vrw'}"
+        lines += ["    # constant bias: not a noise term (removed by calibration); 0 = a calibrated sensor",
+                  f"    '{pfx}_b': np.array({_list([0.0] * 3)}),  # [{bunit}]"]
         if not ctx.channels(quantity):
-            keys = [f"{pfx}_b", f"{pfx}_{'arw' if pfx == 'gyro' else 'vrw'}", f"{pfx}_b_stability", f"{pfx}_b_corr"]
-            lines += _missing_quantity(ctx, "gnss-ins-sim", quantity, keys, "    # ")
+            keys = [nkey, f"{pfx}_b_stability", f"{pfx}_b_corr"]
+            ls, d = _placeholder(ctx, "gnss-ins-sim", quantity, keys, "    # ")
+            lines += ls + [f"    '{k}': np.array({_list([d[k]] * 3)}),  # [{u}] NOT MEASURED"
+                           for k, u in zip(keys, (nunit, bunit, "s"))]
             continue
+        names = [c.name for c in ctx.channels(quantity)]
         n, ln = _vector(ctx, quantity, "N", "    # ", nunit, nfac, "white")
         sig, tcs, lg = _gm_vectors(ctx, quantity, "    # ", bfac, bunit, 1.0, "s")
-        m = len(n)
-        lines += ["    # constant bias: not a noise term (removed by calibration); 0 = a calibrated sensor",
-                  f"    '{pfx}_b': np.array({_list([0.0] * m)}),  # [{bunit}]"]
-        lines += ln + [f"    '{pfx}_{'arw' if pfx == 'gyro' else 'vrw'}': np.array({_list(n)}),  # [{nunit}]"]
-        lines += lg + [f"    '{pfx}_b_stability': np.array({_list(sig)}),  # [{bunit}]",
-                       f"    '{pfx}_b_corr': np.array({_list(tcs)}),  # [s]"]
+        n, pn = _three(ctx, "gnss-ins-sim", quantity, n, names, "    # ")
+        sig, ps = _three(ctx, "gnss-ins-sim", quantity, sig, names, "    # ")
+        tcs, pt = _three(ctx, "gnss-ins-sim", quantity, tcs, names, "    # ")
+        lines += ln + pn + [f"    '{nkey}': np.array({_list(n)}),  # [{nunit}] continuous time"]
+        lines += lg + ps + [f"    '{pfx}_b_stability': np.array({_list(sig)}),  # [{bunit}]",
+                            f"    '{pfx}_b_corr': np.array({_list(tcs)}),  # [s]"]
     lines += ["}"]
+    ctx.fill("gnss-ins-sim", "continuous-time densities (pathgen: per-sample sigma = arw / sqrt(dt)); bias "
+             "Gauss-Markov 1-sigma and b_corr", ["gyro_b, accel_b (0 written: a calibrated constant bias)",
+                                                 "the simulation's fs and motion profile"])
     return "\n".join(lines) + "\n"
 
 
@@ -362,6 +525,7 @@ def write_json(ctx: ExportContext) -> str:
                            "gauss_markov": "phi = exp(-dt/T_c), driving 1-sigma = sigma sqrt(1 - phi^2)",
                            "source": "Kalibr wiki 'IMU Noise Model'; IEEE Std 952-1997 Annex C"},
            "channels": chans}
+    ctx.fill("json", f"SI: continuous values and their discrete values at {fmt(ctx.rate_hz)} Hz", [])
     return json.dumps(_json_safe(doc), indent=1, allow_nan=False, default=_json_default) + "\n"
 
 
