@@ -109,7 +109,7 @@ def test_verdict_line_rules():
     """Inflation is asked for only when some row under-covers beyond counting error; the factor is the largest λ."""
     from types import SimpleNamespace
 
-    from fogdrift.cli.consistency import verdict_line
+    from fogdrift.evaluation.consistency import verdict_line
     from fogdrift.evaluation.consistency import CoverageRow
 
     def res(*infl):
@@ -126,7 +126,7 @@ def test_verdict_line_rules():
 def test_summary_cell_follows_the_verdict_rule():
     from types import SimpleNamespace
 
-    from fogdrift.cli.consistency import summary_cell
+    from fogdrift.evaluation.consistency import summary_cell
     from fogdrift.evaluation.consistency import CoverageRow
 
     def res(*infl):

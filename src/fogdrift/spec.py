@@ -45,7 +45,7 @@ from pathlib import Path
 from ._util import fmt_number
 from .errors import ConfigError
 
-__all__ = ["ITEMS", "G0", "SpecLimit", "Reading", "Judgement", "parse_quantity", "convert", "read_spec",
+__all__ = ["analysis_judgements", "ITEMS", "G0", "SpecLimit", "Reading", "Judgement", "parse_quantity", "convert", "read_spec",
            "parse_spec", "judge", "readings_from_noise_fit", "readings_from_gmwm", "compare", "B_COMPARED",
            "channel_kind", "judgement_line", "spec_columns", "judge_noise_fit"]
 
@@ -426,3 +426,20 @@ def judge_noise_fit(spec: dict, name: str, noise, kind: str = "gyro") -> list[Ju
     """The judgements of one channel's Allan noise fit (:func:`readings_from_noise_fit`): the call a batch row or a
     report's first screen needs."""
     return compare(spec, {name: (kind, readings_from_noise_fit(noise, kind))})
+
+
+def analysis_judgements(result, limits: dict, kind: str = "gyro") -> list:
+    """The datasheet judgements (:func:`compare`) of every axis of an analysis, read from the noise model its
+    headline shows: the GMWM axis when every axis has one (``--noise-method gmwm``), else the Allan fit of the whole
+    record.  ``limits``: a parsed spec (:func:`read_spec`; this function reads nothing); ``kind``: the spec section
+    (``analyze`` takes gyro logs).
+
+    Returns
+    -------
+    list of Judgement
+        Per axis, in the spec's order.
+    """
+    axes = list(result.axes)
+    gmwm = bool(axes) and all(getattr(ax, "gmwm", None) is not None for ax in axes)
+    return compare(limits, {ax.name: (kind, readings_from_gmwm(ax.gmwm, kind) if gmwm
+                                      else readings_from_noise_fit(ax.original.noise, kind)) for ax in axes})

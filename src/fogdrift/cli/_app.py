@@ -773,16 +773,16 @@ def print_table(title, headers, rows) -> None:
     console.print(fitted_table(title, headers, rows))
 
 
-def screen_record_axes(record, segments, gmwm=False):
-    """The record screen of every axis, printed before any fit (what disturbs it, where, what the fit uses), and
-    the segment plan (:func:`fogdrift.segments.plan_segments`); ``gmwm``: say that GMWM fits the longest segment.
-    Returns ``(segments, screens)`` by axis name."""
-    from ..segments import plan_segments, segment_lines
+def print_screen(record, findings, screens, gmwm=None) -> None:
+    """Print what a workflow found before its fit: each plausibility finding as a warning (one line each), then
+    each axis's record screen (what disturbs it, where, what the fit uses).  ``gmwm``: the segment plan, to say
+    that GMWM fits the longest segment."""
+    from ..segments import segment_lines
 
-    segs, screens = plan_segments(record, segments)
+    for finding in findings:
+        warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
     for name in record.axis_names:
         for line in segment_lines(name, screens[name]):
-            if gmwm and segs[name] and line.endswith("fits it all") and len(segs[name]) > 1:
+            if gmwm is not None and gmwm[name] and line.endswith("fits it all") and len(gmwm[name]) > 1:
                 line += "; GMWM: the longest of them"
             say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")
-    return segs, screens

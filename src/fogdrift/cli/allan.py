@@ -4,11 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..plausibility import check_record
 from ..temperature import summary_line
-from ._app import (FLAGS, EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, SegmentsOpt, StatisticOpt, TausOpt,
-                   TermsOpt, app, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, progress,
-                   run, screen_record_axes, warn, with_load_options)
+from ._app import (EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, SegmentsOpt, StatisticOpt, TausOpt, TermsOpt,
+                   app, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, print_screen, progress,
+                   run, with_load_options)
 from ._tables import noise_table, print_noise_notes, relabel_note
 from ._spec import SpecOpt, print_spec_for_allan, read_spec_option
 
@@ -32,8 +31,9 @@ def allan(
 ):
     """Allan variance and IEEE-952 noise coefficients Q, N, B, K, R of every axis: the terms are selected from
     the data, with 95 % intervals, the fit's chi-squared and p-value, and what was left out and why."""
-    from ..pipeline import AnalysisConfig, run_allan
-    from ..report import fit_cell, noise_row, shaped_cell, write_allan_outputs
+    from ..pipeline import AnalysisConfig
+    from ..report import fit_cell, noise_row, shaped_cell
+    from ..workflows.allan import run_allan, screen, write_allan
 
     with run("allan", out, default_out=DEFAULT_OUT, inputs=[load.file, spec], json_out=json_out,
              expect=("allan.json", "allan.csv", "allan.png") + (("spec.json",) if spec is not None else ())) as r:
@@ -44,15 +44,11 @@ def allan(
         limits = read_spec_option(spec)  # read before the work: a bad spec file is one line, nothing computed
         record = load.load()
         echo_record(load, record)
-        # the plausibility check (as _app.check_plausible) keeps the octave ADEV sums of its noise floors: the
-        # Allan analysis reuses them instead of computing that pass again
-        sums = {}
-        for finding in check_record(record, sums=sums):
-            warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
-        segs, screens = screen_record_axes(record, segments)  # the record screen comes before any fit
+        screened = screen(record, segments)  # the checks before any fit: plausibility, the record screen
+        print_screen(record, screened.findings, screened.screens)
         with progress("allan", record.axis_names) as (allan_cb, _):
-            results = run_allan(record, cfg, progress=allan_cb, sums=sums, segments=segs, screens=screens)
-        del sums
+            done = run_allan(record, cfg, progress=allan_cb, screened=screened)
+        results = done.results
         name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}[statistic]
         by_quantity = {}
         for a in results:  # one table per quantity: gyro terms, then accelerometer terms (their own units)
@@ -74,6 +70,6 @@ def allan(
             console.print("  " + summary_line(temp), highlight=False)
         if limits is not None:
             print_spec_for_allan(limits, results, record, r.out.path, spec.name)
-        files = write_allan_outputs(results, record, r.out.path)
+        files = write_allan(done, r.out.path)
         r.wrote()
         r.print_json(files["json"])

@@ -10,9 +10,9 @@ import typer
 
 from ..errors import ConfigError
 from ._app import (gyro_only, EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutliersOpt, OutOpt,
-                   SegmentsOpt, StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_model_rate, check_plausible, console,
+                   SegmentsOpt, StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_plausible, console,
                    csv_list, echo_record, fitted_table, parse_fit_taus, parse_level, parse_taus, parse_terms,
-                   progress, run, say, screen_record_axes, with_load_options)
+                   print_screen, progress, run, say, with_load_options)
 from ._spec import SpecOpt, print_judgements, read_spec_option
 from ._tables import metrics_table, noise_table
 from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt, model_axes_text
@@ -89,8 +89,9 @@ def analyze(
     json_out: JsonOpt = False,
 ):
     """The whole method: Allan analysis, separation, drift models, compensation, Table 2 and an HTML report."""
-    from ..pipeline import AnalysisConfig, run_analysis
-    from ..report import write_report
+    from ..pipeline import AnalysisConfig, model_factor
+    from ..workflows.allan import screen
+    from ..workflows.analyze import run_analyze, write_analyze
 
     with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to, spec], json_out=json_out,
              expect=("analysis.json", "report.html") + (("report.pdf",) if pdf else ())
@@ -119,52 +120,35 @@ def analyze(
             raise ConfigError(f"--apply-to {apply_to}: no such file")
         record = load.load()
         gyro_only(record, "analyze")
-        factor = check_model_rate(record, cfg)
+        model_factor(record, cfg)  # a modelling rate that does not divide the native rate: refused before any work
         echo_record(load, record)
-        check_plausible(record)
-        other, other_factor = None, None
+        other = None
         if apply_to:
             other = load.load(apply_to, unit=apply_unit, time_unit=apply_time_unit)
             other = _match_axes(record, other, apply_to)
-            other_factor = check_model_rate(other, cfg)
+            model_factor(other, cfg)
             echo_record(load, other, apply_to, unit_flag="--apply-unit" if apply_unit else "--unit",
                         time_unit_flag="--apply-time-unit" if apply_time_unit else "--time-unit")
-            check_plausible(other)
         elif apply_unit or apply_time_unit:
             raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
-        segs, screens = screen_record_axes(record, segments)  # the record screen comes before any fit
+        screened = screen(record, segments)  # the checks before any fit: plausibility, the record screen
+        print_screen(record, screened.findings, screened.screens)
+        if other is not None:
+            check_plausible(other)
         with progress("analyze", record.axis_names) as (_, epoch_cb):
-            result = run_analysis(record, cfg, apply_to=other, progress=epoch_cb, factor=factor,
-                                  apply_to_factor=other_factor, segments=segs, screens=screens)
-        evaluations = []
-        if heading:  # compensation evidence on the held-out test block, stored in the result (fogdrift.evaluation)
-            from ..evaluation import evaluated_analysis, evaluations as evaluations_of
-
-            result = evaluated_analysis(result, calib_s=calibration, step_s=origin_step, horizons_s=hs)
-            evaluations = evaluations_of(result)
+            done = run_analyze(record, cfg, apply_to=other, heading=heading, calib_s=calibration, step_s=origin_step,
+                               horizons_s=hs, limits=limits, progress=epoch_cb, screened=screened)
+        result, evaluations = done.result, done.evaluations
         if result.apply_to is not None:
             say(apply_note(result, apply_to))
         if details:
             say(model_axes_text([ax.models for ax in result.axes], record))
             _print_details(result, load.file.name, apply_to.name if apply_to else "", evaluations)
         print_summary(result, record, evaluated=heading, apply_name=apply_to.name if apply_to else "")
-        spec_doc = None
-        if limits is not None:  # the CLI judges; the report only shows the judgements
-            from ..report.summary import analysis_judgements
-
-            js = print_judgements(limits, analysis_judgements(result, limits), r.out.path, source=spec.name,
-                                  compact=True)
-            spec_doc = {"limits": limits, "judgements": js, "source": spec.name}
-        path = write_report(result, record, r.out.path, evaluated=heading, pdf=pdf,
-                            sensor=None if sensor is None or not sensor.strip() else sensor.strip(), spec=spec_doc)
-        # the self-describing bundle 'fogdrift compensate' applies to other logs
-        from ..bundle import write_bundle
-
-        bundle = write_bundle(r.out.path / "bundle", [ax.models for ax in result.axes], cfg, record)
-        # the compensated test block (what each model's causal compensation gives; loadable by fogdrift.io.load)
-        from ..compensate.holdout import write_compensated_test_block
-
-        comp = write_compensated_test_block([ax.models for ax in result.axes], r.out.path, t0_s=record.t0_s)
+        if limits is not None:  # the workflow judged; the report shows the judgements
+            print_judgements(limits, done.judgements, r.out.path, source=spec.name, compact=True)
+        files = write_analyze(done, r.out.path, pdf=pdf, sensor=sensor, spec_source=spec.name if spec else "")
+        path, bundle, comp = files["report"], files["bundle"], files["compensated"]
         r.wrote()
         say(f"report: {path.resolve()}{'  (+ report.pdf)' if pdf else ''}  ({result.wall_s:.1f} s)")
         say(f"bundle: {bundle.path}   (apply it to another log: fogdrift compensate {bundle.path} LOG --unit "

@@ -95,48 +95,11 @@ def _lam_cell(t) -> str:
     return f"{_fmt(lam)} [{_fmt(lo)}, {_fmt(hi)}]"
 
 
-def verdict_line(res, axis: str) -> str:
-    """One sentence per target and axis: the inflation the user needs, or that none is needed.
-
-    Inflation is needed when some horizon and band under-covers beyond counting error (the 95 % interval of its
-    λ lies above 1); the factor to use is then the largest λ over horizons and bands (nominal coverage at every
-    one).  Otherwise: "no inflation needed" (every λ <= 1) or "... within counting error"."""
-    rows = res.axes[axis]["rows"]
-    cells = [(*row.inflation[b], row.horizon_s, b, row.n_origins) for row in rows for b in row.inflation
-             if math.isfinite(row.inflation[b][0])]
-    if not cells:
-        return f"{axis}: too few origins to count"
-    lam, lo, hi, h, band, n = max(cells)
-    if lam <= 1.0:
-        return (f"{axis}: no inflation needed: the model covers at least nominally at every horizon (largest "
-                f"λ {_fmt(lam)} at {h:g} s, {band} band)")
-    significant = [c for c in cells if c[1] > 1.0]
-    if not significant:
-        return (f"{axis}: no inflation needed within counting error: every λ's 95 % interval reaches 1 (largest "
-                f"λ {_fmt(lam)} at {h:g} s, {band} band, {n} origins, interval from {_fmt(lo)})")
-    sig = max(significant, key=lambda c: c[1])
-    where = "" if sig[3:5] == (h, band) else (f"; beyond counting error at {sig[3]:g} s, {sig[4]} band: λ "
-                                              f"{_fmt(sig[0])} [{_fmt(sig[1])}, {_fmt(sig[2])}]")
-    return (f"{axis}: inflate the variances by λ = {_fmt(lam)} ({h:g} s, {band} band, 95 % [{_fmt(lo)}, "
-            f"{_fmt(hi)}], {n} origins{where}): multiply N, K, σ by {_fmt(math.sqrt(lam))}")
-
-
-def summary_cell(res, axis: str) -> str:
-    """``1.67 [1.14, 2.46]`` when inflation is needed (the rule of :func:`verdict_line`), else ``none (largest
-    1.19)``."""
-    cells = [(*row.inflation[b],) for row in res.axes[axis]["rows"] for b in row.inflation
-             if math.isfinite(row.inflation[b][0])]
-    if not cells:
-        return "–"
-    lam, lo, hi = max(cells)
-    if lam <= 1.0 or not any(c[1] > 1.0 for c in cells):
-        return f"none (largest {_fmt(lam)})"
-    return f"{_fmt(lam)} [{_fmt(lo)}, {_fmt(hi)}]"
-
-
 def print_result(res, label: str, kinds=None) -> None:
     """The coverage table of one target model and its verdict lines (angle error in deg for gyro axes, velocity
     error in m/s for accelerometer axes)."""
+    from ..evaluation.consistency import verdict_line
+
     kinds = kinds or {}
     accel = {a for a in res.axes if kinds.get(a) == "accel"}
     rows = []
@@ -193,9 +156,8 @@ def consistency(
     variance inflation that gives nominal coverage; writes consistency.json."""
     with run("consistency", out, default_out=DEFAULT_OUT, inputs=[load.file, *(held_out or [])],
              json_out=json_out, expect=("consistency.json",)) as r:
-        from ..evaluation.consistency import (check_consistency, components_from_noise_fit, random_walk_covering,
-                                              reduced_model)
-        from ..report import write_json
+        from ..evaluation.consistency import summary_cell, verdict_line
+        from ..workflows.consistency import run_consistency, write_consistency
 
         if not held_out:
             raise ConfigError("give at least one --held-out log (a static log of the same sensor, not the "
@@ -216,97 +178,38 @@ def consistency(
         record = load.load()
         echo_record(load, record)
         check_plausible(record)
-        notes, k_bounds = {}, {}
-        if given is None and method == "gmwm":
-            from ..evaluation.consistency import components_from_gmwm
-            from ..gmwm.analysis import analyse_gmwm
-
-            full = {}
-            with progress("consistency", record.axis_names):
-                for name in record.axis_names:
-                    ax = analyse_gmwm(name, record.axis(name), record.dt_s)
-                    full[name], notes[name] = components_from_gmwm(ax)
-                    if "K_dphrh" not in ax.selection.ieee.terms:
-                        k = ax.ieee_terms().get("K")
-                        if k is not None and k.hi95:
-                            k_bounds[name] = k.hi95
-            source = f"the GMWM model of {load.file.name}"
-        elif given is None:
-            from ..pipeline import AnalysisConfig, run_allan
-
-            with progress("consistency", record.axis_names) as (allan_cb, _):
-                fits = run_allan(record, AnalysisConfig().validate(), progress=allan_cb)
-            full = {}
-            for a in fits:
-                full[a.name], notes[a.name] = components_from_noise_fit(a.noise)
-                k = a.noise.terms.get("K")
-                if k is not None and k.value is None and k.hi95:
-                    k_bounds[a.name] = k.hi95
-            source = f"the Allan fit of {load.file.name}"
-        else:
-            missing = [a for a in record.axis_names if a not in given]
-            if missing:
-                raise ConfigError(f"--components has no model for axis {', '.join(missing)} "
-                                  f"(has {', '.join(given)})")
-            full = {a: given[a] for a in record.axis_names}
-            source = f"{components.name}"
-        from .noise import channel_kinds
-
-        kinds = channel_kinds(record)  # gyro: angle error [deg]; accel: velocity error [m/s]
-        for axis, comps in full.items():
-            say(f"{axis}: full model from {source}: {_model_text(comps, kinds.get(axis, 'gyro'))}"
-                + ("" if not notes.get(axis) else f" ({'; '.join(notes[axis])})"))
         train_sha = file_sha256(load.file)
         logs = []
         for path in held_out:
-            rec = load.load(path)
+            logs.append(load.load(path))
             if file_sha256(path) == train_sha:
                 warn(f"{path.name} is the training log itself (same SHA-256): its coverage is no held-out evidence")
-            miss = [a for a in record.axis_names if a not in rec.axis_names]
-            if miss:
-                raise ConfigError(f"{path.name} has no axis {', '.join(miss)} (it has {', '.join(rec.axis_names)}); "
-                                  "held-out logs need the training log's axes")
-            logs.append(({a: rec.axis(a) for a in record.axis_names}, rec.dt_s))
+        with progress("consistency", record.axis_names) as (axis_cb, _):
+            done = run_consistency(record, logs, method=method, components=given, calibration_s=calibration,
+                                   horizons_s=h, cover_s=cover, origin_step_s=origin_step,
+                                   source_name=components.name if given is not None else load.file.name,
+                                   held_out_names=[p.name for p in held_out],
+                                   progress=axis_cb if given is None and method == "allan" else None)
+        kinds = done.kinds  # gyro: angle error [deg]; accel: velocity error [m/s]
+        for axis, comps in done.full.items():
+            say(f"{axis}: full model from {done.source}: {_model_text(comps, kinds.get(axis, 'gyro'))}"
+                + ("" if not done.notes.get(axis) else f" ({'; '.join(done.notes[axis])})"))
         say(f"held out: {', '.join(p.name for p in held_out)}; calibration {calibration:g} s, horizons "
             f"{', '.join(f'{x:g}' for x in h)} s; origins "
             f"{'calibration + horizon' if origin_step is None else f'{origin_step:g} s'} "
             "apart (non-overlapping windows), pooled over the held-out logs")
-        covering = {a: random_walk_covering(c, cover, calibration, k_bound_dphrh=k_bounds.get(a),
-                                            quantity=kinds.get(a, "gyro")) for a, c in full.items()}
-        cov_models = {a: [c for c in reduced_model(full[a]) if c["kind"] == "white"]
-                      + [{"kind": "random_walk", "rrw_dphrh": covering[a]["k_eff_dphrh"]}] for a in full}
-        targets = [("full", f"full model ({source})", full),
-                   ("white+RW", "white + random walk only (Kalibr, VINS, ORB-SLAM3)",
-                    {a: reduced_model(c) for a, c in full.items()}),
-                   (f"white+RW covering {cover:g} s", f"white + the random walk covering the bias wander over "
-                                                      f"{cover:g} s", cov_models)]
-        results = []
-        for key, label, comps in targets:
-            if any(not comps[a] for a in comps):
-                say(f"{label}: skipped (an axis has no white or random-walk component)", style="yellow")
-                continue
-            res = check_consistency(key, comps, logs, t_cal_s=calibration, horizons_s=h, step_s=origin_step,
-                                    quantity=kinds)
-            res.notes = [f"{a}: {'; '.join(n)}" for a, n in notes.items() if n]
+        for label in done.skipped:
+            say(f"{label}: skipped (an axis has no white or random-walk component)", style="yellow")
+        for res, label in done.results:
             print_result(res, label, kinds)
-            results.append((res, label))
-        if results:
-            axes = list(results[0][0].axes)
+        if done.results:
+            axes = list(done.results[0][0].axes)
             console.print(fitted_table(
                 "inflation factor per target model: the largest λ over horizons and bands (95 % interval); "
                 "'none' when no row under-covers beyond counting error",
-                ["target"] + axes, [[res.target] + [summary_cell(res, a) for a in axes] for res, _ in results]))
-        for axis, d in covering.items():
+                ["target"] + axes, [[res.target] + [summary_cell(res, a) for a in axes] for res, _ in done.results]))
+        for axis, d in done.covering.items():
             say(f"{axis}: {d['sentence']}")
-        payload = {"fogdrift_result": "consistency", "training": str(load.file), "quantities": kinds,
-                   "held_out": [str(p) for p in held_out], "model_source": source,
-                   "calibration_s": calibration, "horizons_s": h, "cover_s": cover,
-                   "inflation_definition": "lambda multiplies every component's variance parameter (N^2, K^2, "
-                                           "sigma^2, Q^2, R^2); the smallest lambda with measured coverage >= "
-                                           "nominal; 95 % interval from binomial order-statistic ranks",
-                   "targets": [dict(res.to_dict(), label=label,
-                                    verdicts={a: verdict_line(res, a) for a in res.axes}) for res, label in results],
-                   "covering_random_walk": covering}
-        path = write_json(payload, r.out.path / "consistency.json")
+        path = write_consistency(done, r.out.path, training=str(load.file), held_out=held_out)
         r.wrote()
         r.print_json(path)

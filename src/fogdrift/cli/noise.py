@@ -20,8 +20,8 @@ import typer
 
 from ..errors import ConfigError
 from ..spec import readings_from_gmwm
-from ._app import (JsonOpt, OutOpt, SegmentsOpt, app, check_plausible, console, echo_record, fitted_table, progress,
-                   run, say, screen_record_axes, with_load_options)
+from ._app import (JsonOpt, OutOpt, SegmentsOpt, app, console, echo_record, fitted_table, print_screen, progress, run,
+                   say, with_load_options)
 from ._tables import noise_table, print_noise_notes
 # (the --spec helpers live in the light cli._spec; imported here under their old names too)
 from ._spec import SpecOpt, channel_kinds, print_spec_comparison, print_spec_for_allan, read_spec_option  # noqa: F401
@@ -142,9 +142,10 @@ def noise(
     expect += ("spec.json",) if spec is not None else ()
     with run("noise", out, default_out=DEFAULT_OUT, inputs=[load.file, curve, spec], json_out=json_out,
              expect=expect) as r:
-        from ..gmwm.analysis import analyse_gmwm, analyse_wvar, candidates_for, read_curve_table
-        from ..gmwm.compare import attach_allan_checks
+        from ..gmwm.analysis import analyse_wvar, candidates_for, read_curve_table
         from ..report.gmwm import write_gmwm_outputs
+        from ..workflows.allan import screen
+        from ..workflows.noise import run_noise, write_noise
 
         if method not in ("gmwm", "allan"):
             raise ConfigError(f"{{opt:method}} must be 'gmwm' or 'allan'; got {method!r}")
@@ -180,47 +181,36 @@ def noise(
                 raise ConfigError("--sensor belongs to --curve")
             record = load.load()
             echo_record(load, record)
-            # the plausibility check keeps the octave Allan sums of its noise floors: the Allan fit of the
-            # GMWM-vs-Allan lines reuses them instead of computing that pass again
-            sums = {}
-            check_plausible(record, sums=sums)
-            from ..segments import longest_segment
-
-            # the record screen comes before either fit; GMWM (one wavelet variance) fits the longest quiet
-            # segment of a disturbed axis, the Allan cross-check pools the quiet segments
-            segs, screens = screen_record_axes(record, segments, gmwm=True)
+            # the checks before either fit (plausibility, the record screen); GMWM (one wavelet variance) fits the
+            # longest quiet segment of a disturbed axis, the Allan cross-check pools the quiet segments
+            screened = screen(record, segments)
+            print_screen(record, screened.findings, screened.screens, gmwm=screened.segments)
             with progress("noise", record.axis_names):
-                axes = [analyse_gmwm(name, longest_segment(record.axis(name), segs[name]), record.dt_s, model=model,
-                                     levels=scales, robust=robust)
-                        for name in record.axis_names]
-                attach_allan_checks(record, axes, sums=sums, segments=segs, screens=screens)
-            del sums
-            from ..gmwm.quantity import express_gmwm
-
-            quantities = {c.name: c.quantity for c in record.signal.channels}
-            axes = [express_gmwm(a, quantities[a.name]) for a in axes]  # an accelerometer's terms in its units
+                done = run_noise(record, model=model, levels=scales, robust=robust, screened=screened)
+            axes, quantities = done.axes, done.quantities
             source, meta = str(record.source), record.metadata()
             kinds = channel_kinds(record)
         print_gmwm((curve or load.file).name, axes, None if curve else quantities, details=details)
         if limits is not None:
             print_spec_comparison(limits, {a.name: (kinds[a.name], readings_from_gmwm(a, kinds[a.name]))
                                            for a in axes}, r.out.path, source=spec.name)
-        files = write_gmwm_outputs(axes, r.out.path, source=source, record=meta)
+        files = write_noise(done, r.out.path) if curve is None else write_gmwm_outputs(axes, r.out.path, source=source,
+                                                                                      record=meta)
         r.wrote()
         r.print_json(files["json"])
 
 
 def _allan(load, r, limits=None, spec_path=None, segments="auto"):
     """--method allan: the Allan noise fit of every axis (as 'fogdrift allan'), written as noise.json/noise.png."""
-    from ..pipeline import AnalysisConfig, run_allan
     from ..report import noise_row, plot_allan, write_json
+    from ..workflows.allan import run_allan, screen
 
     record = load.load()
     echo_record(load, record)
-    check_plausible(record)
-    segs, screens = screen_record_axes(record, segments)
+    screened = screen(record, segments)
+    print_screen(record, screened.findings, screened.screens)
     with progress("noise", record.axis_names) as (allan_cb, _):
-        results = run_allan(record, AnalysisConfig().validate(), progress=allan_cb, segments=segs, screens=screens)
+        results = run_allan(record, progress=allan_cb, screened=screened).results
     console.print(noise_table(f"{load.file.name}: Allan fit, 95 % intervals in brackets",
                               [[a.name] + noise_row(a.noise) for a in results]))
     for a in results:

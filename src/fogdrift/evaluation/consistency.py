@@ -52,12 +52,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._util import fmt_number
 from ..errors import ConfigError, InsufficientDataError
 from ..models.components import components_from_gmwm, components_from_noise_fit  # re-exported
 from ..models.statespace import check_components
 
 __all__ = [
     "BANDS",
+    "verdict_line",
+    "summary_cell",
     "angle_error_variance_deg2",
     "observed_angle_errors_deg",
     "inflation_factor",
@@ -508,3 +511,50 @@ def check_consistency(target: str, components_by_axis: dict, held_out: list, *, 
         axes[axis] = {"components": comps, "rows": coverage_rows(e, sigma, h, unit="m/s" if q == "accel" else "deg"),
                       "n_logs": len(held_out), "quantity": q}
     return ConsistencyResult(target=target, axes=axes, t_cal_s=T, horizons_s=tuple(float(x) for x in h))
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# verdicts in words
+# ------------------------------------------------------------------------------------------------------------------
+def _fmt(x, d=3) -> str:
+    """``d`` significant digits, ``–`` when missing or not finite: :func:`fogdrift._util.fmt_number`."""
+    return fmt_number(x, d)
+
+
+def verdict_line(res, axis: str) -> str:
+    """One sentence per target and axis: the inflation the user needs, or that none is needed.
+
+    Inflation is needed when some horizon and band under-covers beyond counting error (the 95 % interval of its
+    λ lies above 1); the factor to use is then the largest λ over horizons and bands (nominal coverage at every
+    one).  Otherwise: "no inflation needed" (every λ <= 1) or "... within counting error"."""
+    rows = res.axes[axis]["rows"]
+    cells = [(*row.inflation[b], row.horizon_s, b, row.n_origins) for row in rows for b in row.inflation
+             if math.isfinite(row.inflation[b][0])]
+    if not cells:
+        return f"{axis}: too few origins to count"
+    lam, lo, hi, h, band, n = max(cells)
+    if lam <= 1.0:
+        return (f"{axis}: no inflation needed: the model covers at least nominally at every horizon (largest "
+                f"λ {_fmt(lam)} at {h:g} s, {band} band)")
+    significant = [c for c in cells if c[1] > 1.0]
+    if not significant:
+        return (f"{axis}: no inflation needed within counting error: every λ's 95 % interval reaches 1 (largest "
+                f"λ {_fmt(lam)} at {h:g} s, {band} band, {n} origins, interval from {_fmt(lo)})")
+    sig = max(significant, key=lambda c: c[1])
+    where = "" if sig[3:5] == (h, band) else (f"; beyond counting error at {sig[3]:g} s, {sig[4]} band: λ "
+                                              f"{_fmt(sig[0])} [{_fmt(sig[1])}, {_fmt(sig[2])}]")
+    return (f"{axis}: inflate the variances by λ = {_fmt(lam)} ({h:g} s, {band} band, 95 % [{_fmt(lo)}, "
+            f"{_fmt(hi)}], {n} origins{where}): multiply N, K, σ by {_fmt(math.sqrt(lam))}")
+
+
+def summary_cell(res, axis: str) -> str:
+    """``1.67 [1.14, 2.46]`` when inflation is needed (the rule of :func:`verdict_line`), else ``none (largest
+    1.19)``."""
+    cells = [(*row.inflation[b],) for row in res.axes[axis]["rows"] for b in row.inflation
+             if math.isfinite(row.inflation[b][0])]
+    if not cells:
+        return "–"
+    lam, lo, hi = max(cells)
+    if lam <= 1.0 or not any(c[1] > 1.0 for c in cells):
+        return f"none (largest {_fmt(lam)})"
+    return f"{_fmt(lam)} [{_fmt(lo)}, {_fmt(hi)}]"

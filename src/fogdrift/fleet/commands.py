@@ -1,7 +1,7 @@
 """The commands ``fogdrift batch`` can run over many logs: one row of :data:`COMMANDS` each.
 
-A command is a function ``run(record, settings, out_dir) -> list[dict]`` that calls the same library and
-report functions as the single command (so each file's folder holds what ``fogdrift allan`` or ``fogdrift
+A command is a function ``run(record, settings, out_dir) -> list[dict]`` that calls the same workflow
+(:mod:`fogdrift.workflows`) as the single command (so each file's folder holds what ``fogdrift allan`` or ``fogdrift
 analyze`` would write there) and returns one summary row per axis (:mod:`.summary` names the columns; a
 noise fit fills them with :func:`noise_columns`).  It runs inside the file's own
 :class:`~fogdrift.output.OutputDir`, so every file it writes through :func:`~fogdrift.output.atomic_path`
@@ -23,8 +23,7 @@ from typing import Callable
 
 from ..errors import ConfigError, FogdriftError
 from ..noise.terms import TERM_TABLE
-from ..spec import (channel_kind, compare, judge_noise_fit, parse_spec, readings_from_gmwm, readings_from_noise_fit,
-                    spec_columns)
+from ..spec import channel_kind, compare, judge_noise_fit, parse_spec, readings_from_gmwm, spec_columns
 
 __all__ = ["CommandSpec", "COMMANDS", "command_spec", "noise_columns", "record_columns", "run_allan_command",
            "run_analyze_command", "TERMS", "spec_from_settings", "axis_kind"]
@@ -157,16 +156,6 @@ def _spec_gmwm(limits, record, axis) -> dict:
     return spec_columns(compare(limits, {axis.name: (kind, readings_from_gmwm(axis, kind))}))
 
 
-def _analysis_judgements(result, limits: dict) -> list:
-    """The judgements of an analysis, as :func:`fogdrift.report.summary.analysis_judgements` makes them for ``analyze
-    --spec`` (GMWM readings when every axis has a GMWM model, else the Allan fit; gyro limits): repeated here so that
-    this module does not import the report at start-up."""
-    axes = list(result.axes)
-    gmwm = bool(axes) and all(getattr(ax, "gmwm", None) is not None for ax in axes)
-    return compare(limits, {ax.name: ("gyro", readings_from_gmwm(ax.gmwm, "gyro") if gmwm
-                                      else readings_from_noise_fit(ax.original.noise, "gyro")) for ax in axes})
-
-
 def _config(settings: dict):
     from ..pipeline import AnalysisConfig
 
@@ -176,49 +165,33 @@ def _config(settings: dict):
 def run_allan_command(record, settings: dict, out_dir) -> list[dict]:
     """``fogdrift allan`` on one record: ``allan.json``, ``allan.csv``, ``allan.png`` and one row per axis.
 
-    The same calls as the ``allan`` command (:func:`fogdrift.pipeline.run_allan`,
-    :func:`fogdrift.report.write_allan_outputs`), so the files are the ones it writes.
+    The workflow of the ``allan`` command (:func:`fogdrift.workflows.allan.run_allan` and ``write_allan``), so the
+    files are the ones it writes.
     """
-    from ..pipeline import run_allan
-    from ..report import write_allan_outputs
-
-    from ..segments import plan_segments
+    from ..workflows.allan import run_allan, write_allan
 
     limits = spec_from_settings(settings)
-    segs, screens = plan_segments(record, settings.get("segments", "auto"))  # as the command: screen, then fit
-    results = run_allan(record, _config(settings), segments=segs, screens=screens)
-    write_allan_outputs(results, record, out_dir)
+    done = run_allan(record, _config(settings), segments=settings.get("segments", "auto"))
+    write_allan(done, out_dir)
     return [{"axis": a.name, **record_columns(record), **noise_columns(a.noise),
-             **_spec_allan(limits, record, a.name, a.noise)} for a in results]
+             **_spec_allan(limits, record, a.name, a.noise)} for a in done.results]
 
 
 def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
-    """``fogdrift analyze`` on one record: the heading-error and artefact evaluation (on by default, as in the
-    single command), ``report.html``, ``analysis.json``, the model ``bundle/``, the compensated test block per
-    axis (``compensated_test_<axis>.csv``) and one row per axis with the verdicts."""
-    from ..bundle import write_bundle
-    from ..compensate.holdout import write_compensated_test_block
-    from ..evaluation import evaluated_analysis
-    from ..pipeline import run_analysis
+    """``fogdrift analyze`` on one record (:func:`fogdrift.workflows.analyze.run_analyze` and ``write_analyze``): the
+    heading-error and artefact evaluation (on by default, as in the single command), ``report.html``,
+    ``analysis.json``, the model ``bundle/``, the compensated test block per axis (``compensated_test_<axis>.csv``)
+    and one row per axis with the verdicts."""
     from ..evaluation.verdicts import paper_measure_verdict
-    from ..report import write_report
+    from ..workflows.analyze import run_analyze, write_analyze
 
-    from ..segments import plan_segments
-
-    cfg = _config(settings)
     limits = spec_from_settings(settings)
-    segs, screens = plan_segments(record, settings.get("segments", "auto"))
-    result = run_analysis(record, cfg, segments=segs, screens=screens)
-    result = evaluated_analysis(result)
+    done = run_analyze(record, _config(settings), limits=limits, segments=settings.get("segments", "auto"))
+    write_analyze(done, out_dir, spec_source=(settings.get("spec") or {}).get("source") or "")
+    result = done.result
     evaluations = {ax.name: ax.evaluation for ax in result.axes}
-    spec_doc, spec_cols = None, {}
-    if limits is not None:  # as 'analyze --spec': the verdicts on the report's first screen and in the rows
-        js = _analysis_judgements(result, limits)
-        spec_doc = {"limits": limits, "judgements": js, "source": (settings.get("spec") or {}).get("source") or ""}
-        spec_cols = {ax.name: spec_columns([j for j in js if j.channel == ax.name]) for ax in result.axes}
-    write_report(result, record, out_dir, evaluated=True, spec=spec_doc)
-    write_bundle(Path(out_dir) / "bundle", [ax.models for ax in result.axes], cfg, record)
-    write_compensated_test_block([ax.models for ax in result.axes], out_dir, t0_s=record.t0_s)
+    spec_cols = {ax.name: spec_columns([j for j in done.judgements if j.channel == ax.name]) for ax in result.axes} \
+        if limits is not None else {}
     rows = []
     for ax in result.axes:
         ev = evaluations.get(ax.name)
@@ -231,38 +204,25 @@ def run_analyze_command(record, settings: dict, out_dir) -> list[dict]:
 
 
 def run_noise_command(record, settings: dict, out_dir) -> list[dict]:
-    """``fogdrift noise`` (GMWM) on one record: ``noise.json``, ``wvar.csv``, ``noise.png`` and one row per axis.
+    """``fogdrift noise`` (GMWM) on one record (:func:`fogdrift.workflows.noise.run_noise` and ``write_noise``):
+    ``noise.json``, ``wvar.csv``, ``noise.png`` and one row per axis.
 
     ``settings["gmwm"]`` holds the options of ``fogdrift noise`` (``model``: ``"auto"`` = selection by WIC,
     or a fixed model such as ``"WN+RW+GM"``; ``levels``: the number of scales J; ``robust``: Huber WV);
-    missing keys take that command's defaults.
-
-    The same calls as the ``noise`` command (:func:`fogdrift.gmwm.analysis.analyse_gmwm`,
-    :func:`fogdrift.report.gmwm.write_gmwm_outputs`).  Row: each IEEE-952 coefficient the selected model
+    missing keys take that command's defaults.  Row: each IEEE-952 coefficient the selected model
     implies with its 95 % interval (``resolved`` when the interval excludes zero, ``absent`` when the model
     has no such term), the selected model, the J test's p-value (``fit_quality`` ``good`` when every check
     passed, else ``poor``) and the bias instability at the AVAR minimum implied by the model.
     """
-    from ..gmwm.analysis import analyse_gmwm
-    from ..gmwm.compare import attach_allan_checks, express_gmwm
-    from ..report.gmwm import write_gmwm_outputs
-
-    from ..segments import longest_segment, plan_segments
+    from ..workflows.noise import run_noise, write_noise
 
     opts = settings.get("gmwm", {})
     limits = spec_from_settings(settings)
-    segs, screens = plan_segments(record, settings.get("segments", "auto"))
-    axes = [analyse_gmwm(name, longest_segment(record.axis(name), segs[name]), record.dt_s,
-                         model=opts.get("model", "auto"), levels=opts.get("levels"),
-                         robust=bool(opts.get("robust", False)))
-            for name in record.axis_names]
-    # as 'fogdrift noise': N and B against the Allan fit, in noise.json
-    attach_allan_checks(record, axes, segments=segs, screens=screens)
-    # an accelerometer axis's reading in its units (B stays m/s^2 here; the batch row shows it in ug)
-    axes = [express_gmwm(a, record.signal.channel(a.name).quantity) for a in axes]
-    write_gmwm_outputs(axes, out_dir, source=str(record.source), record=record.metadata())
+    done = run_noise(record, model=opts.get("model", "auto"), levels=opts.get("levels"),
+                     robust=bool(opts.get("robust", False)), segments=settings.get("segments", "auto"))
+    write_noise(done, out_dir)
     return [{"axis": a.name, **record_columns(record), **gmwm_columns(a), **_spec_gmwm(limits, record, a)}
-            for a in axes]
+            for a in done.axes]
 
 
 def gmwm_columns(axis) -> dict:

@@ -14,7 +14,7 @@ import numpy as np
 from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
 from ..noise import TERM_TABLE
 from ..noise.terms import DISPLAY_UNITS, TERMS
-from ..spec import B_COMPARED, compare, judgement_line, readings_from_gmwm, readings_from_noise_fit
+from ..spec import B_COMPARED, analysis_judgements, judgement_line  # noqa: F401 (analysis_judgements: re-export)
 from .screen import screen_summary
 from .tables import _fmt, noise_row, shaped_cell, term_text
 
@@ -254,23 +254,6 @@ def cannot_support(result) -> dict:
                 items.append((ax.name, f"one-step metrics: {note}"))
     return {"term_headers": ["axis", "term", "status", "95 % bound", "why"], "terms": _term_limits(result),
             "items": _grouped(items)}
-
-
-def analysis_judgements(result, limits: dict, kind: str = "gyro") -> list:
-    """The datasheet judgements (:func:`fogdrift.spec.compare`) of every axis of an analysis, read from the noise
-    model its headline shows: the GMWM axis when every axis has one (``--noise-method gmwm``), else the Allan fit of
-    the whole record.  ``limits``: a parsed spec (:func:`fogdrift.spec.read_spec`; the CLI reads the file, this
-    function reads nothing); ``kind``: the spec section (``analyze`` takes gyro logs).
-
-    Returns
-    -------
-    list of fogdrift.spec.Judgement
-        Per axis, in the spec's order.
-    """
-    axes = list(result.axes)
-    gmwm = bool(axes) and all(getattr(ax, "gmwm", None) is not None for ax in axes)
-    return compare(limits, {ax.name: (kind, readings_from_gmwm(ax.gmwm, kind) if gmwm
-                                      else readings_from_noise_fit(ax.original.noise, kind)) for ax in axes})
 
 
 def spec_summary(limits: dict, judgements, source: str = "") -> dict:
