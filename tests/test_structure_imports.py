@@ -187,6 +187,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
         "fogdrift.gmwm.quantity", "fogdrift.noise.periodic", "fogdrift.noise.quantity", "fogdrift.segments", "fogdrift.pipeline", "fogdrift.report",
         "fogdrift.report.gmwm")),
     "fogdrift.cli.separate": (CLI, ("fogdrift.pipeline", "fogdrift.report")),
+    "fogdrift.cli.plan": (CLI, ("fogdrift.pipeline", "fogdrift.plan", "fogdrift.report", "fogdrift.report.plan_figure")),
     "fogdrift.fleet.commands": (BATCH, ("fogdrift.bundle", "fogdrift.evaluation", "fogdrift.evaluation.verdicts",
         "fogdrift.gmwm.analysis", "fogdrift.gmwm.compare", "fogdrift.pipeline", "fogdrift.report",
         "fogdrift.report.gmwm", "fogdrift.compensate.holdout", "fogdrift.segments")),

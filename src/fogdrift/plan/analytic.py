@@ -51,7 +51,7 @@ def expected_inflation(dof: int) -> float:
     Examples
     --------
     >>> round(expected_inflation(10), 4), round(expected_inflation(1000), 4)
-    (1.1171, 1.0126)
+    (1.1755, 1.0178)
     """
     k = max(int(dof), 1)
     return float(chi2.cdf(k, k) + 1.0 - chi2.cdf(k, k + 2))
