@@ -45,7 +45,7 @@ def _params(command):
 
 
 @pytest.mark.parametrize("command", ["allan", "noise", "separate", "model", "analyze", "batch", "compensate",
-                                     "consistency", "export"])
+                                     "consistency", "export", "plan"])
 def test_every_registry_option_is_a_flag_of_every_reading_command(command):
     params = _params(command)
     for opt in cli_options():

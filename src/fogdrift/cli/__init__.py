@@ -28,6 +28,7 @@ __all__ = ["app", "main"]
 COMMAND_MODULES = {
     "allan": "allan", "model": "model", "analyze": "analyze", "noise": "noise", "batch": "batch",
     "compensate": "compensate", "consistency": "consistency", "export": "export", "separate": "separate",
+    "plan": "plan",
 }
 
 

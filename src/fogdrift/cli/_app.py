@@ -83,6 +83,7 @@ FLAGS = {
     "val_fraction": "--val-fraction", "causal_window_s": "--causal-window", "gm_window": "--gm-window",
     "fit_tau_s": "--fit-taus", "format": "--format", "horizons": "--horizons", "calibration": "--calibration",
     "origin_step": "--origin-step", "spec": "--spec",
+    "target": "--target", "length": "--length", "monte_carlo": "--monte-carlo", "workers": "--workers", "axis": "--axis",
 }
 
 #: The reader options of the ``READERS`` table (fogdrift.io.registry), each once: every one is a flag of every

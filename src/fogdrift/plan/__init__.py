@@ -1,0 +1,14 @@
+"""``fogdrift plan``: how long must a record be for the Allan fit to resolve each noise term and to reach a
+stated interval width (issue 34).
+
+:mod:`.model` (the model, targets and lengths, parsed), :mod:`.analytic` (expected widths from the fit's own
+covariance laws), :mod:`.montecarlo` (simulated records through the real fit), :mod:`.core` (the plan).
+GMWM is not planned yet.
+"""
+
+from .core import MAX_LENGTH_S, Plan, make_plan
+from .model import (DEFAULT_TARGETS, PlanModel, fmt_length, model_from_fit, parse_length, parse_model,
+                    parse_targets, read_model_file)
+
+__all__ = ["make_plan", "Plan", "PlanModel", "parse_model", "parse_targets", "parse_length", "model_from_fit",
+           "read_model_file", "fmt_length", "DEFAULT_TARGETS", "MAX_LENGTH_S"]

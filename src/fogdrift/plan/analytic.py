@@ -1,0 +1,131 @@
+"""Interval width of each term of the Allan fit against record length, from the estimator's own covariance laws.
+
+For a record of ``n`` samples the fit works on the octave taus ``m = 1, 2, 4, ... <= n/4`` (:func:`fogdrift.allan.
+tau_grid`, as ``fogdrift allan``).  At the true model the fit's objective is, to first order, the generalised
+least-squares form ``(y - X A)' V^-1 (y - X A)`` with ``V`` the model covariance the fit itself uses (the
+estimators' covariance of :mod:`fogdrift.noise.covariance` and the model-discrepancy allowance, built by the
+fit's own context, :class:`fogdrift.noise.identify._Context`).  Hence (the "Asimov" record: the expected curve
+fitted, the median record's interval):
+
+* ``Cov(A) = (X' V^-1 X)^-1`` over the model's terms;
+* the 95 % interval of ``A_k`` is ``A_k +- d sd_k`` with ``d^2 = t_{0.975, dof}^2 E[max(1, chi2_red)]`` (the
+  fit's profile threshold and its expected widening for misfit), widened to the union over the models one absent
+  term larger (always plausible at the expected curve: the information criterion ``IC = Q + 2 k`` rises by at most
+  2, inside the plausible window of 6): the absent term may only grow from zero, so one side widens, the side of
+  the sign of its correlation with ``A_k``;
+* the coefficient is ``sqrt(A)``-like, so its interval relative to the value is ``[sqrt(A_lo), sqrt(A_hi)] /
+  sqrt(A)`` and the reported relative width is the half-width ``(hi - lo) / 2``;
+* the term is **resolved** when its interval excludes zero and no model without it is plausible: the model
+  without it, or with it replaced by one absent term, fitted to the expected curve (non-negative least squares
+  in the whitened metric), is more than the plausible window (6) above in IC.
+
+The allowance (2 % on every deviation, :mod:`fogdrift.noise.discrepancy`) puts a floor under every width: a term
+may never reach a target below it at any length, which the plan says.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import nnls
+from scipy.stats import chi2, t as student_t
+
+from ..allan.grid import tau_grid
+from ..noise.identify import _Context
+from ..noise.terms import all_terms
+from .model import PLANNED_TERMS as PLANNED
+
+__all__ = ["analytic_widths", "expected_inflation", "PLAUSIBLE_DELTA", "IC_PENALTY"]
+
+#: The Allan fit's plausible-model window and IC penalty per term (:func:`fogdrift.noise.fit_noise` defaults).
+PLAUSIBLE_DELTA = 6.0
+IC_PENALTY = 2.0
+
+
+def expected_inflation(dof: int) -> float:
+    """``E[max(1, X / dof)]`` for ``X ~ chi2_dof``: the mean widening of the fit's profile threshold.
+
+    ``E[X 1{X > c}] = dof (1 - F_{dof+2}(c))``, so the mean is ``F_dof(dof) + 1 - F_{dof+2}(dof)``.
+
+    Examples
+    --------
+    >>> round(expected_inflation(10), 4), round(expected_inflation(1000), 4)
+    (1.1755, 1.0178)
+    """
+    k = max(int(dof), 1)
+    return float(chi2.cdf(k, k) + 1.0 - chi2.cdf(k, k + 2))
+
+
+def analytic_widths(model, n_samples) -> dict:
+    """Expected 95 % interval of every model term for a record of ``n_samples`` samples at ``model.dt_s``.
+
+    Returns ``{term: {"rel_lo", "rel_hi", "rel_width", "z", "resolved"}}`` (interval ends relative to the true
+    value, relative half-width, ``A / sd``) and ``"_fit"``: ``{"tau_min_s", "tau_max_s", "n_taus", "dof"}``.
+    A record too short for ``len(terms) + 1`` taus gives every term ``rel_width = inf``.
+    """
+    n = int(n_samples)
+    dt = float(model.dt_s)
+    names = model.terms
+    m = tau_grid(n, dt, "octave").astype(np.float64)
+    tau = m * dt
+    k = len(names)
+    out = {"_fit": {"tau_min_s": float(tau[0]), "tau_max_s": float(tau[-1]), "n_taus": int(m.size),
+                    "dof": int(m.size - k)}}
+    if m.size <= k:
+        for t in names:
+            out[t] = {"rel_lo": 0.0, "rel_hi": math.inf, "rel_width": math.inf, "z": 0.0, "resolved": False}
+        return out
+    A = model.law_coefficients()
+    probe = _Context(tau, m, np.ones_like(tau), np.full_like(tau, 2.0), n, dt, "adev", names)
+    mu = probe.X @ A
+    ctx = _Context(tau, m, mu, mu * 2.0, n, dt, "adev", names)
+    V = ctx.relcov(A, exact_ramp=True) * np.outer(mu, mu)
+    L = np.linalg.cholesky(V)
+    full = _Context(tau, m, mu, mu * 2.0, n, dt, "adev", tuple(t for t in PLANNED if t in ctx.laws))
+    Xall = np.linalg.solve(L, full.X)  # whitened design of every column
+    yw = np.linalg.solve(L, mu)
+    col = {t: all_terms().index(t) for t in PLANNED}
+    extras = [e for e in PLANNED if e not in names]
+    dof = int(m.size - k)
+    d = float(student_t.ppf(0.975, dof)) * math.sqrt(expected_inflation(dof))
+    cov = _cov(Xall[:, [col[t] for t in names]])
+    # the models one extra term away (always plausible at the true curve: IC rises by at most 2)
+    cov_ext = {e: _cov(Xall[:, [col[t] for t in names] + [col[e]]]) for e in extras}
+    for j, t in enumerate(names):
+        a = float(A[col[t]])
+        sd = math.sqrt(max(float(cov[j, j]), 0.0))
+        z = a / sd if sd > 0 else math.inf
+        lo_a, hi_a = a - d * sd, a + d * sd
+        for e, ce in cov_ext.items():  # the extra term may only grow from 0: one side of the interval widens
+            sd_e = math.sqrt(max(float(ce[j, j]), 0.0))
+            if ce[j, -1] < 0:
+                lo_a = min(lo_a, a - d * sd_e)
+            else:
+                hi_a = max(hi_a, a + d * sd_e)
+        # resolved: every plausible model needs t -- the model without t, or with t replaced by an absent term,
+        # is out of the plausible window at the expected curve
+        rest = [col[u] for u in names if u != t]
+        dq = min(_q(Xall[:, rest + ([col[e]] if e else [])], yw) + IC_PENALTY * (0 if e else -1)
+                 for e in [None] + extras)
+        resolved = bool(lo_a > 0 and dq > PLAUSIBLE_DELTA)
+        lo = math.sqrt(max(lo_a, 0.0) / a)
+        hi = math.sqrt(hi_a / a)
+        out[t] = {"rel_lo": lo, "rel_hi": hi, "rel_width": (hi - lo) / 2.0 if resolved else math.inf, "z": z,
+                  "delta_ic": float(dq), "resolved": resolved}
+    return out
+
+
+def _cov(Xw):
+    F = Xw.T @ Xw
+    try:
+        return np.linalg.inv(F)
+    except np.linalg.LinAlgError:
+        return np.linalg.pinv(F)
+
+
+def _q(Xw, yw) -> float:
+    """Smallest whitened residual ``||yw - Xw A||^2`` over ``A >= 0`` (0 columns: ``||yw||^2``)."""
+    if Xw.shape[1] == 0:
+        return float(yw @ yw)
+    return float(nnls(Xw, yw)[1] ** 2)

@@ -1,0 +1,208 @@
+"""The plan: for each target term, the record length at which the Allan fit resolves it and at which its 95 %
+interval reaches the requested relative half-width (analytic, :mod:`.analytic`), checked by Monte-Carlo
+(:mod:`.montecarlo`); and what a record of a stated length supports."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..noise.terms import TERM_TABLE
+from .analytic import analytic_widths
+from .model import fmt_length
+from .montecarlo import MC_MAX_SAMPLES, simulate_fits, summarise
+
+__all__ = ["Plan", "make_plan", "MAX_LENGTH_S", "crossing"]
+
+#: Longest record the planner looks at [s] (30 days).
+MAX_LENGTH_S = 30 * 86400.0
+_MIN_SAMPLES = 64
+_STEP = 2.0**0.5  # grid of record lengths: half an octave
+
+
+def crossing(x, y, level):
+    """First ``x`` where ``y`` (sampled at increasing ``x``) falls to ``level`` or below, log-log interpolated
+    between the grid points around it; None if it never does; ``x[0]`` if it starts there.
+
+    Examples
+    --------
+    >>> crossing([1.0, 4.0], [2.0, 1.0], 1.5) == 2 ** (2 * __import__("math").log2(2 / 1.5))
+    True
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    ok = np.flatnonzero(y <= level)
+    if ok.size == 0:
+        return None
+    i = int(ok[0])
+    if i == 0:
+        return float(x[0])
+    y0, y1 = y[i - 1], y[i]
+    if not math.isfinite(y0):
+        return float(x[i])
+    f = (math.log(y0) - math.log(level)) / (math.log(y0) - math.log(y1))
+    return float(math.exp(math.log(x[i - 1]) + f * (math.log(x[i]) - math.log(x[i - 1]))))
+
+
+@dataclass
+class Plan:
+    """Result of :func:`make_plan` (lengths in s; widths are relative 95 % half-widths, 0.1 = +-10 %).
+
+    ``terms``: term -> ``target`` (width asked), ``resolved_s`` (length from which the median record resolves it),
+    ``target_s`` (length at which its expected width reaches the target; None: not within
+    :data:`MAX_LENGTH_S`), ``floor_width`` (width at :data:`MAX_LENGTH_S`), ``mc`` (Monte-Carlo at ``target_s``:
+    median width, fractions, coverage, seeds, and ``length_s``, the length the measured width implies).
+    ``grid``: the analytic curve (``length_s`` and each term's width). ``at_length``: what ``length_s`` supports.
+    """
+
+    model: object
+    targets: dict
+    terms: dict
+    grid: dict
+    at_length: dict | None = None
+    seeds: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+
+    def lines(self) -> list[str]:
+        """The first-screen lines: one per target term, then the stated length's."""
+        out = []
+        for t, r in self.terms.items():
+            w = f"±{100 * r['target']:.3g} %"
+            if r["target_s"] is not None:
+                s = f"{t} to {w}: {fmt_length(r['target_s'])} (Allan fit)"
+                mc = r.get("mc")
+                if mc:
+                    s += (f", Monte-Carlo {len(self.seeds)} seeds at that length: median ±{100 * mc['median_width']:.3g} %"
+                          if math.isfinite(mc["median_width"]) else
+                          f", Monte-Carlo {len(self.seeds)} seeds at that length: resolved in fewer than half")
+                    s += f", coverage {100 * mc['coverage']:.0f} %"
+                    if mc.get("length_s"):
+                        s += f" (implies {fmt_length(mc['length_s'])})"
+            else:
+                s = (f"{t} to {w}: not within {fmt_length(MAX_LENGTH_S)} (Allan fit; the model-discrepancy "
+                     f"allowance keeps it at ±{100 * r['floor_width']:.3g} % or wider)"
+                     if math.isfinite(r["floor_width"]) else f"{t} to {w}: not resolved within "
+                     f"{fmt_length(MAX_LENGTH_S)}")
+            if r["resolved_s"] is not None:
+                s += f"; {t} resolved from {fmt_length(r['resolved_s'])}"
+            out.append(s)
+        if self.at_length:
+            L = self.at_length
+            good = [f"{t} to ±{100 * v['rel_width']:.2g} %" for t, v in L["terms"].items() if v["resolved"]]
+            bound = [t for t, v in L["terms"].items() if not v["resolved"]]
+            s = f"a {fmt_length(L['length_s'])} record " + (f"resolves {', '.join(good)}" if good else "resolves no term")
+            if bound:
+                s += f" and gives {', '.join(bound)} only as a bound"
+            out.append(s)
+        return out
+
+    def to_dict(self) -> dict:
+        def clean(x):
+            if isinstance(x, dict):
+                return {k: clean(v) for k, v in x.items()}
+            if isinstance(x, (list, tuple)):
+                return [clean(v) for v in x]
+            if isinstance(x, float) and not math.isfinite(x):
+                return None
+            if isinstance(x, np.generic):
+                return clean(x.item())
+            return x
+
+        return clean({"fogdrift_result": "plan", "estimator": "allan fit (fogdrift allan)",
+                      "width": "relative 95 % half-width, (hi95 - lo95) / (2 value)",
+                      "model": self.model.to_dict(),
+                      "targets": self.targets, "terms": self.terms, "at_length": self.at_length,
+                      "monte_carlo_seeds": self.seeds, "grid": self.grid, "notes": self.notes,
+                      "lines": self.lines()})
+
+
+def _grid_n(dt_s):
+    n_max = int(MAX_LENGTH_S / dt_s)
+    out, n = [], float(_MIN_SAMPLES)
+    while n <= n_max:
+        out.append(int(round(n)))
+        n *= _STEP
+    return out
+
+
+def _mc_length(L, w_mc, target, grid_len, grid_w):
+    """Length the measured median width implies, with the analytic curve's local log-log slope at ``L``."""
+    gl, gw = np.asarray(grid_len), np.asarray(grid_w)
+    ok = np.isfinite(gw)
+    if not (math.isfinite(w_mc) and ok.sum() >= 2):
+        return None
+    lg, lw = np.log(gl[ok]), np.log(gw[ok])
+    i = int(np.clip(np.searchsorted(lg, math.log(L)), 1, lg.size - 1))
+    s = (lw[i] - lw[i - 1]) / (lg[i] - lg[i - 1])
+    if s > -0.05:  # the width no longer falls with length (at its floor): no length to read
+        return None
+    return float(L * (target / w_mc) ** (1.0 / s))
+
+
+def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=1) -> Plan:
+    """Plan the record for ``model`` (:class:`~fogdrift.plan.model.PlanModel`) and ``targets`` (term -> relative
+    half-width).  ``monte_carlo``: seeds per checked length (0: analytic only); ``workers``: processes."""
+    for t in targets:
+        if t not in model.terms:
+            raise ConfigError(f"{{opt:target}}: the model has no {t} term to plan for")
+    if monte_carlo < 0:
+        raise ConfigError(f"{{opt:monte_carlo}} must be >= 0 seeds; got {monte_carlo}")
+    dt = model.dt_s
+    ns = _grid_n(dt)
+    if len(ns) < 2:
+        raise ConfigError(f"sample interval {dt:g} s leaves fewer than {_MIN_SAMPLES} samples in "
+                          f"{fmt_length(MAX_LENGTH_S)}")
+    curves = [analytic_widths(model, n) for n in ns]
+    lengths = [n * dt for n in ns]
+    grid = {"length_s": lengths, "n_samples": ns,
+            "tau_max_s": [c["_fit"]["tau_max_s"] for c in curves],
+            "width": {t: [c[t]["rel_width"] for c in curves] for t in model.terms},
+            "z": {t: [c[t]["z"] for c in curves] for t in model.terms}}
+    terms = {}
+    seeds = list(range(seed0, seed0 + int(monte_carlo)))
+    notes = []
+    for t, target in targets.items():
+        w = grid["width"][t]
+        res = [0.0 if c[t]["resolved"] else math.inf for c in curves]
+        resolved_s = crossing(lengths, res, 0.0)
+        if resolved_s is not None:  # interpolate the resolving threshold in A/sd between the grid points
+            i = lengths.index(resolved_s)
+            if i > 0:
+                z = grid["z"][t]
+                need = max(math.sqrt(2.0 + 6.0), 2.0)
+                zz = [need / max(v, 1e-300) for v in z]
+                resolved_s = crossing(lengths[i - 1:i + 1], zz[i - 1:i + 1], 1.0) or resolved_s
+        target_s = crossing(lengths, w, target)
+        r = {"target": target, "unit": TERM_TABLE[t].unit, "value": model.coefficients[t],
+             "resolved_s": resolved_s, "target_s": target_s, "floor_width": w[-1]}
+        if target_s is not None:
+            j = min(range(len(lengths)), key=lambda k: abs(math.log(lengths[k] / target_s)))
+            r["tau_range_s"] = [curves[j]["_fit"]["tau_min_s"], curves[j]["_fit"]["tau_max_s"]]
+        if target_s is not None and seeds:
+            n = int(round(target_s / dt))
+            if n > MC_MAX_SAMPLES:
+                notes.append(f"Monte-Carlo of {t} skipped: {fmt_length(target_s)} is {n} samples, beyond the "
+                             f"simulation limit of {MC_MAX_SAMPLES}")
+            else:
+                fits = simulate_fits(model, n, seeds, workers=workers)
+                mc = summarise(model, fits, {t: target})[t]
+                mc["length_s"] = _mc_length(target_s, mc["median_width"], target, lengths, w)
+                mc["n_samples"] = n
+                r["mc"] = mc
+        terms[t] = r
+    at = None
+    if length_s is not None:
+        n = int(round(float(length_s) / dt))
+        if n < _MIN_SAMPLES:
+            raise ConfigError(f"{{opt:length}} {fmt_length(length_s)} is fewer than {_MIN_SAMPLES} samples at "
+                              f"{1 / dt:g} Hz")
+        c = analytic_widths(model, n)
+        at = {"length_s": float(length_s), "n_samples": n, "tau_max_s": c["_fit"]["tau_max_s"],
+              "terms": {t: {"resolved": c[t]["resolved"], "rel_width": c[t]["rel_width"],
+                            "rel_hi": c[t]["rel_hi"], "z": c[t]["z"]} for t in model.terms}}
+        if seeds and n <= MC_MAX_SAMPLES:
+            fits = simulate_fits(model, n, seeds, workers=workers)
+            at["mc"] = summarise(model, fits, {})
+    return Plan(model, dict(targets), terms, grid, at, seeds, notes + list(model.notes))

@@ -1,0 +1,42 @@
+"""Figure of ``fogdrift plan``: expected relative 95 % half-width of each term against record length (log-log),
+each target marked, the Monte-Carlo medians as points."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .figures import _plt, _save
+
+__all__ = ["plot_plan"]
+
+
+def plot_plan(plan, path) -> Path:
+    """Write the plan figure (PNG) of :class:`fogdrift.plan.Plan` to ``path``."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7.0, 4.6))
+    L = np.asarray(plan.grid["length_s"], dtype=float) / 3600.0
+    for i, (t, w) in enumerate(plan.grid["width"].items()):
+        w = 100.0 * np.asarray(w, dtype=float)
+        color = f"C{i}"
+        ax.loglog(L, np.where(np.isfinite(w), w, np.nan), color=color, label=f"{t} (Allan fit, expected)")
+        r = plan.terms.get(t)
+        if r is None:
+            continue
+        ax.axhline(100.0 * r["target"], color=color, ls=":", lw=0.9)
+        if r["target_s"] is not None:
+            ax.plot([r["target_s"] / 3600.0], [100.0 * r["target"]], "o", color=color, mfc="none")
+        mc = r.get("mc")
+        if mc and mc.get("median_width") is not None and math.isfinite(mc["median_width"]):
+            ax.plot([mc["n_samples"] * plan.model.dt_s / 3600.0], [100.0 * mc["median_width"]], "x", color=color,
+                    label=f"{t} Monte-Carlo median ({len(plan.seeds)} seeds)")
+    if plan.at_length:
+        ax.axvline(plan.at_length["length_s"] / 3600.0, color="0.5", ls="--", lw=0.9, label="--length")
+    ax.set_xlabel("record length [h]")
+    ax.set_ylabel("95 % half-width [% of value]")
+    ax.set_title(f"fogdrift plan: {plan.model.text()} at {1 / plan.model.dt_s:g} Hz", fontsize=8)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    return _save(fig, path)

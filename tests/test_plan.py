@@ -1,0 +1,200 @@
+"""fogdrift plan (issue 34): parsing refusals, hand-checked statistics, analytic vs Monte-Carlo lengths and the
+planner's honesty on a simulated MEMS-like gyro (10 Hz: N, B, K)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from fogdrift.errors import ConfigError
+from fogdrift.plan import make_plan, parse_length, parse_model, parse_targets
+from fogdrift.plan.analytic import analytic_widths, expected_inflation
+from fogdrift.plan.core import _mc_length, crossing
+from fogdrift.plan.montecarlo import summarise
+
+MEMS = "N=0.3 deg/sqrt(h), B=5 deg/h, K=20 deg/h^1.5"
+
+
+# -- parsing ----------------------------------------------------------------------------------------------------
+def test_model_units_by_hand():
+    m = parse_model("N=0.6 deg/h/sqrt(Hz), B=0.001 deg/s, K=1 deg/s/sqrt(s), Q=1 arcsec, R=1 deg/s^2", 0.1)
+    assert m.coefficients["N"] == pytest.approx(0.01)          # 1 deg/sqrt(h) = 60 deg/h/sqrt(Hz)
+    assert m.coefficients["B"] == pytest.approx(3.6)
+    assert m.coefficients["K"] == pytest.approx(3600.0**1.5)   # 1/s^1.5 = 3600^1.5 /h^1.5
+    assert m.coefficients["Q"] == pytest.approx(4.8481368)     # 1 arcsec = 4.848 urad
+    assert m.coefficients["R"] == pytest.approx(3600.0**2)
+
+
+def test_law_coefficients_give_the_ieee_allan_variance():
+    # N = 0.3 deg/sqrt(h) -> ADEV(1 s) = 0.3 * 60 = 18 deg/h; B = 5 -> flat AVAR 0.4413 * 25; K = 20 -> K^2 tau / 3
+    m = parse_model(MEMS, 0.1)
+    A = m.law_coefficients()
+    assert A[1] == pytest.approx(18.0**2)
+    assert A[2] == pytest.approx(2 * math.log(2) / math.pi * 25.0)
+    assert A[3] == pytest.approx((20.0 / 60.0) ** 2 / 3.0)
+
+
+@pytest.mark.parametrize("text, words", [
+    ("N=0.3", "no unit"), ("N=0.3 deg/furlong", "unknown unit"), ("X=1 deg/h", "unknown term"),
+    ("N=1 deg/sqrt(h), N=2 deg/sqrt(h)", "twice"), ("N 0.3 deg/sqrt(h)", "TERM=VALUE"), ("", "empty"),
+    ("N=0 deg/sqrt(h)", "no noise term"), ("S=1 deg/h", "unknown term")])
+def test_model_refusals(text, words):
+    with pytest.raises(ConfigError, match=words):
+        parse_model(text, 0.01)
+
+
+def test_model_needs_a_positive_interval():
+    with pytest.raises(ConfigError, match="sample interval"):
+        parse_model("N=1 deg/sqrt(h)", 0.0)
+
+
+@pytest.mark.parametrize("text, words", [
+    ("B:10", "between 0 and 100"), ("B:0%", "between 0 and 100"), ("R:10%", "no R term"), ("B10%", "TERM:WIDTH"),
+    ("Z:5%", "unknown term"), ("B:10%,B:20%", "twice")])
+def test_target_refusals(text, words):
+    with pytest.raises(ConfigError, match=words):
+        parse_targets(text, ("N", "B"))
+
+
+def test_targets_and_lengths_parse():
+    assert parse_targets("B:10%, N:0.02", ("N", "B")) == {"B": 0.1, "N": 0.02}
+    assert parse_targets("", ("N", "K")) == {"N": 0.05, "K": 0.25}
+    assert parse_length("1.5 d") == 129600.0 and parse_length("45min") == 2700.0
+    for bad in ("2 fortnights", "-1h", "h", "0s"):
+        with pytest.raises(ConfigError):
+            parse_length(bad)
+
+
+# -- the small statistics, by hand ------------------------------------------------------------------------------
+def test_expected_inflation_by_hand():
+    # dof = 1: E[max(1, X)] = P(X <= 1) + E[X; X > 1] = 0.682689 + (1 - F_3(1)) = 0.682689 + 0.801252
+    assert expected_inflation(1) == pytest.approx(0.682689 + 0.801252, abs=1e-5)
+    rng = np.random.default_rng(0)
+    x = rng.chisquare(8, 400_000) / 8
+    assert expected_inflation(8) == pytest.approx(np.maximum(1, x).mean(), abs=3e-3)
+
+
+def test_crossing_log_log_interpolation():
+    # y = 1/sqrt(x): falls to 0.25 at x = 16, from the grid points 4 and 64
+    assert crossing([4.0, 64.0], [0.5, 0.125], 0.25) == pytest.approx(16.0)
+    assert crossing([1.0, 2.0], [math.inf, 0.1], 0.2) == 2.0
+    assert crossing([1.0, 2.0], [0.5, 0.4], 0.2) is None
+    assert crossing([1.0, 2.0], [0.1, 0.05], 0.2) == 1.0
+
+
+def test_mc_length_reads_the_local_slope():
+    L = [100.0, 400.0, 1600.0]
+    w = [0.2, 0.1, 0.05]  # slope -1/2
+    assert _mc_length(400.0, 0.12, 0.1, L, w) == pytest.approx(400.0 * 1.2**2)
+    assert _mc_length(400.0, 0.12, 0.1, L, [0.1, 0.1, 0.1]) is None  # at its floor: no length to read
+
+
+def test_summarise_by_hand():
+    m = parse_model("N=1 deg/sqrt(h), B=2 deg/h", 0.1)
+    fits = [{"N": (1.0, 0.9, 1.1, "resolved"), "B": (2.0, 0.0, 3.0, "unresolved")},
+            {"N": (1.05, 0.945, 1.155, "resolved"), "B": (2.5, 2.1, 2.9, "resolved")},
+            {"N": (0.8, 0.76, 0.84, "resolved"), "B": (1.8, 1.44, 2.16, "resolved")}]
+    s = summarise(m, fits, {"N": 0.06})
+    assert s["N"]["median_width"] == pytest.approx(0.1)      # widths 0.1, 0.1, 0.05
+    assert s["N"]["coverage"] == pytest.approx(2 / 3)         # [0.76, 0.84] misses 1
+    assert s["N"]["met_fraction"] == pytest.approx(1 / 3)
+    assert s["B"]["resolved_fraction"] == pytest.approx(2 / 3)
+    assert s["B"]["coverage"] == pytest.approx(2 / 3)         # [0, 3] and [1.44, 2.16] hold 2, [2.1, 2.9] does not
+    assert s["B"]["median_width"] == pytest.approx(0.2)       # inf, 0.16, 0.2 (an unresolved seed counts as infinitely wide)
+
+
+def test_white_noise_width_falls_as_one_over_root_length_then_floors():
+    """N alone: the expected half-width falls about as 1/sqrt(length) on short records and stops at the floor
+    the 2 % model-discrepancy allowance sets."""
+    m = parse_model("N=1 deg/sqrt(h)", 1.0)
+    w = [analytic_widths(m, n)["N"]["rel_width"] for n in (256, 1024, 2**24)]
+    assert 1.5 < w[0] / w[1] < 2.2
+    assert 0.01 < w[2] < 0.03
+
+
+def test_rate_random_walk_is_not_resolved_on_a_short_record():
+    m = parse_model(MEMS, 0.1)
+    short, long_ = analytic_widths(m, 2**12), analytic_widths(m, 2**22)
+    assert not short["K"]["resolved"] and short["N"]["resolved"]
+    assert long_["K"]["resolved"]
+
+
+# -- analytic against Monte-Carlo, and the planner's honesty ------------------------------------------------------
+SEEDS = 12
+
+
+@pytest.fixture(scope="module")
+def mems_plan():
+    m = parse_model(MEMS, 0.1)
+    return make_plan(m, {"N": 0.05, "B": 0.25}, length_s=3600.0, monte_carlo=SEEDS, workers=2)
+
+
+def test_analytic_and_monte_carlo_lengths_agree(mems_plan):
+    r = mems_plan.terms["N"]
+    assert r["mc"]["length_s"] == pytest.approx(r["target_s"], rel=0.25)
+    # B: measured (12 seeds, 10 Hz MEMS, B to +-25 %): the Monte-Carlo width implies ~1.45x the analytic length
+    # (the real fit's B interval is ~15 % wider than the linearised one); a guard here, the 25 % goal below
+    r = mems_plan.terms["B"]
+    assert r["mc"]["length_s"] == pytest.approx(r["target_s"], rel=0.7)
+
+
+@pytest.mark.xfail(strict=True, reason="measured gap (docs/plan.md): with seeds 1-12 the Monte-Carlo B width at the planned length is +-30 %, not +-25 % (at 1 h both give +-29 %: partly the seeds' scatter)")
+def test_analytic_and_monte_carlo_lengths_agree_for_b_within_25_percent(mems_plan):
+    r = mems_plan.terms["B"]
+    assert r["mc"]["length_s"] == pytest.approx(r["target_s"], rel=0.25)
+
+
+def test_recording_the_planned_length_gives_the_promised_width_and_coverage(mems_plan):
+    # with 12 seeds the median width scatters by about 1.25 / sqrt(12) of its spread; coverage >= 9 of 12
+    # (true 95 %: 8 or fewer in 12 has probability 0.002)
+    for t in ("N", "B"):
+        mc = mems_plan.terms[t]["mc"]
+        assert mc["n_seeds"] == SEEDS and mc["resolved_fraction"] >= 0.9
+        # N: as promised; B: the known ~15 % optimism of the analytic width (see above) plus the seeds' scatter
+        assert mc["median_width"] <= (1.15 if t == "N" else 1.3) * mems_plan.terms[t]["target"], t
+        assert mc["coverage"] >= 0.75, t
+    assert mems_plan.seeds == list(range(1, SEEDS + 1))
+
+
+def test_stated_length_verdicts_match_the_monte_carlo(mems_plan):
+    at = mems_plan.at_length
+    assert at["terms"]["N"]["resolved"] and not at["terms"]["K"]["resolved"]
+    assert at["mc"]["N"]["resolved_fraction"] >= 0.9 and at["mc"]["K"]["resolved_fraction"] <= 0.5
+    lines = mems_plan.lines()
+    assert lines[-1].startswith("a 60 min record resolves N to ±") and "K only as a bound" in lines[-1]
+    json.dumps(mems_plan.to_dict())
+
+
+# -- the command ------------------------------------------------------------------------------------------------
+def test_cli_plan_writes_json_and_figure(tmp_path):
+    from typer.testing import CliRunner
+
+    from fogdrift.cli import _commands
+
+    out = tmp_path / "p"
+    res = CliRunner().invoke(_commands(), ["plan", "--model", MEMS, "--rate", "10", "--target", "N:5%,B:20%",
+                                           "--length", "2h", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "N to ±5 %:" in res.output and "(Allan fit)" in res.output and "a 2 h record resolves N" in res.output
+    d = json.loads((out / "plan.json").read_text())
+    assert d["terms"]["B"]["target"] == 0.2 and d["terms"]["B"]["unit"] == "deg/h"
+    assert d["terms"]["B"]["target_s"] > d["terms"]["B"]["resolved_s"] > 0
+    assert (out / "plan.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--model", MEMS], "needs the sample rate"), (["--model", "N=1 deg/furlong", "--rate", "10"], "unknown unit"),
+    (["--model", MEMS, "--rate", "10", "--target", "R:5%"], "no R term"), ([], "either a pilot log"),
+    (["--model", MEMS, "--rate", "10", "--length", "3 fortnights"], "unknown time unit")])
+def test_cli_refusals_are_one_line(tmp_path, args, words):
+    from typer.testing import CliRunner
+
+    from fogdrift.cli import _commands
+
+    res = CliRunner().invoke(_commands(), ["plan", *args, "--out", str(tmp_path / "p")])
+    assert res.exit_code == 1
+    text = res.output.strip()
+    assert words in text and len(text.splitlines()) == 1, text
