@@ -11,7 +11,9 @@ above the truth).  The seeds are ``seed0, seed0 + 1, ...`` and are reported.
 from __future__ import annotations
 
 import math
+import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
@@ -38,8 +40,13 @@ def simulate_fits(model, n_samples, seeds, workers: int = 1) -> list[dict]:
         raise ValueError(f"{n_samples} samples is beyond the Monte-Carlo limit of {MC_MAX_SAMPLES}")
     jobs = [(model.terms, model.dt_s, int(n_samples), int(s), model.simulate_kwargs()) for s in seeds]
     if workers > 1 and len(jobs) > 1:
-        with ProcessPoolExecutor(max_workers=int(workers)) as ex:
-            return list(ex.map(_one, jobs))
+        # fresh interpreters ("spawn"): a forked child of a process that already runs threads (numba, BLAS, a
+        # test runner's worker) can die on start; a pool that breaks anyway falls back to one process
+        try:
+            with ProcessPoolExecutor(max_workers=int(workers), mp_context=multiprocessing.get_context("spawn")) as ex:
+                return list(ex.map(_one, jobs))
+        except BrokenProcessPool:
+            pass
     return [_one(j) for j in jobs]
 
 
