@@ -51,6 +51,7 @@ from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
 from ..io import load, load_segments
 from ..io import load as _io_load
 from ..io.registry import cli_options, reader_by_name, select_reader
+from .. import output as _output
 from ..output import OutputDir, active
 from ..plausibility import check_record
 
@@ -383,8 +384,8 @@ def emergency_exit() -> None:
     unfinished temporary files, print the one line, end the process with 130.  Runs in another thread."""
     if _state["finish"].acquire(timeout=0.3):
         out = active()
-        if out is not None:
-            out.abort(timeout=0.2)
+        for od in reversed(list(_output._active)):  # every folder of the run (a batch's and a file's)
+            od.abort(timeout=0.2)
         summary = out.summary() if out is not None else "nothing was written"
         tty = sys.stderr.isatty()
         text = ("\r\x1b[2K" if tty else "") + f"interrupted: {summary}\n" + ("\x1b[?25h" if tty else "")
