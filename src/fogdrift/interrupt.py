@@ -18,9 +18,10 @@ So an interruption here is a **flag** that survives such a loss:
 * a watchdog thread, woken by the signal itself (``signal.set_wakeup_fd``, written by the C-level handler even
   while the main thread is stuck in compiled code that released the GIL), calls ``on_timeout`` when the main
   thread has not finished ``grace_s`` seconds after the signal.  The CLI uses it to clean up and exit.  While
-  the main thread runs a :func:`cleanup` block (a batch killing its worker processes and removing what they
-  left), the watchdog waits for it (at most :data:`CLEANUP_MAX_S`) and then gives the run its grace again: a
-  loaded machine slows the cleanup down, and ending the process in the middle of it would leave those behind.
+  the main thread runs a :func:`shielded` block (a batch starting its worker processes, or killing them and
+  removing what they left), the watchdog waits for it (at most :data:`SHIELD_MAX_S`) and then gives the run its
+  grace again: a loaded machine slows such a block down, and ending the process in the middle of it would leave
+  processes and files behind.
 
 :func:`checkpoint` also tells registered listeners (:func:`stage_listener`) which stage, axis and model a run
 is in; the CLI shows them on its progress bar.  Without a guard or a listener, a checkpoint costs one flag test.
@@ -40,11 +41,11 @@ __all__ = [
     "SigintGuard",
     "check",
     "checkpoint",
-    "cleanup",
     "critical",
     "request",
     "requested",
     "reset",
+    "shielded",
     "stage_listener",
     "FOREIGN_RUNTIMES",
 ]
@@ -60,10 +61,10 @@ class Interrupted(KeyboardInterrupt):
 _flag = threading.Event()
 _listeners: list[Callable] = []
 _critical_depth = 0
-_cleanups = threading.Condition()
-_cleanup_depth = 0
-#: Seconds the watchdog waits at most for a :func:`cleanup` block before it ends the process anyway.
-CLEANUP_MAX_S = 60.0
+_shields = threading.Condition()
+_shield_depth = 0
+#: Seconds the watchdog waits at most for a :func:`shielded` block before it ends the process anyway.
+SHIELD_MAX_S = 60.0
 
 
 def request() -> None:
@@ -140,28 +141,29 @@ def critical():
 
 
 @contextlib.contextmanager
-def cleanup():
-    """A bounded cleanup after an interruption that the :class:`SigintGuard` watchdog waits for (at most
-    :data:`CLEANUP_MAX_S`) instead of ending the process in the middle of it (see the module docstring); a
-    second SIGINT does not cut it either (as in :func:`critical`, the handler only sets the flag)."""
-    global _cleanup_depth, _critical_depth
-    with _cleanups:
-        _cleanup_depth += 1
+def shielded():
+    """A bounded block that an interruption must not cut short (see the module docstring): a SIGINT only sets the
+    flag (as in :func:`critical`, a second one too), and the :class:`SigintGuard` watchdog waits for the block (at
+    most :data:`SHIELD_MAX_S`) instead of ending the process in the middle of it.  Unlike :func:`critical` it does
+    not raise at its end: the caller checks (:func:`check`) where it can stop."""
+    global _shield_depth, _critical_depth
+    with _shields:
+        _shield_depth += 1
     _critical_depth += 1
     try:
         yield
     finally:
         _critical_depth -= 1
-        with _cleanups:
-            _cleanup_depth -= 1
-            _cleanups.notify_all()
+        with _shields:
+            _shield_depth -= 1
+            _shields.notify_all()
 
 
-def _wait_for_cleanups(timeout: float) -> bool:
-    """Wait until no :func:`cleanup` block runs (at most ``timeout`` seconds); True if one ran."""
-    with _cleanups:
-        busy = _cleanup_depth > 0
-        _cleanups.wait_for(lambda: _cleanup_depth == 0, timeout)
+def _wait_for_shields(timeout: float) -> bool:
+    """Wait until no :func:`shielded` block runs (at most ``timeout`` seconds); True if one ran."""
+    with _shields:
+        busy = _shield_depth > 0
+        _shields.wait_for(lambda: _shield_depth == 0, timeout)
     return busy
 
 
@@ -230,8 +232,8 @@ class SigintGuard:
             if signal.SIGINT in data:
                 if self._done.wait(self.grace_s):
                     return
-                if _wait_for_cleanups(CLEANUP_MAX_S) and self._done.wait(self.grace_s):
-                    return  # the cleanup ended, then the run within its grace
+                if _wait_for_shields(SHIELD_MAX_S) and self._done.wait(self.grace_s):
+                    return  # the shielded block ended, then the run within its grace
                 if self.on_timeout is not None:
                     self.on_timeout()
                 return

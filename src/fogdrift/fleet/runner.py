@@ -417,7 +417,9 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
             if n < 1:
                 raise ConfigError(f"workers must be >= 1; got {workers!r} in {{opt:workers}}")
             interrupt.checkpoint(f"starting a local Dask cluster of {n} worker processes")
-            with _sigint_blocked_for_children():
+            # shielded: a Ctrl-C cut into the cluster's start would leave its loop starting workers after the batch
+            # had gone; the flag raises at the checkpoint below, with the cluster there to be stopped
+            with _sigint_blocked_for_children(), interrupt.shielded():
                 _quiet_resource_tracker()
                 before = set(_children())
                 cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
@@ -445,7 +447,7 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
             logging.getLogger(name).setLevel(logging.CRITICAL + 1)
         raise
     finally:
-        with interrupt.cleanup() if interrupted else contextlib.nullcontext():
+        with interrupt.shielded() if interrupted else contextlib.nullcontext():
             _shut_down(client, cluster, before, tasks, interrupted)
         for name, level in muted.items():          # closed: a library caller's logging as it was
             logging.getLogger(name).setLevel(level)
@@ -460,7 +462,7 @@ def _shut_down(client, cluster, before, tasks, interrupted: bool) -> None:
     are killed too.  Every process the local cluster started (``before``: this process's children before it
     started; None for a ``tcp://`` scheduler, whose workers are not ours) has ended when this returns; then
     the lock and temporary files the killed ones left in the files' folders are removed.  The watchdog of the
-    CLI waits for this (:func:`fogdrift.interrupt.cleanup`), so a loaded machine does not cut it short.
+    CLI waits for this (:func:`fogdrift.interrupt.shielded`), so a loaded machine does not cut it short.
     """
     killed = []
     if interrupted and before is not None:
