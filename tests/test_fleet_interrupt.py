@@ -1,8 +1,10 @@
 """Ctrl-C during ``fogdrift batch``: one line, exit 130, finished per-file folders complete (a re-run skips
 them), unfinished ones without ``batch.json``, no temporary file, and no new (half-written) summary or page.
 
-In process (serial scheduler, the interruption requested between two files) and, marked slow, a real SIGINT
-to a real ``fogdrift batch`` on a local Dask cluster of two worker processes.
+In process (serial scheduler, the interruption requested between two files; the local cluster's start and an
+interrupted batch's cleanup shielded, on a stand-in cluster) and, marked slow, a real SIGINT to a real ``fogdrift
+batch`` on a local Dask cluster of two worker processes, at ten moments (issue 36): no lock file, no temporary
+file and no live process after.
 """
 
 from __future__ import annotations
@@ -159,6 +161,61 @@ def test_a_killed_workers_probe_file_above_the_files_folders_is_removed(tmp_path
         for p in (live, unreaped):
             p.kill()
             p.wait()
+
+
+def test_the_local_clusters_start_and_an_interrupted_batchs_cleanup_are_shielded(tmp_path, monkeypatch):
+    """The wiring, without a cluster and without a clock: the local cluster starts, and an interrupted batch shuts
+    it down, inside interrupt.shielded() (a Ctrl-C only sets the flag there, and the CLI's watchdog waits), so a
+    Ctrl-C cut into neither (the Dask tests below show what was left otherwise: workers running after the batch)."""
+    distributed = pytest.importorskip("distributed")
+    from fogdrift.fleet import runner
+
+    seen = {}
+
+    class Cluster:
+        def __init__(self, **kwargs):
+            seen["start"] = interrupt._shield_depth
+
+        def close(self, **kwargs):
+            pass
+
+    class Client:
+        def __init__(self, cluster):
+            self.futures = {}
+
+        def run(self, fn):
+            pass
+
+        def submit(self, fn, task, **kwargs):
+            return object()
+
+        def cancel(self, futures, **kwargs):
+            pass
+
+        def close(self, **kwargs):
+            pass
+
+    def ctrl_c_during_the_batch(futures):
+        interrupt.request()
+        raise Interrupted()
+        yield
+
+    close = runner._close
+
+    def recording_close(client, cluster, *, quick):
+        seen.setdefault("close", []).append((interrupt._shield_depth, quick))
+        close(client, cluster, quick=quick)
+
+    monkeypatch.setattr(distributed, "LocalCluster", Cluster)
+    monkeypatch.setattr(distributed, "Client", Client)
+    monkeypatch.setattr(distributed, "as_completed", ctrl_c_during_the_batch)
+    monkeypatch.setattr(runner, "_close", recording_close)
+    files = _logs(tmp_path / "in", 2, 1000, seed=36)
+    with pytest.raises(Interrupted):
+        run_batch(files, tmp_path / "out", settings={"load": {"unit": "deg/h", "rate_hz": 100.0}}, workers=1)
+    assert seen["start"] > 0                 # the cluster was started inside a shielded block
+    assert seen["close"] == [(1, True)]      # and closed, quickly, inside one after the interruption
+    assert interrupt._shield_depth == 0
 
 
 BOOT = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); sys.argv[0] = 'fogdrift'; "
