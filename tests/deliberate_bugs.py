@@ -152,3 +152,53 @@ H_TESTS24 = [
 if __name__ == "__main__":
     BUGS[:] = H_TESTS24  # main() above ran the earlier entries; now this block's, with the same apply/run/restore
     main()
+
+
+# H-tests36 (issue 36: the holes of "Why" 7 and the wall-clock / lock / process rules of "Why" 6).  Each entry is
+# one plausible one-line bug and the test that must fail on it; every one was applied by hand when its test was
+# written and passed the tests that existed then (the commit messages say which).
+H_TESTS36 = [
+    ("consistency: the ramp variance loses the square on its slope",
+     "src/fogdrift/evaluation/consistency.py", "        return (r * (h * h / 2.0 + h * T / 2.0)) ** 2\n",
+     "        return r * (h * h / 2.0 + h * T / 2.0) ** 2\n",
+     ["tests/test_consistency.py", "-k", "ramp_closed_form_by_hand_at_a_slope"]),
+    ("unit table: K in m/s/h/sqrt(h) divided by 3600, not 3600^1.5",
+     "src/fogdrift/export/conversions.py", '("K", "m/s/h/sqrt(h)"): ("accel", 1.0 / 216000.0)',
+     '("K", "m/s/h/sqrt(h)"): ("accel", 1.0 / 3600.0)', ["tests/test_unit_table.py"]),
+    ("unit table: R in m/s/h^2 divided by 3600, not 3600^2",
+     "src/fogdrift/export/conversions.py", '("R", "m/s/h^2"): ("accel", 1.0 / 3600.0 ** 2)',
+     '("R", "m/s/h^2"): ("accel", 1.0 / 3600.0)', ["tests/test_unit_table.py"]),
+    ("export: an accelerometer's K in m/s^2/sqrt(h) (what allan writes) taken as m/s^2/sqrt(s)",
+     "src/fogdrift/export/conversions.py", '("K", "m/s^2/sqrt(h)"): ("accel", 1.0 / 60.0)',
+     '("K", "m/s^2/sqrt(h)"): ("accel", 1.0)',
+     ["tests/test_export.py", "-k", "fogdrift_allan_writes_for_an_accelerometer"]),
+    ("S term: every harmonic fitted at the fundamental's power",
+     "src/fogdrift/noise/identify.py", "    lines = tuple(periodic.lines) if periodic is not None else ()\n",
+     "    lines = tuple((f, 1.0) for f, _ in periodic.lines) if periodic is not None else ()\n",
+     ["tests/test_noise_periodic.py", "-k", "sawtooth_fundamental"]),
+    ("GMWM batch row (through fogdrift batch): fit_n_points counts the excluded scales too",
+     "src/fogdrift/fleet/commands.py", "fit_n_points=int(len(axis.wvar.scale_s) - len(sel.excluded)))",
+     "fit_n_points=int(len(axis.wvar.scale_s)))", ["tests/test_fleet.py", "-k", "batch_noise_row_counts"]),
+    ("progress lines: no quiet start",
+     "src/fogdrift/cli/_app.py", "            if now - self._t0 < QUIET_S:\n", "            if False:\n",
+     ["tests/test_progress_piped.py", "-k", "quiet_start_a_short"]),
+    ("progress lines: the still-running line only after more than HEARTBEAT_S",
+     "src/fogdrift/cli/_app.py", "and now - self._t_last >= HEARTBEAT_S", "and now - self._t_last > HEARTBEAT_S",
+     ["tests/test_progress_piped.py", "-k", "still_running_line_comes"]),
+    ("watchdog: ends the process in the middle of a shielded block (a batch's cleanup)",
+     "src/fogdrift/interrupt.py", "if _wait_for_shields(SHIELD_MAX_S) and self._done.wait(self.grace_s):",
+     "if False and self._done.wait(self.grace_s):", ["tests/test_interrupt.py", "-k", "shielded"]),
+    ("watchdog exit (OutputDir.abort) leaves the folder's lock file",
+     "src/fogdrift/output.py", "            self._pending.clear()\n            self._folder_lock.release()\n",
+     "            self._pending.clear()\n", ["tests/test_output_lock.py", "-k", "watchdogs_exit"]),
+    ("batch: a Ctrl-C cuts into the local cluster's start (its workers outlive the batch)",
+     "src/fogdrift/fleet/runner.py", "            with _sigint_blocked_for_children(), interrupt.shielded():\n",
+     "            with _sigint_blocked_for_children():\n",
+     ["tests/test_fleet_interrupt.py", "-k", "shielded"]),
+    ("batch: an interrupted batch's cleanup not shielded from the watchdog",
+     "src/fogdrift/fleet/runner.py", "        with interrupt.shielded() if interrupted else contextlib.nullcontext():\n",
+     "        with contextlib.nullcontext():\n", ["tests/test_fleet_interrupt.py", "-k", "shielded"]),
+]
+if __name__ == "__main__":
+    BUGS[:] = H_TESTS36
+    main()

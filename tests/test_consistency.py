@@ -51,6 +51,20 @@ def test_quantization_and_ramp_closed_forms_by_hand():
     assert r[0] == pytest.approx(16.0, rel=1e-12)
 
 
+def test_ramp_closed_form_by_hand_at_a_slope_other_than_one():
+    # at 1 deg/s^2 (above) the slope and its square are equal: a variance linear in R would pass there.
+    # R = 36 deg/h^2 = 36 / 3600^2 deg/s^2 = 1/360000 deg/s^2; h = 100 s, T = 50 s: h^2/2 + h T/2 = 5000 + 2500
+    # = 7500 s^2, so the angle error is 7500/360000 = 1/48 deg and its variance (1/48)^2 = 1/2304 deg^2
+    r = angle_error_variance_deg2([{"kind": "ramp", "ramp_dph2": 36.0}], [100.0, 50.0], 50.0)
+    assert r[0] == pytest.approx(1.0 / 2304.0, rel=1e-12)
+    # h = T = 50 s: 1250 + 1250 = 2500 s^2 -> 2500/360000 = 1/144 deg -> 1/20736 deg^2
+    assert r[1] == pytest.approx(1.0 / 20736.0, rel=1e-12)
+    # an accelerometer's velocity error: R = 36 m/s^2 per hour = 0.01 m/s^3 (only the hour goes: m/s^2 stands where
+    # deg/h stood); h = 100 s, T = 50 s: 0.01 * 7500 = 75 m/s, variance 5625 (m/s)^2
+    a = angle_error_variance_deg2([{"kind": "ramp", "ramp_dph2": 36.0}], 100.0, 50.0, quantity="accel")
+    assert a[0] == pytest.approx(5625.0, rel=1e-12)
+
+
 def test_variance_is_sum_of_components_and_linear_in_parameter_variance():
     comps = [{"kind": "white", "arw_dprh": 0.3}, {"kind": "random_walk", "rrw_dphrh": 5.0},
              {"kind": "gauss_markov", "tc_s": 30.0, "sigma_dph": 2.0}]

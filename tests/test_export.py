@@ -473,3 +473,34 @@ def test_gmwm_accelerometer_result(tmp_path):
     assert ctx.accel[0].quantity == "accel"
     d = yaml.safe_load(render("kf-gins", ctx))["imunoise"]
     assert d["vrw"] == pytest.approx([0.1] * 3) and d["abstd"] == pytest.approx([2e-4 / 1e-5] * 3)   # mGal
+
+
+def test_export_of_what_fogdrift_allan_writes_for_an_accelerometer(tmp_path):
+    # the fixtures above write K in m/s^2/sqrt(s); `fogdrift allan` writes an accelerometer's K in m/s^2/sqrt(h)
+    # (and N in m/s/sqrt(h)): this goes through the file it really writes (issue 36).  Simulated in m/s^2: white
+    # noise of density 0.002 m/s^2/sqrt(Hz) (0.12 m/s/sqrt(h)) and a random walk of 1e-3 m/s^2.5 (0.06
+    # m/s^2/sqrt(h)), 2000 s at 100 Hz, three axes.
+    fs, n, dens, walk = 100.0, 200_000, 2e-3, 1e-3
+    rng = np.random.default_rng(36)
+    x = dens * math.sqrt(fs) * rng.standard_normal((n, 3)) \
+        + np.cumsum(walk / math.sqrt(fs) * rng.standard_normal((n, 3)), axis=0)
+    log = tmp_path / "acc.csv"
+    np.savetxt(log, np.column_stack([np.arange(n) / fs, x]), delimiter=",", header="t_s,ax,ay,az", comments="",
+               fmt="%.12g")
+    res = runner.invoke(app, ["allan", str(log), "--unit", "m/s^2", "--out", str(tmp_path / "a")])
+    assert res.exit_code == 0, res.output
+    axes = json.loads((tmp_path / "a" / "allan.json").read_text())["axes"]
+    terms = [ax["noise"]["terms"] for ax in axes]
+    assert {t["N"]["unit"] for t in terms} == {"m/s/sqrt(h)"} and {t["K"]["unit"] for t in terms} == {"m/s^2/sqrt(h)"}
+    assert all(t["K"]["status"] == "resolved" for t in terms)
+    n_max = max(t["N"]["value"] for t in terms)      # m/s/sqrt(h)
+    k_max = max(t["K"]["value"] for t in terms)      # m/s^2/sqrt(h)
+    assert 0.10 < n_max < 0.14 and 0.04 < k_max < 0.08  # the simulation's 0.12 and 0.06, as allan read them
+    res = runner.invoke(app, ["export", "--accel", str(tmp_path / "a" / "allan.json"), "--target", "kalibr",
+                              "--out", str(tmp_path / "e")])
+    assert res.exit_code == 0, res.output
+    d = yaml.safe_load((tmp_path / "e" / "imu.yaml").read_text())
+    # by hand: sqrt(h) = 60 sqrt(s), so m/s/sqrt(h) / 60 = m/s^2/sqrt(Hz) and m/s^2/sqrt(h) / 60 = m/s^3/sqrt(Hz)
+    assert d["accelerometer_noise_density"] == pytest.approx(n_max / 60.0, rel=1e-5, abs=0)
+    assert d["accelerometer_random_walk"] == pytest.approx(k_max / 60.0, rel=1e-5, abs=0)
+    assert d["accelerometer_random_walk"] == pytest.approx(walk, rel=0.35)  # the simulated one, in SI

@@ -229,8 +229,43 @@ def test_noise_command_passes_model_scales_and_robust_like_fogdrift_noise(tmp_pa
     assert got["axes"] == want["axes"]
     (row,) = duckdb.sql(f"SELECT noise_model, fit_n_points FROM '{out / 'summary.parquet'}'").fetchall()
     assert row[0] == "WN+RW" and row[1] <= 8
+    assert [row[1]] == [len(u) for u in _levels_used(got)]  # the scales the fit used, no more
     manifest = json.loads((out / "u.npy" / "batch.json").read_text())
     assert manifest["settings"]["gmwm"] == {"model": "WN+RW", "levels": 8, "robust": True}
+
+
+def _levels_used(noise_json) -> list:
+    """Every ``levels_used`` list in a noise.json (one per axis): the scales its selected fit used."""
+    found = []
+
+    def walk(x):
+        if isinstance(x, dict):
+            for k, v in x.items():
+                found.append(v) if k == "levels_used" else walk(v)
+        elif isinstance(x, list):
+            for v in x:
+                walk(v)
+    walk(noise_json)
+    return found
+
+
+def test_batch_noise_row_counts_only_the_scales_the_fit_used(tmp_path):
+    # issue 36: a GMWM point count that includes the excluded scales passed every batch test.  WN+RW through a
+    # 2-tap moving average (an output filter): the selection leaves out the leading scales (levels 1-3 of 14, as
+    # in tests/test_rules_table_edges.py); the row's fit_n_points is the count of noise.json's levels_used
+    from fogdrift.gmwm import simulate_latent
+
+    x = simulate_latent("WN+RW", [1.0, 1e-5], 2**16, seed=8)
+    f = tmp_path / "filtered.npy"
+    np.save(f, np.convolve(x, [0.5, 0.5], mode="valid"))
+    out = tmp_path / "b"
+    res = runner.invoke(app, ["batch", str(f), "--unit", "deg/h", "--rate", "100", "--command", "noise", "--model",
+                              "WN+RW", "--scheduler", "serial", "--out", str(out)])
+    assert res.exit_code == 0, res.output + repr(res.exception)
+    (used,) = _levels_used(json.loads((out / "filtered.npy" / "noise.json").read_text()))
+    assert used == list(range(4, 15))  # 14 scales, the first 3 excluded
+    (row,) = duckdb.sql(f"SELECT fit_n_points, fit_dof FROM '{out / 'summary.parquet'}'").fetchall()
+    assert row == (len(used), len(used) - 2)  # 11 points, 2 parameters (WN, RW)
 
 
 @pytest.mark.parametrize(("args", "message"), [

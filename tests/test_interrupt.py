@@ -147,6 +147,35 @@ def test_watchdog_stays_quiet_when_the_run_stops_in_time():
     assert not guard._thread.is_alive() and not fired.is_set()
 
 
+def test_watchdog_waits_for_a_shielded_block_instead_of_cutting_it_short(monkeypatch):
+    # a batch starting its workers, or killing them and removing their lock files, runs in interrupt.shielded(): on
+    # a loaded machine it outlasts the grace time, and the watchdog ending the process then left workers running
+    # and a lock file behind (issue 36).  The rule, without a clock: once its grace is over the watchdog waits
+    wanted = interrupt._wait_for_shields
+    waiting = threading.Event()
+
+    def wait_for_shields(timeout):
+        waiting.set()
+        return wanted(timeout)
+
+    monkeypatch.setattr(interrupt, "_wait_for_shields", wait_for_shields)
+    fired = threading.Event()
+    with SigintGuard(on_timeout=fired.set, grace_s=0.01) as guard:
+        with interrupt.shielded():
+            os.kill(os.getpid(), signal.SIGINT)  # only the flag
+            for _ in range(6000):  # a hang guard only: ends as soon as the watchdog waits, or acts
+                if waiting.is_set() or fired.is_set():
+                    break
+                time.sleep(0.01)
+            assert waiting.is_set() and not fired.is_set()
+            assert interrupt.requested()
+        # the block is over: the watchdog gives the run its grace again, then acts (the run is still here)
+        assert fired.wait(60.0)
+        guard_thread = guard._thread
+    guard_thread.join(60.0)
+    assert not guard_thread.is_alive()
+
+
 def test_ignored_sigint_is_respected():
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:

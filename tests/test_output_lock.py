@@ -95,6 +95,27 @@ def test_a_killed_run_does_not_leave_the_folder_locked(tmp_path):
     assert (out / "a.txt").read_text() == "y" and not (out / LOCK).exists()
 
 
+def test_the_watchdogs_exit_leaves_no_lock_file_of_any_folder_of_the_run(tmp_path):
+    # the CLI's watchdog ends a run that did not stop in time with os._exit: the kernel drops the locks, but the
+    # lock files stayed (a batch's folder and the file's folder inside it: issue 36); every active folder's goes
+    code = ("import sys; from pathlib import Path; from fogdrift.output import OutputDir; from fogdrift.cli import _app\n"
+            "root = Path(sys.argv[1])\n"
+            "batch = OutputDir(root, command='batch allan').__enter__()\n"
+            "with batch.file('started.txt') as t: t.write_text('1')\n"
+            "one = OutputDir(root / 'a.npy', command='batch allan', create_parents=True).__enter__()\n"
+            "with one.file('allan.json') as t: t.write_text('{}')\n"
+            "writing = one.file('allan.csv')\n"
+            "writing.__enter__().write_text('half of it')\n"
+            "assert (root / %r).exists() and (root / 'a.npy' / %r).exists()\n"
+            "_app.emergency_exit()\n") % (LOCK, LOCK)
+    out = tmp_path / "out"
+    proc = subprocess.run([sys.executable, "-c", code, str(out)], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 130, proc.stderr
+    assert proc.stderr.startswith("interrupted: wrote 1 complete file(s) to "), proc.stderr
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == [
+        MANIFEST, "a.npy", f"a.npy/{MANIFEST}", "a.npy/allan.json", "started.txt"]  # no lock, no temporary file
+
+
 def test_a_second_run_in_the_same_process_is_refused_and_the_first_finishes(tmp_path):
     with OutputDir(tmp_path, command="allan") as first:
         with pytest.raises(ConfigError, match=rf"'fogdrift allan' \(process {os.getpid()}, started .*is writing"):

@@ -106,6 +106,37 @@ def test_a_long_silence_gets_a_still_running_line(monkeypatch, capsys):
     assert not any(t.name == "fogdrift-progress-heartbeat" for t in threading.enumerate())  # stopped with the block
 
 
+class FakeClock:
+    """The progress lines' clock (cli_app.CLOCK), read by the tests' own hand: no rule depends on the machine's load."""
+
+    def __init__(self, now: float = 1000.0, step: float = 0.0):
+        self.now, self.step = now, step
+
+    def __call__(self) -> float:
+        self.now += self.step
+        return self.now
+
+
+def test_the_still_running_line_comes_after_heartbeat_s_without_a_line(monkeypatch, capsys):
+    clock = FakeClock()
+    monkeypatch.setattr(cli_app, "CLOCK", clock)
+    with cli_app._Lines("compensate") as display:
+        display.stage("compensate · heading-error evaluation")       # a line at t0
+        clock.now += cli_app.HEARTBEAT_S - 0.5
+        display.beat()                                               # not yet
+        assert lines(capsys.readouterr().err) == ["compensate · heading-error evaluation"]
+        clock.now += 0.5
+        display.beat()                                               # HEARTBEAT_S since the last line
+        display.beat()                                               # and not again at once
+        clock.now += 10.0
+        display.count("compensate · heading-error evaluation", 1, 10, "samples")  # a line: the silence ends
+        clock.now += cli_app.HEARTBEAT_S - 1.0
+        display.beat()
+    assert lines(capsys.readouterr().err) == [
+        f"compensate · heading-error evaluation: still running ({cli_app.HEARTBEAT_S:.0f} s since the start)",
+        "compensate · heading-error evaluation: 10 % (1 of 10 samples)"]
+
+
 def test_a_terminal_gets_the_bar_and_a_pipe_the_lines(monkeypatch):
     monkeypatch.setattr(cli_app, "_bar_on_terminal", lambda: True)
     assert isinstance(cli_app._display("x"), cli_app._Bar)
@@ -212,23 +243,56 @@ def test_compensate_piped_counts_the_samples(tmp_path):
     assert counts(result.stderr)[-1]["total"] == "12345"
 
 
-def test_quiet_start_a_short_run_prints_no_progress(bundled_path, tmp_path):
+def test_quiet_start_a_short_run_prints_no_progress(bundled_path, tmp_path, monkeypatch):
+    # the rule, whatever the machine's load: a run that ends within QUIET_S of its start prints no progress (a
+    # frozen clock: the whole run within the quiet start; the real one took ~1 s idle, more than QUIET_S loaded)
     assert cli_app.QUIET_S > 0
+    monkeypatch.setattr(cli_app, "CLOCK", FakeClock())
     result = runner.invoke(app, ["allan", str(bundled_path), "--unit", "deg/h", "--columns", "gz",
                                  "--out", str(tmp_path)])
     assert result.exit_code == 0, result.output
-    assert not [ln for ln in lines(result.stderr) if ln.startswith("allan · ")]  # ~1 s: only the result
+    assert not [ln for ln in lines(result.stderr) if ln.startswith("allan · ")]  # only the result
+
+
+def test_quiet_start_a_run_past_it_prints_its_progress(bundled_path, tmp_path, monkeypatch):
+    # the same run on a clock that passes QUIET_S at its second reading: the stage and its counts are printed
+    monkeypatch.setattr(cli_app, "CLOCK", FakeClock(step=cli_app.QUIET_S))
+    result = runner.invoke(app, ["allan", str(bundled_path), "--unit", "deg/h", "--columns", "gz",
+                                 "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    per_stage = assert_counts_follow_the_rule(result.stderr, "taus")
+    assert [ln for ln in lines(result.stderr) if ln.startswith("allan · ") and not COUNT.match(ln)] == [
+        "allan · axis gz (1/1) · Allan variance"]
+    assert per_stage["allan · axis gz (1/1) · Allan variance"][-1] == 100
 
 
 def test_quiet_start_a_long_run_prints_the_line_it_is_at_then_every_line(monkeypatch, capsys):
-    monkeypatch.setattr(cli_app, "QUIET_S", 0.2)
-    monkeypatch.setattr(cli_app, "HEARTBEAT_S", 60.0)
+    clock = FakeClock()
+    monkeypatch.setattr(cli_app, "CLOCK", clock)
     with cli_app._Lines("job") as display:
         display.stage("job · stage 1")
+        clock.now += cli_app.QUIET_S - 0.5
         display.stage("job · stage 2")          # held back: within the quiet start
-        deadline = time.monotonic() + 30        # hang guard only: wait for the quiet start to pass and flush
-        while display._pending is not None and time.monotonic() < deadline:
-            time.sleep(0.01)
+        display.beat()                          # still within it
+        assert capsys.readouterr().err == ""
+        clock.now += 0.5
+        display.beat()                          # the quiet start is over: the line it is at, once
+        display.beat()
         display.stage("job · stage 3")
     err = lines(capsys.readouterr().err)
     assert err == ["job · stage 2", "job · stage 3"]  # the latest held-back line once, then each line
+
+
+def test_quiet_start_the_heartbeat_thread_prints_the_held_back_line(monkeypatch, capsys):
+    # the wiring: the thread beats on its own (a hang guard only: it ends as soon as the line is there)
+    clock = FakeClock()
+    monkeypatch.setattr(cli_app, "CLOCK", clock)
+    monkeypatch.setattr(cli_app, "HEARTBEAT_S", 60.0)
+    with cli_app._Lines("job") as display:
+        display.stage("job · stage 1")
+        clock.now += cli_app.QUIET_S
+        for _ in range(6000):
+            if display._pending is None:
+                break
+            time.sleep(0.01)
+    assert lines(capsys.readouterr().err) == ["job · stage 1"]

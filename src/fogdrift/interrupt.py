@@ -17,7 +17,11 @@ So an interruption here is a **flag** that survives such a loss:
   taus, training epochs) call :func:`check`, so a dropped interrupt is raised again within one step;
 * a watchdog thread, woken by the signal itself (``signal.set_wakeup_fd``, written by the C-level handler even
   while the main thread is stuck in compiled code that released the GIL), calls ``on_timeout`` when the main
-  thread has not finished ``grace_s`` seconds after the signal.  The CLI uses it to clean up and exit.
+  thread has not finished ``grace_s`` seconds after the signal.  The CLI uses it to clean up and exit.  While
+  the main thread runs a :func:`shielded` block (a batch starting its worker processes, or killing them and
+  removing what they left), the watchdog waits for it (at most :data:`SHIELD_MAX_S`) and then gives the run its
+  grace again: a loaded machine slows such a block down, and ending the process in the middle of it would leave
+  processes and files behind.
 
 :func:`checkpoint` also tells registered listeners (:func:`stage_listener`) which stage, axis and model a run
 is in; the CLI shows them on its progress bar.  Without a guard or a listener, a checkpoint costs one flag test.
@@ -41,6 +45,7 @@ __all__ = [
     "request",
     "requested",
     "reset",
+    "shielded",
     "stage_listener",
     "FOREIGN_RUNTIMES",
 ]
@@ -56,6 +61,10 @@ class Interrupted(KeyboardInterrupt):
 _flag = threading.Event()
 _listeners: list[Callable] = []
 _critical_depth = 0
+_shields = threading.Condition()
+_shield_depth = 0
+#: Seconds the watchdog waits at most for a :func:`shielded` block before it ends the process anyway.
+SHIELD_MAX_S = 60.0
 
 
 def request() -> None:
@@ -131,6 +140,33 @@ def critical():
     check()
 
 
+@contextlib.contextmanager
+def shielded():
+    """A bounded block that an interruption must not cut short (see the module docstring): a SIGINT only sets the
+    flag (as in :func:`critical`, a second one too), and the :class:`SigintGuard` watchdog waits for the block (at
+    most :data:`SHIELD_MAX_S`) instead of ending the process in the middle of it.  Unlike :func:`critical` it does
+    not raise at its end: the caller checks (:func:`check`) where it can stop."""
+    global _shield_depth, _critical_depth
+    with _shields:
+        _shield_depth += 1
+    _critical_depth += 1
+    try:
+        yield
+    finally:
+        _critical_depth -= 1
+        with _shields:
+            _shield_depth -= 1
+            _shields.notify_all()
+
+
+def _wait_for_shields(timeout: float) -> bool:
+    """Wait until no :func:`shielded` block runs (at most ``timeout`` seconds); True if one ran."""
+    with _shields:
+        busy = _shield_depth > 0
+        _shields.wait_for(lambda: _shield_depth == 0, timeout)
+    return busy
+
+
 #: Packages whose Python code runs inside compiled runtimes (tracing, lowering, compiling, object-cache
 #: callbacks): an exception raised in the middle of them can be dropped or leave the runtime broken (a crash at
 #: exit was seen when a KeyboardInterrupt unwound through XLA lowering), so the handler only sets the flag there.
@@ -196,6 +232,8 @@ class SigintGuard:
             if signal.SIGINT in data:
                 if self._done.wait(self.grace_s):
                     return
+                if _wait_for_shields(SHIELD_MAX_S) and self._done.wait(self.grace_s):
+                    return  # the shielded block ended, then the run within its grace
                 if self.on_timeout is not None:
                     self.on_timeout()
                 return

@@ -508,7 +508,9 @@ class OutputDir:
 
     # -- interruption -------------------------------------------------------------------------------
     def abort(self, timeout: float = 0.3) -> None:
-        """From another thread: stop further renames and remove unfinished temporary files."""
+        """From another thread, right before the process ends (the CLI's watchdog): stop further renames, remove
+        unfinished temporary files and the folder's lock file (the lock would die with the process; its file
+        would not)."""
         got = self._lock.acquire(timeout=timeout)
         try:
             self._aborted = True
@@ -516,6 +518,7 @@ class OutputDir:
                 with contextlib.suppress(OSError):
                     os.unlink(tmp)
             self._pending.clear()
+            self._folder_lock.release()
         finally:
             if got:
                 self._lock.release()

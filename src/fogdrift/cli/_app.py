@@ -51,6 +51,7 @@ from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
 from ..io import load, load_segments
 from ..io import load as _io_load
 from ..io.registry import cli_options, reader_by_name, select_reader
+from .. import output as _output
 from ..output import OutputDir, active
 from ..plausibility import check_record
 
@@ -384,8 +385,8 @@ def emergency_exit() -> None:
     unfinished temporary files, print the one line, end the process with 130.  Runs in another thread."""
     if _state["finish"].acquire(timeout=0.3):
         out = active()
-        if out is not None:
-            out.abort(timeout=0.2)
+        for od in reversed(list(_output._active)):  # every folder of the run (a batch's and a file's)
+            od.abort(timeout=0.2)
         summary = out.summary() if out is not None else "nothing was written"
         tty = sys.stderr.isatty()
         text = ("\r\x1b[2K" if tty else "") + f"interrupted: {summary}\n" + ("\x1b[?25h" if tty else "")
@@ -576,6 +577,7 @@ def progress_label(description: str, axes, stage: str = "", axis=None, model=Non
 PROGRESS_STEP_PCT = 10
 HEARTBEAT_S = 30.0
 QUIET_S = 3.0
+CLOCK = time.monotonic  # the clock of those rules (seconds; a test injects its own)
 
 
 def _bar_on_terminal() -> bool:
@@ -616,7 +618,7 @@ class _Lines:
         self._last_stage = None
         self._count_key, self._step = None, -1
         self._lock = threading.Lock()
-        self._t0 = self._t_last = time.monotonic()
+        self._t0 = self._t_last = CLOCK()
         self._stop = threading.Event()
         self._thread = None
         self._pending = None  # the latest line held back during the first QUIET_S seconds
@@ -635,7 +637,7 @@ class _Lines:
 
     def _emit(self, text: str) -> None:
         with self._lock:
-            now = time.monotonic()
+            now = CLOCK()
             if now - self._t0 < QUIET_S:
                 self._pending = text
                 return
@@ -646,13 +648,17 @@ class _Lines:
     def _heartbeat(self) -> None:
         tick = min(x for x in (HEARTBEAT_S / 4, 0.25 if QUIET_S > 0 else math.inf) if x > 0)
         while not self._stop.wait(tick):
-            now = time.monotonic()
-            with self._lock:  # taken under the lock: a line printed meanwhile clears it, never printed twice
-                pending, self._pending = (self._pending, None) if now - self._t0 >= QUIET_S else (None, self._pending)
-            if pending is not None:
-                self._emit(pending)
-            elif HEARTBEAT_S > 0 and now - self._t_last >= HEARTBEAT_S and now - self._t0 >= QUIET_S:
-                self._emit(f"{self._label}: still running ({now - self._t0:.0f} s since the start)")
+            self.beat()
+
+    def beat(self) -> None:
+        """One beat of the heartbeat thread: the held-back line once QUIET_S has passed, a "still running" line."""
+        now = CLOCK()
+        with self._lock:  # taken under the lock: a line printed meanwhile clears it, never printed twice
+            pending, self._pending = (self._pending, None) if now - self._t0 >= QUIET_S else (None, self._pending)
+        if pending is not None:
+            self._emit(pending)
+        elif HEARTBEAT_S > 0 and now - self._t_last >= HEARTBEAT_S and now - self._t0 >= QUIET_S:
+            self._emit(f"{self._label}: still running ({now - self._t0:.0f} s since the start)")
 
     def stage(self, label: str) -> None:
         self._label = label

@@ -21,7 +21,8 @@ worker, ``batch.json`` last); ``summary.parquet`` and ``fleet.html`` are written
 :func:`~fogdrift.output.atomic_path` after every file has finished.  An interruption (Ctrl-C,
 :mod:`fogdrift.interrupt`) stops the batch: finished folders stay complete (a re-run skips them), unfinished
 ones have no ``batch.json``, and no summary or page is written.  Local workers ignore SIGINT (a Ctrl-C in
-the terminal reaches the whole process group): the batch process alone decides, and its workers end with it.
+the terminal reaches the whole process group): the batch process alone decides, and its workers end before it
+does (killed after an interruption, the lock and temporary files they left removed: :func:`_shut_down`).
 """
 
 from __future__ import annotations
@@ -399,6 +400,7 @@ def _ignore_sigint() -> bool:
 def _run_dask(tasks, scheduler, workers, done) -> str:
     distributed = require("distributed", "fleet", "running a batch on Dask")
     cluster = client = None
+    before = None                                # local cluster: this process's children before it started
     interrupted = False
     muted = {}
     try:
@@ -415,8 +417,11 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
             if n < 1:
                 raise ConfigError(f"workers must be >= 1; got {workers!r} in {{opt:workers}}")
             interrupt.checkpoint(f"starting a local Dask cluster of {n} worker processes")
-            with _sigint_blocked_for_children():
+            # shielded: a Ctrl-C cut into the cluster's start would leave its loop starting workers after the batch
+            # had gone; the flag raises at the checkpoint below, with the cluster there to be stopped
+            with _sigint_blocked_for_children(), interrupt.shielded():
                 _quiet_resource_tracker()
+                before = set(_children())
                 cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                                    host="127.0.0.1", dashboard_address=HTTP_ADDRESS,
                                                    silence_logs=logging.ERROR, env=_worker_env(n))
@@ -440,14 +445,35 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
         muted = {name: logging.getLogger(name).level for name in ("distributed", "tornado")}
         for name in muted:
             logging.getLogger(name).setLevel(logging.CRITICAL + 1)
-        if cluster is not None:                      # our own workers: stop them now, then tidy their folders
-            _remove_temporaries(tasks, killed=_kill_workers(cluster))
         raise
     finally:
-        _close(client, cluster, quick=interrupted)
+        with interrupt.shielded() if interrupted else contextlib.nullcontext():
+            _shut_down(client, cluster, before, tasks, interrupted)
         for name, level in muted.items():          # closed: a library caller's logging as it was
             logging.getLogger(name).setLevel(level)
     return used
+
+
+def _shut_down(client, cluster, before, tasks, interrupted: bool) -> None:
+    """Close the client and the cluster; a local cluster leaves no process and no lock file behind.
+
+    After an interruption its workers are killed first (their tasks cannot be stopped any other way), the
+    cluster is closed without waiting, and the worker processes still there (a nanny may have started another)
+    are killed too.  Every process the local cluster started (``before``: this process's children before it
+    started; None for a ``tcp://`` scheduler, whose workers are not ours) has ended when this returns; then
+    the lock and temporary files the killed ones left in the files' folders are removed.  The watchdog of the
+    CLI waits for this (:func:`fogdrift.interrupt.shielded`), so a loaded machine does not cut it short.
+    """
+    killed = []
+    if interrupted and before is not None:
+        if cluster is not None:
+            _stop_restarts(cluster)
+        killed += _end_processes(_children(exclude=before))
+    _close(client, cluster, quick=interrupted)
+    if before is not None:
+        killed += _end_processes(_children(exclude=before))  # a graceful close leaves none; a quick one may
+    if killed:
+        _remove_temporaries(tasks, killed=killed)
 
 
 @contextlib.contextmanager
@@ -469,18 +495,58 @@ def _sigint_blocked_for_children():
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
-def _kill_workers(cluster) -> list[int]:
-    """SIGKILL the worker processes of a local cluster (their tasks cannot be stopped any other way); return
-    their process ids."""
-    import signal
+#: Seconds to wait for a killed worker process to end (SIGKILL: at once, unless the machine is very busy).
+WORKER_EXIT_WAIT_S = 60.0
 
-    killed = []
+
+def _children(exclude=()) -> list:
+    """This process's descendants (psutil processes) that are not in ``exclude``, but multiprocessing's resource
+    tracker (it ends by itself when this process does, after removing what the workers left registered)."""
+    import psutil
+    from multiprocessing import resource_tracker
+
+    tracker = getattr(resource_tracker._resource_tracker, "_pid", None)
+    try:
+        kids = psutil.Process().children(recursive=True)
+    except psutil.Error:
+        return []
+    return [p for p in kids if p not in exclude and p.pid != tracker]
+
+
+def _stop_restarts(cluster) -> None:
+    """Tell the local cluster's nannies not to start another worker when theirs dies: they close instead."""
+    from distributed.core import Status
+
     for nanny in list(getattr(cluster, "workers", {}).values()):
         with contextlib.suppress(Exception):
-            pid = nanny.process.process.pid
-            os.kill(pid, signal.SIGKILL)
-            killed.append(pid)
+            nanny.status = Status.closing_gracefully
+
+
+def _end_processes(procs) -> list[int]:
+    """SIGKILL the processes (psutil's, which checks that a pid is still the same process) and wait until each
+    has ended (at most WORKER_EXIT_WAIT_S; a zombie has ended, its parent reaps it); return their ids."""
+    import psutil
+
+    killed = []
+    for p in procs:
+        with contextlib.suppress(psutil.Error):
+            p.kill()
+            killed.append(p.pid)
+    deadline = time.monotonic() + WORKER_EXIT_WAIT_S
+    while procs and time.monotonic() < deadline:
+        procs = [p for p in procs if _running(p)]
+        if procs:
+            time.sleep(0.01)
     return killed
+
+
+def _running(proc) -> bool:
+    import psutil
+
+    try:
+        return proc.status() != psutil.STATUS_ZOMBIE
+    except psutil.Error:
+        return False
 
 
 def _remove_temporaries(tasks, killed=()) -> None:
@@ -514,11 +580,7 @@ def _remove_temporaries(tasks, killed=()) -> None:
 
 
 def _close(client, cluster, *, quick: bool) -> None:
-    """Close the client and the local cluster; after an interruption, without waiting for running tasks.
-
-    The local workers are child processes that end when this process does (distributed's parent-alive
-    pipe), so a quick close never leaves a worker behind.
-    """
+    """Close the client and the local cluster; after an interruption, without waiting for running tasks."""
     kwargs = {"timeout": 2} if quick else {}
     if client is not None:
         with contextlib.suppress(Exception):
