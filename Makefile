@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed
 OUT    ?= out/demo
 DATA   := data/psins_lasergyro_rlg/psins_lasergyro_rlg.csv.gz
 
-.PHONY: demo test bench venv clean mutation
+.PHONY: demo test bench venv clean mutation docs
 
 $(STAMP): pyproject.toml
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "need $(PYTHON) (set PYTHON=...)"; exit 1; }
@@ -39,6 +39,13 @@ mutation: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[test,mutation]'
 	NUMBA_THREADING_LAYER=workqueue $(BIN)/mutmut run --max-children 2 $(MUTANTS)
 	$(BIN)/mutmut results
+
+# The documentation site (mkdocs-material + mkdocstrings; mkdocs.yml): the CLI reference is generated from the
+# commands first; --strict turns every warning (a broken link, a docstring it cannot read) into an error.
+docs: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[test,docs]'
+	$(BIN)/python scripts/gen_cli_reference.py
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
 
 bench: $(STAMP)
 	$(BIN)/python bench/run_all.py

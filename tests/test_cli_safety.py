@@ -168,9 +168,11 @@ def test_out_is_a_file(bundled_path, tmp_path, no_load):
     assert f"--out {f} exists and is not a folder" in result.output
 
 
-def test_out_parent_missing(bundled_path, tmp_path, no_load):
+def test_out_parent_missing_is_created_and_said(bundled_path, tmp_path, no_load):
+    # as mkdir -p (issue 38): the missing parents are created, and one line says so (a typo shows there)
     result = runner.invoke(app, ["allan", str(bundled_path), "--unit", "deg/h", "--out", str(tmp_path / "typo" / "x")])
-    assert result.exit_code == 1 and "its parent folder" in result.output and "does not exist" in result.output
+    assert f"creating its parent folder {tmp_path / 'typo'}" in result.output
+    assert "does not exist" not in result.output
 
 
 def test_out_not_writable(bundled_path, no_load):
