@@ -133,21 +133,41 @@ def _homogeneous(r: ScreenResult) -> tuple:
 MAX_LISTED = 4
 
 
-def segment_lines(name, screen) -> list[str]:
-    """The console lines of one axis's screen: what disturbs the record, and what the fit uses."""
+def segment_lines(name, screen, *, compact: bool = False) -> list[str]:
+    """The console lines of one axis's screen: what disturbs the record, and what the fit uses (``compact``: one
+    short line per axis, for a summary such as ``analyze``'s first screen; the JSON and the report hold the rest)."""
     dt = screen["dt_s"]
     n = screen["n_samples"]
     ivs = screen.get("intervals") or []
+    used = screen.get("segments_used")
+    if compact:
+        if screen["stationary"]:
+            return [f"{name}: stationary (no disturbance found); the noise fit uses the whole record"]
+        cover = sum(d["end_s"] - d["start_s"] for d in ivs) / (n * dt)
+        peak = max((d.get("peak") or 0.0 for d in ivs), default=0.0)
+        fitted = (f"the noise fit uses the quiet {sum(b - a for a, b in used) * dt:.4g} s of {n * dt:.4g} s" if used
+                  else "the noise fit uses the whole record, disturbance included")
+        return [f"{name}: disturbed: {len(ivs)} interval{'s' if len(ivs) != 1 else ''} over {100 * cover:.0f} % of "
+                f"the record, peak {peak:.2g}x the quiet level; {fitted}"]
     if len(ivs) > MAX_LISTED:  # disturbed throughout: one line, the intervals are in the JSON
         kinds = {}
         for d in ivs:
             kinds[d["kind"]] = kinds.get(d["kind"], 0) + 1
         cover = sum(d["end_s"] - d["start_s"] for d in ivs) / (n * dt)
         top = max(ivs, key=lambda d: d.get("peak") or 0.0)
-        out = [f"{name}: screen: disturbed throughout: {len(ivs)} intervals ("
-               + ", ".join(f"{v} {k}{'s' if v > 1 else ''}" for k, v in kinds.items())
-               + f") over {100 * cover:.0f} % of the record, peak {top.get('peak', 0):.2g}x the quiet level at "
-               f"t = {top['start_s']:g}-{top['end_s']:g} s (each in the JSON's screen)"]
+        head = (f"{name}: screen: disturbed throughout: {len(ivs)} intervals ("
+                + ", ".join(f"{v} {k}{'s' if v > 1 else ''}" for k, v in kinds.items())
+                + f") over {100 * cover:.0f} % of the record, peak {top.get('peak', 0):.2g}x the quiet level at "
+                f"t = {top['start_s']:g}-{top['end_s']:g} s")
+        used = screen.get("segments_used")
+        if used and screen["mode"] == "auto" and len(used) > MAX_LISTED:  # one line: what disturbs it, what is fitted
+            span = sum(b - a for a, b in used) * dt
+            return [f"{head}; the noise fit uses the quiet {span:.4g} s of {n * dt:.4g} s ({len(used)} segments, "
+                    "pooled without bridging a gap; each in the JSON's screen); --segments whole fits it all"] + \
+                [f"{name}: left out {d['start_s']:g}-{d['end_s']:g} s too: below the detection threshold but "
+                 f"{d['ratio']:.2g}x the level of the quietest segment (a disturbance's tail; not pooled with it)"
+                 for d in screen.get("segments_dropped") or ()]
+        out = [head + " (each in the JSON's screen)"]
     else:
         out = [f"{name}: screen: {line}" for line in screen["text"].splitlines()]
     used = screen.get("segments_used")

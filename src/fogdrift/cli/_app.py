@@ -782,7 +782,7 @@ def print_table(title, headers, rows) -> None:
     console.print(fitted_table(title, headers, rows))
 
 
-def print_screen(record, findings, screens, gmwm=None) -> None:
+def print_screen(record, findings, screens, gmwm=None, compact=False) -> None:
     """Print what a workflow found before its fit: each plausibility finding as a warning (one line each), then
     each axis's record screen (what disturbs it, where, what the fit uses).  ``gmwm``: the segment plan, to say
     that GMWM fits the longest segment."""
@@ -791,7 +791,7 @@ def print_screen(record, findings, screens, gmwm=None) -> None:
     for finding in findings:
         warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
     for name in record.axis_names:
-        for line in segment_lines(name, screens[name]):
+        for line in segment_lines(name, screens[name], compact=compact):
             if gmwm is not None and gmwm[name] and line.endswith("fits it all") and len(gmwm[name]) > 1:
                 line += "; GMWM: the longest of them"
             say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")

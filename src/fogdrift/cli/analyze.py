@@ -132,7 +132,7 @@ def analyze(
         elif apply_unit or apply_time_unit:
             raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
         screened = screen(record, segments)  # the checks before any fit: plausibility, the record screen
-        print_screen(record, screened.findings, screened.screens)
+        print_screen(record, screened.findings, screened.screens, compact=not details)
         if other is not None:
             check_plausible(other)
         with progress("analyze", record.axis_names) as (_, epoch_cb):
@@ -150,13 +150,10 @@ def analyze(
         files = write_analyze(done, r.out.path, pdf=pdf, sensor=sensor, spec_source=spec.name if spec else "")
         path, bundle, comp = files["report"], files["bundle"], files["compensated"]
         r.wrote()
-        say(f"report: {path.resolve()}{'  (+ report.pdf)' if pdf else ''}  ({result.wall_s:.1f} s)")
-        say(f"bundle: {bundle.path}   (apply it to another log: fogdrift compensate {bundle.path} LOG --unit "
-            f"{record.input_unit}, or the unit LOG declares)")
-        say(f"compensated test block: {', '.join(p.name for p in comp)} (modelling rate, deg/h)")
-        if not details:
-            say("every table (Table 2, one-step metrics, heading error, artefacts): the report, analysis.json, "
-                "or --details", style="dim")
+        say(f"report: {path.resolve()}{'  (+ report.pdf)' if pdf else ''}  ({result.wall_s:.1f} s); every table "
+            "there, in analysis.json, or with --details")
+        say(f"bundle: {bundle.path} (apply it: fogdrift compensate {bundle.path} LOG --unit {record.input_unit}); "
+            f"compensated test block: {', '.join(p.name for p in comp)} (deg/h)")
         r.print_json(r.out.path / "analysis.json")
 
 
