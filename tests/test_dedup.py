@@ -62,15 +62,16 @@ def test_bundle_manifest_and_model_json_are_strict(small, tmp_path):
 
 def test_discretize_uses_the_allan_laws_of_the_term_table():
     """The Allan coefficients A_n of Q, N, B, K, R from one value X each: 3X², X², (2 ln2/π)X², X²/3, X²/2."""
-    from fogdrift.models import statespace
+    from fogdrift.noise.processes import flicker, quantization
     from fogdrift.noise.terms import TERM_TABLE, TERMS
 
     assert TERMS == ("Q", "N", "B", "K", "R")
     by_hand = {"Q": 3.0, "N": 1.0, "B": 2.0 * math.log(2.0) / math.pi, "K": 1.0 / 3.0, "R": 0.5}
     for name in TERMS:
         assert TERM_TABLE[name].avar_coefficient == pytest.approx(by_hand[name], rel=1e-15)
-    assert statespace._B_AVAR == pytest.approx(2.0 * math.log(2.0) / math.pi, rel=1e-15)
-    assert statespace.URAD_PER_ARCSEC == pytest.approx(4.8481368110953599, rel=1e-15)
+    # the rows the state-space model and the exports read are the same objects
+    assert TERM_TABLE["B"] is flicker.TERM and TERM_TABLE["Q"] is quantization.TERM
+    assert quantization.TERM.to_unit == pytest.approx(4.8481368110953599, rel=1e-15)
 
 
 def test_evaluated_analysis_returns_a_new_result_and_reads_the_stored_window(small, monkeypatch):

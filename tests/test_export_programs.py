@@ -14,6 +14,7 @@ import json
 import math
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,9 @@ from typer.testing import CliRunner
 
 from fogdrift.cli import app
 from fogdrift.export import build_context, render
-from test_export import _accel_result, _gyro_result
+
+sys.path.insert(0, str(Path(__file__).parent))  # the result fixtures of tests/test_export.py (import mode importlib)
+from test_export import _accel_result, _gyro_result  # noqa: E402
 
 D = math.pi / 180.0
 

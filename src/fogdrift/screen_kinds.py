@@ -30,6 +30,8 @@ __all__ = ["BAND_FRACTION", "STEADY_RATIO", "welch_windows", "is_vibration_burst
 
 #: Share of an interval's excess power inside one octave around its peak for a vibration burst.
 BAND_FRACTION = 0.6
+#: ... and at least this many times the octave's share of the frequency bins (broadband excess fills its share).
+CONCENTRATION = 2.0
 
 #: Largest ratio of a window's excess level to the interval's median excess level for a steady (vibration) burst.
 STEADY_RATIO = 3.0
@@ -85,7 +87,11 @@ def is_vibration_burst(y: np.ndarray, a: int, b: int, L: int, quiet_psd: np.ndar
         return False
     k = int(np.argmax(excess))
     lo, hi = int(math.floor(k / math.sqrt(2.0))), int(math.ceil(k * math.sqrt(2.0)))
-    if float(excess[lo:hi + 1].sum()) < BAND_FRACTION * total:
+    hi = min(hi, excess.size - 1)
+    # concentrated: the octave holds BAND_FRACTION of the excess AND at least CONCENTRATION times its share of the
+    # frequency bins (an octave near the Nyquist frequency spans half of them: broadband noise fills it by chance)
+    share = (hi - lo + 1) / max(1, excess.size - 1)
+    if float(excess[lo:hi + 1].sum()) < max(BAND_FRACTION, CONCENTRATION * share) * total:
         return False
     excess_w = np.asarray(window_ratios, dtype=np.float64) - 1.0  # each window's excess over the quiet level
     med = float(np.median(excess_w))

@@ -89,9 +89,8 @@ def analyze(
     json_out: JsonOpt = False,
 ):
     """The whole method: Allan analysis, separation, drift models, compensation, Table 2 and an HTML report."""
-    from ..pipeline import AnalysisConfig, model_factor
-    from ..workflows.allan import screen
-    from ..workflows.analyze import run_analyze, write_analyze
+    from ..pipeline import AnalysisConfig
+    from ..workflows.analyze import prepare_analyze, run_analyze, write_analyze
 
     with run("analyze", out, default_out=DEFAULT_OUT, inputs=[load.file, apply_to, spec], json_out=json_out,
              expect=("analysis.json", "report.html") + (("report.pdf",) if pdf else ())
@@ -118,26 +117,25 @@ def analyze(
         hs = parse_heading_options(calibration, origin_step, horizons)
         if apply_to is not None and not apply_to.is_file():
             raise ConfigError(f"--apply-to {apply_to}: no such file")
+        if (apply_unit or apply_time_unit) and not apply_to:
+            raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
         record = load.load()
         gyro_only(record, "analyze")
-        model_factor(record, cfg)  # a modelling rate that does not divide the native rate: refused before any work
-        echo_record(load, record)
         other = None
         if apply_to:
-            other = load.load(apply_to, unit=apply_unit, time_unit=apply_time_unit)
-            other = _match_axes(record, other, apply_to)
-            model_factor(other, cfg)
+            other = _match_axes(record, load.load(apply_to, unit=apply_unit, time_unit=apply_time_unit), apply_to)
+        # the modelling factors decided (a rate that does not divide: one line, before any work), the record screened
+        prepared = prepare_analyze(record, cfg, apply_to=other, segments=segments)
+        echo_record(load, record)
+        if other is not None:
             echo_record(load, other, apply_to, unit_flag="--apply-unit" if apply_unit else "--unit",
                         time_unit_flag="--apply-time-unit" if apply_time_unit else "--time-unit")
-        elif apply_unit or apply_time_unit:
-            raise ConfigError("--apply-unit / --apply-time-unit need --apply-to")
-        screened = screen(record, segments)  # the checks before any fit: plausibility, the record screen
-        print_screen(record, screened.findings, screened.screens, compact=not details)
+        print_screen(record, prepared.screened.findings, prepared.screened.screens, compact=not details)
         if other is not None:
             check_plausible(other)
         with progress("analyze", record.axis_names) as (_, epoch_cb):
             done = run_analyze(record, cfg, apply_to=other, heading=heading, calib_s=calibration, step_s=origin_step,
-                               horizons_s=hs, limits=limits, progress=epoch_cb, screened=screened)
+                               horizons_s=hs, limits=limits, progress=epoch_cb, prepared=prepared)
         result, evaluations = done.result, done.evaluations
         if result.apply_to is not None:
             say(apply_note(result, apply_to))

@@ -20,7 +20,7 @@ from ..spec import analysis_judgements
 
 from .allan import Screened, screen
 
-__all__ = ["AnalyzeRun", "run_analyze", "write_analyze", "HEADING_DEFAULTS"]
+__all__ = ["AnalyzeRun", "Prepared", "prepare_analyze", "run_analyze", "write_analyze", "HEADING_DEFAULTS"]
 
 #: The heading evaluation's defaults: calibration window and origin spacing [s], free-run horizons [s].
 HEADING_DEFAULTS = {"calib_s": 300.0, "step_s": 60.0, "horizons_s": (60.0, 600.0, 3600.0)}
@@ -62,9 +62,29 @@ class AnalyzeRun:
         return self.result.config
 
 
+@dataclass
+class Prepared:
+    """What ``analyze`` decides before any work: the validated configuration, the block-average factor of the record
+    (and of the ``apply_to`` record) to the modelling rate, decided once here, and the record screen."""
+
+    config: object
+    factor: int
+    apply_factor: int | None
+    screened: Screened
+
+
+def prepare_analyze(record, config=None, *, apply_to=None, segments="auto") -> Prepared:
+    """Decide the modelling factors (a modelling rate that does not divide a record's rate is refused here, before
+    any work) and screen the record; :func:`run_analyze` takes the result as ``prepared=``."""
+    cfg = (config or AnalysisConfig()).validate()
+    factor = model_factor(record, cfg)
+    other = None if apply_to is None else model_factor(apply_to, cfg)
+    return Prepared(cfg, factor, other, screen(record, segments))
+
+
 def run_analyze(record, config=None, *, apply_to=None, heading=True, calib_s=HEADING_DEFAULTS["calib_s"],
                 step_s=HEADING_DEFAULTS["step_s"], horizons_s=HEADING_DEFAULTS["horizons_s"], limits=None,
-                segments="auto", progress: Callable | None = None, screened: Screened | None = None) -> AnalyzeRun:
+                segments="auto", progress: Callable | None = None, prepared: Prepared | None = None) -> AnalyzeRun:
     """Run ``fogdrift analyze`` on a recording.
 
     Parameters
@@ -77,9 +97,10 @@ def run_analyze(record, config=None, *, apply_to=None, heading=True, calib_s=HEA
         The heading-error and artefact evaluation (``calib_s``, ``step_s``, ``horizons_s`` in s).
     limits : dict, optional
         Datasheet limits (:func:`fogdrift.spec.read_spec`), judged against the headline noise model.
-    segments, screened
-        As :func:`fogdrift.workflows.allan.run_allan` (``screened`` covers ``record``; ``apply_to``'s plausibility
-        findings are added to the run's).
+    segments : str
+        As :func:`fogdrift.workflows.allan.run_allan` (``apply_to``'s plausibility findings are added to the run's).
+    prepared : Prepared, optional
+        :func:`prepare_analyze` made already (for ``config``, ``apply_to`` and ``segments``).
     progress : callable, optional
         The epoch callback of the drift models.
 
@@ -89,10 +110,8 @@ def run_analyze(record, config=None, *, apply_to=None, heading=True, calib_s=HEA
         A modelling rate that does not divide either record's rate by an integer (before any work).
     """
 
-    cfg = (config or AnalysisConfig()).validate()
-    factor = model_factor(record, cfg)  # refused here, before any work
-    other_factor = None if apply_to is None else model_factor(apply_to, cfg)
-    sc = screened if screened is not None else screen(record, segments)
+    prep = prepared if prepared is not None else prepare_analyze(record, config, apply_to=apply_to, segments=segments)
+    cfg, factor, other_factor, sc = prep.config, prep.factor, prep.apply_factor, prep.screened
     findings, segs, screens = list(sc.findings), sc.segments, sc.screens
     if apply_to is not None:
     

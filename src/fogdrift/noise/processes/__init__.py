@@ -140,7 +140,7 @@ def power_law_sdf(name, A, dt_s):
     Examples
     --------
     >>> s = power_law_sdf("N", 4.0, 0.01)            # white noise: A = N^2 = sigma2 dt
-    >>> float(s(0.25))
+    >>> round(float(s(0.25)), 9)
     400.0
     """
     p = process(name)
@@ -167,7 +167,7 @@ def model_sdf(A, dt_s):
     Examples
     --------
     >>> S = model_sdf([0, 4.0, 0, 0, 0], 0.01)
-    >>> float(S(np.array([0.25]))[0])
+    >>> round(float(S(np.array([0.25]))[0]), 9)
     400.0
     """
     parts = [power_law_sdf(name, a, dt_s) for name, a in zip(power_law_names(), A)
