@@ -136,12 +136,13 @@ def test_model_names_in_any_case_are_accepted(bundled_path, tmp_path):
 
 def test_model_rate_that_does_not_divide_is_refused_before_the_work(bundled_path, tmp_path, monkeypatch):
     import fogdrift.cli.analyze as cli_analyze
-    import fogdrift.pipeline as pipeline
+    import fogdrift.workflows.analyze as workflow
     from fogdrift import interrupt
 
     def fail(*a, **k):
         raise AssertionError("analysis started before the bad --model-rate was refused")
-    monkeypatch.setattr(pipeline, "run_analysis", fail)
+    monkeypatch.setattr(workflow, "run_analysis", fail)  # the analysis the analyze workflow runs
+    monkeypatch.setattr(workflow, "screen", fail)  # nor the record screen
     monkeypatch.setattr(cli_analyze, "progress", fail)  # the progress frame of the work is never entered
     stages = []
     read = []

@@ -400,12 +400,12 @@ def test_atomic_path_outside_an_output_folder_on_a_full_disk(tmp_path):
 
 
 def test_a_memory_error_in_a_command_is_one_line(tmp_path, npy_log, monkeypatch):
-    import fogdrift.pipeline
+    import fogdrift.workflows.allan
 
     def exhausted(*args, **kwargs):
         raise MemoryError()
 
-    monkeypatch.setattr(fogdrift.pipeline, "run_allan", exhausted)
+    monkeypatch.setattr(fogdrift.workflows.allan, "run_allan", exhausted)  # the allan workflow the command runs
     out = tmp_path / "o"
     result = runner.invoke(app, ["allan", str(npy_log), "--unit", "deg/h", "--rate", "100", "--out", str(out)])
     assert result.exit_code == 1 and "Traceback" not in result.output, result.output
