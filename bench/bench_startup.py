@@ -11,6 +11,9 @@ Cases:
   what a command did before) against the default (one BLAS thread, set by ``fogdrift.cli.main``).
 * ``stats``: ``import fogdrift.pipeline`` (this tree) with and without ``scipy.stats`` imported first: what the
   noise fit's move from ``scipy.stats`` to ``scipy.special`` (``noise.distributions``) saves an importer.
+* ``csv``: reading ADIS16405 session 1 (CSV.gz, 10^6 rows x 4) in this process: ``numpy.loadtxt`` (``FAST_CSV =
+  False``) against the fast path (pyarrow's reader, one thread), alternating; also checks the arrays are equal bit
+  for bit.
 * ``base``: any command, this tree against another source tree (``--base DIR``, e.g. ``git archive <commit> src |
   tar -x -C DIR``), both under the same environment: ``--cmd 'allan {ADIS1} --unit deg/s'``.
 
@@ -78,6 +81,35 @@ def pairs(name: str, rival: tuple, mine: tuple, rounds: int) -> dict:
     return row
 
 
+def csv_pairs(rounds: int) -> dict:
+    sys.path.insert(0, str(SRC))
+    import numpy as np
+
+    from fogdrift.io.readers import text
+
+    def read(fast: bool):
+        text.FAST_CSV = fast
+        table = text.open_table(ADIS1)
+        t = time.perf_counter()
+        data = table.read(set(range(table.n_fields)))
+        return time.perf_counter() - t, data
+
+    read(True)  # imports pyarrow once
+    a, b, same = [], [], True
+    before = _load()
+    for i in range(rounds):
+        for fast in ((False, True) if i % 2 == 0 else (True, False)):
+            dt, _ = read(fast)
+            (b if fast else a).append(dt)
+        same &= np.array_equal(read(True)[1].view(np.int64), read(False)[1].view(np.int64)) if i == 0 else True
+    ratios = [x / y for x, y in zip(a, b)]
+    row = {"case": "read ADIS imu1 CSV.gz: loadtxt vs fast", "rival_s": statistics.median(a),
+           "fogdrift_s": statistics.median(b), "ratio": statistics.median(ratios), "load": f"{before} -> {_load()}"}
+    print(f"| {row['case']} (bit-identical: {same}) | {row['rival_s']:.2f} | {row['fogdrift_s']:.2f} | "
+          f"{row['ratio']:.2f}x | {min(ratios):.2f}-{max(ratios):.2f} | {row['load']} |", flush=True)
+    return row
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=5)
@@ -99,6 +131,8 @@ def main(argv=None) -> int:
         pairs("import fogdrift.pipeline: with scipy.stats vs without",
               ([py, "-c", "import scipy.stats, fogdrift.pipeline"], _env(SRC)),
               ([py, "-c", "import fogdrift.pipeline"], _env(SRC)), args.rounds)
+    if "csv" in cases:
+        csv_pairs(args.rounds)
     if "base" in cases:
         if args.base is None:
             ap.error("the 'base' case needs --base DIR")
