@@ -10,8 +10,16 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
+
+import fogdrift
+
+#: The source tree of the fogdrift under test: a probe imports it, not whatever copy the interpreter has installed
+#: (an editable install may point at another checkout).
+_SRC = str(Path(fogdrift.__file__).resolve().parents[1])
+
 
 #: Runs main() with the given argv and prints, as JSON, the exit code, stdout and the fogdrift/scipy modules loaded.
 _PROBE = r"""
@@ -27,13 +35,15 @@ with contextlib.redirect_stdout(buf):
     except SystemExit as exc:
         code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
 mods = sorted(m for m in sys.modules if m.startswith(("fogdrift", "scipy")))
-print(json.dumps({"code": code, "out": buf.getvalue(), "modules": mods}))
+import os
+blas = {v: os.environ.get(v) for v in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
+print(json.dumps({"code": code, "out": buf.getvalue(), "modules": mods, "blas": blas}))
 """
 
 
-def _probe(*argv):
+def _probe(*argv, env=None):
     proc = subprocess.run([sys.executable, "-c", _PROBE, json.dumps(list(argv))], capture_output=True, text=True,
-                          timeout=300, env={"COLUMNS": "200", "PATH": "/usr/bin:/bin"})
+                          timeout=300, env={"COLUMNS": "200", "PATH": "/usr/bin:/bin", "PYTHONPATH": _SRC, **(env or {})})
     assert proc.returncode == 0, proc.stderr[-2000:]
     return json.loads(proc.stdout.strip().splitlines()[-1]), proc.stderr
 
@@ -97,3 +107,25 @@ def test_lazy_command_matches_the_eager_one(name):
         for opt in param.opts:
             if opt.startswith("--"):
                 assert opt in res["out"], (name, opt)
+
+
+def test_a_command_runs_blas_on_one_thread_unless_the_user_chose():
+    """Issue 35: OpenBLAS's threads thrash on a busy machine (the CLI's matrices are small), so ``main()`` sets
+    ``OPENBLAS_NUM_THREADS``/``MKL_NUM_THREADS`` to 1 before NumPy loads; a count the user set is kept."""
+    res, _ = _probe("allan", "--help")
+    assert res["blas"] == {"OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+    res, _ = _probe("allan", "--help", env={"OPENBLAS_NUM_THREADS": "3"})
+    assert res["blas"]["OPENBLAS_NUM_THREADS"] == "3"
+
+
+def test_one_blas_thread_changes_nothing_once_numpy_is_loaded(monkeypatch):
+    """Called in a process that already imported NumPy (a test, a notebook) it cannot act, so it leaves the
+    environment (what child processes inherit) alone."""
+    import numpy  # noqa: F401
+
+    from fogdrift.cli import BLAS_THREAD_VARS, one_blas_thread
+
+    for var in BLAS_THREAD_VARS:
+        monkeypatch.delenv(var, raising=False)
+    assert one_blas_thread() is False
+    assert all(var not in __import__("os").environ for var in BLAS_THREAD_VARS)

@@ -11,9 +11,17 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
+
+import fogdrift
+
+#: The source tree of the fogdrift under test: a probe imports it, not whatever copy the interpreter has installed
+#: (an editable install may point at another checkout).
+_SRC = str(Path(fogdrift.__file__).resolve().parents[1])
+
 
 #: Runs the code in argv[1], then prints the sorted names of the loaded fogdrift/scipy modules as JSON.
 _PROBE = r"""
@@ -31,7 +39,7 @@ print(json.dumps(sorted(m for m in sys.modules if m.startswith(("fogdrift", "sci
 
 def _modules(code: str, argv=()) -> set:
     proc = subprocess.run([sys.executable, "-c", _PROBE, code, json.dumps(list(argv))], capture_output=True,
-                          text=True, timeout=600, env={"COLUMNS": "200", "PATH": "/usr/bin:/bin"})
+                          text=True, timeout=600, env={"COLUMNS": "200", "PATH": "/usr/bin:/bin", "PYTHONPATH": _SRC})
     assert proc.returncode == 0, proc.stderr[-3000:]
     return set(json.loads(proc.stdout.strip().splitlines()[-1]))
 
@@ -45,6 +53,16 @@ def test_importing_the_pipeline_loads_no_gmwm():
     assert "fogdrift.pipeline" in mods
     assert _gmwm(mods) == []
     assert "scipy.signal" not in mods  # was imported through gmwm.simulate
+
+
+def test_importing_the_noise_fit_loads_no_scipy_stats():
+    """Issue 35: the noise fit's chi-squared and t quantiles come from scipy.special (noise.distributions), so
+    importing the pipeline, the noise package or the Allan noise identification does not load scipy.stats (0.3-0.6 s).
+    (A command that computes the spectrum still loads it: scipy.signal's welch imports scipy.stats itself.)"""
+    mods = _modules("import fogdrift.pipeline, fogdrift.noise.identify, fogdrift.noise.spectral")
+    assert "fogdrift.noise.identify" in mods
+    assert "scipy.stats" not in mods
+    assert "scipy.signal" not in mods
 
 
 def test_the_gmwm_path_still_loads_it_on_use():

@@ -121,6 +121,30 @@ def _after_the_run(code: int) -> bytes:
             else b"interrupted: after the run had ended\n")
 
 
+#: BLAS thread variables :func:`one_blas_thread` sets (OpenBLAS: NumPy's and SciPy's wheels; MKL: conda builds).
+BLAS_THREAD_VARS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def one_blas_thread() -> bool:
+    """Run BLAS/LAPACK on one thread in this command unless the user chose a count (issue 35, threads).
+
+    The CLI's matrices are small (the record screen's null law: ``eigvalsh`` of a few hundred square; GMWM's
+    covariances): on a busy machine OpenBLAS's threads spin against each other and the other jobs, measured 3-37x
+    slower per ``eigvalsh`` at load 5 on two cores and 1.6x on a whole ``fogdrift allan`` (bench/RESULTS.md),
+    while on an idle machine the second thread saves a few ms.  Numba's threads are sized by the kernels
+    themselves (``allan._kernels``).  A value the user set (``OPENBLAS_NUM_THREADS=4 fogdrift ...``) is kept.
+    The variables are read when the library loads, so this acts only before NumPy is imported (a fresh command);
+    called later (``main()`` inside a test or a notebook) it changes nothing, not even the environment its child
+    processes inherit.  Returns whether it set the count.  A command's children (fleet workers, Monte-Carlo pools)
+    inherit the setting.
+    """
+    if "numpy" in sys.modules:
+        return False
+    for var in BLAS_THREAD_VARS:
+        os.environ.setdefault(var, "1")
+    return True
+
+
 def main():  # console-script entry point
     import _signal  # loaded by the interpreter itself; ``signal`` (the enum wrapper) would import enum first
 
@@ -130,6 +154,7 @@ def main():  # console-script entry point
             _signal.signal(_signal.SIGINT, _outside_the_guard)
         except ValueError:  # not the main thread: no handler can be set there
             pass
+    one_blas_thread()
     from .. import interrupt
 
     code = 0

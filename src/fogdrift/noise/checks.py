@@ -13,9 +13,9 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.stats import chi2
 
 from ..units import B_FACTOR
+from .distributions import chi2_ppf
 from .engine import ScoreProblem, profile_interval
 from .periodic import Q_OVER_ENVELOPE, q_stands_above_lines
 from .result import NoiseTerm
@@ -31,15 +31,15 @@ def _point_limits(y, nu) -> np.ndarray:
     """Each point's ~4-sigma upper limit ``y nu / chi2_nu(3.17e-5)`` (the 4-sigma lower quantile of chi2_nu / nu);
     inf where nu << 1 (the quantile is 0: the point bounds nothing)."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        return y * nu / chi2.ppf(3.17e-5, nu)
+        return y * nu / chi2_ppf(3.17e-5, nu)
 
 
 def _points_outside(y, mu, nu) -> np.ndarray:
     """Indices of the points whose own 95 % chi-squared interval (EDF ``nu``) does not hold the model value."""
     nu = np.maximum(np.asarray(nu, dtype=np.float64), 1e-6)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        lo = y * nu / chi2.ppf(0.975, nu)
-        hi = y * nu / chi2.ppf(0.025, nu)  # inf where nu << 1: such a point bounds nothing above
+        lo = y * nu / chi2_ppf(0.975, nu)
+        hi = y * nu / chi2_ppf(0.025, nu)  # inf where nu << 1: such a point bounds nothing above
     return np.flatnonzero((mu < lo) | (mu > hi))
 
 

@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import brentq
-from scipy.stats import chi2
 
+from .distributions import chi2_ppf
 from .result import NoiseTerm
 from .rules import SLOPES, slope_claim
 from .terms import TERM_TABLE, all_terms, power_terms
@@ -42,7 +42,7 @@ def _measured_limits(c: _Context, nu):
         if np.isfinite(r) and 1.0 < r < 1e5:
             nu[i] = _edf_from_upper(float(r))
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        return c.y * nu / chi2.ppf(0.975, nu), c.y * nu / chi2.ppf(0.025, nu)
+        return c.y * nu / chi2_ppf(0.975, nu), c.y * nu / chi2_ppf(0.025, nu)
 
 
 @functools.lru_cache(maxsize=4096)
@@ -51,7 +51,7 @@ def _edf_from_upper(ratio: float) -> float:
     (``nu / chi2_nu(0.025) = ratio``; 0.2-1e7)."""
     def f(lnu):
         nu = math.exp(lnu)
-        return math.log(nu / chi2.ppf(0.025, nu)) - math.log(ratio)
+        return math.log(nu / chi2_ppf(0.025, nu)) - math.log(ratio)
 
     lo, hi = math.log(0.2), math.log(1e7)
     if f(hi) >= 0:

@@ -37,12 +37,12 @@ import math
 
 import numpy as np
 from scipy.optimize import brentq
-from scipy.stats import chi2, t as student_t
 
 from ..allan.ci import edf_simple_safe
 from ..errors import ConfigError, InsufficientDataError
 from .checks import _check_floor, _classical_b, _drop_rejected, _point_limits, _q_at_whole_periods
 from .discrepancy import discrepancy_relcov
+from .distributions import chi2_sf, t_ppf
 from .covariance import estimator_covariance, expected_variance, ramp_cross_variance
 from .engine import ScoreProblem, all_subsets, fit_subsets, profile_interval
 from .notes import (_absent_reason, _at_bound_notes, _describe_excluded, _largest_gap_note, _misfit_note, _no_fit,
@@ -511,11 +511,11 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     n_par = len(best) + (1 if _names().index("M") in best else 0)
     dof = max(1, c.tau.size - n_par)
     chi2_red = q / dof
-    p = float(chi2.sf(q, dof))
+    p = float(chi2_sf(q, dof))
     quality = "good" if p >= 0.01 else "acceptable" if chi2_red <= POOR_CHI2_RED else "poor"
     infl = max(1.0, chi2_red)
-    d2 = float(student_t.ppf(0.975, dof) ** 2) * infl
-    d1 = float(student_t.ppf(0.95, dof) ** 2) * infl
+    d2 = float(t_ppf(0.975, dof) ** 2) * infl
+    d1 = float(t_ppf(0.95, dof) ** 2) * infl
     mu = c.X @ A
     z = prob.scores(mu)
 
@@ -730,7 +730,7 @@ def _markov_stage(c: _Context, C, res, best, penalty):
     # profile-likelihood interval of T_c: {T : min_q(T) <= q_min + t^2 chi2_red}
     q_min = res2[best2]["q"]
     dof = max(1, c.tau.size - len(best2) - 1)
-    d2 = float(student_t.ppf(0.975, dof) ** 2) * max(1.0, q_min / dof)
+    d2 = float(t_ppf(0.975, dof) ** 2) * max(1.0, q_min / dof)
     lt_lo, lt_hi = lo_t - math.log(8.0), hi_t + math.log(16.0)  # the interval's range: tau_min/8 .. 8 tau_max
     cache = {}
 

@@ -11,9 +11,9 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.stats import chi2
 
 from .checks import _point_limits, _points_outside
+from .distributions import chi2_ppf
 from .spectral import sinusoid_avar
 from .terms import DISPLAY_UNITS, all_terms
 
@@ -167,7 +167,7 @@ def _largest_gap_note(tau, y, mu, nu) -> list:
     r, v = float(ratio[k]), float(nu[k])
     if max(r, 1.0 / r) < GAP_NOTE_RATIO or not np.isfinite(v) or v <= 0:
         return []
-    lo, hi = chi2.ppf(0.025, v) / v, chi2.ppf(0.975, v) / v  # measured/true variance, 95 %
+    lo, hi = chi2_ppf(0.025, v) / v, chi2_ppf(0.975, v) / v  # measured/true variance, 95 %
     inside = lo <= 1.0 / r**2 <= hi
     side = "above" if r > 1 else "below"
     verdict = ("inside that point's own 95 % interval: with so few averaging intervals the data cannot tell, so "

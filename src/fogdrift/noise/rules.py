@@ -45,8 +45,8 @@ from functools import lru_cache
 import numpy as np
 from scipy.optimize import brentq
 from scipy.special import polygamma, psi
-from scipy.stats import chi2
 
+from .distributions import chi2_ppf
 from .processes import processes as _processes
 
 __all__ = ["SlopeClaim", "slope_claim", "DOMINANCE", "Z_SLOPE", "N_LAST", "SLOPES"]
@@ -108,7 +108,7 @@ def _edf_from_interval(ratio: float) -> float:
     a model selection asks the rule about many candidates on the same measured points)."""
     def f(lnu):
         nu = math.exp(lnu)
-        return math.log(chi2.ppf(0.975, nu) / chi2.ppf(0.025, nu)) - math.log(ratio)
+        return math.log(chi2_ppf(0.975, nu) / chi2_ppf(0.025, nu)) - math.log(ratio)
 
     if not math.isfinite(ratio) or ratio <= 1.0:
         return 1e6 if ratio <= 1.0 else 0.2
@@ -229,7 +229,7 @@ def slope_claim(tau_s, var, lo95, hi95, model_var, term_var, slope, *, name="K",
         if lo[j] > 0 and y[j] > 0:  # the point's interval at LAST_LEVEL, from the EDF of its own 95 % interval
             nu_j = _edf_from_interval(float(hi[j] / lo[j]))
             a = (1.0 - LAST_LEVEL) / 2.0
-            lo_j, hi_j = y[j] * nu_j / chi2.ppf(1.0 - a, nu_j), y[j] * nu_j / chi2.ppf(a, nu_j)
+            lo_j, hi_j = y[j] * nu_j / chi2_ppf(1.0 - a, nu_j), y[j] * nu_j / chi2_ppf(a, nu_j)
         else:
             lo_j, hi_j = lo[j], hi[j]
         if not lo_j <= mu[j] <= hi_j:

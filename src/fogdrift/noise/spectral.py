@@ -56,6 +56,7 @@ from .._util import check_count, check_series
 from ..errors import ConfigError
 from ..units import check_dt_s
 from ._spectral_null import _null_and_critical
+from .distributions import chi2_median
 
 __all__ = ["SpectralLine", "PeriodicComponent", "SpectrumSummary", "analyse_spectrum", "sinusoid_avar",
            "MIN_SAMPLES"]
@@ -416,8 +417,6 @@ def _search_level(p: np.ndarray, L: int, nu: float, r: np.ndarray, alpha: float,
     dict with fine-bin ``lo``/``hi`` (its extent, main lobe included), ``peak`` (fine bin of the maximum), ``p``
     (Sidak-corrected), ``power`` [(deg/h)^2], ``floor`` [(deg/h)^2/Hz] and ``L``.
     """
-    from scipy.stats import chi2
-
     if L == 1:
         pl = p
     else:
@@ -440,7 +439,7 @@ def _search_level(p: np.ndarray, L: int, nu: float, r: np.ndarray, alpha: float,
         if cand.size:
             pb = null.sf(ratio[cand])
             p_fw[cand] = np.where(pb < 1e-12, m * pb, -np.expm1(m * np.log1p(-np.minimum(pb, 1.0 - 1e-16))))
-    q = chi2.median(nu_l) / nu_l
+    q = chi2_median(nu_l) / nu_l
     idx = np.nonzero(ok)[0]
     band = (float((idx[0] * L + 0.5 * (L - 1)) * df), float((idx[-1] * L + 0.5 * (L - 1)) * df))  # bin centres
     sig = np.nonzero(ok & (p_fw <= alpha))[0]
