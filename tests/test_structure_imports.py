@@ -174,7 +174,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.cli.allan": (CLI, ("fogdrift.pipeline", "fogdrift.report", "fogdrift.workflows.allan")),
     "fogdrift.cli.analyze": (CLI, ("fogdrift.cli.compensate", "fogdrift.cli.noise",
         "fogdrift.evaluation.verdicts", "fogdrift.pipeline",
-        "fogdrift.report", "fogdrift.report.pdf", "fogdrift.report.summary", "fogdrift.workflows.allan",
+        "fogdrift.report", "fogdrift.report.pdf", "fogdrift.report.summary",
         "fogdrift.workflows.analyze")),
     "fogdrift.cli.batch": (CLI, ("fogdrift.fleet", "fogdrift.fleet.commands", "fogdrift.fleet.summary")),
     "fogdrift.cli.compensate": (CLI, ("fogdrift.compensate", "fogdrift.evaluation")),
