@@ -266,7 +266,7 @@ _HEADERS = {
               "Kalibr discretises at update_rate)",
     "openvins": "# fogdrift export --target openvins: noise model for OpenVINS kalibr_imu_chain.yaml "
                 "(read with cv::FileStorage)",
-    "vins-fusion": "# fogdrift export --target vins-fusion: noise model for VINS-Fusion config (IMU noise block; "
+    "vins-fusion": "# fogdrift export --target vins-fusion: noise model for VINS-Fusion config (IMU block; "
                    "cv::FileStorage)",
     "orbslam3": "# fogdrift export --target orbslam3: noise model for ORB-SLAM3 settings (IMU block; cv::FileStorage)",
     "kf-gins": "# fogdrift export --target kf-gins: noise model for KF-GINS imunoise block (merge into kf-gins.yaml)",
@@ -276,29 +276,49 @@ _HEADERS = {
                     "(README 'Step 1.1'; imu_model.IMU)",
 }
 
-#: Lines each file must carry: where its conventions come from (cited documentation) and what is not written.
+#: Lines each file must carry: where its conventions come from (cited source code or documentation) and what is
+#: written as the program's default, NOT MEASURED (issue 37: every key the program requires is written).
 _CITED = {
-    "openvins": ["# T_i_b is the identity: fogdrift does not calibrate extrinsics"],
+    "openvins": ["# OpenVINS reads continuous-time densities and discretises itself (ov_msckf Propagator: sigma^2 / dt for",
+                 "# the white noises, sigma_b^2 dt for the bias walks per IMU step)",
+                 "  # T_i_b: NOT MEASURED: identity (fogdrift does not calibrate extrinsics; Kalibr's multi-IMU pose)",
+                 '  model: "kalibr"  # VioManagerOptions / StateOptions read kalibr, calibrated or rpng']
+                + [f"  # {m}: NOT MEASURED: fogdrift does not calibrate IMU intrinsics; OpenVINS's neutral value (its own "
+                   "default in VioManagerOptions.h: an ideal IMU)" for m in ("Tw", "R_IMUtoGYRO", "Ta", "R_IMUtoACC", "Tg")],
     "vins-fusion": [
-        "# merge these keys into your VINS-Fusion config.  Its comments call them 'measurement noise standard",
-        "# deviation' and 'bias random work noise standard deviation' without saying continuous or discrete time "
-        "(questions open",
-        "# in VINS-Mono issues #102, #327); written here: the continuous-time densities, the Kalibr values; the",
-        "# per-sample (discrete) values at the update rate are in the comments.  VINS's own EuRoC config uses values",
-        "# 10-100x the EuRoC Kalibr densities (inflated by hand)."],
+        "# merge these keys into your VINS-Fusion config (parameters.cpp readParameters reads imu, imu_topic,",
+        "# acc_n, acc_w, gyr_n, gyr_w, g_norm; a missing number reads as 0 without an error).",
+        "# TIME CONVENTION: per IMU step at 100.0 Hz, as VINS-Fusion's integration code applies them",
+        "# (vins_estimator/src/factor/integration_base.h, midPointIntegration: covariance += V noise V^T, noise =",
+        "# diag(acc_n^2, gyr_n^2, acc_n^2, gyr_n^2, acc_w^2, gyr_w^2), V = 0.5 dt on each of the two averaged samples",
+        "# and dt on the bias walks): matching the continuous model per step needs",
+        "#   acc_n, gyr_n = N sqrt(2 f) = N x 14.1421;  acc_w, gyr_w = K sqrt(f) = K x 10.0",      # sqrt(200), sqrt(100)
+        "# at 100.0 Hz only: re-export with --update-rate for another IMU rate.",
+        "# g_norm: NOT MEASURED: standard gravity (CGPM 1901); put your local gravity magnitude",
+        "g_norm: 9.80665  # [m/s^2]"],
     "orbslam3": ["# ORB-SLAM3 reads continuous densities and discretises itself: noise x sqrt(IMU.Frequency), "
                  "walk / sqrt(IMU.Frequency) (Tracking: IMU::Calib(Tbc, Ng*sf, Na*sf, Ngw/sf, Naw/sf), "
-                 "sf = sqrt(freq))"],
-    "kf-gins": ["# KF-GINS models each bias as one first-order Gauss-Markov process: gbstd/abstd its 1-sigma,",
-                "# corrtime its correlation time (one value for all biases); a random walk K has no place in it",
-                "  # gsstd, asstd (scale-factor instability [ppm]): not written: a static record does not observe "
-                "scale factors; take them from the datasheet"],
+                 "sf = sqrt(freq))",
+                 "# IMU.T_b_c1 (camera 1 to IMU body): NOT MEASURED: identity (fogdrift does not calibrate extrinsics); "
+                 "put your camera-IMU calibration (Kalibr's T_cam_imu, inverted)"],
+    "kf-gins": ["# KF-GINS (src/kf_gins.cpp, loading the configuration) requires imunoise: arw, vrw, gbstd, abstd, gsstd,",
+                "# asstd (three numbers each) and corrtime; it converts arw x (pi/180)/60, vrw / 60, gbstd x (pi/180)/3600,",
+                "# abstd x 1e-5, gsstd and asstd x 1e-6, corrtime x 3600 and uses them in continuous time",
+                "# scale factor): each bias one first-order Gauss-Markov, ONE correlation time for all of them; a random",
+                "# walk K has no place in it",
+                "  # gsstd, asstd (scale-factor instability): NOT MEASURED: a static record does not observe scale factors;",
+                "  # KF-GINS's dataset/kf-gins.yaml values are written: replace them with your datasheet's",
+                "  gsstd: [300.0, 300.0, 300.0]  # [ppm] NOT MEASURED",
+                "  asstd: [300.0, 300.0, 300.0]  # [ppm] NOT MEASURED"],
     "matlab": ["% Units per the gyroparams / accelparams reference pages: NoiseDensity (rad/s)/sqrt(Hz) and "
                "(m/s^2)/sqrt(Hz), RandomWalk (rad/s)*sqrt(Hz) and (m/s^2)*sqrt(Hz), BiasInstability rad/s and m/s^2",
                "% (MathWorks Answers 1631045: RandomWalk is the rate random walk K, NoiseDensity the white density N)",
                "% BiasInstability is B (the flicker floor); BiasInstabilityCoefficients is left at its default"],
-    "gnss-ins-sim": ["# b_stability is the 1-sigma of a first-order Gauss-Markov bias with correlation time b_corr "
-                     "(gnss-ins-sim's bias_drift)",
+    "gnss-ins-sim": ["# gnss_ins_sim/sim/imu_model.py IMU(accuracy=imu_err) requires gyro_b, gyro_b_stability, gyro_arw, "
+                     "accel_b, accel_b_stability, accel_vrw (b_corr optional: infinite = white bias); pathgen.py applies "
+                     "arw and",
+                     "# vrw as continuous densities (per sample / sqrt(dt)); b_stability is the 1-sigma of a first-order "
+                     "Gauss-Markov bias with correlation time b_corr (bias_drift)",
                      "    # constant bias: not a noise term (removed by calibration); 0 = a calibrated sensor"],
 }
 
@@ -346,7 +366,7 @@ def test_every_term_comment_says_how_it_is_discretised(both, target):
 #: Per target: each "written ..." comment line (the output unit of the value under it).
 _WRITTEN = {
     "kf-gins": ["  # written per axis (gx, gy, gz) in deg/sqrt(h)", "  # written per axis (ax, ay, az) in m/s/sqrt(h)",
-                "  # written per axis: sigma in deg/h, T_c in h", "  # written per axis: sigma in mGal, T_c in h"],
+                "  # written per axis: sigma in deg/h, T_c in s", "  # written per axis: sigma in mGal, T_c in s"],
     "matlab": ["% written per axis (gx, gy, gz) in (rad/s)/sqrt(Hz)", "% written per axis (gx, gy, gz) in (rad/s)*sqrt(Hz)",
                "% written per axis (gx, gy, gz) in rad/s", "% written per axis (ax, ay, az) in (m/s^2)/sqrt(Hz)",
                "% written per axis (ax, ay, az) in (m/s^2)*sqrt(Hz)", "% written per axis (ax, ay, az) in m/s^2"],
@@ -356,7 +376,8 @@ _WRITTEN = {
 
 #: Per target: the unit in the bracket after each key (targets.py's units, from each project's documentation).
 _KEY_UNITS = {
-    "kf-gins": {"arw": "deg/sqrt(h)", "vrw": "m/s/sqrt(h)", "gbstd": "deg/h", "abstd": "mGal", "corrtime": "h"},
+    "kf-gins": {"arw": "deg/sqrt(h)", "vrw": "m/s/sqrt(h)", "gbstd": "deg/h", "abstd": "mGal", "gsstd": "ppm",
+                "asstd": "ppm", "corrtime": "h"},
     "gnss-ins-sim": {"'gyro_b'": "deg/h", "'gyro_arw'": "deg/sqrt(h)", "'gyro_b_stability'": "deg/h",
                      "'gyro_b_corr'": "s", "'accel_b'": "m/s^2", "'accel_vrw'": "m/s/sqrt(h)",
                      "'accel_b_stability'": "m/s^2", "'accel_b_corr'": "s"},
@@ -368,11 +389,12 @@ def test_per_axis_values_say_their_units(both, target):
     lines = render(target, both).splitlines()
     assert [ln for ln in lines if re.match(r"^\s*[#%] written per axis", ln)] == _WRITTEN[target]
     if target in _KEY_UNITS:
-        got = {m.group(1): m.group(2) for m in (re.match(r"^\s*('?\w+'?): .*# \[(.+)\]$", ln) for ln in lines) if m}
+        # the bracket is the first "# [" after the value; words may follow it ("continuous time", "NOT MEASURED")
+        got = {m.group(1): m.group(2) for m in (re.match(r"^\s*('?\w+'?): [^#]*# \[([^\]]+)\]", ln) for ln in lines) if m}
         assert got == _KEY_UNITS[target]
 
 
-def test_gauss_markov_comment_by_hand(both):
+def test_gauss_markov_comment_by_hand(both, tmp_path):
     # gx: B = 2 deg/h read at tau_B = 100 s: sigma = 1.0760 * 2 deg/h, T_c = 100 / 1.8926 s; at 100 Hz
     # phi = exp(-0.01 / T_c), driving sigma = sigma sqrt(1 - phi^2)
     text = render("kf-gins", both)
@@ -388,8 +410,25 @@ def test_gauss_markov_comment_by_hand(both):
     assert lo == approx(1.0760 * 1.5, rel=1e-3) and hi == approx(1.0760 * 2.5, rel=1e-3)  # deg/h
     assert p == approx(math.exp(-0.01 / t), abs=2e-9)            # the identity, on the printed T_c
     assert q == approx(sigma * math.sqrt(1 - phi * phi), rel=1e-3)
-    assert ("# corrtime: the longest gyroscope correlation time; per axis: gyro 0.0146769, 0.0146769, 0.0146769 h, "
-            "accel 0.0146769, 0.0146769, 0.0146769 h") in text        # 52.8369 s = 0.0146769 h
+    # one corrtime for all six biases: the geometric mean of equal T_c is that T_c, given in s per axis and written
+    # in h (52.8369 s = 0.0146769 h); each sigma re-matched to it is then the axis's own 1.0760 B
+    lines = text.splitlines()
+    assert ("  # corrtime: KF-GINS takes one correlation time for all six biases (and the scale factors): the geometric "
+            "mean of the axes' T_c (gyroscope 52.8369, 52.8369, 52.8369 s; accelerometer 52.8369, 52.8369, 52.8369 s), "
+            "each axis's sigma re-matched to it above") in lines
+    assert "  corrtime: 0.0146769  # [h]" in lines
+    assert ("  # gx: for the one corrtime 52.8369 s: sigma = 2.152 deg/h (its Allan variance at 1.8926 x 52.8369 s, "
+            "the peak of the axis's own Gauss-Markov, kept)") in lines
+    d = yaml.safe_load(text)["imunoise"]
+    assert d["corrtime"] == approx(tc / 3600.0, rel=1e-5)
+    assert d["gbstd"] == approx([1.0760 * 2.0, 1.0760 * 3.0, 1.0760 * 1.0], rel=1e-5)   # B = 2, 3, 1 deg/h
+    # the gyro's B read at tau_B = 200 s, the accelerometer's at 100 s: the one corrtime is the geometric mean over
+    # all six axes, sqrt(T_g T_a), of both quantities (not the gyroscope's, not the longest)
+    ctx = build_context([_gyro_result(tmp_path, name="gyro200.json", b_tau=200.0)], [_accel_result(tmp_path)])
+    text = render("kf-gins", ctx)
+    assert yaml.safe_load(text)["imunoise"]["corrtime"] == approx(math.sqrt(200.0 * 100.0) / 1.8926 / 3600.0, rel=1e-5)
+    assert ("the geometric mean of the axes' T_c (gyroscope 105.674, 105.674, 105.674 s; accelerometer 52.8369, "
+            "52.8369, 52.8369 s)") in text                                  # 200 / 1.8926, 100 / 1.8926
 
 
 def test_openvins_extrinsics_identity_and_keys_read_by_opencv(both, tmp_path):
@@ -401,6 +440,11 @@ def test_openvins_extrinsics_identity_and_keys_read_by_opencv(both, tmp_path):
     t = imu0.getNode("T_i_b")
     rows = [[t.at(i).at(j).real() for j in range(t.at(i).size())] for i in range(t.size())]
     assert rows == [[1.0 if i == j else 0.0 for j in range(4)] for i in range(4)]
+    # the IMU intrinsics OpenVINS requires, NOT MEASURED: its own ideal-IMU defaults (identity; Tg zero)
+    for name, want in (("Tw", 1.0), ("R_IMUtoGYRO", 1.0), ("Ta", 1.0), ("R_IMUtoACC", 1.0), ("Tg", 0.0)):
+        m = imu0.getNode(name)
+        got = [[m.at(i).at(j).real() for j in range(m.at(i).size())] for i in range(m.size())]
+        assert got == [[want if i == j else 0.0 for j in range(3)] for i in range(3)], name
     assert imu0.getNode("time_offset").isReal() and imu0.getNode("time_offset").real() == 0.0
     assert imu0.getNode("model").string() == "kalibr" and imu0.getNode("rostopic").string() == "/imu0"
     fs.release()
@@ -410,8 +454,17 @@ def test_matlab_file_is_comments_and_four_statements(both):
     code = [ln for ln in render("matlab", both).splitlines() if not ln.startswith("% ")]
     assert [ln.split("(")[0] for ln in code if not ln.startswith("    '")] == \
         ["gyro = gyroparams", "accel = accelparams", "imu = imuSensor"]
-    assert len(code) == 9 and all(ln.endswith(("( ...", ", ...", ");", "% (rad/s)/sqrt(Hz)", "% (rad/s)*sqrt(Hz)", "% rad/s",
-                                               "% (m/s^2)/sqrt(Hz)", "% (m/s^2)*sqrt(Hz)", "% m/s^2")) for ln in code)
+    assert len(code) == 9
+    # each statement line, its trailing "% unit" comment set aside, continues ("( ...", ", ...") or ends (");"), and
+    # that comment is one of the units of the reference pages
+    units = ("(rad/s)/sqrt(Hz)", "(rad/s)*sqrt(Hz)", "rad/s", "(m/s^2)/sqrt(Hz)", "(m/s^2)*sqrt(Hz)", "m/s^2",
+             "SampleRate [Hz]")
+    for ln in code:
+        stmt, _, comment = ln.partition("%")
+        assert stmt.rstrip().endswith(("( ...", ", ...", ");")), ln
+        assert comment == "" or comment.strip() in units, ln
+    assert code[-1] == "imu = imuSensor('accel-gyro', 'SampleRate', 100.0, 'Gyroscope', gyro, 'Accelerometer', accel);  " \
+                       "% SampleRate [Hz]"
 
 
 def _gyro_only(tmp_path):
@@ -422,47 +475,100 @@ def _accel_only(tmp_path):
     return build_context(accel=[_accel_result(tmp_path)])
 
 
-_NOT_WRITTEN = ("not written: no {w} result was given (fogdrift export --{q} RESULT.json); fogdrift never writes a "
-                "noise figure it did not measure")
+#: The comment above the keys of a quantity without a result (issue 37: written as the program's default, NOT MEASURED).
+_NOT_MEASURED = ("{keys}: NOT MEASURED: no {w} result was given (fogdrift export --{q} RESULT.json); the program requires "
+                 "them, so {src} values are written: replace them with your {w}'s")
+#: The console warning that names the missing input.
+_WARNED = "{target}: no {w} result given (--{q} FILE): {keys} written as {src} values, NOT MEASURED"
+#: What MATLAB's file says of a quantity it leaves out (imuSensor has an ideal default).
+_LEFT_OUT = "not written: no {w} result was given (fogdrift export --{q} RESULT.json); matlab then uses its own ideal default"
+
+#: Each program's default / shipped example, the values written for a quantity without a result (docs/export.md).
+_SRC = {"kalibr": "OpenVINS's default (ov_msckf/src/utils/NoiseManager.h; Kalibr has none)",
+        "openvins": "OpenVINS's own default (ov_msckf/src/utils/NoiseManager.h)",
+        "vins-fusion": "VINS-Fusion's config/euroc/euroc_mono_imu_config.yaml",
+        "orbslam3": "ORB-SLAM3's Examples/Monocular-Inertial/EuRoC.yaml",
+        "kf-gins": "KF-GINS's dataset/kf-gins.yaml",
+        "gnss-ins-sim": "gnss-ins-sim's default profile 'low-accuracy' (gnss_ins_sim/sim/imu_model.py)"}
+_GNSS_DEFAULT = {"gyro_arw": 0.75, "gyro_b_stability": 10.0, "gyro_b_corr": 100.0,           # 'low-accuracy'
+                 "accel_vrw": 0.05, "accel_b_stability": 2.0e-4, "accel_b_corr": 100.0}
 
 
 def test_gnss_ins_sim_with_one_quantity(tmp_path):
     for ctx, have, miss, w in ((_gyro_only(tmp_path), "gyro", "accel", "accelerometer"),
                                (_accel_only(tmp_path), "accel", "gyro", "gyroscope")):
         text = render("gnss-ins-sim", ctx)
-        assert text.splitlines()[0] == _HEADERS["gnss-ins-sim"]
-        keys = [f"{miss}_b", f"{miss}_{'arw' if miss == 'gyro' else 'vrw'}", f"{miss}_b_stability", f"{miss}_b_corr"]
-        assert f"    # {', '.join(keys)}: " + _NOT_WRITTEN.format(w=w, q=miss) in text.splitlines()
+        lines = text.splitlines()
+        assert lines[0] == _HEADERS["gnss-ins-sim"]
+        keys = [f"{miss}_{'arw' if miss == 'gyro' else 'vrw'}", f"{miss}_b_stability", f"{miss}_b_corr"]
+        src = _SRC["gnss-ins-sim"]
+        assert lines.count("    # " + _NOT_MEASURED.format(keys=", ".join(keys), w=w, q=miss, src=src)) == 1
+        units = ("deg/sqrt(h)", "deg/h", "s") if miss == "gyro" else ("m/s/sqrt(h)", "m/s^2", "s")
+        for k, u in zip(keys, units):                           # each written once, its unit, said NOT MEASURED
+            assert sum(1 for ln in lines if ln.startswith(f"    '{k}': ")) == 1
+            assert [ln for ln in lines if ln.startswith(f"    '{k}': ")][0].endswith(f"  # [{u}] NOT MEASURED"), k
+        assert _WARNED.format(target="gnss-ins-sim", w=w, q=miss, keys=", ".join(keys), src=src) in ctx.notes
         ns = {}
         exec(text, ns)  # noqa: S102 - our own generated file
-        err = ns["imu_err"]
-        assert sorted(err) == sorted([f"{have}_b", f"{have}_{'arw' if have == 'gyro' else 'vrw'}",
-                                      f"{have}_b_stability", f"{have}_b_corr"])
+        err = ns["imu_err"]                                     # every key IMU() requires, three values each
+        assert sorted(err) == sorted(f"{q}_{k}" for q in ("gyro", "accel")
+                                     for k in ("b", "arw" if q == "gyro" else "vrw", "b_stability", "b_corr"))
+        assert all(len(v) == 3 for v in err.values())
+        for k in keys:
+            assert list(err[k]) == approx([_GNSS_DEFAULT[k]] * 3, rel=1e-12), k
+        assert list(err[f"{miss}_b"]) == [0.0, 0.0, 0.0]        # a calibrated constant bias, as for a measured one
         assert list(err[f"{have}_b_corr"]) == approx([100 / 1.8926] * 3, rel=1e-4)
+        assert not any("NOT MEASURED" in ln for ln in lines if ln.startswith(f"    '{have}_"))
 
 
 def test_kfgins_and_matlab_with_one_quantity(tmp_path):
     g = _gyro_only(tmp_path)
     kf = render("kf-gins", g).splitlines()
     assert kf[0] == _HEADERS["kf-gins"]
-    assert yaml.safe_load("\n".join(kf))["imunoise"]["arw"] == approx([0.15, 0.20, 0.10], rel=1e-5)
-    assert "  # vrw: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in kf
-    assert "  # abstd: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in kf
+    d = yaml.safe_load("\n".join(kf))["imunoise"]
+    assert d["arw"] == approx([0.15, 0.20, 0.10], rel=1e-5)
+    src = _SRC["kf-gins"]
+    for key, val, unit in (("vrw", 0.03, "m/s/sqrt(h)"), ("abstd", 15.0, "mGal")):   # KF-GINS's example values
+        assert "  # " + _NOT_MEASURED.format(keys=key, w="accelerometer", q="accel", src=src) in kf
+        assert f"  {key}: [{val}, {val}, {val}]  # [{unit}] NOT MEASURED" in kf
+        assert d[key] == [val] * 3
+        assert _WARNED.format(target="kf-gins", w="accelerometer", q="accel", keys=key, src=src) in g.notes
     m = render("matlab", g).splitlines()
     assert m[0] == _HEADERS["matlab"]
-    assert "% accelparams: " + _NOT_WRITTEN.format(w="accelerometer", q="accel") in m
-    assert m[-1] == "imu = imuSensor('accel-gyro', 'SampleRate', 100.0, 'Gyroscope', gyro);"
+    assert "% accelparams: " + _LEFT_OUT.format(w="accelerometer", q="accel") in m
+    assert not any(ln.startswith("accel = ") for ln in m)
+    assert m[-1] == "imu = imuSensor('accel-gyro', 'SampleRate', 100.0, 'Gyroscope', gyro);  % SampleRate [Hz]"
+    assert "matlab: no accelerometer result given (--accel FILE): its accelerometer is left at the program's ideal " \
+           "default" in g.notes
     a = _accel_only(tmp_path)
     m = render("matlab", a).splitlines()
-    assert "% gyroparams: " + _NOT_WRITTEN.format(w="gyroscope", q="gyro") in m
-    assert m[-1] == "imu = imuSensor('accel-gyro', 'SampleRate', 100.0, 'Accelerometer', accel);"
+    assert "% gyroparams: " + _LEFT_OUT.format(w="gyroscope", q="gyro") in m
+    assert not any(ln.startswith("gyro = ") for ln in m)
+    assert m[-1] == "imu = imuSensor('accel-gyro', 'SampleRate', 100.0, 'Accelerometer', accel);  % SampleRate [Hz]"
     kf = render("kf-gins", a).splitlines()
-    assert "  # arw: " + _NOT_WRITTEN.format(w="gyroscope", q="gyro") in kf
-    assert "  # corrtime: the longest accelerometer correlation time; per axis: accel 0.0146769, 0.0146769, " \
-           "0.0146769 h" in kf
-    assert any("no gyroscope result given (--gyro FILE): the gyroscope fields of every target are left out "
-               "(each file says which)" == n for n in a.notes)
-    assert "kf-gins: gsstd, asstd not written (scale factors are not observable in a static record)" in a.notes
+    d = yaml.safe_load("\n".join(kf))["imunoise"]
+    for key, val, unit in (("arw", 0.003, "deg/sqrt(h)"), ("gbstd", 0.027, "deg/h")):
+        assert "  # " + _NOT_MEASURED.format(keys=key, w="gyroscope", q="gyro", src=src) in kf
+        assert f"  {key}: [{val}, {val}, {val}]  # [{unit}] NOT MEASURED" in kf
+        assert d[key] == [val] * 3
+        assert _WARNED.format(target="kf-gins", w="gyroscope", q="gyro", keys=key, src=src) in a.notes
+    # the one corrtime from the accelerometer's axes alone (52.8369 s = 0.0146769 h), not KF-GINS's example 4 h
+    assert ("  # corrtime: KF-GINS takes one correlation time for all six biases (and the scale factors): the geometric "
+            "mean of the axes' T_c (accelerometer 52.8369, 52.8369, 52.8369 s), each axis's sigma re-matched to it "
+            "above") in kf
+    assert d["corrtime"] == approx(100.0 / 1.8926 / 3600.0, rel=1e-5)
+    assert d["gsstd"] == d["asstd"] == [300.0] * 3
+    assert "matlab: no gyroscope result given (--gyro FILE): its gyroscope is left at the program's ideal default" \
+        in a.notes
+    assert ("kf-gins: gsstd, asstd NOT MEASURED (scale factors are not observable in a static record): KF-GINS's "
+            "example 300 ppm written") in a.notes
+
+
+#: The defaults written for a missing accelerometer, per target (key -> value), from the sources in _SRC.
+_ACC_DEFAULT = {"kalibr": {"accelerometer_noise_density": 2.0e-3, "accelerometer_random_walk": 3.0e-3},
+                "openvins": {"accelerometer_noise_density": 2.0e-3, "accelerometer_random_walk": 3.0e-3},
+                "vins-fusion": {"acc_n": 0.1, "acc_w": 0.001},
+                "orbslam3": {"IMU.NoiseAcc": 2.0e-3, "IMU.AccWalk": 3.0e-3}}
 
 
 @pytest.mark.parametrize("target, keys", [
@@ -470,11 +576,24 @@ def test_kfgins_and_matlab_with_one_quantity(tmp_path):
     ("openvins", "accelerometer_noise_density, accelerometer_random_walk"),
     ("vins-fusion", "acc_n, acc_w"), ("orbslam3", "IMU.NoiseAcc, IMU.AccWalk")])
 def test_kalibr_family_with_the_gyro_only(tmp_path, target, keys):
-    text = render(target, _gyro_only(tmp_path))
+    ctx = _gyro_only(tmp_path)
+    text = render(target, ctx)
     ind = "  " if target == "openvins" else ""
-    assert text.splitlines().count(f"{ind}# {keys}: " + _NOT_WRITTEN.format(w="accelerometer", q="accel")) == 1
-    body = [ln for ln in text.splitlines() if not ln.lstrip().startswith("#") and ":" in ln]
-    assert not any(k in ln for ln in body for k in keys.split(", "))
+    lines = text.splitlines()
+    src = _SRC[target]
+    # one NOT MEASURED comment for the quantity (not one per key), then each key once with the program's default
+    assert lines.count(f"{ind}# " + _NOT_MEASURED.format(keys=keys, w="accelerometer", q="accel", src=src)) == 1
+    assert sum(1 for ln in lines if "NOT MEASURED: no accelerometer result" in ln) == 1
+    for k in keys.split(", "):
+        body = [ln for ln in lines if ln.startswith(f"{ind}{k}: ")]
+        assert len(body) == 1, (k, body)
+        m = re.match(rf"^{re.escape(ind + k)}: (\S+)  # \[[^\]]+\] NOT MEASURED \(", body[0])
+        assert m, body[0]
+        assert float(m.group(1)) == approx(_ACC_DEFAULT[target][k], rel=1e-12), k
+    assert _WARNED.format(target=target, w="accelerometer", q="accel", keys=keys, src=src) in ctx.notes
+    # the gyroscope's keys are measured values, not defaults
+    gyro_keys = [ln for ln in lines if re.match(r"^\s*(gyr|IMU\.(NoiseGyro|GyroWalk))", ln)]
+    assert len(gyro_keys) == 2 and not any("NOT MEASURED" in ln for ln in gyro_keys)
 
 
 def test_every_axis_of_a_per_axis_value_is_described(both):
@@ -510,8 +629,20 @@ def test_gm_comment_gives_the_intervals_it_has(tmp_path):
     assert sig[1].startswith(f"#   sigma = {2.0 * DPH:.6g} rad/s, T_c = 40.0 s; discrete at 100.0 Hz: ")
     assert sig[2].startswith(f"#   sigma = {1.0 * DPH:.6g} rad/s (95 % [0.5, 2.0] deg/h), T_c = 60.0 s; ")
     d = yaml.safe_load("\n".join(text))["imunoise"]
-    assert d["gbstd"] == approx([4.0, 2.0, 1.0], rel=1e-5)
-    assert d["corrtime"] == approx(100.0 / 3600.0, rel=1e-5)
+    # KF-GINS's one corrtime: the geometric mean of 100, 40 and 60 s (not the longest, not the first axis's); each
+    # sigma re-matched so that the axis's Allan variance at its own peak tau = 1.8926 T_c is kept
+    tc = (100.0 * 40.0 * 60.0) ** (1.0 / 3.0)                   # 62.1447 s
+    assert d["corrtime"] == approx(tc / 3600.0, rel=1e-5)
+
+    def gm_avar(tau, t):  # Allan variance of a unit first-order Gauss-Markov of correlation time t (IEEE 952)
+        return 2.0 * t / tau * (1.0 - t / (2.0 * tau) * (3.0 - 4.0 * math.exp(-tau / t) + math.exp(-2.0 * tau / t)))
+
+    want = [s * math.sqrt(gm_avar(1.8926 * t, t) / gm_avar(1.8926 * t, tc)) for s, t in ((4.0, 100.0), (2.0, 40.0),
+                                                                                       (1.0, 60.0))]
+    assert d["gbstd"] == approx(want, rel=1e-5)                 # 4.15325, 2.06227, 1.0002 deg/h
+    assert f"  # corrtime: KF-GINS takes one correlation time for all six biases (and the scale factors): the " \
+           "geometric mean of the axes' T_c (gyroscope 100.0, 40.0, 60.0 s), each axis's sigma re-matched to it " \
+           "above" in text
 
 
 _TERM_KEYS = {"name", "value", "lo95", "hi95", "unit", "status", "reason", "si", "si_lo95", "si_hi95", "si_unit",
