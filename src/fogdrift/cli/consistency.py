@@ -154,7 +154,7 @@ def consistency(
     """Will these noise numbers work in my filter?  Coverage of the predicted angle error on held-out static logs
     (full model, white + random walk, white + the random walk that covers the bias wander), and the smallest
     variance inflation that gives nominal coverage; writes consistency.json."""
-    with run("consistency", out, default_out=DEFAULT_OUT, inputs=[load.file, *(held_out or [])],
+    with run("consistency", out, default_out=DEFAULT_OUT, inputs=[load.file, *(held_out or []), components],
              json_out=json_out, expect=("consistency.json",)) as r:
         from ..evaluation.consistency import summary_cell, verdict_line
         from ..workflows.consistency import run_consistency, write_consistency
