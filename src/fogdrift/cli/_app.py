@@ -83,7 +83,7 @@ FLAGS = {
     "curve": "--curve", "sensor": "--sensor", "robust": "--robust", "train_fraction": "--train-fraction",
     "val_fraction": "--val-fraction", "causal_window_s": "--causal-window", "gm_window": "--gm-window",
     "fit_tau_s": "--fit-taus", "format": "--format", "horizons": "--horizons", "calibration": "--calibration",
-    "origin_step": "--origin-step", "spec": "--spec",
+    "origin_step": "--origin-step", "spec": "--spec", "segments": "--segments",
     "target": "--target", "length": "--length", "monte_carlo": "--monte-carlo", "workers": "--workers", "axis": "--axis",
 }
 
