@@ -19,6 +19,7 @@ from typing import Annotated, List, Optional
 
 import typer
 
+from .. import documents
 from .._util import fmt_number
 from ..errors import ConfigError
 from ..io import file_sha256
@@ -62,9 +63,11 @@ def _read_components(path: Path) -> dict:
     from ..models.statespace import check_components
 
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        data = documents.read(path, yaml=False)
     except FileNotFoundError:
         raise ConfigError(f"--components: no such file {path}") from None
+    except documents.DocumentError as exc:
+        raise ConfigError(f"--components: {exc}") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ConfigError(f"--components: {path} is no JSON file ({exc})") from None
     if isinstance(data, dict) and isinstance(data.get("channels"), list):  # a 'fogdrift export --target json' file

@@ -115,7 +115,7 @@ class BatchOutputDir(OutputDir):
             try:
                 fresh = man.stat().st_mtime >= self._t0 - 1.0
                 same = fresh and json.loads(man.read_text()).get("settings_sha256") == t.settings_sha256
-            except (OSError, ValueError, AttributeError):
+            except (OSError, ValueError, AttributeError, RecursionError):
                 same = False
             if same:
                 done.append(t.rel_out)
