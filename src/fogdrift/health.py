@@ -35,8 +35,15 @@ Rules (each a tuple ``(rule, axes, message, likely_units)``; settings as ``{opt:
     or a time in ms (a 1 kHz log read as 1 Hz); steps of 10 s and more are the plausibility ``sample-rate``
     rule's.
 
-The rules warn; they never change the data.  Measured false alarms on clean simulated logs:
-``tests/test_health.py``.
+The rules warn; they never change the data (but ``--segments auto`` fits around a frozen stretch:
+:func:`fogdrift.segments.plan_segments`).
+
+Measured false alarms: 0 findings on 520 clean simulated logs (white noise; white + random walk + bias
+instability; quantised counts with many repeats; triads whose axes' noise differ up to 10x, with the Earth rate;
+``tests/test_health.py`` keeps 120 of them), and none on 12 of the 13 real logs in the shared data (ADIS16405 gyros
+and accelerometers, MTi-G, the PSINS RLG).  The 13th, the ROMY ring laser sampled at 1 Hz with whole-second
+stamps from 0, gets the ``time-step`` note: a genuine 1 Hz log with integer stamps cannot be told from a sample
+index or from ms read as s, so the note says that such a log needs nothing.
 """
 
 from __future__ import annotations
