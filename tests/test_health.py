@@ -205,3 +205,17 @@ def _clean(seed):
 def test_clean_logs_get_no_health_finding():
     hits = [(seed, rules(_clean(seed))) for seed in range(120)]
     assert [h for h in hits if h[1]] == []
+
+
+def test_a_time_column_in_microseconds_read_as_s_is_named(tmp_path):
+    from fogdrift.errors import render_options
+
+    x = _gyro(n=5000, dt=0.001) / 3600
+    rec = load(_csv(tmp_path / "us.csv", np.arange(x.size) * 1000.0, x, "t_s,gz[deg/s]"))  # 1 kHz, t in us
+    found = [f for f in check_record(rec) if f.rule == "sample-rate"]
+    assert len(found) == 1
+    text = render_options(found[0].message, FLAGS)
+    assert "a time column in us read as s gives a 10^6 times longer step (1000 Hz read as 0.001 Hz)" in text
+    ms = load(_csv(tmp_path / "ms.csv", np.arange(x.size) * 10.0, x, "t_s,gz[deg/s]"))  # 100 Hz, t in ms
+    assert "in ms read as s gives a 1000 times longer step" in [f.message for f in check_record(ms)
+                                                                if f.rule == "sample-rate"][0]

@@ -352,9 +352,17 @@ def _rate_findings(record) -> list[Finding]:
         findings.append(Finding(
             "sample-rate", (),
             f"sample rate {fs:.4g} Hz (interval {record.dt_s:.4g} s) is unusually {'low' if slow else 'high'} for a "
-            f"gyro log; check {{opt:time_unit}} ({'a time column in ms read as s gives a 1000 times longer step' if slow else 'a time column in s read as ms gives a 1000 times shorter step'}) "
+            f"gyro log; check {{opt:time_unit}} ({_slow_words(record.dt_s) if slow else 'a time column in s read as ms gives a 1000 times shorter step'}) "
             "and {opt:rate_hz}"))
     return findings
+
+
+def _slow_words(dt_s: float) -> str:
+    """What a long step suggests: ms read as s (1000x), or us read as s (10^6x) for a step of 500 s and more."""
+    if dt_s >= 500.0:
+        return (f"a time column in us read as s gives a 10^6 times longer step ({1e6 / dt_s:.4g} Hz read as "
+                f"{1 / dt_s:.4g} Hz); in ms, 1000 times")
+    return "a time column in ms read as s gives a 1000 times longer step"
 
 
 #: Relative tolerance of "the mean vector of a static accelerometer triad is 1 g".
