@@ -84,8 +84,9 @@ def test_a_rate_clipped_at_its_range_limit_is_said(side):
 
 
 def test_a_quantised_gaussian_has_fewer_samples_at_its_extremes_than_next_to_them():
-    x = np.round(np.random.default_rng(4).normal(0.0, 1.5, 200_000))
-    assert np.count_nonzero(x == x.max()) >= 1
+    x = np.round(np.random.default_rng(4).normal(0.0, 0.5, 200_000))  # levels -2..2: +-2 hold about 0.13 % each
+    for v in (x.max(), x.min()):  # enough to count as a pile by number and fraction: only the pile rule decides
+        assert np.count_nonzero(x == v) >= max(20, 1e-3 * x.size)
     assert rules(from_array(x, dt_s=0.01, unit="deg/h")) == []
 
 
