@@ -140,9 +140,15 @@ def test_inputs_and_paths_outside_are_never_removed(tmp_path):
     doc = json.loads((folder / MANIFEST).read_text())
     doc["files"] += ["../keep.txt", str(outside), "", 7]  # a tampered manifest
     (folder / MANIFEST).write_text(json.dumps(doc))
-    _run(folder, ["y.json"], protect=[folder / "separation.csv"])  # separation.csv is this run's input
+    # separation.csv is this run's input and a file of the previous run, which a run there replaces: refused at
+    # the start, before any work, nothing touched (issue 36)
+    with pytest.raises(ConfigError, match=r"holds the files of an earlier 'fogdrift test' run, which this run "
+                                          r"would replace, and separation.csv among them is an input of this run"):
+        _run(folder, ["y.json"], protect=[folder / "separation.csv"])
+    assert listing(folder) == sorted([MANIFEST, "separation.csv", "x.json"])
+    _run(folder, ["y.json"])
     assert outside.read_text() == "keep"
-    assert listing(folder) == sorted([MANIFEST, "separation.csv", "y.json"])
+    assert listing(folder) == sorted([MANIFEST, "y.json"])
 
 
 def test_nothing_is_touched_before_the_first_write(tmp_path):

@@ -49,7 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from . import __version__, documents
 from ._util import safe_name, strict_json
 from .allan import allan_variance
 from .errors import ConfigError, FogdriftError, ModelFileError
@@ -423,7 +423,9 @@ def load_bundle(path) -> Bundle:
     root = p.parent if p.name == MANIFEST else p
     mpath = root / MANIFEST
     try:
-        raw = json.loads(mpath.read_text())
+        raw = documents.read(mpath, yaml=False)
+    except documents.DocumentError as exc:
+        raise ModelFileError(str(exc)) from None
     except (FileNotFoundError, NotADirectoryError):
         raise ModelFileError(f"{mpath}: bundle manifest not found; expected the directory written by "
                              "'fogdrift analyze' or 'fogdrift model' (OUT/bundle)") from None

@@ -7,17 +7,26 @@
   name holds a complete file or nothing.
 * :class:`OutputDir` is one run's output folder.  Inside ``with OutputDir(...)``, every :func:`atomic_path`
   under it is recorded in a manifest (:data:`MANIFEST`, JSON, rewritten after each file).  At the run's first
-  write, the files the previous run's manifest lists are removed (and the folders it created, when empty):
-  the folder then holds the files of one run only, listed in its manifest with ``"complete": true`` once the
-  run finished.  Files fogdrift did not write (not in a manifest) are never touched; nor are the run's inputs.
-  Leftover temporary files of a process that no longer runs (in the folder and the subfolders the previous run
-  created) are removed at the first write too.
+  previous run's files are replaced only once this run is complete: a file of the previous run that this run
+  writes again is first moved aside (into the folder :data:`BACKUP_PREFIX` + process id), and when the run ends
+  without error the previous run's other files (and the folders it created, when empty) and the moved ones are removed:
+  the folder then holds the files of one run only, listed in its manifest with ``"complete": true``.  A run
+  that fails or is interrupted puts the previous run's files back and takes its own away (the folder is as it
+  was before the run; a run killed outright is taken back by the next run there, :func:`recover`).  Leftover
+  temporary files of a process that no longer runs are removed at the first write.
 
-An interrupted run (see :mod:`fogdrift.interrupt`) leaves only complete files; :meth:`OutputDir.summary` says
-which were written and which were not.
+Inputs are sacred (checked when the run starts, before any work; :meth:`OutputDir.__enter__`): a run whose
+previous-run files (which it replaces) include one of its inputs (``protect``: files or folders, e.g. a bundle
+folder) is refused; so is an output that would replace an input, or a file fogdrift did not write (one not
+listed in the folder's manifest, e.g. a user's own ``allan.json``) -- the expected names at the start, every
+other name at its write.
+
+An interrupted run into a new folder leaves only complete files; :meth:`OutputDir.summary` says which were
+written and which were not.
 
 One run per folder at a time: :class:`OutputDir` holds an exclusive ``flock`` on :data:`LOCK` in the folder from
-its start (or from its first write, when the folder does not exist yet) to its end; a second run is refused with
+its start (a folder that does not exist yet is created then, and removed again if the run wrote nothing) to its
+end; a second run, also one started into the same new folder at the same moment, is refused with
 one line naming the first (its command, process id and start).  The kernel drops the lock when a process ends,
 so a crashed run never leaves the folder locked.  An output that would replace one of the run's inputs is
 refused.
@@ -26,10 +35,12 @@ refused.
 from __future__ import annotations
 
 import contextlib
+import glob as _glob
 import errno
 import json
 import os
 import re
+import shutil
 import tempfile
 import threading
 import time
@@ -46,8 +57,8 @@ try:  # POSIX; elsewhere runs are not serialised (said in the docstring of _Fold
 except ImportError:  # pragma: no cover - not on the supported platforms
     fcntl = None
 
-__all__ = ["MANIFEST", "LOCK", "TMP_PREFIX", "OutputDir", "atomic_path", "check_out_dir", "active",
-           "remove_stale_temporaries"]
+__all__ = ["MANIFEST", "LOCK", "TMP_PREFIX", "BACKUP_PREFIX", "OutputDir", "atomic_path", "check_out_dir",
+           "active", "remove_stale_temporaries", "recover"]
 
 #: Name of the manifest a run keeps in its output folder.
 MANIFEST = ".fogdrift-manifest.json"
@@ -56,6 +67,8 @@ LOCK = ".fogdrift-lock"
 #: Prefix of the temporary files (followed by the process id, a dash and the final name).
 TMP_PREFIX = ".fogdrift-tmp-"
 _TMP = re.compile(re.escape(TMP_PREFIX) + r"(\d+)-")
+#: Folder (followed by the process id) where a run keeps the previous run's files it rewrites until it is complete.
+BACKUP_PREFIX = ".fogdrift-previous-"
 
 _active: list["OutputDir"] = []
 
@@ -301,35 +314,163 @@ class _FolderLock:
         self.fd = None
 
 
+def _inside(folder: Path, rel) -> Path | None:
+    """``rel`` as a path inside ``folder``, or None if it is absolute or leaves it (a tampered manifest)."""
+    if not isinstance(rel, str) or not rel or Path(rel).is_absolute():
+        return None
+    target = (folder / rel).absolute()
+    try:
+        target.resolve().relative_to(folder.resolve())
+    except (ValueError, OSError):
+        return None
+    return target
+
+
+def _read_doc(folder: Path) -> dict:
+    try:
+        doc = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return {}
+    return doc if isinstance(doc, dict) and doc.get("fogdrift_manifest") == 1 else {}
+
+
+def _write_doc(folder: Path, doc: dict) -> None:
+    target = folder / MANIFEST
+    tmp = target.with_name(f"{TMP_PREFIX}{os.getpid()}-{MANIFEST}")
+    try:
+        tmp.write_text(strict_json(doc, indent=1), encoding="utf-8")
+        os.replace(tmp, target)
+    except BaseException:  # disk full: no 0-byte temporary manifest left behind
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def _strings(items) -> list[str]:
+    return [r for r in (items if isinstance(items, list) else []) if isinstance(r, str)]
+
+
+def _remove_empty_dirs(folder: Path, rels) -> None:
+    for rel in sorted(_strings(rels), key=lambda r: r.count("/"), reverse=True):
+        target = _inside(folder, rel)
+        if target is not None and target.is_dir() and not target.is_symlink() and not any(target.iterdir()):
+            with contextlib.suppress(OSError):
+                target.rmdir()
+
+
+def _take_back(folder: Path, files, dirs, previous: dict, backup) -> None:
+    """Undo an unfinished run in ``folder``: remove its ``files``, put the previous run's files moved aside
+    into ``backup`` back, remove the folders it created (``dirs``, when empty), restore the previous manifest."""
+    for rel in _strings(files):
+        target = _inside(folder, rel)
+        if target is not None and target.is_file() and not target.is_symlink():
+            with contextlib.suppress(OSError):
+                target.unlink()
+    kept = set(_strings(previous.get("files")))
+    b = folder / backup if isinstance(backup, str) and backup.startswith(BACKUP_PREFIX) and "/" not in backup \
+        else None
+    if b is not None and b.is_dir() and not b.is_symlink():
+        for moved in sorted(b.rglob("*")):
+            rel = moved.relative_to(b).as_posix()
+            target = _inside(folder, rel)
+            if rel in kept and target is not None and moved.is_file() and not moved.is_symlink():
+                with contextlib.suppress(OSError):
+                    target.parent.mkdir(parents=True, exist_ok=True)
+                    os.replace(moved, target)
+        shutil.rmtree(b, ignore_errors=True)
+    _remove_empty_dirs(folder, dirs)
+    with contextlib.suppress(OSError):
+        if previous:
+            _write_doc(folder, previous)
+        else:
+            (folder / MANIFEST).unlink()
+
+
+def _drop_previous(folder: Path, previous: dict, keep, backup, is_input=lambda p: False) -> None:
+    """A run is complete: remove the previous run's files it did not write again (``keep``: the ones it wrote),
+    the previous files it moved aside into ``backup``, and the previous run's folders that are now empty."""
+    keep = set(keep)
+    for rel in _strings(previous.get("files")):
+        target = _inside(folder, rel)
+        if rel in keep or target is None or is_input(target) or not target.is_file() or target.is_symlink():
+            continue
+        with contextlib.suppress(OSError):
+            target.unlink()
+    if isinstance(backup, str) and backup.startswith(BACKUP_PREFIX) and "/" not in backup:
+        shutil.rmtree(folder / backup, ignore_errors=True)
+    _remove_empty_dirs(folder, previous.get("dirs"))
+
+
+def recover(folder, killed=()) -> bool:
+    """Finish what a run killed outright (SIGKILL, power loss) left in ``folder``; return True if there was any.
+
+    Its manifest says: a run that had not finished gets taken back (its files removed, the previous run's files
+    it had moved aside put back, the previous manifest restored); a run that had finished but not yet removed the
+    previous run's files gets them removed.  Only when that run's process no longer runs (or is in ``killed``);
+    call it holding the folder's lock (:class:`OutputDir` does, at its start)."""
+    folder = Path(folder)
+    doc = _read_doc(folder)
+    previous = doc.get("previous")
+    if not isinstance(previous, dict):
+        return False
+    pid = doc.get("pid")
+    if not isinstance(pid, int) or (pid not in set(killed) and _pid_alive(pid)):
+        return False
+    if doc.get("complete") is True:
+        _drop_previous(folder, previous, _strings(doc.get("files")), doc.get("backup"))
+        _write_doc(folder, {k: v for k, v in doc.items() if k not in ("previous", "pid", "backup")})
+    else:
+        _take_back(folder, doc.get("files"), doc.get("dirs"), previous, doc.get("backup"))
+    return True
+
+
+def _expand(paths) -> list[Path]:
+    """The inputs as absolute paths; a wildcard that names no file as it is (``batch 'logs/*.csv'``) becomes
+    the files it matches."""
+    out = []
+    for p in paths:
+        if p is None:
+            continue
+        q = Path(p).expanduser()
+        if not q.exists() and any(c in str(p) for c in "*?["):
+            out += [Path(m).absolute() for m in sorted(_glob.glob(str(q), recursive=True))]
+        out.append(q.absolute())
+    return out
+
+
 class OutputDir:
     """One run's output folder (see the module docstring).
 
     Parameters
     ----------
     path : str or Path
-        The folder; validated at once by :func:`check_out_dir`, created at the first write.
+        The folder; validated at once by :func:`check_out_dir`, created (and locked) at :meth:`__enter__`.
     command : str
         What wrote it (stored in the manifest).
     create_parents : bool
         Create missing parent folders (the CLI allows it only for its default ``out/<command>``).
     protect : sequence of paths
-        Files never removed as stale (the run's inputs).
+        The run's inputs: files, folders (every file in them; a bundle) or wildcards.  Never removed nor
+        replaced: a run whose previous-run files include one is refused at its start.
 
     Attributes
     ----------
     written : list of str
         Files written so far by this run, relative to the folder, in order.
     removed : list of str
-        Files of the previous run removed at this run's first write.
+        Files of the previous run this run replaces (removed or overwritten once it is complete).
+    taken_back : list of str
+        Files this run had written and took back because it did not finish (the previous run's are kept).
     """
 
     def __init__(self, path, *, command: str, create_parents: bool = False, protect=()):
         self.path = check_out_dir(path, create_parents=create_parents)
         self.command = command
         self.create_parents = create_parents
-        self.protect = {Path(p).absolute() for p in protect}
+        self.protect = _expand(protect)
         self.written: list[str] = []
         self.removed: list[str] = []
+        self.taken_back: list[str] = []
         self.expected: list[str] = []
         self.complete = False
         self._created_dirs: list[str] = []
@@ -337,14 +478,44 @@ class OutputDir:
         self._opened = False
         self._lock = threading.RLock()
         self._aborted = False
+        self._ended = False
+        self._made: list[Path] = []
+        self._previous: dict = {}
+        self._prev_files: list[str] = []
+        self._backup = f"{BACKUP_PREFIX}{os.getpid()}"
         self._started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
         self._folder_lock = _FolderLock(self.path, f"'fogdrift {command}' (process {os.getpid()}, started "
                                                    f"{self._started})")
 
     # -- context ------------------------------------------------------------------------------------
     def __enter__(self):
-        if self.path.is_dir():  # an existing folder is taken before any work; a new one at its creation
+        """Create the folder if needed and lock it; take back a killed run; refuse, before any work, a run that
+        would remove or replace one of its inputs or a file fogdrift did not write."""
+        try:
+            self._make_folder()
             self._folder_lock.acquire()
+            recover(self.path)
+            self._previous = {k: v for k, v in _read_doc(self.path).items() if k not in ("previous", "pid", "backup")}
+            self._prev_files = []
+            for rel in _strings(self._previous.get("files")):
+                target = _inside(self.path, rel)
+                if target is not None and target.is_file() and not target.is_symlink():
+                    self._prev_files.append(rel)
+            for rel in self._prev_files:
+                inp = self._input_of(self.path / rel)
+                if inp is not None:
+                    was = self._previous.get("command")
+                    raise ConfigError(
+                        f"{{opt:out}} {self.path} holds the files of an earlier "
+                        f"{repr('fogdrift ' + was) if isinstance(was, str) else 'fogdrift'} run, which this run would "
+                        f"replace, and {rel} among them is an input of this run ({inp}); choose another output "
+                        "folder")
+            for rel in self.expected:
+                self._check_target(self.path / rel, rel)
+        except BaseException:
+            self._folder_lock.release()
+            self._unmake_folder()
+            raise
         _active.append(self)
         return self
 
@@ -357,11 +528,17 @@ class OutputDir:
                         self._write_manifest()
                     except OSError as err:
                         self.complete = False
+                        self._end()
                         raise _write_error(self.path, MANIFEST, err, self.summary()) from err
+                    self._end()
+            else:
+                self._end()
         finally:
             self._discard_pending()
             _active.remove(self)
             self._folder_lock.release()
+            if not self._opened:
+                self._unmake_folder()
         if exc is not None and not check_requested():
             if _out_of_memory(exc):
                 inputs = ", ".join(sorted(str(p) for p in self.protect)) or "its input"
@@ -373,9 +550,53 @@ class OutputDir:
                                    self.summary()) from exc
         return False
 
+    def _end(self) -> None:
+        """Complete: remove the previous run's files this run did not write again.  Not complete: take this
+        run's files back when a previous run's are there (the folder stays as it was)."""
+        with self._lock:
+            if self._ended or not self._opened:
+                return
+            self._ended = True
+            if not self._prev_files:
+                return
+            if self.complete:
+                _drop_previous(self.path, self._previous, self.written, self._backup,
+                               lambda t: self._input_of(t) is not None)
+                with contextlib.suppress(OSError):
+                    self._write_manifest()
+            else:
+                _take_back(self.path, self.written, self._created_dirs, self._previous, self._backup)
+                self.taken_back, self.written, self.removed = list(self.written), [], []
+
     def expect(self, *names) -> None:
         """Declare files the run means to write (relative names), for :meth:`summary`."""
         self.expected.extend(str(n) for n in names)
+
+    # -- inputs -------------------------------------------------------------------------------------
+    def _input_of(self, target: Path) -> Path | None:
+        """The input ``target`` is (or lies in, for an input folder that is not above this folder), else None."""
+        t = Path(target).absolute()
+        for p in self.protect:
+            if t == p:
+                return p
+            with contextlib.suppress(OSError):
+                if t.exists() and p.exists() and t.samefile(p):
+                    return p
+                if p.is_dir():
+                    rp, out = p.resolve(), self.path.resolve()
+                    if rp != out and rp not in out.parents and rp in t.resolve().parents:
+                        return p
+        return None
+
+    def _check_target(self, final: Path, rel: str) -> None:
+        """Refuse an output that would replace an input, or a file fogdrift did not write."""
+        if self._input_of(final) is not None:
+            raise ConfigError(f"{{opt:out}} {self.path}: the output {rel} would replace the input file {final}; "
+                              "choose another output folder")
+        if rel not in self.written and rel not in self._prev_files and (final.is_symlink() or final.is_file()):
+            raise ConfigError(f"{{opt:out}} {self.path}: the output {rel} would replace {final}, a file fogdrift "
+                              f"did not write (not listed in the folder's {MANIFEST}); move it away or choose "
+                              "another output folder")
 
     # -- writing ------------------------------------------------------------------------------------
     def _rel(self, path) -> str:
@@ -387,10 +608,7 @@ class OutputDir:
         check()
         final = Path(path) if Path(path).is_absolute() else self.path / path
         rel = self._rel(final)
-        if final.absolute() in self.protect or any(final.exists() and p.exists() and final.samefile(p)
-                                                   for p in self.protect):
-            raise ConfigError(f"{{opt:out}} {self.path}: the output {rel} would replace the input file {final}; "
-                              "choose another output folder")
+        self._check_target(final, rel)
         with self._lock:
             if self._aborted:
                 raise RuntimeError("output folder closed after an interruption")
@@ -406,6 +624,10 @@ class OutputDir:
             with critical(), self._lock:
                 if self._aborted:
                     raise RuntimeError("output folder closed after an interruption")
+                if rel in self._prev_files and rel not in self.written and final.is_file():
+                    aside = self.path / self._backup / rel  # the previous run's file, until this run is complete
+                    aside.parent.mkdir(parents=True, exist_ok=True)
+                    os.replace(final, aside)
                 os.replace(tmp, final)
                 self._pending.discard(tmp)
                 if rel not in self.written:
@@ -419,6 +641,33 @@ class OutputDir:
             if isinstance(exc, OSError) and not check_requested():  # disk full, quota: one line, no traceback
                 raise _write_error(self.path, rel, exc, self.summary()) from exc
             raise
+
+    def _make_folder(self) -> None:
+        """Create the folder (and its missing parents, with create_parents) at the start of the run."""
+        missing, f = [], self.path
+        while not f.exists():
+            missing.append(f)
+            f = f.parent
+        if len(missing) > 1 and not self.create_parents:
+            raise ConfigError(f"{{opt:out}} {self.path}: its parent folder {self.path.parent} does not exist; "
+                              "create it first or choose another folder")
+        for d in reversed(missing):
+            try:
+                d.mkdir()
+            except FileExistsError:  # another run created it at the same moment: the lock decides
+                continue
+            except OSError as exc:
+                raise ConfigError(f"{{opt:out}} {self.path}: cannot create {d} ({exc.strerror or exc})") from None
+            self._made.append(d)
+        if not self.path.is_dir():
+            raise ConfigError(f"{{opt:out}} {self.path} exists and is not a folder")
+
+    def _unmake_folder(self) -> None:
+        """Remove the folders :meth:`_make_folder` created, when they are (still) empty."""
+        for d in reversed(self._made):
+            with contextlib.suppress(OSError):
+                d.rmdir()
+        self._made = []
 
     def _make_dirs(self, folder: Path) -> None:
         missing = []
@@ -436,68 +685,31 @@ class OutputDir:
                 self._created_dirs.append(rel)
 
     def _open(self) -> None:
-        """First write: create the folder, remove the previous run's files and dead temporaries."""
+        """First write: remove dead processes' temporaries (the previous run's files stay until the end)."""
         if self._opened:
             return
-        if self.path.exists() and not self.path.is_dir():
-            raise ConfigError(f"{{opt:out}} {self.path} exists and is not a folder")
-        if not self.path.exists():
-            if self.create_parents:
-                self.path.mkdir(parents=True, exist_ok=True)
-            else:
-                self.path.mkdir(exist_ok=True)  # another run may create it at the same moment: the lock decides
-        self._folder_lock.acquire()
-        previous = self._read_manifest()
-        for rel in previous.get("files", []):
-            target = self._inside(rel)
-            if target is None or target in self.protect or not target.is_file() or target.is_symlink():
-                continue
-            with contextlib.suppress(OSError):
-                target.unlink()
-                self.removed.append(rel)
-        for rel in sorted(previous.get("dirs", []), key=lambda r: r.count("/"), reverse=True):
-            target = self._inside(rel)
-            if target is not None and target.is_dir() and not any(target.iterdir()):
-                with contextlib.suppress(OSError):
-                    target.rmdir()
-        folders = [self.path] + [d for d in (self._inside(r) for r in previous.get("dirs", [])) if d is not None]
+        folders = [self.path] + [d for d in (_inside(self.path, r) for r in _strings(self._previous.get("dirs")))
+                                 if d is not None]
         for folder in folders:  # not recursive: --out may be a big folder of other things
             remove_stale_temporaries(folder)
+        self.removed = list(self._prev_files)
         self._opened = True
         self._write_manifest()
 
     def _inside(self, rel) -> Path | None:
         """``rel`` as a path inside the folder, or None if it is absolute or leaves it."""
-        if not isinstance(rel, str) or not rel or Path(rel).is_absolute():
-            return None
-        target = (self.path / rel).absolute()
-        try:
-            target.resolve().relative_to(self.path.resolve())
-        except (ValueError, OSError):
-            return None
-        return target
+        return _inside(self.path, rel)
 
     def _read_manifest(self) -> dict:
-        try:
-            doc = json.loads((self.path / MANIFEST).read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            return {}
-        return doc if isinstance(doc, dict) and doc.get("fogdrift_manifest") == 1 else {}
+        return _read_doc(self.path)
 
     def _write_manifest(self) -> None:
-
         doc = {"fogdrift_manifest": 1, "command": self.command, "fogdrift_version": __version__,
                "started": self._started, "complete": self.complete, "files": self.written,
                "dirs": self._created_dirs}
-        target = self.path / MANIFEST
-        tmp = target.with_name(f"{TMP_PREFIX}{os.getpid()}-{MANIFEST}")
-        try:
-            tmp.write_text(strict_json(doc, indent=1), encoding="utf-8")
-            os.replace(tmp, target)
-        except BaseException:  # disk full: no 0-byte temporary manifest left behind
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
-            raise
+        if self._prev_files and not self._ended:  # how to take this run back, or finish it, if it is killed
+            doc.update(previous=self._previous, pid=os.getpid(), backup=self._backup)
+        _write_doc(self.path, doc)
 
     def _discard_pending(self) -> None:
         with self._lock:
@@ -509,8 +721,8 @@ class OutputDir:
     # -- interruption -------------------------------------------------------------------------------
     def abort(self, timeout: float = 0.3) -> None:
         """From another thread, right before the process ends (the CLI's watchdog): stop further renames, remove
-        unfinished temporary files and the folder's lock file (the lock would die with the process; its file
-        would not)."""
+        unfinished temporary files, take this run's files back when a previous run's are there, and remove the
+        folder's lock file (the lock would die with the process; its file would not)."""
         got = self._lock.acquire(timeout=timeout)
         try:
             self._aborted = True
@@ -518,7 +730,12 @@ class OutputDir:
                 with contextlib.suppress(OSError):
                     os.unlink(tmp)
             self._pending.clear()
+            if got:
+                with contextlib.suppress(OSError):
+                    self._end()
             self._folder_lock.release()
+            if not self._opened:
+                self._unmake_folder()
         finally:
             if got:
                 self._lock.release()
@@ -526,6 +743,10 @@ class OutputDir:
     def summary(self) -> str:
         """One line: what this run wrote and what it did not (complete files only; no partial file left)."""
         where = str(self.path)
+        if self.taken_back:
+            return (f"nothing was kept in {where}: the earlier run's files there are unchanged (the "
+                    f"{len(self.taken_back)} file(s) this run had written were taken back, a folder holds one "
+                    "complete run)")
         if not self.written:
             kept = " (the earlier run's files there are unchanged)" if not self._opened and \
                 (self.path / MANIFEST).exists() else ""
@@ -537,7 +758,7 @@ class OutputDir:
         elif not self.complete:
             text += "; the rest of the run's files were not written"
         if self.removed:
-            text += f"; the earlier run's {len(self.removed)} file(s) there were removed"
+            text += f"; the earlier run's {len(self.removed)} file(s) there were replaced"
         return text + "; no partial file left"
 
 

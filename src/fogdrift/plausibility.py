@@ -63,6 +63,7 @@ import numpy as np
 
 from ._util import fmt_number
 from .errors import ConfigError, FogdriftWarning, render_options
+from .health import health_findings
 from .pipeline_sums import AllanSums
 from .units import EARTH_RATE_DPH, STANDARD_GRAVITY_MPS2, parse_unit
 
@@ -142,7 +143,9 @@ class Finding:
     Attributes
     ----------
     rule : str
-        ``"white-noise"``, ``"range"``, ``"earth-rate"`` or ``"sample-rate"``.
+        ``"white-noise"``, ``"range"``, ``"earth-rate"``, ``"sample-rate"``, ``"gravity"``, or a sensor-health
+        rule of :mod:`fogdrift.health` (``"frozen"``, ``"saturated"``, ``"unit-mix"``, ``"gravity-like"``,
+        ``"time-step"``).
     axes : tuple of str
         Axes concerned (empty for the sample rate).
     message : str
@@ -253,6 +256,9 @@ def check_record(record, *, sums: dict | None = None) -> list[Finding]:
     noise floor (:class:`~fogdrift.pipeline_sums.AllanSums`), for :func:`fogdrift.pipeline.run_allan` (``sums=``)
     to reuse instead of computing the octave ADEV again.
 
+    The sensor-health rules of :mod:`fogdrift.health` (frozen stretches, clipping, axes in mixed units,
+    gravity on a gyro channel, a time column counting samples or ms) are added after the unit rules.
+
     Returns
     -------
     list of Finding
@@ -269,11 +275,17 @@ def check_record(record, *, sums: dict | None = None) -> list[Finding]:
     >>> [(f.rule, f.likely_units) for f in check_record(from_array(numbers, dt_s=0.01, unit="deg/s"))]
     [('white-noise', ('deg/h',))]
     """
+    findings = _unit_findings(record, sums)
+    gravity = any(f.rule == "gravity" for f in findings)
+    return findings + [Finding(*h) for h in health_findings(record) if not (gravity and h[0] == "gravity-like")]
+
+
+def _unit_findings(record, sums: dict | None = None) -> list[Finding]:
     quantities = record.quantities
     if "specific_force" in quantities:  # the gyro rules for the gyro channels, the accelerometer rules for the rest
         gyro = [n for n, q in zip(record.axis_names, quantities) if q == "angular_rate"]
         accel = [n for n, q in zip(record.axis_names, quantities) if q == "specific_force"]
-        findings = [f for f in check_record(record.select(gyro), sums=sums) if f.rule != "sample-rate"] if gyro else []
+        findings = [f for f in _unit_findings(record.select(gyro), sums) if f.rule != "sample-rate"] if gyro else []
         return findings + accel_findings(record.select(accel)) + _rate_findings(record)
     return _gyro_findings(record, sums) + gravity_like_findings(record) + _rate_findings(record)
 
@@ -340,9 +352,17 @@ def _rate_findings(record) -> list[Finding]:
         findings.append(Finding(
             "sample-rate", (),
             f"sample rate {fs:.4g} Hz (interval {record.dt_s:.4g} s) is unusually {'low' if slow else 'high'} for a "
-            f"gyro log; check {{opt:time_unit}} ({'a time column in ms read as s gives a 1000 times longer step' if slow else 'a time column in s read as ms gives a 1000 times shorter step'}) "
+            f"gyro log; check {{opt:time_unit}} ({_slow_words(record.dt_s) if slow else 'a time column in s read as ms gives a 1000 times shorter step'}) "
             "and {opt:rate_hz}"))
     return findings
+
+
+def _slow_words(dt_s: float) -> str:
+    """What a long step suggests: ms read as s (1000x), or us read as s (10^6x) for a step of 500 s and more."""
+    if dt_s >= 500.0:
+        return (f"a time column in us read as s gives a 10^6 times longer step ({1e6 / dt_s:.4g} Hz read as "
+                f"{1 / dt_s:.4g} Hz); in ms, 1000 times")
+    return "a time column in ms read as s gives a 1000 times longer step"
 
 
 #: Relative tolerance of "the mean vector of a static accelerometer triad is 1 g".

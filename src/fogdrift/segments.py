@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from .errors import ConfigError
+from .health import frozen_stretch
 from .screen import ScreenResult, dynamic_adev, screen_record
 
 __all__ = ["SEGMENT_MODES", "parse_segments", "plan_segments", "segment_lines", "longest_segment", "MAX_LISTED"]
@@ -75,7 +76,12 @@ def plan_segments(record, mode="auto") -> tuple[dict, dict]:
     for name in record.axis_names:
         r = screen_record(record.axis(name), record.dt_s, min_quiet_s=min_quiet_s)
         dropped = []
-        if chosen == "auto":
+        frozen = frozen_stretch(record.axis(name)) if chosen == "auto" else None
+        healthy = tuple((a, b) for a, b in ((0, frozen[0]), (frozen[1], record.n_samples)) if b - a >= 2) \
+            if frozen is not None else ()
+        if healthy:  # a frozen (stuck) stretch is no quiet noise: the fit takes the rest (fogdrift.health)
+            use = healthy
+        elif chosen == "auto":
             use, dropped = (None, []) if r.stationary or not r.quiet_segments else _homogeneous(r)
         elif chosen == "whole":
             use = None
@@ -83,6 +89,7 @@ def plan_segments(record, mode="auto") -> tuple[dict, dict]:
             use = chosen
         segments[name] = use
         screens[name] = {**r.to_dict(), "mode": chosen if isinstance(chosen, str) else "ranges",
+                         **({"frozen": [int(frozen[0]), int(frozen[1])]} if healthy else {}),
                          "segments_used": None if use is None else [[int(a), int(b)] for a, b in use],
                          "segments_dropped": dropped, "text": r.text()}
         if not r.stationary:
@@ -174,6 +181,8 @@ def segment_lines(name, screen, *, compact: bool = False) -> list[str]:
     if used:
         what = ("the quiet segment" if len(used) == 1 else "the quiet segments") if screen["mode"] == "auto" else \
             "the segments"
+        if screen.get("frozen"):
+            what = f"the healthy part (the frozen samples {screen['frozen'][0]}-{screen['frozen'][1] - 1} left out):"
         span = sum(b - a for a, b in used) * dt
         where = (", ".join(f"{a * dt:g}-{b * dt:g} s" for a, b in used) if len(used) <= MAX_LISTED else
                  f"({len(used)} of them, from {used[0][0] * dt:g} s to {used[-1][1] * dt:g} s; each in the JSON)")

@@ -42,6 +42,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from . import documents
 from ._util import fmt_number
 from .errors import ConfigError
 
@@ -204,14 +205,18 @@ def read_spec(path) -> dict:
             raise ConfigError(f"{p}: reading YAML needs PyYAML (pip install pyyaml); or write the spec as JSON") \
                 from None
         try:
-            data = yaml.safe_load(text)
+            data = documents.loads(text, p, yaml=True)
+        except documents.DocumentError as exc:
+            raise ConfigError(str(exc)) from None
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             where = f":{mark.line + 1}" if mark is not None else ""
             raise ConfigError(f"{p}{where}: not valid YAML ({getattr(exc, 'problem', None) or exc})") from None
     else:
         try:
-            data = json.loads(text)
+            data = documents.loads(text, p)
+        except documents.DocumentError as exc:
+            raise ConfigError(str(exc)) from None
         except json.JSONDecodeError as exc:
             raise ConfigError(f"{p}:{exc.lineno}: not valid JSON ({exc.msg}); a .yaml/.yml name reads YAML") \
                 from None

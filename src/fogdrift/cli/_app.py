@@ -54,6 +54,7 @@ from ..io.registry import cli_options, reader_by_name, select_reader
 from .. import output as _output
 from ..output import OutputDir, active
 from ..plausibility import check_record
+from ._safe import SafeConsole
 
 app = typer.Typer(
     add_completion=False,
@@ -63,8 +64,8 @@ app = typer.Typer(
     help="Characterise, separate, model and compensate optical-gyro drift (rates in deg/h, tau in s).",
 )
 # stdout (tables, the result) and stderr (progress, warnings, errors); widths are set per run by _configure().
-console = Console(highlight=False)
-err_console = Console(stderr=True, highlight=False)
+console = SafeConsole(highlight=False)  # text from a file (a column name) cannot move the cursor or recolour
+err_console = SafeConsole(stderr=True, highlight=False)
 _state = {"traceback": False, "json": False, "finish": threading.Lock()}
 #: Width off a terminal when COLUMNS is not set: logs and CI keep whole table rows.
 PIPE_WIDTH = 220
@@ -83,7 +84,7 @@ FLAGS = {
     "curve": "--curve", "sensor": "--sensor", "robust": "--robust", "train_fraction": "--train-fraction",
     "val_fraction": "--val-fraction", "causal_window_s": "--causal-window", "gm_window": "--gm-window",
     "fit_tau_s": "--fit-taus", "format": "--format", "horizons": "--horizons", "calibration": "--calibration",
-    "origin_step": "--origin-step", "spec": "--spec",
+    "origin_step": "--origin-step", "spec": "--spec", "segments": "--segments",
     "target": "--target", "length": "--length", "monte_carlo": "--monte-carlo", "workers": "--workers", "axis": "--axis",
 }
 

@@ -59,7 +59,7 @@ def compensate(
     from ..compensate import compensate_file
 
     fmts = tuple(csv_list(formats) or ())
-    with run("compensate", out, default_out=DEFAULT_OUT, inputs=[load.file],
+    with run("compensate", out, default_out=DEFAULT_OUT, inputs=[bundle, load.file],
              expect=tuple(n for n in EXPECTED if n.rsplit(".", 1)[-1] in fmts or n.endswith(".json"))):
         try:
             hs = tuple(float(h) for h in csv_list(horizons))

@@ -19,6 +19,7 @@ from typing import Annotated, List, Optional
 
 import typer
 
+from .. import documents
 from .._util import fmt_number
 from ..errors import ConfigError
 from ..io import file_sha256
@@ -62,9 +63,11 @@ def _read_components(path: Path) -> dict:
     from ..models.statespace import check_components
 
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        data = documents.read(path, yaml=False)
     except FileNotFoundError:
         raise ConfigError(f"--components: no such file {path}") from None
+    except documents.DocumentError as exc:
+        raise ConfigError(f"--components: {exc}") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ConfigError(f"--components: {path} is no JSON file ({exc})") from None
     if isinstance(data, dict) and isinstance(data.get("channels"), list):  # a 'fogdrift export --target json' file
@@ -154,7 +157,7 @@ def consistency(
     """Will these noise numbers work in my filter?  Coverage of the predicted angle error on held-out static logs
     (full model, white + random walk, white + the random walk that covers the bias wander), and the smallest
     variance inflation that gives nominal coverage; writes consistency.json."""
-    with run("consistency", out, default_out=DEFAULT_OUT, inputs=[load.file, *(held_out or [])],
+    with run("consistency", out, default_out=DEFAULT_OUT, inputs=[load.file, *(held_out or []), components],
              json_out=json_out, expect=("consistency.json",)) as r:
         from ..evaluation.consistency import summary_cell, verdict_line
         from ..workflows.consistency import run_consistency, write_consistency

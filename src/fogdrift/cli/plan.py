@@ -46,7 +46,7 @@ def plan(
 ):
     """How long must I record?  The length at which each term is resolved and reaches its target 95 % width
     (Allan fit; analytic, checked by Monte-Carlo); writes plan.json and plan.png."""
-    with run("plan", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
+    with run("plan", out, default_out=DEFAULT_OUT, inputs=[load.file, model if model and model.strip().lower().endswith(".json") else None], json_out=json_out,
              expect=("plan.json", "plan.png")) as r:
         from ..plan import make_plan, parse_length, parse_model, parse_targets, read_model_file
         from ..report import write_json

@@ -22,6 +22,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .. import documents
 from ..errors import ConfigError, DataFormatError
 from ..noise.terms import TERMS
 from .conversions import quantity_of_unit, single_gm_from_flicker, to_si
@@ -166,7 +167,9 @@ def load_result(path) -> dict:
         raise DataFormatError("no such result file; expected the allan.json or noise.json of a fogdrift run "
                               "(or what 'fogdrift allan --json' printed)", path=p)
     try:
-        data = json.loads(p.read_text(encoding="utf-8"))
+        data = documents.read(p, yaml=False)
+    except documents.DocumentError as exc:
+        raise DataFormatError(exc.reason, path=p, line=exc.line) from None
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise DataFormatError(f"not a JSON file ({exc.__class__.__name__}: {exc})".split("\n")[0], path=p) from None
     if not isinstance(data, dict) or not isinstance(data.get("axes"), list) or not data["axes"]:

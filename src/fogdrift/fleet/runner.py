@@ -44,7 +44,7 @@ from ..errors import ConfigError
 from ..io import load as load_fn
 from ..io.load import _options
 from ..io.readers.base import require
-from ..output import LOCK, TMP_PREFIX, OutputDir, _FolderLock, active, remove_stale_temporaries
+from ..output import LOCK, TMP_PREFIX, OutputDir, _FolderLock, active, recover, remove_stale_temporaries
 from .commands import command_spec, spec_from_settings
 from .summary import COLUMNS, write_summary
 from .tasks import MANIFEST, FileTask, run_file
@@ -115,7 +115,7 @@ class BatchOutputDir(OutputDir):
             try:
                 fresh = man.stat().st_mtime >= self._t0 - 1.0
                 same = fresh and json.loads(man.read_text()).get("settings_sha256") == t.settings_sha256
-            except (OSError, ValueError, AttributeError):
+            except (OSError, ValueError, AttributeError, RecursionError):
                 same = False
             if same:
                 done.append(t.rel_out)
@@ -555,7 +555,8 @@ def _remove_temporaries(tasks, killed=()) -> None:
     file of :class:`fogdrift.output.OutputDir`.  Also the folders above them up to the batch's folder: a worker
     checking a file's folder that does not exist yet probes the nearest existing one for writability
     (:func:`fogdrift.output.check_out_dir`), and a worker killed during that probe leaves its file there
-    (``killed``: the workers' process ids; there, only their files and dead processes' are removed)."""
+    (``killed``: the workers' process ids; there, only their files and dead processes' are removed).  A killed
+    worker that was re-running a finished folder is taken back (:func:`fogdrift.output.recover`)."""
     deadline = time.monotonic() + STALE_LOCK_WAIT_S
     above = {Path(t.out_dir).parents[k] for t in tasks for k in range(len(Path(t.rel_out).parts))}
     for folder in sorted(above):
@@ -577,6 +578,8 @@ def _remove_temporaries(tasks, killed=()) -> None:
                 continue
             lock.release()  # unlinks the file
             break
+        with contextlib.suppress(OSError, ConfigError):
+            recover(folder, killed)  # a killed worker's re-run of a finished folder: the earlier files come back
 
 
 def _close(client, cluster, *, quick: bool) -> None:

@@ -68,7 +68,7 @@ def cached_rows(task: FileTask, sha256: str):
     man = Path(task.out_dir) / MANIFEST
     try:
         doc = json.loads(man.read_text())
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
     if not isinstance(doc, dict) or doc.get("sha256") != sha256 or doc.get("settings_sha256") != task.settings_sha256:
         return None

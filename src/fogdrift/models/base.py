@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import documents
 from .._util import check_series, strict_json
 from ..errors import ConfigError, ModelFileError, NotFittedError
 from ..output import atomic_path
@@ -174,9 +175,11 @@ def load_model(path) -> DriftModel:
     """
     json_path, npz_path = model_file_paths(path)
     try:
-        doc = json.loads(json_path.read_text())
+        doc = documents.read(json_path, yaml=False)
     except FileNotFoundError:
         raise ModelFileError(f"{json_path}: model file not found") from None
+    except documents.DocumentError as exc:
+        raise ModelFileError(str(exc)) from None
     except json.JSONDecodeError as exc:
         raise ModelFileError(f"{json_path}:{exc.lineno}:{exc.colno}: not valid JSON ({exc.msg})") from exc
     if not isinstance(doc, dict) or doc.get("format") != "fogdrift-model":

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import documents
 from ..errors import ConfigError
 from ..noise.terms import TERM_TABLE, all_terms, laws_of
 from ..spec import _norm_unit
@@ -254,9 +255,11 @@ def read_model_file(path, dt_s=None, axis=None) -> PlanModel:
     ``axis`` or the first) or ``noise_model.json`` (``fogdrift export``).  ``dt_s`` overrides the file's rate."""
     p = Path(path)
     try:
-        data = json.loads(p.read_text())
+        data = documents.read(p, yaml=False)
     except FileNotFoundError:
         raise ConfigError(f"{p}: no such file") from None
+    except documents.DocumentError as e:
+        raise ConfigError(str(e)) from None
     except (OSError, ValueError) as e:
         raise ConfigError(f"{p}: not a readable JSON file ({e.__class__.__name__})") from None
     if not isinstance(data, dict):

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import ConfigError, DataFormatError, ResourceError
+from .limits import check_columns
 
 __all__ = ["Table", "split_unit_label", "numeric_column", "describe_exception", "PARSER_ERRORS",
            "require", "MissingDependencyError"]
@@ -174,6 +175,8 @@ class Table:
         if format is not None:
             self.format = str(format)
         self.path = Path(path)
+        names = list(names)
+        check_columns(len(names), self.path, n_rows=None if data is None or np.ndim(data) != 2 else data.shape[0])
         self.names = [str(n) for n in names]
         self.named = bool(named)
         self.units = list(units) if units is not None else [None] * len(self.names)
@@ -187,8 +190,9 @@ class Table:
         self.extra_notes = []
         if len(self.units) != len(self.names):
             raise ValueError(f"reader bug: {len(self.units)} units for {len(self.names)} columns")
-        dup = next((a for j, a in enumerate(self.names) if a in self.names[:j]), None)
-        if dup is not None:
+        if len(set(self.names)) != len(self.names):
+            seen: set = set()
+            dup = next(a for a in self.names if a in seen or seen.add(a))
             raise DataFormatError(
                 f"duplicate column name; expected unique names, got {dup!r} twice", path=self.path, column=dup
             )

@@ -15,6 +15,10 @@ Environment variable         Limit                                              
 ``FOGDRIFT_MAX_MEMORY``      bytes of the float64 table a reader builds (``2G``, ``512M``)     half the machine's
                                                                                              memory (or of the
                                                                                              process's RLIMIT_AS)
+``FOGDRIFT_MAX_COLUMNS``     columns of a table: text fields, array columns, ``.npz``          1024
+                             members, datasets (each a possible axis)
+``FOGDRIFT_MAX_PREAMBLE``    bytes of comment or blank lines before a text file's header       16 MiB
+                             and first data row
 ===========================  ==============================================================  ======================
 
 A memory-mapped float64 ``.npy`` costs no memory and is not held to the budget (another dtype's float64 copy is;
@@ -34,16 +38,20 @@ from ...errors import ConfigError, DataFormatError, ResourceLimitError
 
 __all__ = ["ENV_LINE", "ENV_ROWS", "ENV_EXPANSION", "ENV_MEMORY", "EXPANSION_FLOOR", "max_line_bytes", "max_rows",
            "max_expansion", "memory_budget", "check_rows", "check_memory", "check_expansion", "format_bytes",
-           "GuardedStream"]
+           "GuardedStream", "ENV_COLUMNS", "ENV_PREAMBLE", "max_columns", "max_preamble_bytes", "check_columns"]
 
 ENV_LINE = "FOGDRIFT_MAX_LINE_BYTES"
 ENV_ROWS = "FOGDRIFT_MAX_ROWS"
 ENV_EXPANSION = "FOGDRIFT_MAX_EXPANSION"
 ENV_MEMORY = "FOGDRIFT_MAX_MEMORY"
+ENV_COLUMNS = "FOGDRIFT_MAX_COLUMNS"
+ENV_PREAMBLE = "FOGDRIFT_MAX_PREAMBLE"
 
 DEFAULT_LINE_BYTES = 1 << 20
 DEFAULT_ROWS = 1_000_000_000
 DEFAULT_EXPANSION = 50.0
+DEFAULT_COLUMNS = 1024
+DEFAULT_PREAMBLE = 16 << 20
 #: Decompressed bytes always allowed, whatever the ratio (a small, very compressible file is harmless).
 EXPANSION_FLOOR = 16 << 20
 
@@ -79,6 +87,29 @@ def max_rows() -> int | None:
 def max_expansion() -> float | None:
     """Most decompressed bytes per stored byte beyond :data:`EXPANSION_FLOOR` (``FOGDRIFT_MAX_EXPANSION``)."""
     return _env(ENV_EXPANSION, DEFAULT_EXPANSION)
+
+
+def max_columns() -> int | None:
+    """Most columns of a table (``FOGDRIFT_MAX_COLUMNS``; None: no limit)."""
+    v = _env(ENV_COLUMNS, DEFAULT_COLUMNS)
+    return None if v is None else int(v)
+
+
+def max_preamble_bytes() -> int | None:
+    """Most bytes of comment/blank lines before a text file's content (``FOGDRIFT_MAX_PREAMBLE``)."""
+    v = _env(ENV_PREAMBLE, DEFAULT_PREAMBLE, sizes=True)
+    return None if v is None else int(v)
+
+
+def check_columns(n_columns: int, path, what: str = "columns", n_rows: int | None = None) -> None:
+    """ResourceLimitError if a table has more than ``FOGDRIFT_MAX_COLUMNS`` columns (each a possible axis: a
+    file of thousands is no gyro log, or an array stored transposed)."""
+    limit = max_columns()
+    if limit is not None and n_columns > limit:
+        turned = (f"; {n_rows} rows x {n_columns} columns: stored transposed? (samples go down the rows, one "
+                  "column per axis)" if n_rows is not None and n_rows < n_columns else "")
+        raise ResourceLimitError(f"{n_columns} {what}; expected at most {limit} ({ENV_COLUMNS}: each column is a "
+                                 f"possible axis){turned}; {_raise_it(ENV_COLUMNS)}", limit=ENV_COLUMNS, path=path)
 
 
 def _machine_memory() -> int:

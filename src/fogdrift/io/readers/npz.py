@@ -20,7 +20,7 @@ import numpy as np
 from ...errors import DataFormatError
 from ..hashing import file_sha256
 from .base import PARSER_ERRORS, Table, describe_exception, numeric_column
-from .limits import check_expansion, check_memory, check_rows
+from .limits import check_expansion, check_memory, check_rows, check_columns
 
 __all__ = ["open_table"]
 
@@ -95,6 +95,7 @@ def open_table(path: Path) -> Table:
         ) from exc
     with zf as z:
         infos = [i for i in z.infolist() if not i.is_dir()]
+        check_columns(len(infos), p, "members (arrays)")
         others = [i.filename for i in infos if not i.filename.endswith(".npy")]
         if others:
             listing = ", ".join(repr(n) for n in others[:5]) + (f" and {len(others) - 5} more" if len(others) > 5

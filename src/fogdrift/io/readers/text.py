@@ -23,7 +23,7 @@ import numpy as np
 from ...errors import ConfigError, DataFormatError, ResourceLimitError
 from ..hashing import hashing_stream
 from .base import Table, describe_exception, split_unit_label
-from .limits import GuardedStream
+from .limits import ENV_PREAMBLE, GuardedStream, check_columns, format_bytes, max_preamble_bytes
 
 __all__ = ["open_table", "TextTable", "delimiter_option"]
 
@@ -315,13 +315,16 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
     p = Path(path)
     try:
         with open(p, "rb") as fh:
-            gzip_magic = fh.read(2) == b"\x1f\x8b"
+            head = fh.read(8)
     except OSError as exc:
         raise DataFormatError(f"cannot read file; expected a readable file, got {exc.strerror or exc}",
                               path=p) from exc
+    gzip_magic = head[:2] == b"\x1f\x8b"
+    refuse_foreign(head, p)
     probe = TextTable(p, names=[], named=False, units=[], header_line=0, delimiter=None, n_fields=0,
                       is_gz=gzip_magic, decimal_comma=False)
-    content, first_lineno, lineno = [], 0, 0
+    content, first_lineno, lineno, skipped = [], 0, 0, 0
+    preamble = max_preamble_bytes()
     try:
         with probe.stream() as fh:
             for lineno, raw in enumerate(fh, start=1):
@@ -331,6 +334,14 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
                     first_lineno = first_lineno or lineno
                     if len(content) == 2:
                         break
+                else:
+                    skipped += len(raw)
+                    if preamble is not None and skipped > preamble:
+                        raise ResourceLimitError(
+                            f"no header or data row in the first {lineno} lines ({format_bytes(skipped)} of comment "
+                            f"or blank lines); expected the table within the first {format_bytes(preamble)} "
+                            f"({ENV_PREAMBLE}); raise it with the environment variable {ENV_PREAMBLE} (0: no limit) "
+                            "if the file is genuine", limit=ENV_PREAMBLE, path=p, line=lineno)
     except _STREAM_ERRORS as exc:
         raise DataFormatError(f"unreadable file; expected text or gzip text, got {describe_exception(exc)}",
                               path=p) from exc
@@ -348,6 +359,7 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
     decimal_comma = (data_line is not None and delim != ","
                      and any(_DECIMAL_COMMA.match(f.strip()) for f in _split(data_line, delim)))
     fields = [f.strip() for f in _split(first, delim)]
+    check_columns(len(fields), p, "columns (fields in the first line)")
     common = dict(delimiter=delim, n_fields=len(fields), is_gz=gzip_magic, decimal_comma=decimal_comma)
     if not is_header:
         table = TextTable(p, names=[f"col{j}" for j in range(len(fields))], named=False,
@@ -368,6 +380,29 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
     table = TextTable(p, names=names, named=True, units=units, header_line=first_lineno, **common)
     table.sha256 = probe.sha256
     return table
+
+
+#: Encodings (byte-order marks, longest first) and compressions (magic bytes) a text log is refused in, by name.
+FOREIGN = (
+    (b"\xff\xfe\x00\x00", "UTF-32 text (little-endian byte-order mark FF FE 00 00)", "iconv -f UTF-32 -t UTF-8"),
+    (b"\x00\x00\xfe\xff", "UTF-32 text (big-endian byte-order mark 00 00 FE FF)", "iconv -f UTF-32 -t UTF-8"),
+    (b"\xff\xfe", "UTF-16 text (little-endian byte-order mark FF FE)", "iconv -f UTF-16 -t UTF-8"),
+    (b"\xfe\xff", "UTF-16 text (big-endian byte-order mark FE FF)", "iconv -f UTF-16 -t UTF-8"),
+    (b"BZh", "bzip2-compressed (magic bytes 42 5A 68)", "bunzip2 -k, or recompress with gzip"),
+    (b"\xfd7zXZ\x00", "xz-compressed (magic bytes FD 37 7A 58 5A 00)", "unxz -k, or recompress with gzip"),
+    (b"\x28\xb5\x2f\xfd", "Zstandard-compressed (magic bytes 28 B5 2F FD)", "unzstd, or recompress with gzip"),
+    (b"\x04\x22\x4d\x18", "LZ4-compressed (magic bytes 04 22 4D 18)", "unlz4, or recompress with gzip"),
+    (b"7z\xbc\xaf\x27\x1c", "a 7-Zip archive (magic bytes 37 7A BC AF 27 1C)", "extract the log from it"),
+)
+
+
+def refuse_foreign(head: bytes, path) -> None:
+    """DataFormatError naming the encoding or compression when ``head`` (a file's first bytes) is one that the
+    text reader does not read (UTF-16/UTF-32, bzip2, xz, zstd, lz4, 7z): plain or gzip UTF-8 text only."""
+    for magic, what, fix in FOREIGN:
+        if head.startswith(magic) and not (magic == b"BZh" and not head[3:4].isdigit()):  # BZh1..BZh9
+            raise DataFormatError(f"the file is {what}; expected UTF-8 (or ASCII) text, plain or gzip: convert it "
+                                  f"({fix})", path=path, line=1)
 
 
 def _detect_layout(first: str, second):
