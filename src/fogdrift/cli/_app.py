@@ -439,9 +439,9 @@ def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool
     try:
         with errors(), _warning_lines():
             missing = [q for q in Path(out).expanduser().absolute().parents if not q.exists()]
-            if missing:  # as mkdir -p, and said: a typo shows in this line
-                say(f"--out {out}: creating its parent folder {missing[0]}", style="dim")
             outdir = out_class(out, command=command, create_parents=True, protect=[p for p in inputs if p is not None])
+            if missing:  # as mkdir -p, and said (once the folder is known to be usable): a typo shows in this line
+                say(f"--out {out}: creating its parent folder {missing[0]}", style="dim")
             outdir.expect(*expect)
             try:
                 with outdir:
