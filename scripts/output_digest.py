@@ -2,7 +2,8 @@
 
 Runs ``allan``, ``noise`` and ``analyze`` (as the README runs them) into ``OUT/<case>/`` with the fogdrift found on
 ``sys.path`` (set ``PYTHONPATH`` to a checkout's ``src``), then writes ``OUT/digest.json``: per output file, the
-SHA-256 of its content with the run-dependent fields blanked (wall-clock seconds, the output path).  Compare two
+SHA-256 of its content with the run-dependent fields blanked (wall-clock seconds, the output path) and every float
+to 12 significant digits; the run manifests (timestamps, versions) are not compared.  Compare two
 digests with ``--compare A.json B.json``: it prints the files that differ and exits 1 if any does.
 
     PYTHONPATH=old/src python scripts/output_digest.py /tmp/old
@@ -30,8 +31,12 @@ CASES = [
     ("romy_allan", ["allan", str(SHARED / "romy_teleseism_1hz/romy_teleseism_1hz.csv.gz"), "--unit", "rad/s"]),
     ("rlg_analyze", ["analyze", "data/psins_lasergyro_rlg/psins_lasergyro_rlg.csv.gz", "--unit", "deg/h"]),
 ]
-#: JSON keys whose values depend on the run, not on the method.
-VOLATILE = {"wall_s", "elapsed_s", "created", "created_utc", "out", "output", "out_dir", "fogdrift_version"}
+#: JSON keys whose values depend on the run, not on the method (wall-clock seconds, paths, versions).
+VOLATILE = {"wall_s", "elapsed_s", "fit_seconds", "seconds", "created", "created_utc", "started_utc", "finished_utc",
+            "out", "output", "out_dir", "fogdrift_version", "versions", "duration_s_wall"}
+#: Significant digits a float is compared to: the last bits of a BLAS reduction depend on its thread count and the
+#: CPU, not on the method.
+DIGITS = 12
 
 
 def _clean(obj):
@@ -39,6 +44,8 @@ def _clean(obj):
         return {k: (None if k in VOLATILE else _clean(v)) for k, v in obj.items()}
     if isinstance(obj, list):
         return [_clean(v) for v in obj]
+    if isinstance(obj, float):
+        return float(f"{obj:.{DIGITS}g}")
     return obj
 
 
@@ -65,7 +72,7 @@ def run(out: Path) -> dict:
         digest[f"{case}/exit"] = str(res.returncode)
         digest[f"{case}/stdout.json"] = hashlib.sha256(json.dumps(_clean(json.loads(res.stdout)), sort_keys=True)
                                                        .encode()).hexdigest() if res.returncode == 0 else res.stderr
-        for f in sorted(p for p in target.rglob("*") if p.is_file()):
+        for f in sorted(p for p in target.rglob("*") if p.is_file() and p.name != ".fogdrift-manifest.json"):
             digest[f"{case}/{f.relative_to(target)}"] = _digest(f)
     (out / "digest.json").write_text(json.dumps(digest, indent=1, sort_keys=True))
     return digest
