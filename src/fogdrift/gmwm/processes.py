@@ -45,13 +45,12 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
 from typing import Callable
 
 import numpy as np
 
 from ..errors import ConfigError
-from ..noise.processes import LatentSpec, latent_processes
+from ..noise.processes import LatentSpec, TableView, latent_processes
 from ..noise.processes.flicker import B_FLAT_WV, flicker_wv_factor
 from ..noise.processes.gauss_markov import ar1_wv
 
@@ -182,24 +181,8 @@ def _wv_kernel():
 Process = LatentSpec
 
 
-class _LatentView(Mapping):
-    """GMWM name -> :class:`Process`, from the rows of :mod:`fogdrift.noise.processes` (live)."""
-
-    def __getitem__(self, key):
-        return latent_processes()[key]
-
-    def __iter__(self):
-        return iter(latent_processes())
-
-    def __len__(self):
-        return len(latent_processes())
-
-    def __repr__(self):
-        return f"PROCESSES({list(self)})"
-
-
 #: GMWM name (``"WN"``, ``"QN"``, ``"RW"``, ``"DR"``, ``"FLICKER"``, ``"GM"``, and any registered row's) -> Process.
-PROCESSES = _LatentView()
+PROCESSES = TableView(latent_processes, "PROCESSES")
 
 
 #: A natural parameter in words, as shown to the user (``"RW.gamma2"`` -> ``"RW variance"``).
@@ -222,24 +205,9 @@ def param_label(name: str) -> str:
 
 
 
-class _AliasView(Mapping):
-    """Accepted spellings in model strings (upper-cased) -> registry key: each latent form's name and aliases."""
-
-    def _rows(self):
-        return {a: p.name for p in latent_processes().values() for a in (p.name, *p.aliases)}
-
-    def __getitem__(self, key):
-        return self._rows()[key]
-
-    def __iter__(self):
-        return iter(self._rows())
-
-    def __len__(self):
-        return len(self._rows())
-
-
 #: Accepted spellings in model strings (upper-cased) -> registry key (GM = AR1, WN = ARW, RW = RRW, DR = RAMP, ...).
-ALIASES = _AliasView()
+ALIASES = TableView(lambda: {a: p.name for p in latent_processes().values() for a in (p.name, *p.aliases)},
+                    "ALIASES")
 _BUILTIN_ORDER = ("QN", "WN", "RW", "DR", "FLICKER", "GM")
 
 

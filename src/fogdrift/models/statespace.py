@@ -47,13 +47,12 @@ R. E. Kalman, "A new approach to linear filtering and prediction problems", J. B
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ConfigError
-from ..noise.processes import component_specs, power_law_names, processes
+from ..noise.processes import TableView, component_specs, power_law_names, processes
 from ..noise.processes.flicker import flicker_as_gauss_markov
 from ..noise.processes.gauss_markov import gm_avar_dph2
 from ..noise.terms import TERMS
@@ -71,25 +70,9 @@ __all__ = [
     "forecast_uncertainty",
 ]
 
-class _KindView(Mapping):
-    """Component kind -> (parameter keys in order, one-line description with units), from the rows'
-    :class:`~fogdrift.noise.processes.ComponentSpec` (live)."""
-
-    def _rows(self):
-        return {k: (c.keys, c.description) for k, c in component_specs().items()}
-
-    def __getitem__(self, key):
-        return self._rows()[key]
-
-    def __iter__(self):
-        return iter(self._rows())
-
-    def __len__(self):
-        return len(self._rows())
-
-
 #: Component kinds -> (parameter keys in order, one-line description with units): the rows' components.
-COMPONENT_KINDS = _KindView()
+COMPONENT_KINDS = TableView(lambda: {k: (c.keys, c.description) for k, c in component_specs().items()},
+                            "COMPONENT_KINDS")
 
 
 def check_components(components) -> list[dict]:

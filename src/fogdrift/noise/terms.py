@@ -18,15 +18,14 @@ simulated signals at a tolerance set by the EDF.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from types import MappingProxyType
 
 from ..errors import ConfigError
 from .processes import gauss_markov, sinusoid
 from .processes import power_law_names as _power_law_names
+from .processes import TableView
 from .processes import processes as _processes
 from .processes import shaped_names as _shaped_names
-from .processes import version as _version
 from .processes.base import TermLaw, TermSpec
 from .processes.gauss_markov import markov_shape
 from .processes.sinusoid import periodic_shape, sinusoid_shape
@@ -61,38 +60,12 @@ __all__ = [
 # ----------------------------------------------------------------------------------------
 # The IEEE-952 terms: views of the noise-process table
 # ----------------------------------------------------------------------------------------
-class _TermView(Mapping):
-    """Letter -> :class:`TermSpec` of the power-law rows of :mod:`fogdrift.noise.processes`, live (a registered
-    process appears), in order of the power of tau."""
-
-    def __init__(self, attr: str):
-        self._attr = attr
-        self._cache = [None, None]
-
-    def _rows(self):
-        if self._cache[0] != _version():
-            self._cache[:] = [_version(), {p.name: getattr(p, self._attr) for p in _processes() if p.power_law}]
-        return self._cache[1]
-
-    def __getitem__(self, key):
-        return self._rows()[key]
-
-    def __iter__(self):
-        return iter(self._rows())
-
-    def __len__(self):
-        return len(self._rows())
-
-    def __repr__(self):
-        return f"TermView({list(self)})"
-
-
 #: The IEEE-952 power-law terms (Q, N, B, K, R, and any registered one), in order of the power of tau in the Allan
 #: variance: the ``term`` of each row of :mod:`fogdrift.noise.processes`.
-TERM_TABLE = _TermView("term")
+TERM_TABLE = TableView(lambda: {p.name: p.term for p in _processes() if p.power_law}, "TERM_TABLE")
 
 #: The accelerometer twins (IEEE Std 1293): the same Allan laws with specific force [m/s^2] in place of rate; B in ug.
-ACCEL_TERM_TABLE = _TermView("accel_term")
+ACCEL_TERM_TABLE = TableView(lambda: {p.name: p.accel_term for p in _processes() if p.power_law}, "ACCEL_TERM_TABLE")
 
 #: The term table of each quantity (:data:`fogdrift.units.QUANTITIES`): the gyro's IEEE-952 table and the
 #: accelerometer's.  The Allan laws (powers, coefficients, alphas) are the same; units and names differ.
@@ -154,57 +127,16 @@ def term_spec(name) -> TermSpec:
 _STATISTIC_NAMES = ("adev", "hdev", "mdev")
 
 
-class _LawView(Mapping):
-    """Term -> :class:`TermLaw` of one statistic, from the rows (live)."""
-
-    def __init__(self, statistic: str):
-        self._statistic = statistic
-        self._cache = [None, None]
-
-    def _rows(self):
-        if self._cache[0] != _version():
-            self._cache[:] = [_version(), {p.name: p.laws[self._statistic] for p in _processes()
-                                           if p.power_law and self._statistic in p.laws}]
-        return self._cache[1]
-
-    def __getitem__(self, key):
-        return self._rows()[key]
-
-    def __iter__(self):
-        return iter(self._rows())
-
-    def __len__(self):
-        return len(self._rows())
-
-
 #: The law of each term under each statistic (keys: ``AllanResult.statistic``, then term), from the rows' ``laws``.
 #: A term missing from a statistic's table contributes nothing to it (see :data:`UNESTIMABLE`).
-VARIANCE_LAWS = MappingProxyType({st: _LawView(st) for st in _STATISTIC_NAMES})
-
-
-class _UnestimableView(Mapping):
-    """(statistic, term) -> why the statistic cannot see the term, from the rows' ``unestimable``."""
-
-    def __init__(self):
-        self._cache = [None, None]
-
-    def _rows(self):
-        if self._cache[0] != _version():
-            self._cache[:] = [_version(), {(st, p.name): why for p in _processes() for st, why in p.unestimable.items()}]
-        return self._cache[1]
-
-    def __getitem__(self, key):
-        return self._rows()[key]
-
-    def __iter__(self):
-        return iter(self._rows())
-
-    def __len__(self):
-        return len(self._rows())
+VARIANCE_LAWS = MappingProxyType({
+    st: TableView(lambda st=st: {p.name: p.laws[st] for p in _processes() if p.power_law and st in p.laws}, st)
+    for st in _STATISTIC_NAMES})
 
 
 #: Why a statistic cannot estimate a term: (statistic, term) -> reason.
-UNESTIMABLE = _UnestimableView()
+UNESTIMABLE = TableView(lambda: {(st, p.name): why for p in _processes() for st, why in p.unestimable.items()},
+                        "UNESTIMABLE")
 
 
 def laws_of(statistic):

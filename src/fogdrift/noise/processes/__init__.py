@@ -36,6 +36,7 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from contextlib import contextmanager
 from types import MappingProxyType
 
@@ -48,7 +49,7 @@ from .base import ComponentSpec, LatentSpec, NoiseProcess, TermLaw, TermSpec
 __all__ = [
     "NoiseProcess", "TermSpec", "TermLaw", "LatentSpec", "ComponentSpec",
     "PROCESSES", "process", "processes", "power_law_names", "shaped_names", "register", "unregister", "registered",
-    "latent_processes", "component_specs", "version", "power_law_sdf", "model_sdf",
+    "latent_processes", "component_specs", "version", "power_law_sdf", "model_sdf", "TableView",
 ]
 
 #: The rows, in the order of the Allan-fit columns: the power-law terms by their power of tau, then S and M.
@@ -103,6 +104,39 @@ def _spellings(p: NoiseProcess) -> tuple:
     if p.latent is not None:
         out += [p.latent.name, *p.latent.aliases]
     return tuple(s.upper() for s in out)
+
+
+class TableView(Mapping):
+    """A read-only mapping built from the rows by ``build()`` (a dict), rebuilt only when the table changes: the live
+    views other modules keep (``TERM_TABLE``, GMWM's ``PROCESSES``, ``COMPONENT_KINDS``, ...), so that a registered
+    process appears in every one of them.
+
+    Examples
+    --------
+    >>> letters = TableView(lambda: {p.name: p.key for p in processes()}, "letters")
+    >>> letters["N"], len(letters) >= 7
+    ('white', True)
+    """
+
+    def __init__(self, build, name: str = "view"):
+        self._build, self._name, self._cache = build, name, (None, {})
+
+    def _rows(self) -> dict:
+        if self._cache[0] != _VERSION[0]:
+            self._cache = (_VERSION[0], self._build())
+        return self._cache[1]
+
+    def __getitem__(self, key):
+        return self._rows()[key]
+
+    def __iter__(self):
+        return iter(self._rows())
+
+    def __len__(self):
+        return len(self._rows())
+
+    def __repr__(self):
+        return f"{self._name}({list(self)})"
 
 
 def process(name) -> NoiseProcess:
