@@ -810,3 +810,23 @@ def test_when_nothing_passes_the_fallback_is_scored_under_the_pilots_v():
     pilot = min(score, key=score.get)
     assert sorted(score.values())[1] - score[pilot] > 1.0  # a clear pilot
     assert sel.omega_source == f"common: V at the iterated fit of {pilot}"
+
+
+def test_n_line_with_a_gmwm_bound_and_no_allan_n_claims_no_estimate():
+    # ROMY's quiet segment: no GMWM candidate passed (N only bounded by the WV) and the Allan fit holds no N: two
+    # bounds, not "N differs ... the estimate lies above the other side's bound" (there is no estimate)
+    from types import SimpleNamespace as NS
+
+    from fogdrift.gmwm.compare import _n_line
+
+    axis = NS(selection=NS(no_result=True, ieee=NS(terms={})), data_bounds=lambda: {"N": 4.8e-7})
+    fit = NS(terms={"N": NS(value=None, lo95=0.0, hi95=3.1e-7, status="absent", reason="not in the model")})
+    ok, line = _n_line(axis, fit)
+    assert ok is None and line.startswith("N: no estimate on either side: GMWM: no candidate passed")
+    assert "< 3.1e-07 deg/√h, its 95 % bound" in line and "lies above" not in line
+    # with an Allan estimate inside the WV's bound: consistent; above it: differs
+    fit_in = NS(terms={"N": NS(value=3e-7, lo95=2.5e-7, hi95=3.5e-7, status="resolved")})
+    assert _n_line(axis, fit_in)[0] is True
+    fit_out = NS(terms={"N": NS(value=6e-7, lo95=5.5e-7, hi95=6.5e-7, status="resolved")})
+    ok, line = _n_line(axis, fit_out)
+    assert ok is False and "lies above the other side's bound" in line

@@ -62,10 +62,15 @@ def _no_result_n_line(axis, fit):
              else "the Allan fit has no N")
     if not g_pass and not a_fit:
         return None, f"N: neither estimator has a result: {g_txt}; {a_txt}"
+    a_est = a is not None and a.value is not None
+    if (not g_pass and not a_est) or (not a_fit and g is None):  # two bounds (or one and nothing): no estimate
+        if a is not None and not a_est and a_fit and a.hi95 is not None:
+            a_txt = f"the Allan fit has no N (< {_g(a.hi95, 4)} deg/√h, its 95 % bound)"
+        return None, f"N: no estimate on either side: {g_txt}; {a_txt}"
     if not g_pass:
-        ok = a is not None and a.value is not None and gb is not None and (a.lo95 or a.value) <= gb
+        ok = gb is not None and (a.lo95 or a.value) <= gb
     else:
-        ok = g is not None and a is not None and a.hi95 is not None and g.lo95 <= a.hi95
+        ok = a.hi95 is not None and g.lo95 <= a.hi95
     return (ok, f"N {'is consistent' if ok else 'differs'}: {g_txt}; {a_txt}"
             + ("" if ok else "; the estimate lies above the other side's bound"))
 
