@@ -30,7 +30,7 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -q
 
-# Mutation testing (mutmut, config in pyproject.toml [tool.mutmut]; docs/testing.md). Not part of `make test`.
+# Mutation testing (mutmut, config in pyproject.toml [tool.mutmut]; docs/testing-rounds.md). Not part of `make test`.
 # One module: make mutation MUTANTS='fogdrift.metrics.*'   (names as `mutmut results` prints them)
 # NUMBA_THREADING_LAYER=workqueue: numba's OpenMP pool SIGTERMs a child forked after the parent ran a parallel kernel
 # (mutmut forks its workers from the process that ran the clean tests); those mutants ended 'exit -15', undecided.

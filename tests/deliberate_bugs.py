@@ -1,5 +1,5 @@
 """Deliberate bugs for issue 14's holes outside the pipeline: apply one (an exact one-line replacement), run the
-test that guards it, restore the file; prints one markdown row per bug (docs/testing.md).
+test that guards it, restore the file; prints one markdown row per bug (docs/testing-rounds.md).
 
     .venv/bin/python tests/deliberate_bugs.py        # needs a clean src/ (refuses otherwise); ~5 min on 2 cores
 
@@ -85,7 +85,7 @@ if __name__ == "__main__":
 
 
 # H-tests24 (issue 24, round 2: the GMWM statistics, evaluation at dt != 1 s, edges of tables).  Each entry is one
-# realistic one-line bug and the test of tests/test_rules_*.py that must fail on it (docs/testing.md, "Round 2
+# realistic one-line bug and the test of tests/test_rules_*.py that must fail on it (docs/testing-rounds.md, "Round 2
 # (issue 24)").  Run as part of the whole script (after the entries above), or one at a time from Python:
 #     import runpy; m = runpy.run_path("tests/deliberate_bugs.py"); m["H_TESTS24"]   # then apply/run/restore by hand
 H_TESTS24 = [

@@ -187,7 +187,7 @@ def _n_of(doc):
 
 
 # measured on clean simulated logs (white, white + random walk + bias, flicker-like bias instability, quantised
-# counts, triads a few times apart): 0 findings in 120 logs (tests below; docs/testing.md)
+# counts, triads a few times apart): 0 findings in 120 logs (tests below; docs/testing-rounds.md)
 def _clean(seed):
     rng = np.random.default_rng(seed)
     kind = seed % 4

@@ -1,4 +1,4 @@
-"""Edges of fogdrift.metrics that the mutation run (docs/testing.md) found unasserted.
+"""Edges of fogdrift.metrics that the mutation run (docs/testing-rounds.md) found unasserted.
 
 Hand values and exact boundaries: the p0 of AGO values, the training-block checks of ``mase`` and
 ``evaluate`` (exactly 2 samples accepted, 2-D or NaN refused), inf refused in either prediction, the
@@ -19,7 +19,7 @@ from fogdrift.errors import DataFormatError, FogdriftWarning, InsufficientDataEr
 from fogdrift.metrics import evaluate, mase, p0, p0_ago, skill
 
 # mutmut's trampolines add stack frames, so "the warning points at the caller" cannot hold under mutation
-# testing; the normal suite checks it (stacklevel mutants are listed as tool-equivalent in docs/testing.md)
+# testing; the normal suite checks it (stacklevel mutants are listed as tool-equivalent in docs/testing-rounds.md)
 import fogdrift.metrics  # noqa: E402
 
 CALLER_LINE_CHECKED = "mutants" not in Path(fogdrift.metrics.__file__).parts

@@ -1,4 +1,4 @@
-"""Tests added for the surviving mutants of ``fogdrift.evaluation.consistency`` (issue 24 item 2, docs/testing.md
+"""Tests added for the surviving mutants of ``fogdrift.evaluation.consistency`` (issue 24 item 2, docs/testing-rounds.md
 "Round 2: new modules (issues 21-23)"): the closed forms where the existing by-hand cases sit on a symmetric point
 (quantization at h != T; the Gauss-Markov small-x series branch), the origin-step validator at 0, and the keys and
 units of the returned records."""

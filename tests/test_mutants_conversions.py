@@ -1,4 +1,4 @@
-"""Tests added for the surviving mutants of ``fogdrift.export.conversions`` (issue 24 item 2, docs/testing.md
+"""Tests added for the surviving mutants of ``fogdrift.export.conversions`` (issue 24 item 2, docs/testing-rounds.md
 "Round 2: new modules (issues 21-23)").
 
 Each test pins a rule a one-line change would break: the inverse conversions by hand, the edges of the rate and

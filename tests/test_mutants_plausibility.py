@@ -449,7 +449,7 @@ def test_mixed_record_applies_the_gyro_rules_to_the_gyros_and_gravity_to_the_acc
 
 
 # ---------------------------------------------------------------------------------------------------------------
-# survivors of the full re-run with the workqueue layer (docs/testing.md)
+# survivors of the full re-run with the workqueue layer (docs/testing-rounds.md)
 
 
 @pytest.mark.parametrize("fs, text", [

@@ -1,4 +1,4 @@
-"""Tests added for the surviving mutants of ``fogdrift.noise.quantity`` (issue 24 item 2, docs/testing.md "Round 2:
+"""Tests added for the surviving mutants of ``fogdrift.noise.quantity`` (issue 24 item 2, docs/testing-rounds.md "Round 2:
 new modules (issues 21-23)"): :func:`express` re-states every number of a fit (value, interval, B_min and its SI
 copy, read-outs) by the factor of its own term, relabels the units, and leaves a gyro fit alone.
 

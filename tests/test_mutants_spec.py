@@ -1,4 +1,4 @@
-"""Tests added for the surviving mutants of ``fogdrift.spec`` (issue 24 item 2, docs/testing.md "Round 2: new
+"""Tests added for the surviving mutants of ``fogdrift.spec`` (issue 24 item 2, docs/testing-rounds.md "Round 2: new
 modules (issues 21-23)"): the accelerometer re-reading of gyro-labelled readings (every reading, bounds and
 missing values kept, the label saying what was done), the ``_why`` summary column, and ``judge_noise_fit`` on an
 accelerometer channel."""

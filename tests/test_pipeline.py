@@ -11,7 +11,7 @@ What is checked here, each against values written by hand (never against the pip
 - the model factory (registry names -> classes) and the verdict sentences (beat / did NOT beat / MIXED).
 
 A spy drift model records what the pipeline feeds it and returns predictions chosen by the test, so the
-expected metrics are exact numbers. Each test was shown to fail on a deliberate bug (docs/testing.md).
+expected metrics are exact numbers. Each test was shown to fail on a deliberate bug (docs/testing-rounds.md).
 """
 
 from __future__ import annotations
@@ -253,7 +253,7 @@ def test_verdict_sentences_on_constructed_metrics():
 
 
 # ---------------------------------------------------------------------------------------------------------
-# found unasserted by the mutation run (docs/testing.md): the causal path, as-measured p0, block-size
+# found unasserted by the mutation run (docs/testing-rounds.md): the causal path, as-measured p0, block-size
 # check, rate-input models, the factory call, config validation boundaries
 
 
