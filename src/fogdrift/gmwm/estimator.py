@@ -314,8 +314,12 @@ class _Problem:
         z0 = self.clipped(z0)
         with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
-            res = optimize.least_squares(self._fun, z0, jac=self._jac, bounds=(self.lo, self.hi), method="trf",
-                                         xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=max_nfev, x_scale="jac")
+            try:
+                res = optimize.least_squares(self._fun, z0, jac=self._jac, bounds=(self.lo, self.hi), method="trf",
+                                             xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=max_nfev, x_scale="jac")
+            except ValueError:  # the model gave no finite Jacobian on the way (a column scaled by "jac" became 0):
+                q0 = self.q(z0)  # a failed start, not a failed fit: the other starts decide
+                return z0, (q0 if np.isfinite(q0) else np.inf), False
         return res.x, float(2.0 * res.cost), bool(res.success)
 
     def clipped(self, z0) -> np.ndarray:
