@@ -12,8 +12,8 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from fogdrift import pipeline_sums
-from fogdrift.pipeline_sums import AllanSums
+from fogdrift.allan import sums as pipeline_sums
+from fogdrift.allan.sums import AllanSums
 
 N = 1 << 22            # 32 MB of float64 input
 CHUNK = 1 << 18        # start indices per out-of-core chunk: windows of a few MB

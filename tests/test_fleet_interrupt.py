@@ -103,7 +103,7 @@ def test_a_killed_workers_dead_lock_file_is_removed_a_live_one_kept(tmp_path, mo
     # kernel drops the lock itself); the batch removes it after killing its workers, never one still held
     from fogdrift.fleet import runner
     from fogdrift.fleet.tasks import FileTask
-    from fogdrift.output import LOCK, _FolderLock
+    from fogdrift.output import LOCK, FolderLock
 
     monkeypatch.setattr(runner, "STALE_LOCK_WAIT_S", 0.05)
     dead, live = tmp_path / "dead.npy", tmp_path / "live.npy"
@@ -111,7 +111,7 @@ def test_a_killed_workers_dead_lock_file_is_removed_a_live_one_kept(tmp_path, mo
         folder.mkdir()
         (folder / BATCH_JSON).write_text("{}")
     (dead / LOCK).write_text("'fogdrift allan' (process 12345, killed)")  # nobody holds it
-    held = _FolderLock(live, "a run still writing")
+    held = FolderLock(live, "a run still writing")
     held.acquire()
     try:
         tasks = [FileTask(path=str(f), file=f.name, out_dir=str(f), rel_out=f.name, command="allan", settings={},

@@ -132,7 +132,7 @@ def _record(n=2**14, seed=5):
 def test_allan_check_reuses_the_plausibility_sums(monkeypatch):
     from fogdrift.allan import _kernels
     from fogdrift.gmwm.analysis import analyse_gmwm
-    from fogdrift.gmwm.compare import attach_allan_checks
+    from fogdrift.workflows.noise import attach_allan_checks
     from fogdrift.plausibility import check_record
 
     rec = _record()
@@ -155,8 +155,8 @@ def test_allan_check_reuses_the_plausibility_sums(monkeypatch):
 
 def test_noise_command_hands_the_plausibility_sums_to_the_allan_check(monkeypatch, tmp_path):
     from fogdrift.cli import app
-    from fogdrift.gmwm import compare
-    from fogdrift.pipeline_sums import AllanSums
+    from fogdrift.workflows import noise as compare
+    from fogdrift.allan.sums import AllanSums
 
     rec = _record(2**13)
     path = tmp_path / "log.csv"

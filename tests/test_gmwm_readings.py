@@ -26,7 +26,7 @@ from fogdrift.allan import allan_variance
 from fogdrift.cli import app
 from fogdrift.gmwm import gmwm_fit, haar_wvar, simulate_latent, to_ieee
 from fogdrift.gmwm.analysis import analyse_gmwm, b_detail_lines, ieee_rows, read_curve_table
-from fogdrift.gmwm.compare import compare_with_allan
+from fogdrift.evaluation.gmwm_vs_allan import compare_with_allan
 from fogdrift.gmwm.ieee import B_ADEV_FACTOR
 from fogdrift.noise import fit_noise
 

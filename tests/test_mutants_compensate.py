@@ -743,7 +743,7 @@ def test_plot_before_after_draws_what_it_says(monkeypatch, tmp_path):
         saved.update(fig=fig, path=path, kw=kw)
         return "returned"
 
-    monkeypatch.setattr(outputs, "_save", fake_save)
+    monkeypatch.setattr(outputs, "save_figure", fake_save)
 
     def res(adev):
         adev = np.asarray(adev, dtype=float)
@@ -786,18 +786,18 @@ def test_plot_before_after_draws_what_it_says(monkeypatch, tmp_path):
 
     assert text.get_text() == literal(textwrap.fill(caveats["gx"], width=80)) and "\n" in text.get_text()
     assert [t.get_text() for t in axs[1].texts] == ["fine"] and axs[1].texts[0].get_color() == "k"
-    outputs._plt().close(fig)
+    outputs.pyplot().close(fig)
     for cav in (None, {}, {"gx": ""}, {"gz": "not checked"}):
         outputs.plot_before_after(curves[:1], tmp_path / "g.png", "t", cav)
         assert len(saved["fig"].axes[0].texts) == 0
         assert_allclose(saved["fig"].get_size_inches(), [5.2, 4.2])
-        outputs._plt().close(saved["fig"])
+        outputs.pyplot().close(saved["fig"])
     outputs.plot_before_after(curves[:1], tmp_path / "g.png", "t", {"gx": "x not checked"})
     assert saved["fig"].axes[0].texts[0].get_color() == "C3"
-    outputs._plt().close(saved["fig"])
+    outputs.pyplot().close(saved["fig"])
     outputs.plot_before_after(curves[:1], tmp_path / "g.png", "t", {"gx": "a" * 40 + " " + "b" * 40})  # 81 chars
     assert saved["fig"].axes[0].texts[0].get_text() == "a" * 40 + "\n" + "b" * 40  # wrapped at 80
-    outputs._plt().close(saved["fig"])
+    outputs.pyplot().close(saved["fig"])
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -1,9 +1,9 @@
 """Rules of the GMWM read-outs that mutation round 3 (issue 24) found unpinned: the accelerometer re-statement
-(:mod:`fogdrift.gmwm.quantity`), the GMWM-vs-Allan sentences (:mod:`fogdrift.gmwm.compare`) and the model selection
+(:mod:`fogdrift.gmwm.quantity`), the GMWM-vs-Allan sentences (:mod:`fogdrift.evaluation.gmwm_vs_allan`) and the model selection
 (:mod:`fogdrift.gmwm.selection`: WIC ordering, checks, exclusion scan, fallbacks).
 
 Every expected value is written here by hand from the rule (the factor table of ``gmwm/quantity.py``'s docstring,
-the comparison rules of ``gmwm/compare.py``'s docstring, the check rules of ``gmwm/selection.py``'s docstring); the
+the comparison rules of ``evaluation/gmwm_vs_allan.py``'s docstring, the check rules of ``gmwm/selection.py``'s docstring); the
 objects fed to the read-outs are built by hand (only the public attributes the functions read), so each case runs in
 milliseconds.  The few selection cases that fit models use small seeded simulations (2^12-2^15 samples).
 """
@@ -18,8 +18,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from fogdrift.gmwm import compare as cmp
-from fogdrift.gmwm.compare import attach_allan_checks, compare_with_allan
+from fogdrift.evaluation import gmwm_vs_allan as cmp
+from fogdrift.evaluation.gmwm_vs_allan import compare_with_allan
+from fogdrift.workflows.noise import attach_allan_checks
 from fogdrift.gmwm.ieee import BiasInstability, IEEEResult, IEEEValue
 from fogdrift.gmwm.quantity import GMWM_ACCEL_UNITS, UG_PER_MPS2, accel_rows, express_gmwm
 from fogdrift.noise.quantity import restate_text
@@ -138,7 +139,7 @@ def test_accel_rows_show_b_in_micro_g():
 
 
 # ---------------------------------------------------------------------------------------------------------------
-# gmwm/compare.py: GMWM against the Allan fit, in words
+# evaluation/gmwm_vs_allan.py: GMWM against the Allan fit, in words
 # ---------------------------------------------------------------------------------------------------------------
 def _n(value, lo=None, hi=None, reason=None):
     ns = SimpleNamespace(value=value, lo95=lo, hi95=hi)
@@ -817,7 +818,7 @@ def test_n_line_with_a_gmwm_bound_and_no_allan_n_claims_no_estimate():
     # bounds, not "N differs ... the estimate lies above the other side's bound" (there is no estimate)
     from types import SimpleNamespace as NS
 
-    from fogdrift.gmwm.compare import _n_line
+    from fogdrift.evaluation.gmwm_vs_allan import _n_line
 
     axis = NS(selection=NS(no_result=True, ieee=NS(terms={})), data_bounds=lambda: {"N": 4.8e-7})
     fit = NS(terms={"N": NS(value=None, lo95=0.0, hi95=3.1e-7, status="absent", reason="not in the model")})

@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
-from fogdrift.noise import checks
+from fogdrift.noise import checks, context
 from fogdrift.noise._spectral_null import _MedianNull, _null_and_critical
 from fogdrift.noise.periodic import NULL_TOLERANCE, PeriodicContent, null_taus, periodic_content
 from fogdrift.noise.result import NoiseTerm
@@ -48,7 +48,7 @@ def _chi2_2_ppf(p):
 
 def test_point_limit_is_the_4_sigma_lower_chi2_quantile():
     y = np.array([1.0, 4.0])
-    got = checks._point_limits(y, np.array([2.0, 2.0]))
+    got = context.point_limits(y, np.array([2.0, 2.0]))
     np.testing.assert_allclose(got, y * 2.0 / _chi2_2_ppf(3.17e-5), rtol=1e-9)
     assert got[0] == pytest.approx(1.0 / 3.17e-5, rel=1e-4)  # ~31500 y: one point bounds little
     # an EDF far below 1 (quantile 0) bounds nothing: inf, and no RuntimeWarning, even for y = 0 (0 / 0)
@@ -56,7 +56,7 @@ def test_point_limit_is_the_4_sigma_lower_chi2_quantile():
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        got = checks._point_limits(np.array([0.0, 1.0]), np.array([1e-9, 1e-9]))
+        got = context.point_limits(np.array([0.0, 1.0]), np.array([1e-9, 1e-9]))
     assert np.isinf(got[1])
 
 

@@ -421,7 +421,7 @@ def test_range_finding_names_only_the_axes_above_the_range():
 
 
 def test_check_record_hands_back_the_sums_of_each_axis():
-    from fogdrift.pipeline_sums import AllanSums
+    from fogdrift.allan.sums import AllanSums
 
     sums = {}
     rec = _triad((0.0, 0.0, 15.0), sd=1.0, n=2000)
@@ -490,7 +490,7 @@ def test_mixed_record_sample_rate_once_and_sums_of_its_gyro_axes(tmp_path):
     """A gyro + accelerometer record at an implausible 0.05 Hz: the sample-rate finding once (not once more from
     the gyro sub-record), and the gyro axes' Allan sums handed back to the caller."""
     from fogdrift.io import load
-    from fogdrift.pipeline_sums import AllanSums
+    from fogdrift.allan.sums import AllanSums
 
     rng = np.random.default_rng(9)
     n = 400

@@ -44,7 +44,7 @@ from fogdrift.noise import (
     paper_table1_from_A,
     term_spec,
 )
-from fogdrift.noise.identify import flicker_shape
+from fogdrift.noise.context import flicker_shape
 from fogdrift.simulate import simulate
 
 R10_A = [1.27635511e-1, 9.0e-2, 4.412712e-5, 3.7037037e-8, 9.6450617e-11]

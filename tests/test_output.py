@@ -91,15 +91,15 @@ def test_atomic_path_renames_only_a_complete_file(tmp_path):
 
 def test_numpy_and_matplotlib_writers_keep_the_extension(tmp_path):
     import numpy as np
-    from fogdrift.report import _plt, _save
+    from fogdrift.report import pyplot, save_figure
 
     with atomic_path(tmp_path / "s.npz") as tmp:
         np.savez(tmp, x=np.arange(3))
     with np.load(tmp_path / "s.npz") as z:
         assert z["x"].tolist() == [0, 1, 2]
-    plt = _plt()
+    plt = pyplot()
     fig, _ = plt.subplots()
-    _save(fig, tmp_path / "f.png")
+    save_figure(fig, tmp_path / "f.png")
     assert (tmp_path / "f.png").read_bytes()[:4] == b"\x89PNG"
     assert listing(tmp_path) == ["f.png", "s.npz"]
 

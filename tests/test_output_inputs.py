@@ -249,7 +249,7 @@ def test_an_interrupted_allan_rerun_keeps_the_earlier_output(tmp_path, monkeypat
     def ctrl_c(*a, **k):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(report, "_save", ctrl_c)  # Ctrl-C as the figure is written (after allan.json)
+    monkeypatch.setattr(report, "save_figure", ctrl_c)  # Ctrl-C as the figure is written (after allan.json)
     second = runner.invoke(app, ["allan", str(log), "--out", str(out)])
     assert second.exit_code == 130, second.output
     assert "the earlier run's files there are unchanged" in second.output and "were taken back" in second.output

@@ -12,7 +12,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from fogdrift import pipeline, pipeline_sums
+from fogdrift import pipeline
+from fogdrift.allan import sums as pipeline_sums
 from fogdrift.allan import allan_variance
 from fogdrift.allan.ci import periodic_alpha
 from fogdrift.noise.periodic import null_taus, periodic_content
@@ -179,7 +180,7 @@ def test_plausibility_sums_are_handed_on_and_reused(monkeypatch):
 
 
 def test_sums_of_another_array_are_not_reused():
-    from fogdrift.pipeline_sums import AllanSums
+    from fogdrift.allan.sums import AllanSums
 
     x = _series(5000, False)
     s = AllanSums(x, DT)

@@ -134,14 +134,14 @@ def test_plot_allan_size_and_no_text_clipped(tmp_path, monkeypatch):
     rec = from_array(y, dt_s=dt, unit="deg/h", axis_names=["gx", "gyro y (the long name of a column)", "gz"])
     res = run_allan(rec, AnalysisConfig().validate())
     seen = {}
-    save = figures._save
+    save = figures.save_figure
 
     def checked_save(fig, path, **kw):
         seen["engine"] = fig.get_layout_engine()
         seen["problems"] = _problems(fig)
         return save(fig, path, **kw)
 
-    monkeypatch.setattr(figures, "_save", checked_save)
+    monkeypatch.setattr(figures, "save_figure", checked_save)
     path = figures.plot_allan(res, tmp_path / "allan.png")
     assert seen["engine"] is None
     assert seen["problems"] == []

@@ -132,7 +132,7 @@ VALUES = [None, 0.0, -0.0, 1.0, -2.5, 2.41234e-4, 9.99949e-4, 1e-3, 0.012345678,
 @pytest.mark.parametrize("x", VALUES)
 def test_one_formatter_prints_what_each_old_one_printed(x):
     from fogdrift.fleet.page import _fmt as page
-    from fogdrift.gmwm.compare import _g
+    from fogdrift.evaluation.gmwm_vs_allan import _g
     from fogdrift.report.gmwm import fmt as gmwm
     from fogdrift.report.tables import _fmt as table
 
@@ -152,7 +152,7 @@ def test_no_copies_in_the_report_and_fleet_packages():
 
     src = Path(__file__).resolve().parents[1] / "src" / "fogdrift"
     files = [*sorted((src / "report").glob("*.py")), src / "fleet" / "commands.py", src / "fleet" / "page.py",
-             src / "fleet" / "summary.py", src / "gmwm" / "ieee.py", src / "gmwm" / "compare.py"]
+             src / "fleet" / "summary.py", src / "gmwm" / "ieee.py", src / "evaluation" / "gmwm_vs_allan.py"]
     for f in files:
         text = f.read_text(encoding="utf-8")
         assert '"Q", "N", "B", "K", "R"' not in text, f"{f.name}: read the term list from noise.terms.TERMS"

@@ -54,14 +54,18 @@ def _is_type_checking(node: ast.AST) -> bool:
                                          or (isinstance(t, ast.Attribute) and t.attr == "TYPE_CHECKING"))
 
 
-def import_edges(src: Path, package: str) -> tuple[dict, list[Edge]]:
-    """Every internal import of ``package`` (module-level and deferred) as :class:`Edge`."""
+def import_edges(src: Path, package: str, *, type_checking: bool = False) -> tuple[dict, list[Edge]]:
+    """Every internal import of ``package`` (module-level and deferred) as :class:`Edge`; with ``type_checking``
+    also the imports under ``if TYPE_CHECKING:`` (as deferred edges: they never run, but a type-only circle still
+    ties two modules together)."""
     mods = _modules(src, package)
     edges: list[Edge] = []
     for mod, (path, is_pkg) in mods.items():
         def visit(node, deferred):
             for ch in ast.iter_child_nodes(node):
                 if _is_type_checking(ch):
+                    if type_checking:
+                        visit(ch, True)
                     continue
                 d = deferred or isinstance(ch, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
                 if isinstance(ch, ast.Import):
@@ -199,10 +203,9 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.pipeline": ("model modules load on use, through the registry (test_model_registry: importing the "
                           "pipeline imports no model module); GMWM (gmwm.estimator: scipy.optimize's least squares, "
                           "gmwm.simulate: scipy.signal) only for noise_method='gmwm', so allan, separate and model "
-                          "never load it (test_speed_imports)", ("fogdrift.models.grey", "fogdrift.gmwm.analysis")),
-    "fogdrift.report.summary": ("GMWM's comparison with the Allan fit (gmwm.compare -> gmwm.estimator: scipy.optimize) "
-                                "only for an axis that has a GMWM fit, so allan and separate never load gmwm "
-                                "(test_speed_imports)", ("fogdrift.gmwm.compare",)),
+                          "never load it (test_speed_imports)", ("fogdrift.gmwm.analysis", "fogdrift.evaluation.gmwm_vs_allan")),
+    "fogdrift.pipeline.config": ("model modules load on use, through the registry (test_model_registry)",
+                                 ("fogdrift.models.grey",)),
     "fogdrift.io.load": ("optional readers: the reader registry imports a reader module on first use", (
         "fogdrift.io.registry",)),
     "fogdrift.lifting._kernels": (NUMBA, ("fogdrift.lifting._numba",)),

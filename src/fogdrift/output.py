@@ -52,13 +52,13 @@ from .errors import ConfigError, FogdriftError, ResourceError
 from .interrupt import check, critical
 from .interrupt import requested as check_requested
 
-try:  # POSIX; elsewhere runs are not serialised (said in the docstring of _FolderLock)
+try:  # POSIX; elsewhere runs are not serialised (said in the docstring of FolderLock)
     import fcntl
 except ImportError:  # pragma: no cover - not on the supported platforms
     fcntl = None
 
 __all__ = ["MANIFEST", "LOCK", "TMP_PREFIX", "BACKUP_PREFIX", "OutputDir", "atomic_path", "check_out_dir",
-           "active", "remove_stale_temporaries", "recover"]
+           "active", "remove_stale_temporaries", "recover", "FolderLock"]
 
 #: Name of the manifest a run keeps in its output folder.
 MANIFEST = ".fogdrift-manifest.json"
@@ -258,7 +258,7 @@ def _out_of_memory(exc: BaseException) -> bool:
     return False
 
 
-class _FolderLock:
+class FolderLock:
     """Exclusive, non-blocking ``flock`` on ``folder/LOCK``; the holder's description is written into the file.
 
     The file is unlinked while still locked when released; a process that opened the old file before the unlink
@@ -484,7 +484,7 @@ class OutputDir:
         self._prev_files: list[str] = []
         self._backup = f"{BACKUP_PREFIX}{os.getpid()}"
         self._started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
-        self._folder_lock = _FolderLock(self.path, f"'fogdrift {command}' (process {os.getpid()}, started "
+        self._folder_lock = FolderLock(self.path, f"'fogdrift {command}' (process {os.getpid()}, started "
                                                    f"{self._started})")
 
     # -- context ------------------------------------------------------------------------------------

@@ -64,7 +64,7 @@ import numpy as np
 from ._util import fmt_number
 from .errors import ConfigError, FogdriftWarning, render_options
 from .health import health_findings
-from .pipeline_sums import AllanSums
+from .allan.sums import AllanSums
 from .units import EARTH_RATE_DPH, STANDARD_GRAVITY_MPS2, parse_unit
 
 __all__ = [
@@ -171,7 +171,7 @@ def noise_floor(rate_dph, dt_s, *, keep: list | None = None) -> NoiseFloor:
     up to 1/:data:`MIN_CLUSTERS` of the record, and at most :data:`MAX_CHECK_SAMPLES` samples.
     ``lo68``/``hi68`` take the same minimum over the 68 % bounds.
 
-    ``keep``: a list to which the :class:`~fogdrift.pipeline_sums.AllanSums` behind the floor is appended when
+    ``keep``: a list to which the :class:`~fogdrift.allan.sums.AllanSums` behind the floor is appended when
     it covers the whole series (at most :data:`MAX_CHECK_SAMPLES` samples), for the Allan analysis to reuse.
 
     Examples
@@ -253,7 +253,7 @@ def check_record(record, *, sums: dict | None = None) -> list[Finding]:
     """Findings for a :class:`~fogdrift.io.GyroRecord` that no gyro would produce (see the module docstring).
 
     ``sums``: a dict that receives, per gyro axis checked on its whole series, the Allan operator sums of its
-    noise floor (:class:`~fogdrift.pipeline_sums.AllanSums`), for :func:`fogdrift.pipeline.run_allan` (``sums=``)
+    noise floor (:class:`~fogdrift.allan.sums.AllanSums`), for :func:`fogdrift.pipeline.run_allan` (``sums=``)
     to reuse instead of computing the octave ADEV again.
 
     The sensor-health rules of :mod:`fogdrift.health` (frozen stretches, clipping, axes in mixed units,

@@ -48,7 +48,7 @@ from .errors import ConfigError
 
 __all__ = ["analysis_judgements", "ITEMS", "G0", "SpecLimit", "Reading", "Judgement", "parse_quantity", "convert", "read_spec",
            "parse_spec", "judge", "readings_from_noise_fit", "readings_from_gmwm", "compare", "B_COMPARED",
-           "channel_kind", "judgement_line", "spec_columns", "judge_noise_fit"]
+           "channel_kind", "judgement_line", "spec_columns", "judge_noise_fit", "norm_unit"]
 
 #: Standard gravity [m/s^2] (CGPM 1901; ISO 80000-3).
 G0 = 9.80665
@@ -81,7 +81,7 @@ _KINDS = {"gyro": "gyro", "gyroscope": "gyro", "accel": "accel", "accelerometer"
 _NUMBER = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(.*?)\s*$")
 
 
-def _norm_unit(text: str) -> str:
+def norm_unit(text: str) -> str:
     """Lower case, no spaces, one spelling: ° -> deg, µ -> u, hr -> h, sec -> s, √x / rt(x) -> sqrt(x), ² -> ^2."""
     u = str(text).strip().lower().replace(" ", "")
     u = u.replace("°", "deg").replace("µ", "u").replace("μ", "u").replace("²", "^2").replace("**", "^")
@@ -122,7 +122,7 @@ def parse_quantity(text, kind: str, item: str) -> tuple[float, str]:
     if not unit:
         raise ConfigError(f"spec {where}: {text!r} has no unit; write it with one, e.g. \"{text.strip()} "
                           f"{canonical}\"")
-    key = _norm_unit(unit)
+    key = norm_unit(unit)
     if key not in table:
         raise ConfigError(f"spec {where}: unknown unit {unit!r} for the {what}; expected one of "
                           f"{', '.join(table)}")
@@ -142,7 +142,7 @@ def convert(value: float, unit: str, kind: str, item: str) -> float:
     60.0
     """
     table = ITEMS[(kind, item)][1]
-    key = _norm_unit(unit)
+    key = norm_unit(unit)
     if key not in table:
         raise ConfigError(f"unit {unit!r} is not one of the {kind} {item} units ({', '.join(table)})")
     return float(value) * table[key]
@@ -363,7 +363,7 @@ def _accel_in_place_of_deg_h(readings: dict) -> dict:
     accelerometer unit is kept)."""
     out = {}
     for item, r in readings.items():
-        key = None if r is None else _norm_unit(r.unit)
+        key = None if r is None else norm_unit(r.unit)
         if key not in _GYRO_LABEL_AS_ACCEL:
             out[item] = r
             continue

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..output import TMP_PREFIX
-from ..report.figures import _plt, _save, literal
+from ..report.figures import pyplot, save_figure, literal
 
 __all__ = ["CsvWriter", "NpzWriter", "AllanAccumulator", "plot_before_after"]
 
@@ -153,7 +153,7 @@ def plot_before_after(curves, path, title, caveats: dict | None = None) -> Path:
     """
     import textwrap
 
-    plt = _plt()  # matplotlib stays lazy (Agg backend), as for every figure of the package
+    plt = pyplot()  # matplotlib stays lazy (Agg backend), as for every figure of the package
     n = len(curves)
     fig, axs = plt.subplots(1, n, figsize=(5.2 * n, 4.2), squeeze=False)
     for ax, (name, before, after, label) in zip(axs[0], curves):
@@ -174,4 +174,4 @@ def plot_before_after(curves, path, title, caveats: dict | None = None) -> Path:
         if text:
             ax.text(0.0, -0.17, literal(textwrap.fill(text, width=80)), transform=ax.transAxes, ha="left", va="top",
                     fontsize=7, color="C3" if "not evidence" in text or "not checked" in text else "k")
-    return _save(fig, path, dpi=110, bbox_inches="tight")  # atomic, and the figure closed whatever happens
+    return save_figure(fig, path, dpi=110, bbox_inches="tight")  # atomic, and the figure closed whatever happens

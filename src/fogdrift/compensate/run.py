@@ -136,7 +136,7 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", unit=None
     figures : bool
         Write the before/after Allan figure (:func:`fogdrift.compensate.outputs.plot_before_after`: column and
         model names drawn as written through :func:`fogdrift.report.figures.literal`, never as mathtext, and
-        saved by :func:`fogdrift.report.figures._save` like every figure of the package).
+        saved by :func:`fogdrift.report.figures.save_figure` like every figure of the package).
     heading, artefacts : bool
         Run the heading-error evaluation (every model of the bundle plus constant bias, on the whole log) /
         the filtering-artefact check (both by default; the before/after figure and the messages carry the

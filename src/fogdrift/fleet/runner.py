@@ -42,9 +42,9 @@ from typing import Callable
 from .. import interrupt
 from ..errors import ConfigError
 from ..io import load as load_fn
-from ..io.load import _options
+from ..io.load import check_load_options
 from ..io.readers.base import require
-from ..output import LOCK, TMP_PREFIX, OutputDir, _FolderLock, active, recover, remove_stale_temporaries
+from ..output import LOCK, TMP_PREFIX, OutputDir, FolderLock, active, recover, remove_stale_temporaries
 from .commands import command_spec, spec_from_settings
 from .summary import COLUMNS, write_summary
 from .tasks import MANIFEST, FileTask, run_file
@@ -354,7 +354,7 @@ def _validate(settings: dict) -> None:
     if set(load) - allowed:
         raise ConfigError(f"unknown load settings {sorted(set(load) - allowed)}; expected some of {sorted(allowed)}")
     try:
-        _options(load.get("columns"), load.get("time_column", "auto"), load.get("dt_s"), load.get("rate_hz"),
+        check_load_options(load.get("columns"), load.get("time_column", "auto"), load.get("dt_s"), load.get("rate_hz"),
                  load.get("unit"), load.get("time_unit"), load.get("delimiter"), "error", load.get("min_samples", 2),
                  load.get("format"), load.get("reader_options"), load.get("temperature"))
     except TypeError as exc:
@@ -568,7 +568,7 @@ def _remove_temporaries(tasks, killed=()) -> None:
                 with contextlib.suppress(OSError):
                     tmp.unlink()
         while (folder / LOCK).exists():
-            lock = _FolderLock(folder, f"fogdrift batch (process {os.getpid()}) removing a killed worker's lock")
+            lock = FolderLock(folder, f"fogdrift batch (process {os.getpid()}) removing a killed worker's lock")
             try:
                 lock.acquire()  # free once the worker's process has exited
             except (ConfigError, OSError):

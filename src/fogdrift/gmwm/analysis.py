@@ -66,7 +66,7 @@ class GmwmAxis:
     name: str
     wvar: WvarResult
     selection: SelectionResult
-    #: The comparison with the Allan fit of the same record (:func:`fogdrift.gmwm.compare.compare_with_allan`),
+    #: The comparison with the Allan fit of the same record (:func:`fogdrift.evaluation.gmwm_vs_allan.compare_with_allan`),
     #: when one was made: ``{"agree": bool, "lines": [str, ...], ...}``.
     allan_check: dict | None = None
     #: The spectral lines of the rate (:class:`fogdrift.noise.periodic.PeriodicContent`) the selection took into

@@ -32,7 +32,7 @@ from .record import GyroRecord
 from .registry import reader_by_name, select_reader
 
 __all__ = ["load", "load_segments", "time_unit_of_name", "TIME_COLUMN_NAMES", "GAP_FACTOR", "DT_TOLERANCE",
-           "SHORT_STEP_FACTOR", "JITTER_TOLERANCE"]
+           "SHORT_STEP_FACTOR", "JITTER_TOLERANCE", "check_load_options"]
 
 #: Column names (compared case-insensitively) that ``time_column="auto"`` takes as time; so does one of the
 #: first, third or last with a time-unit suffix (``t_ms``, ``time_us``, ``timestamp_ns``).
@@ -178,8 +178,8 @@ def load(
     """
     if gaps not in ("error", "split"):
         raise ConfigError(f"gaps must be 'error' or 'split'; got {gaps!r}")
-    opts = _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
-                    reader_options, temperature)
+    opts = check_load_options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples,
+                              format, reader_options, temperature)
     records = _load_records(path, opts)
     if len(records) == 1:
         return records[0]
@@ -234,8 +234,8 @@ def load_segments(
     """
     if gaps not in ("error", "split"):
         raise ConfigError(f"gaps must be 'error' or 'split'; got {gaps!r}")
-    opts = _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
-                    reader_options, temperature)
+    opts = check_load_options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples,
+                              format, reader_options, temperature)
     return _load_records(path, opts)
 
 
@@ -256,7 +256,7 @@ class _Options:
     temperature: object = None
 
 
-def _options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
+def check_load_options(columns, time_column, dt_s, rate_hz, unit, time_unit, delimiter, gaps, min_samples, format,
              reader_options, temperature=None) -> _Options:
     """Validate every option before the file is touched."""
     spec = None if unit is None else parse_unit_choice(unit)

@@ -10,28 +10,20 @@ error; and B read the IEEE-952 way, min ADEV / 0.664.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..units import B_FACTOR
+from .context import FitContext, point_limits
 from .distributions import chi2_ppf
 from .engine import ScoreProblem, profile_interval
 from .periodic import Q_OVER_ENVELOPE, q_stands_above_lines
 from .result import NoiseTerm
 from .terms import DISPLAY_UNITS, TERM_TABLE, all_terms, markov_shape, periodic_shape
 
-if TYPE_CHECKING:
-    from .identify import _Context
 
 _names = all_terms  # the fit's columns: Q N B K R (then any registered power-law term), S, M
 
-
-def _point_limits(y, nu) -> np.ndarray:
-    """Each point's ~4-sigma upper limit ``y nu / chi2_nu(3.17e-5)`` (the 4-sigma lower quantile of chi2_nu / nu);
-    inf where nu << 1 (the quantile is 0: the point bounds nothing)."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        return y * nu / chi2_ppf(3.17e-5, nu)
 
 
 def _points_outside(y, mu, nu) -> np.ndarray:
@@ -43,7 +35,7 @@ def _points_outside(y, mu, nu) -> np.ndarray:
     return np.flatnonzero((mu < lo) | (mu > hi))
 
 
-def _check_floor(terms, c: _Context, A) -> None:
+def _check_floor(terms, c: FitContext, A) -> None:
     """Refuse a flat B floor above the measured curve's minimum (its 95 % upper bound): the data fall below it."""
     i = _names().index("B")
     floor_var = A[i]
@@ -59,7 +51,7 @@ def _check_floor(terms, c: _Context, A) -> None:
             f"record; classical bound B <= min {name} / {math.sqrt(scale):.4g} = {bound:.3g} deg/h")
 
 
-def _classical_b(c: _Context, A, floor_refused: bool = False) -> dict:
+def _classical_b(c: FitContext, A, floor_refused: bool = False) -> dict:
     """IEEE-952 practice: bias instability read at the minimum of the (fitted) Allan deviation, B = min ADEV / 0.664.
 
     The minimum is searched on the fitted curve inside the fitted tau range.  When it sits at the longest tau the
@@ -105,7 +97,7 @@ def _classical_b(c: _Context, A, floor_refused: bool = False) -> dict:
     }
 
 
-def _drop_rejected(c: _Context, prob, res, best, plausible_delta=6.0):
+def _drop_rejected(c: FitContext, prob, res, best, plausible_delta=6.0):
     """Re-select without every selected term its own checks reject.  Returns ``(best, {index: NoiseTerm})`` with
     the dropped terms' entries (status ``not_estimable``, the bound and the reason).
 
@@ -132,7 +124,7 @@ def _drop_rejected(c: _Context, prob, res, best, plausible_delta=6.0):
                 u = float(prob.upper[i])
                 if u > 0 and a[i] >= (1.0 - 1e-3) * u and len(best) > 1:
                     name = _names()[i]
-                    ub_pt = _point_limits(prob.y, prob.nu)
+                    ub_pt = point_limits(prob.y, prob.nu)
                     k = int(np.nanargmin(np.where(prob.X[:, i] > 0, ub_pt / np.where(prob.X[:, i] > 0, prob.X[:, i], 1),
                                                   np.inf)))
                     if name in c.laws:
@@ -166,7 +158,7 @@ def _drop_rejected(c: _Context, prob, res, best, plausible_delta=6.0):
     return best, dropped
 
 
-def _q_at_whole_periods(c: _Context, prob, best, A, d2, periodic, out_terms) -> None:
+def _q_at_whole_periods(c: FitContext, prob, best, A, d2, periodic, out_terms) -> None:
     """Quantization and a periodic error both fall like tau^-2 below the period, and lines the spectrum did not
     detect (the weak harmonics of a sawtooth) add exactly such a tail; only the taus from the shortest period on
     (where every line of a component vanishes at its whole periods) tell them apart.  A Q the fit resolves is kept

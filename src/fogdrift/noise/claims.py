@@ -12,18 +12,15 @@ from __future__ import annotations
 
 import functools
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import brentq
 
+from .context import FitContext
 from .distributions import chi2_ppf
 from .result import NoiseTerm
 from .rules import SLOPES, slope_claim
 from .terms import TERM_TABLE, all_terms, power_terms
-
-if TYPE_CHECKING:
-    from .identify import _Context
 
 _names = all_terms  # the fit's columns: Q N B K R (then any registered power-law term), S, M
 
@@ -31,7 +28,7 @@ _names = all_terms  # the fit's columns: Q N B K R (then any registered power-la
 _CURVE = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}
 
 
-def _measured_limits(c: _Context, nu):
+def _measured_limits(c: FitContext, nu):
     """The 95 % chi-squared interval ``[y nu / chi2_nu(0.975), y nu / chi2_nu(0.025)]`` of each point: with the
     EDF of the measured curve's own interval (its ``var_hi95``), which the slope rule needs -- the model's EDF at
     a long tau is that of the model being judged (a K model lends the long taus its own, wider, scatter) --
@@ -61,7 +58,7 @@ def _edf_from_upper(ratio: float) -> float:
     return math.exp(brentq(f, lo, hi, xtol=1e-6))
 
 
-def _slope_refusals(c: _Context, prob, res) -> dict:
+def _slope_refusals(c: FitContext, prob, res) -> dict:
     """``{subset: SlopeClaim}`` of the candidates of ``res`` whose K or R fails the sustained-slope rule
     (:func:`fogdrift.noise.rules.slope_claim`: it must dominate over an octave, the curve must rise there as the
     model says, and the model must meet the longest taus).  Such a candidate is not selectable: a hump is a
@@ -84,7 +81,7 @@ def _slope_refusals(c: _Context, prob, res) -> dict:
     return out
 
 
-def _rising_var(c: _Context, a, name):
+def _rising_var(c: FitContext, a, name):
     """The variance the rule weighs for ``name``: K's stretch is the rise of K and R together (a K between a
     flicker floor and a ramp shapes a sustained rise without ever holding half the variance alone); R's is R's."""
     cols = ("K", "R") if name == "K" else (name,)
@@ -97,7 +94,7 @@ def _best_claimable(res, refused, fallback=None):
     return min(keep, key=lambda k: res[k]["ic"]) if keep else fallback
 
 
-def _no_fit_terms(c: _Context, out_terms: dict, laws, dt_s) -> None:
+def _no_fit_terms(c: FitContext, out_terms: dict, laws, dt_s) -> None:
     """The terms of a model that misses the curve are no result: every estimated or absent power-law term becomes
     status ``"no_fit"`` with, as its ``hi95``, the bound the measured curve itself sets.
 

@@ -8,17 +8,14 @@ These functions only describe a fit the procedure in :mod:`.identify` has made; 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .checks import _point_limits, _points_outside
+from .context import FitContext, point_limits
+from .checks import _points_outside
 from .distributions import chi2_ppf
 from .spectral import sinusoid_avar
 from .terms import DISPLAY_UNITS, all_terms
-
-if TYPE_CHECKING:
-    from .identify import _Context
 
 _names = all_terms  # the fit's columns: Q N B K R (then any registered power-law term), S, M
 
@@ -56,7 +53,7 @@ def _lines_that_matter(periodic, tau, y) -> list:
     return out
 
 
-def _describe_excluded(ctx: _Context, start: int, sel, periodic=None, spectrum_given=False, rolloff_hz=None) -> str:
+def _describe_excluded(ctx: FitContext, start: int, sel, periodic=None, spectrum_given=False, rolloff_hz=None) -> str:
     """Why the short taus [0, start) were left out, in words.
 
     An oscillation is named by the real frequency of the spectral lines when the spectrum found any (the tau of a
@@ -178,10 +175,10 @@ def _largest_gap_note(tau, y, mu, nu) -> list:
 
 
 def _at_bound_notes(prob, A, best, tau, out_terms) -> list:
-    """A selected term whose estimate sits at its upper bound (:meth:`_Context._upper`): the value is set by one
+    """A selected term whose estimate sits at its upper bound (:meth:`FitContext._upper`): the value is set by one
     point of the curve (the term alone would exceed that point's ~4-sigma upper limit), not by the fit."""
     notes = []
-    ub_pt = _point_limits(prob.y, prob.nu)
+    ub_pt = point_limits(prob.y, prob.nu)
     for i in best:
         u = float(prob.upper[i])
         if not (u > 0 and A[i] >= (1.0 - 1e-3) * u):
@@ -215,7 +212,7 @@ def _unresolved_reason(name, lacking, plaus, res, ic_best) -> str:
     return "not resolved from zero: its 95 % interval reaches 0"
 
 
-def _absent_reason(c: _Context, name, A, hi_a) -> str:
+def _absent_reason(c: FitContext, name, A, hi_a) -> str:
     """Why a term is not in the model: where would it show at its upper bound?"""
     law = c.laws[name]
     i = _names().index(name)

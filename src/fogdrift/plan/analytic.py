@@ -4,7 +4,7 @@ For a record of ``n`` samples the fit works on the octave taus ``m = 1, 2, 4, ..
 tau_grid`, as ``fogdrift allan``).  At the true model the fit's objective is, to first order, the generalised
 least-squares form ``(y - X A)' V^-1 (y - X A)`` with ``V`` the model covariance the fit itself uses (the
 estimators' covariance of :mod:`fogdrift.noise.covariance` and the model-discrepancy allowance, built by the
-fit's own context, :class:`fogdrift.noise.identify._Context`).  Hence (the "Asimov" record: the expected curve
+fit's own context, :class:`fogdrift.noise.context.FitContext`).  Hence (the "Asimov" record: the expected curve
 fitted, the median record's interval):
 
 * ``Cov(A) = (X' V^-1 X)^-1`` over the model's terms;
@@ -32,7 +32,7 @@ from scipy.optimize import nnls
 from scipy.stats import chi2, t as student_t
 
 from ..allan.grid import tau_grid
-from ..noise.identify import _Context
+from ..noise.context import FitContext
 from ..noise.terms import all_terms
 from .model import PLANNED_TERMS as PLANNED
 
@@ -77,12 +77,12 @@ def analytic_widths(model, n_samples) -> dict:
             out[t] = {"rel_lo": 0.0, "rel_hi": math.inf, "rel_width": math.inf, "z": 0.0, "resolved": False}
         return out
     A = model.law_coefficients()
-    probe = _Context(tau, m, np.ones_like(tau), np.full_like(tau, 2.0), n, dt, "adev", names)
+    probe = FitContext(tau, m, np.ones_like(tau), np.full_like(tau, 2.0), n, dt, "adev", names)
     mu = probe.X @ A
-    ctx = _Context(tau, m, mu, mu * 2.0, n, dt, "adev", names)
+    ctx = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", names)
     V = ctx.relcov(A, exact_ramp=True) * np.outer(mu, mu)
     L = np.linalg.cholesky(V)
-    full = _Context(tau, m, mu, mu * 2.0, n, dt, "adev", tuple(t for t in PLANNED if t in ctx.laws))
+    full = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", tuple(t for t in PLANNED if t in ctx.laws))
     Xall = np.linalg.solve(L, full.X)  # whitened design of every column
     yw = np.linalg.solve(L, mu)
     col = {t: all_terms().index(t) for t in PLANNED}

@@ -20,7 +20,7 @@ import numpy as np
 from .. import documents
 from ..errors import ConfigError
 from ..noise.terms import TERM_TABLE, all_terms, laws_of
-from ..spec import _norm_unit
+from ..spec import norm_unit
 
 __all__ = ["PlanModel", "parse_model", "parse_targets", "parse_length", "model_from_fit", "read_model_file",
            "DEFAULT_TARGETS", "PLANNED_TERMS", "fmt_length"]
@@ -131,7 +131,7 @@ def parse_model(text: str, dt_s) -> PlanModel:
         if not unit:
             raise ConfigError(f"{{opt:model}}: {item!r} has no unit; write it with one, e.g. "
                               f"\"{name}={m.group(2)} {TERM_TABLE[name].unit}\"")
-        key = _norm_unit(unit).replace("^(1.5)", "^1.5")
+        key = norm_unit(unit).replace("^(1.5)", "^1.5")
         if key not in _UNITS[name]:
             raise ConfigError(f"{{opt:model}}: unknown unit {unit!r} for {name}; expected one of "
                               f"{', '.join(_UNITS[name])}")
@@ -240,7 +240,7 @@ def _from_terms(d: dict, dt_s, source) -> PlanModel:
             status = e.get("status", "resolved")
             if v is None or status in ("absent", "not_estimable", "no_fit"):
                 continue
-            key = _norm_unit(unit)
+            key = norm_unit(unit)
             if key not in _UNITS[t]:
                 raise ConfigError(f"{source}: unit {unit!r} of {t} is not a gyro unit the planner knows "
                                   f"({', '.join(_UNITS[t])})")

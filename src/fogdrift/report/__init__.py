@@ -6,7 +6,7 @@ it.  Figures follow the reference paper's numbering (Tang et al. 2012): 1 signal
 and white noise, 6 Allan of the drift, 8 model against drift, 9 residual, 10–11 the same on a second recording.
 
 * :mod:`.tables` -- rows of strings with units (noise coefficients, one-step metrics), shared with the console;
-* :mod:`.figures` -- the PNG figures (every one saved by ``_save``; user text drawn literally by ``literal``);
+* :mod:`.figures` -- the PNG figures (every one saved by ``save_figure``; user text drawn literally by ``literal``);
 * :mod:`.files` -- the per-command output files (strict JSON, CSV, NPZ), each written atomically;
 * :mod:`.sections` -- the report's sections as a table (one render function + one row adds a section);
 * :mod:`.html` -- ``report.html``, built from that table; :mod:`.pdf` -- ``report.pdf``;
@@ -14,7 +14,7 @@ and white noise, 6 Allan of the drift, 8 model against drift, 9 residual, 10–1
   temperature figure.
 """
 
-from .figures import (_plt, _safe, _save, plot_allan, plot_models, plot_residuals, plot_separation,
+from .figures import (pyplot, _safe, save_figure, plot_allan, plot_models, plot_residuals, plot_separation,
                       plot_separation_allan, plot_signal, plot_spectrum)
 from .files import write_allan_outputs, write_json, write_model_outputs, write_separation_outputs
 from .html import write_report

@@ -33,7 +33,7 @@ BLOCK_LABELS = {"train": "training", "val": "validation", "test": "test (held ou
 UNSCORED = "0.8"
 
 
-def _plt():
+def pyplot():
     import matplotlib
 
     matplotlib.use("Agg")
@@ -49,7 +49,7 @@ def _styled(fn):
     def wrapper(*args, **kwargs):
         import matplotlib
 
-        _plt()
+        pyplot()
         with matplotlib.rc_context(STYLE):
             return fn(*args, **kwargs)
 
@@ -174,7 +174,7 @@ def _place(fig, pad_in=PAD_IN):
             ax.title.set_fontsize(max(7.0, ax.title.get_fontsize() * min(slot / width, 0.97)))
 
 
-def _save(fig, path, **savefig) -> Path:
+def save_figure(fig, path, **savefig) -> Path:
     """Write ``fig`` to ``path`` atomically (complete or absent) and close it, whatever happens.
 
     ``savefig`` keywords go to :meth:`matplotlib.figure.Figure.savefig` (default ``dpi=DPI``); every figure of
@@ -185,7 +185,7 @@ def _save(fig, path, **savefig) -> Path:
         with atomic_path(path) as tmp:
             fig.savefig(tmp, **{"dpi": DPI, **savefig})
     finally:
-        _plt().close(fig)
+        pyplot().close(fig)
     return path
 
 
@@ -251,7 +251,7 @@ def _limits(*arrays, pad=0.08):
 def plot_allan(axes_list, path, title=None) -> Path:
     """Fig. 3: log-log deviation with 68 % error bars, the fitted curve over the fitted range (points used marked,
     left-out taus shaded), each selected term's asymptote, and the fit statistic."""
-    plt = _plt()
+    plt = pyplot()
     n = len(axes_list)
     size = (FIG_WIDTH_IN, 5.6) if n == 1 else (5.6 * n, 4.8)
     fig, axs = plt.subplots(1, n, figsize=size, squeeze=False)
@@ -290,14 +290,14 @@ def plot_allan(axes_list, path, title=None) -> Path:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(ncols=2 if n == 1 else 1)
     _place(fig)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 @_styled
 def plot_signal(record, path, split_s=None) -> Path:
     """Fig. 1: the rate of every axis over time (min/max envelope of long records and the mean), with the
     train / validation / test blocks shaded when ``split_s`` ``{"train": (t0, t1), ...}`` [s] is given."""
-    plt = _plt()
+    plt = pyplot()
     fig, axs = plt.subplots(record.n_axes, 1, figsize=(FIG_WIDTH_IN, 1.0 + 2.3 * record.n_axes), squeeze=False,
                             sharex=True)
     t = record.t0_s + np.arange(record.n_samples) * record.dt_s
@@ -312,7 +312,7 @@ def plot_signal(record, path, split_s=None) -> Path:
     axs[-1, 0].set_xlabel("t [s]")
     fig.suptitle("Gyro output (Fig. 1)" + ("; dashed: train / validation / test split" if split_s else ""))
     _place(fig)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 @_styled
@@ -320,7 +320,7 @@ def plot_spectrum(record, path) -> Path:
     """Fig. 2: Welch power spectral density of every axis."""
     from scipy.signal import welch
 
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(FIG_WIDTH_IN, 4.8))
     for name in record.axis_names:
         x = np.asarray(record.axis(name), dtype=float)
@@ -332,14 +332,14 @@ def plot_spectrum(record, path) -> Path:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     _place(fig)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 @_styled
 def plot_separation(sep, path, split=None) -> Path:
     """Fig. 5: drift and white noise over time; ``split`` ``{"train": [i0, i1), ...}`` (sample indices at the
     separation's rate) draws the blocks the models use (they separate inside each block)."""
-    plt = _plt()
+    plt = pyplot()
     t = np.arange(sep.rate_dph.size) * sep.dt_s
     fig, axs = plt.subplots(2, 1, figsize=(FIG_WIDTH_IN, 6.0), sharex=True)
     tb, lo, hi, mean = _envelope(t, sep.rate_dph)
@@ -363,13 +363,13 @@ def plot_separation(sep, path, split=None) -> Path:
             _draw_split(ax, {k: (a * sep.dt_s, b * sep.dt_s) for k, (a, b) in split.items()}, label=i == 0)
     fig.suptitle(literal(f"Drift and white noise of the whole record, axis {sep.name}, dt = {sep.dt_s:g} s (Fig. 5)"))
     _place(fig)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 @_styled
 def plot_separation_allan(sep, path) -> Path:
     """Fig. 6: ADEV of original, drift and noise."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(FIG_WIDTH_IN, 5.2))
     for (label, aa), color in zip(sep.rows, ("k", "C3", "C0")):
         r = aa.allan
@@ -383,7 +383,7 @@ def plot_separation_allan(sep, path) -> Path:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     _place(fig)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def _test_axis(model_axis):
@@ -411,7 +411,7 @@ def plot_models(model_axis, path, fig_no=8, *, residual=False) -> Path:
     largest excursion; with ``residual``, Fig. 9 (:func:`plot_residuals`)."""
     if residual:
         return plot_residuals(model_axis, path, fig_no)
-    plt = _plt()
+    plt = pyplot()
     t, y, k = _test_axis(model_axis)
     dt = model_axis.dt_s
     fig, axs = plt.subplots(2, 1, figsize=(FIG_WIDTH_IN, 8.0))
@@ -434,14 +434,14 @@ def plot_models(model_axis, path, fig_no=8, *, residual=False) -> Path:
     axs[1].set_title(f"zoom on the largest drift excursion, t = {t[lo]:g} – {t[hi - 1]:g} s")
     axs[0].legend(ncols=2, loc="best")
     _place(fig)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 @_styled
 def plot_residuals(model_axis, path, fig_no=9) -> Path:
     """Fig. 9: residual drift after compensation (wavelet drift minus each model's one-step prediction) on the
     test block, one panel per model, each scaled on its scored part and labelled with its RMS."""
-    plt = _plt()
+    plt = pyplot()
     t, y, k = _test_axis(model_axis)
     preds = list(model_axis.predictions.items())
     n = max(1, len(preds))
@@ -464,7 +464,7 @@ def plot_residuals(model_axis, path, fig_no=9) -> Path:
     fig.suptitle(literal(f"Residual drift after one-step compensation, axis {model_axis.name} (Fig. {fig_no}); "
                          "y scales differ between panels; grey: not scored"))
     _place(fig)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 @_styled
@@ -474,7 +474,7 @@ def plot_dynamic_adev(allan_axes, path) -> Path | None:
     shown = [a for a in allan_axes if (getattr(a, "screen", None) or {}).get("dynamic_adev")]
     if not shown:
         return None
-    plt = _plt()
+    plt = pyplot()
     fig, axs = plt.subplots(len(shown), 1, figsize=(FIG_WIDTH_IN, 3.4 * len(shown) + 0.6), squeeze=False)
     for ax, a in zip(axs[:, 0], shown):
         d = a.screen["dynamic_adev"]
@@ -492,4 +492,4 @@ def plot_dynamic_adev(allan_axes, path) -> Path | None:
         ax.set_title(literal(f"{a.name}: dynamic ADEV (windows of {d['window_s']:.4g} s); red: disturbed intervals"))
     _place(fig)
     fig.subplots_adjust(hspace=0.55)  # each panel's title clear of the time ticks above it
-    return _save(fig, path)
+    return save_figure(fig, path)

@@ -17,7 +17,7 @@ import numpy as np
 from .._util import fmt_number
 from ..gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
 from ..output import atomic_path
-from .figures import _place, _save, literal
+from .figures import _place, save_figure, literal
 from .files import write_json
 
 __all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
@@ -60,7 +60,7 @@ def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     _place(fig)  # margins measured once (bbox_inches="tight" drew the figure twice)
-    return _save(fig, path, dpi=110)
+    return save_figure(fig, path, dpi=110)
 
 
 def write_gmwm_outputs(axes: list[GmwmAxis], out_dir, *, source: str, record: dict | None = None) -> dict:

@@ -8,14 +8,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .figures import _plt, _save
+from .figures import pyplot, save_figure
 
 __all__ = ["plot_plan"]
 
 
 def plot_plan(plan, path) -> Path:
     """Write the plan figure (PNG) of :class:`fogdrift.plan.Plan` to ``path``."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
     L = np.asarray(plan.grid["length_s"], dtype=float) / 3600.0
     for i, (t, w) in enumerate(plan.grid["width"].items()):
@@ -39,4 +39,4 @@ def plot_plan(plan, path) -> Path:
     ax.set_title(f"fogdrift plan: {plan.model.text()} at {1 / plan.model.dt_s:g} Hz", fontsize=8)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
-    return _save(fig, path)
+    return save_figure(fig, path)

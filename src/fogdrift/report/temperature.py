@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..temperature import summary_line, temperature_summary
-from .figures import _save, literal
+from .figures import save_figure, literal
 
 __all__ = ["plot_rate_and_temperature", "MAX_POINTS"]
 
@@ -83,4 +83,4 @@ def plot_rate_and_temperature(record, path) -> Path:
         fig.suptitle(f"Rate and temperature (block means of {k} samples)", fontsize=9)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    return _save(fig, path, dpi=110, bbox_inches="tight", format="png")  # complete or absent (fogdrift.output)
+    return save_figure(fig, path, dpi=110, bbox_inches="tight", format="png")  # complete or absent (fogdrift.output)

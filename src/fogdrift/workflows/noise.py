@@ -6,15 +6,17 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
+from ..errors import InsufficientDataError
+from ..evaluation.gmwm_vs_allan import compare_with_allan
 from ..gmwm.analysis import analyse_gmwm
-from ..gmwm.compare import attach_allan_checks
 from ..gmwm.quantity import express_gmwm
 from ..report.gmwm import write_gmwm_outputs
+from ..pipeline import AnalysisConfig, run_allan
 from ..segments import longest_segment
 
 from .allan import Screened, screen
 
-__all__ = ["NoiseRun", "run_noise", "write_noise"]
+__all__ = ["NoiseRun", "run_noise", "write_noise", "attach_allan_checks"]
 
 
 @dataclass
@@ -76,3 +78,27 @@ def write_noise(run: NoiseRun, out_dir) -> dict:
     """``noise.json``, ``wvar.csv`` and ``noise.png`` in ``out_dir``; returns the paths by kind."""
 
     return write_gmwm_outputs(run.axes, out_dir, source=str(run.record.source), record=run.record.metadata())
+
+
+def attach_allan_checks(record, axes, *, sums=None, segments=None, screens=None) -> list:
+    """Set ``allan_check`` on each GMWM axis of a record: its comparison with the Allan fit of the same axis (the
+    default fit of ``fogdrift allan``, :func:`fogdrift.pipeline.run_allan`;
+    :func:`fogdrift.evaluation.gmwm_vs_allan.compare_with_allan`); returns ``axes``.
+
+    ``sums``, ``segments``, ``screens``: what the record screen already took of each axis
+    (:class:`fogdrift.workflows.allan.Screened`), handed to :func:`~fogdrift.pipeline.run_allan`, which reuses the
+    octave Allan sums instead of computing them again (the same fit, field by field)."""
+
+    try:
+        # both readings in the units of the internal unit (the GMWM's are re-stated per quantity afterwards)
+        fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate(), own_units=False, sums=sums,
+                                                   segments=segments, screens=screens)}
+    except InsufficientDataError as exc:  # too short for the Allan fit: the GMWM result stands, and says so
+        for a in axes:
+            a.allan_check = {"agree": None, "n_agree": None, "b_agree": None,
+                             "lines": [f"no comparison: the Allan fit needs more data ({exc})"]}
+        return axes
+    for a in axes:
+        if a.name in fits:
+            a.allan_check = compare_with_allan(a, fits[a.name])
+    return axes

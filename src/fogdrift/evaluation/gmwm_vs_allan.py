@@ -25,12 +25,9 @@ Units: N in deg/sqrt(h), B in deg/h, tau in s.
 from __future__ import annotations
 
 from .._util import fmt_number
-from ..errors import InsufficientDataError
-from ..pipeline import AnalysisConfig, run_allan
 from ..noise.terms import DISPLAY_UNITS, TERM_TABLE
-from .quantity import express_gmwm  # noqa: F401 -- re-exported for the batch worker (one allowed import edge)
 
-__all__ = ["compare_with_allan", "attach_allan_checks"]
+__all__ = ["compare_with_allan"]
 
 
 def _g(x, d=3):
@@ -333,27 +330,3 @@ def _m_line(axis, fit) -> tuple:
     ok = any((lo or 0.0) <= t <= (hi or float('inf')) for _, t in gms) if tc else None
     return ok, (f"M {'agrees' if ok else 'differs'}: {a_txt}; {g_txt}"
                 + ("" if ok else " (no GM correlation time inside the Allan fit's T_c interval)"))
-
-
-def attach_allan_checks(record, axes, *, sums=None, segments=None, screens=None) -> list:
-    """Set ``allan_check`` on each GMWM axis of a record: its comparison with the Allan fit of the same axis (the
-    default fit of ``fogdrift allan``, :func:`fogdrift.pipeline.run_allan`).  Used by ``fogdrift noise`` and
-    ``fogdrift batch --command noise`` alike; returns ``axes``.
-
-    ``sums``: axis name -> :class:`~fogdrift.pipeline_sums.AllanSums` the plausibility check already took of that
-    axis (:func:`fogdrift.plausibility.check_record` ``sums=``), handed to :func:`~fogdrift.pipeline.run_allan`, which
-    reuses them instead of computing the octave Allan sums again (the same fit, field by field)."""
-
-    try:
-        # both readings in the units of the internal unit (the GMWM's are re-stated per quantity afterwards)
-        fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate(), own_units=False, sums=sums,
-                                                   segments=segments, screens=screens)}
-    except InsufficientDataError as exc:  # too short for the Allan fit: the GMWM result stands, and says so
-        for a in axes:
-            a.allan_check = {"agree": None, "n_agree": None, "b_agree": None,
-                             "lines": [f"no comparison: the Allan fit needs more data ({exc})"]}
-        return axes
-    for a in axes:
-        if a.name in fits:
-            a.allan_check = compare_with_allan(a, fits[a.name])
-    return axes

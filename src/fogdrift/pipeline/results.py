@@ -16,12 +16,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:  # result types of other stages, for the annotations only (no import at run time)
-    from .allan import AllanResult
-    from .evaluation import AxisEvaluation
-    from .gmwm.analysis import GmwmAxis
-    from .noise import NoiseFit
-    from .outliers import OutlierReport
-    from .pipeline import AnalysisConfig
+    from ..allan import AllanResult
+    from ..evaluation import AxisEvaluation
+    from ..gmwm.analysis import GmwmAxis
+    from ..noise import NoiseFit
+    from ..outliers import OutlierReport
+    from .config import AnalysisConfig
 
 __all__ = ["AllanAxis", "SeparationAxis", "ModelAxis", "CompensatedSignal", "AnalysisAxis", "AnalysisResult"]
 

@@ -15,14 +15,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ._util import check_series
-from .allan import _kernels, chunked
-from .allan.core import _fast_strides, result_from_sums
-from .allan.grid import tau_grid
-from .allan.statistics import get_statistic
-from .errors import ConfigError, InsufficientDataError
-from .io.chunked import ChunkSource
-from .units import check_dt_s
+from .._util import check_series
+from . import _kernels, chunked
+from .core import _fast_strides, result_from_sums
+from .grid import tau_grid
+from .statistics import get_statistic
+from ..errors import ConfigError, InsufficientDataError
+from ..io.chunked import ChunkSource
+from ..units import check_dt_s
 
 __all__ = ["AllanSums", "CHUNKED_MIN_SAMPLES", "OUT_OF_CORE_CHUNK"]
 

@@ -1,0 +1,238 @@
+"""The settings of an analysis (:class:`AnalysisConfig`), each checked before any data is touched, with the
+option named in the message (the CLI renders ``{opt:name}`` as its flag)."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from ..allan import ESTIMATORS, STATISTICS
+from ..allan.grid import MAX_TAUS
+from ..errors import ConfigError
+from ..lifting import MODES, get_wavelet
+from ..models import MODEL_NAMES, model_spec
+from ..noise.terms import TERM_TABLE
+from ..outliers import OUTLIER_ACTIONS
+from ..units import check_rate_hz
+
+__all__ = ["AnalysisConfig", "check_options"]
+
+
+@dataclass
+class AnalysisConfig:
+    """Every setting of an analysis; stored in the result JSON.
+
+    Attributes
+    ----------
+    model_rate_hz : float or None
+        Modelling rate [Hz]: the rate is block-averaged to this before separation and drift modelling.
+        ``None`` keeps the native rate. Default 1 Hz (drift lives below ~0.1 Hz).
+    wavelet, level, mode
+        Lifting separation: wavelet name, decomposition level (int or ``"auto"``) and boundary mode
+        (``"symmetric"`` avoids joining the end of a block to its start; ``"periodization"`` is
+        PyWavelets-compatible).
+    train_fraction, val_fraction : float
+        Chronological split; the test block is the rest.
+    latitude_deg : float or None
+        If given, the Earth-rate projection for each axis in ``earth_axes`` is removed before the bias.
+    earth_axes : dict
+        Axis name -> orientation (``"up"``, ``"north"``, … or an east-north-up vector).
+    models : tuple of str
+        Names from :data:`MODEL_NAMES`.
+    lags, hidden, epochs, seed, activation, training
+        Elman / grey-Elman hyper-parameters (``lags`` is also the AR order).
+    gm_window : int
+        Rolling window [samples] of the one-step GM(1,1).
+    causal_window_s : float
+        Length [s] of the sliding window of the causal drift used by the practical compensation.
+    taus : str
+        Tau grid of the Allan analyses (``"octave"``, ``"decade"``, ``"all"`` or a number of log-spaced taus).
+    estimator : str
+        Allan estimator (``"overlapping"``, ``"non-overlapping"`` or ``"fast"``).
+    statistic : str
+        Allan-family statistic of the noise analyses (``"adev"``, ``"hdev"`` or ``"mdev"``).
+    terms : tuple of str or None
+        ``None`` (default): the noise model is selected from the data; a tuple fixes the terms fitted.
+    outliers : str
+        ``"warn"`` (report samples beyond 6 robust sigma), ``"clip"`` or ``"replace"`` them before the analyses.
+    fit_tau_s : tuple of (float or None, float or None)
+        Tau range [s] of the noise fit (None = no limit), e.g. to leave out a vibration bump that the
+        IEEE-952 model does not describe.
+    noise_method : str
+        ``"allan"`` (default): the noise table is the Allan fit (:mod:`fogdrift.noise`); ``"gmwm"``: also the GMWM
+        model selection on the Haar wavelet variance of the native-rate record (:mod:`fogdrift.gmwm.analysis`),
+        which the report shows as the noise table; the Kalman drift model then identifies its noise components
+        by a GMWM fit of its training block too (:class:`fogdrift.models.kalman.Kalman` ``noise_method``).
+    """
+
+    model_rate_hz: float | None = 1.0
+    wavelet: str = "db2"
+    level: int | str = 4
+    mode: str = "symmetric"
+    train_fraction: float = 0.6
+    val_fraction: float = 0.2
+    latitude_deg: float | None = None
+    earth_axes: dict = field(default_factory=dict)
+    models: tuple = MODEL_NAMES
+    lags: int = 4
+    hidden: int = 16
+    epochs: int = 2000
+    seed: int = 0
+    activation: str = "tanh"
+    training: str = "bptt"
+    gm_window: int = 8
+    causal_window_s: float = 128.0
+    taus: str = "octave"
+    estimator: str = "overlapping"
+    statistic: str = "adev"
+    terms: tuple | None = None
+    fit_tau_s: tuple = (None, None)
+    outliers: str = "warn"
+    noise_method: str = "allan"
+
+    def validate(self) -> "AnalysisConfig":
+        """Check every setting; return the config with canonical model names (``self`` is never modified).
+
+        The one validation point of the settings: the CLI builds a config and calls this before reading
+        the file; nothing re-checks these settings elsewhere.
+
+        Returns
+        -------
+        AnalysisConfig
+            ``self`` when the model names are already the registry's, else a copy with them canonical
+            (``"AR"`` -> ``"ar"``), duplicates dropped.
+
+        Raises
+        ------
+        ConfigError
+            The first invalid setting, named as ``{opt:NAME}``, with the rule and the value.
+        """
+        if not (_finite_number(self.train_fraction) and _finite_number(self.val_fraction)) \
+                or not 0 < self.train_fraction < 1 or not 0 <= self.val_fraction < 1:
+            raise ConfigError(
+                f"the training share ({{opt:train_fraction}}) must be in (0, 1) and the validation share "
+                f"({{opt:val_fraction}}) in [0, 1); got {self.train_fraction}, {self.val_fraction}"
+            )
+        if self.train_fraction + self.val_fraction >= 1:
+            raise ConfigError(
+                f"the training and validation shares ({{opt:train_fraction}} + {{opt:val_fraction}}) must leave a "
+                f"test block; got {self.train_fraction + self.val_fraction:.3g} >= 1"
+            )
+
+        if not self.models:
+            raise ConfigError(f"no drift model given; pass {{opt:models}} with one or more of {list(MODEL_NAMES)}")
+        # canonical registry names (any case accepted); an unknown name is an error, never a fallback
+        models = tuple(dict.fromkeys(model_spec(m).name for m in self.models))
+
+        if self.statistic not in STATISTICS:
+            raise ConfigError(f"statistic must be one of {tuple(STATISTICS)}, got {self.statistic!r} ({{opt:statistic}})")
+        if self.outliers not in OUTLIER_ACTIONS:
+            raise ConfigError(f"outliers must be one of {OUTLIER_ACTIONS}, got {self.outliers!r} ({{opt:outliers}})")
+        if self.noise_method not in ("allan", "gmwm"):
+            raise ConfigError(f"noise_method must be 'allan' or 'gmwm', got {self.noise_method!r} ({{opt:noise_method}})")
+        if self.model_rate_hz is not None and (isinstance(self.model_rate_hz, bool) or not _finite_number(
+                self.model_rate_hz) or not self.model_rate_hz > 0):
+            raise ConfigError(f"the modelling rate ({{opt:model_rate_hz}}) must be > 0 Hz; got {self.model_rate_hz!r}")
+        if self.model_rate_hz is not None:
+            check_rate_hz(self.model_rate_hz, "the modelling rate ({opt:model_rate_hz})")
+        for key in ("lags", "hidden", "epochs", "gm_window", "seed"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+                raise ConfigError(f"{{opt:{key}}} must be an integer; got {value!r}")
+        if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
+            raise ConfigError(f"{{opt:lags}}, {{opt:hidden}} and {{opt:epochs}} must be >= 1; got {self.lags}, "
+                              f"{self.hidden}, {self.epochs}")
+
+        from ..models.grey import GM11_MIN_LENGTH  # model modules load on use (the registry's rule)
+
+        if self.gm_window < GM11_MIN_LENGTH:
+            raise ConfigError(f"{{opt:gm_window}} must be an integer >= {GM11_MIN_LENGTH} samples; got {self.gm_window!r}")
+        if self.seed < 0:
+            raise ConfigError(f"{{opt:seed}} must be an integer >= 0; got {self.seed!r}")
+        if not _finite_number(self.causal_window_s) or not self.causal_window_s > 0:
+            raise ConfigError(f"the causal window ({{opt:causal_window_s}}) must be > 0 s; got {self.causal_window_s!r}")
+        if self.latitude_deg is not None and not (_finite_number(self.latitude_deg)
+                                                  and -90.0 <= float(self.latitude_deg) <= 90.0):
+            raise ConfigError(f"latitude must be in [-90, 90] deg; got {self.latitude_deg!r} (option {{opt:latitude_deg}})")
+        if self.latitude_deg is not None and not self.earth_axes:
+            raise ConfigError("a latitude was given without the axis it applies to; pass {opt:earth_axes} AXIS=up|down|"
+                              "north|south|east|west (the Earth-rate component depends on the axis orientation)")
+        if not isinstance(self.earth_axes, dict):
+            raise ConfigError(f"{{opt:earth_axes}} must map axis names to orientations; got {self.earth_axes!r}")
+        if self.earth_axes and self.latitude_deg is None:
+            raise ConfigError("an Earth-rate axis orientation ({opt:earth_axes}) was given without a latitude; pass "
+                              "{opt:latitude_deg} DEG")
+        if self.latitude_deg is not None:
+            for orient in self.earth_axes.values():
+                earth_rate_projection_dph(self.latitude_deg, orient)  # refuses an unknown orientation
+        # activation: checked by the Elman models when built (reading their table here would import JAX)
+        check_options(wavelet=self.wavelet, mode=self.mode, training=self.training, estimator=self.estimator,
+                      terms=self.terms)
+        if not (self.level == "auto" or (isinstance(self.level, (int, np.integer)) and not isinstance(self.level, bool)
+                                         and self.level >= 1)):
+            raise ConfigError(f"{{opt:level}} must be an integer >= 1 or 'auto', got {self.level!r}")
+        _check_taus(self.taus)
+        _check_fit_taus(self.fit_tau_s)
+        return self if models == tuple(self.models) else dataclasses.replace(self, models=models)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["models"] = list(self.models)
+        d["terms"] = None if self.terms is None else list(self.terms)
+        d["fit_tau_s"] = list(self.fit_tau_s)
+        return d
+
+
+def _finite_number(x) -> bool:
+    try:
+        return not isinstance(x, bool) and np.isfinite(float(x))
+    except (TypeError, ValueError, OverflowError):
+        return False
+
+
+def check_options(*, wavelet=None, mode=None, training=None, estimator=None, terms=None) -> None:
+    """Refuse a bad value of any of these settings (None: not checked), with the messages the CLI shows.
+
+    Used by :meth:`AnalysisConfig.validate` and by commands that take some of these options without a full
+    analysis configuration.
+    """
+    if wavelet is not None:
+        get_wavelet(wavelet)
+    if mode is not None:
+        if mode not in MODES:
+            raise ConfigError(f"{{opt:mode}} must be one of {list(MODES)}; got {mode!r}")
+    if training is not None and training not in ("bptt", "bp"):
+        raise ConfigError(f"{{opt:training}} must be 'bptt' or 'bp'; got {training!r}")
+    if estimator is not None:
+        if estimator not in ESTIMATORS:
+            raise ConfigError(f"{{opt:estimator}} must be one of {list(ESTIMATORS)}; got {estimator!r}")
+    if terms is not None:
+        bad = [t for t in terms if t not in TERM_TABLE]
+        if bad or not terms:
+            raise ConfigError(f"{{opt:terms}} must list noise terms among Q, N, B, K, R; got {','.join(terms)!r}")
+
+
+def _check_taus(taus) -> None:
+    if isinstance(taus, str):
+        if taus.lower() not in ("octave", "decade", "all"):
+            raise ConfigError(f"{{opt:taus}} must be 'octave', 'decade', 'all' or a number of taus, got {taus!r}")
+    elif isinstance(taus, (int, np.integer)) and not isinstance(taus, bool):
+        if not 1 <= int(taus) <= MAX_TAUS:
+            raise ConfigError(f"{{opt:taus}} as a count must be in [1, {MAX_TAUS}], got {taus!r}")
+    else:
+        raise ConfigError(f"{{opt:taus}} must be 'octave', 'decade', 'all' or a number of taus, got {taus!r}")
+
+
+def _check_fit_taus(fit_tau_s) -> None:
+    try:
+        lo, hi = fit_tau_s
+    except (TypeError, ValueError):
+        raise ConfigError(f"{{opt:fit_tau_s}} must be (MIN, MAX) in s, either None; got {fit_tau_s!r}") from None
+    for v in (lo, hi):
+        if v is not None and not (_finite_number(v) and float(v) > 0):
+            raise ConfigError(f"{{opt:fit_tau_s}} bounds must be finite numbers of seconds > 0 (or None); "
+                              f"got {fit_tau_s!r}")
+    if lo is not None and hi is not None and not float(lo) < float(hi):
+        raise ConfigError(f"{{opt:fit_tau_s}} must have MIN < MAX; got {fit_tau_s!r}")
