@@ -412,7 +412,7 @@ class Run:
     def wrote(self) -> None:
         """One human line: the files this run wrote."""
         w = self.out.written
-        shown = ", ".join(w) if len(w) <= 6 else ", ".join(w[:6]) + f" and {len(w) - 6} more"
+        shown = ", ".join(w) if len(w) <= 4 else ", ".join(w[:3]) + f" and {len(w) - 3} more"
         removed = f"; the earlier run's {len(self.out.removed)} file(s) there replaced" if self.out.removed else ""
         say(f"wrote {len(w)} file(s) to {self.out.path}: {shown}{removed}")
 

@@ -282,8 +282,7 @@ def print_summary(result, record, *, evaluated: bool, apply_name: str = "") -> N
     keep = [[row[0]] + [_stacked(_terse(c)) for c in row[1:]] for row in keep]
     console.print(fitted_table(f"Noise of the original output: {headers[0]}, 95 % intervals",
                                [""] + [h.replace("axis ", "") for h in headers[1:]], keep))
-    say("  – (< x): not in the selected model, x its 95 % upper bound; n/e: not estimable (the report says why)",
-        style="dim")
+    say("  – (< x): not in the model, x its 95 % bound; n/e: not estimable (the report says why)", style="dim")
     for res, name in ((result, ""), (getattr(result, "apply_to", None), apply_name)):
         if res is None:
             continue
@@ -292,9 +291,12 @@ def print_summary(result, record, *, evaluated: bool, apply_name: str = "") -> N
             st = ev.settings
             e, f = res.axes[0].models.split["test"]
             block = (f - e) * res.axes[0].models.dt_s
-            say(f"compensation verdict{' on ' + name if name else ''}: heading error on the held-out test block "
-                f"({block:.4g} s, last {100 * (1 - res.config.train_fraction - res.config.val_fraction):.0f} % of "
-                f"the record), {st['calibration_window_s']:g}-s calibrations every {st['origin_step_s']:g} s, "
-                "judged against constant bias:", style="bold")
+            say(f"compensation verdict{' on ' + name if name else ''}: heading error on the held-out last "
+                f"{100 * (1 - res.config.train_fraction - res.config.val_fraction):.0f} % ({block:.4g} s), "
+                f"{st['calibration_window_s']:g}-s calibrations every {st['origin_step_s']:g} s, against constant "
+                "bias:", style="bold")
+        short = {ax.name: ax.evaluation.headline.short for ax in res.axes
+                 if getattr(ax, "evaluation", None) is not None and ax.evaluation.headline is not None}
         for item in verdict_items(res, evaluated=evaluated):
-            say(f"  [{OUTCOME_LABELS.get(item['outcome'], item['outcome'])}] {item['sentence']}")
+            say(f"  [{OUTCOME_LABELS.get(item['outcome'], item['outcome'])}] "
+                f"{short.get(item['axis']) or item['sentence']}")

@@ -51,6 +51,10 @@ class Verdict:
     kind: str
     lines: list
     data: dict = field(default_factory=dict)
+    #: The same verdict in one short sentence for a console summary whose heading already states the protocol
+    #: (held-out block, calibration, constant bias as reference); "" when the verdict has no short form.  Not
+    #: stored: the JSON and the report keep the full sentences.
+    short: str = ""
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, "lines": list(self.lines), "data": self.data}
@@ -572,7 +576,10 @@ def headline_verdict(heading=None, artefacts=None, *, axis: str = "", reason: st
         line = (f"{axis}: cannot judge whether any model reduces the heading error: the held-out block gives "
                 f"{count} at {h0:g} s ({heading.calib_s:g}-s calibrations every "
                 f"{heading.step_s:g} s; need {min_origins}).")
-        return Verdict("headline", [line], {"outcome": "undetermined", "model": None, "judged_horizons_s": []})
+        short = (f"{axis}: cannot judge: {n_ind0} non-overlapping origin(s) at {h0:g} s, {min_origins} needed "
+                 "(a longer held-out block or shorter horizons).")
+        return Verdict("headline", [line], {"outcome": "undetermined", "model": None, "judged_horizons_s": []},
+                       short)
     better, worse, judgements = {}, {}, {}
     for h in judged:
         for label, r in by_h[h].items():
@@ -597,7 +604,9 @@ def headline_verdict(heading=None, artefacts=None, *, axis: str = "", reason: st
                 f"non-overlapping origins at {_horizon_list(judged)} s after a {heading.calib_s:g}-s calibration "
                 f"(constant bias leaves {rms} deg RMS" + (f"; worse: {', '.join(sorted(worse))}" if worse else "")
                 + ").")
-        return Verdict("headline", [line], {"outcome": "none", "model": None, **data})
+        short = (f"{axis}: no model gains {100 * material:.0f} % at {' / '.join(f'{h:g}' for h in judged)} s "
+                 f"(constant bias: {rms} deg RMS)" + (f"; worse: {', '.join(sorted(worse))}" if worse else "") + ".")
+        return Verdict("headline", [line], {"outcome": "none", "model": None, **data}, short)
 
     def gain(label):
         return min(by_h[h][label].ratio_to_bias for h in better[label])
@@ -616,12 +625,16 @@ def headline_verdict(heading=None, artefacts=None, *, axis: str = "", reason: st
             for x in worse[best]))
     if best in flagged:
         buts.append(f"removes real rate near {', '.join(f'{f:g}' for f in flagged[best])} Hz (artefact check)")
+    gain = (f"{axis}: {best} -{100 * (1 - r.ratio_to_bias):.0f} % at {h:g} s ({_f(r.rms_deg)} vs "
+            f"{_f(base[h].rms_deg)} deg RMS, {judgements[(best, h)].counts()})")
     if buts:
         line = what + " but " + " and ".join(buts) + "."
+        short = gain + " but " + " and ".join(buts) + "."
         outcome = "mixed"
     else:
         check = "artefact check not run" if artefacts is None else "artefact check clean"
         line = what + f" and worsens it at no judged horizon ({', '.join(f'{x:g}' for x in judged)} s); {check}."
+        short = gain + f"; worse nowhere; {check}."
         outcome = "reduces"
     return Verdict("headline", [line], {"outcome": outcome, "model": best, "horizon_s": h,
-                                        "ratio_to_bias": r.ratio_to_bias, **data})
+                                        "ratio_to_bias": r.ratio_to_bias, **data}, short)
