@@ -170,7 +170,7 @@ def angle_error_variance_deg2(components, horizons_s, t_cal_s, *, by_component: 
     h = _horizons(horizons_s)
     T = _t_cal(t_cal_s)
     parts = [_component_variance_deg2(c, h, T) for c in comps]
-    if _quantity(quantity) == "accel":  # the formulas carry (1/3600)^2 for deg/h -> deg/s; m/s^2 needs none
+    if _quantity(quantity) == "accel":  # the formulas carry 1/S_PER_H^2 for deg/h -> deg/s; m/s^2 needs none
         parts = [p * S_PER_H**2 for p in parts]
     total = np.sum(parts, axis=0) if parts else np.zeros_like(h)
     return (total, parts) if by_component else total

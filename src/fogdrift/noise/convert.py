@@ -84,7 +84,7 @@ def paper_table1_from_A(A) -> dict[str, float]:
     """
     a = _check_A(A)
     return {
-        "Q": 1e6 * S_PER_H * math.pi * math.sqrt(3.0 * a[0]) / 180.0,  # as printed (pi / 180 split around the sqrt)
+        "Q": 1e6 * S_PER_H * math.pi * math.sqrt(3.0 * a[0]) / 180.0,  # as printed (the degree factor split around the sqrt)
         "N": math.sqrt(a[1]) / 60.0,
         "B": math.sqrt(a[2]) / 0.6643,
         "K": 60.0 * math.sqrt(3.0 * a[3]),
