@@ -52,6 +52,8 @@ import math
 
 import numpy as np
 
+from .units import DEG_PER_RAD, S_PER_H, S_PER_MIN
+
 __all__ = ["health_findings", "frozen_stretch", "FROZEN_MIN_RUN", "FROZEN_P", "CLIP_MIN_COUNT", "CLIP_MIN_FRACTION", "CLIP_PILE",
            "UNIT_FACTORS", "UNIT_MIX_RTOL", "GRAVITY_RTOL", "GRAVITY_STEADY"]
 
@@ -65,8 +67,9 @@ CLIP_MIN_COUNT = 20
 CLIP_MIN_FRACTION = 1e-3
 CLIP_PILE = 3.0
 #: Unit factors between axes: (factor, what it suggests).
-UNIT_FACTORS = ((180.0 / math.pi, "rad/s beside deg/s (or rad/h beside deg/h)"), (60.0, "per minute beside per second"),
-                (1000.0, "milli-units beside units (e.g. mrad/s beside rad/s)"), (3600.0, "deg/h beside deg/s"))
+UNIT_FACTORS = ((DEG_PER_RAD, "rad/s beside deg/s (or rad/h beside deg/h)"),
+                (S_PER_MIN, "per minute beside per second"),
+                (1000.0, "milli-units beside units (e.g. mrad/s beside rad/s)"), (S_PER_H, "deg/h beside deg/s"))
 #: Relative tolerance of a unit factor between axes' noise.
 UNIT_MIX_RTOL = 0.15
 #: Relative tolerance of "the mean vector is 1 g".

@@ -64,8 +64,13 @@ import numpy as np
 from ._util import fmt_number
 from .errors import ConfigError, FogdriftWarning, render_options
 from .health import health_findings
+<<<<<<< HEAD
 from .allan.sums import AllanSums
 from .units import EARTH_RATE_DPH, STANDARD_GRAVITY_MPS2, parse_unit
+=======
+from .pipeline_sums import AllanSums
+from .units import EARTH_RATE_DPH, S_PER_H, STANDARD_GRAVITY_MPS2, parse_unit
+>>>>>>> hunits
 
 __all__ = [
     "Finding",
@@ -96,7 +101,7 @@ QUIETEST_DPRH = 1e-8
 #: Noisier than any gyro [deg/sqrt(h)].
 ARW_MAX_DPRH = 100.0
 #: Beyond the measurement range of any gyro: 1e4 deg/s [deg/h].
-RANGE_MAX_DPH = 1e4 * 3600.0
+RANGE_MAX_DPH = 1e4 * S_PER_H
 #: A white-noise floor below this [deg/sqrt(h)] is navigation grade: such a gyro resolves the Earth rate.
 NAV_GRADE_DPRH = 0.01
 #: A static navigation-grade triad's mean vector is at least this fraction of the Earth rate.
@@ -328,9 +333,9 @@ def _gyro_findings(record, sums: dict | None = None) -> list[Finding]:
             findings.append(Finding("white-noise", axes, f"{what}; {hint}", likely))
         if "range" in broken:
             axes = tuple(n for n, p in zip(names, peaks) if p > RANGE_MAX_DPH)
-            levels = ", ".join(f"{n} {p / 3600.0:.3g} deg/s" for n, p in zip(names, peaks) if n in axes)
+            levels = ", ".join(f"{n} {p / S_PER_H:.3g} deg/s" for n, p in zip(names, peaks) if n in axes)
             findings.append(Finding("range", axes, f"max |rate| {levels} with the rate read as {unit} is beyond the "
-                                                   f"range of any gyro ({RANGE_MAX_DPH / 3600:g} deg/s); {hint}",
+                                                   f"range of any gyro ({RANGE_MAX_DPH / S_PER_H:g} deg/s); {hint}",
                                     likely))
         if "earth-rate" in broken:
             norm = float(np.linalg.norm(means))

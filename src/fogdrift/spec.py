@@ -45,14 +45,14 @@ from pathlib import Path
 from . import documents
 from ._util import fmt_number
 from .errors import ConfigError
+from .units import DEG_PER_RAD, S_PER_H, STANDARD_GRAVITY_MPS2
 
 __all__ = ["analysis_judgements", "ITEMS", "G0", "SpecLimit", "Reading", "Judgement", "parse_quantity", "convert", "read_spec",
            "parse_spec", "judge", "readings_from_noise_fit", "readings_from_gmwm", "compare", "B_COMPARED",
            "channel_kind", "judgement_line", "spec_columns", "judge_noise_fit", "norm_unit"]
 
 #: Standard gravity [m/s^2] (CGPM 1901; ISO 80000-3).
-G0 = 9.80665
-_DEG_PER_RAD = 180.0 / math.pi
+G0 = STANDARD_GRAVITY_MPS2
 
 #: What B is compared, in words (printed under every comparison).
 B_COMPARED = ("B compared: the IEEE-952 reading B_min = min of the fitted Allan deviation / 0.664 (what datasheets "
@@ -60,10 +60,10 @@ B_COMPARED = ("B compared: the IEEE-952 reading B_min = min of the fitted Allan 
 
 # unit tables: normalised unit text -> factor to the item's canonical unit
 _ARW = {"deg/sqrt(h)": 1.0, "deg/h/sqrt(hz)": 1.0 / 60.0, "deg/sqrt(s)": 60.0, "deg/s/sqrt(hz)": 60.0,
-        "rad/sqrt(s)": 60.0 * _DEG_PER_RAD, "rad/s/sqrt(hz)": 60.0 * _DEG_PER_RAD,
-        "rad/sqrt(h)": _DEG_PER_RAD, "mrad/sqrt(h)": 1e-3 * _DEG_PER_RAD}
-_GYRO_B = {"deg/h": 1.0, "deg/s": 3600.0, "rad/s": 3600.0 * _DEG_PER_RAD, "rad/h": _DEG_PER_RAD,
-           "mdeg/s": 3.6, "arcsec/s": 1.0}
+        "rad/sqrt(s)": 60.0 * DEG_PER_RAD, "rad/s/sqrt(hz)": 60.0 * DEG_PER_RAD,
+        "rad/sqrt(h)": DEG_PER_RAD, "mrad/sqrt(h)": 1e-3 * DEG_PER_RAD}
+_GYRO_B = {"deg/h": 1.0, "deg/s": S_PER_H, "rad/s": S_PER_H * DEG_PER_RAD, "rad/h": DEG_PER_RAD,
+           "mdeg/s": S_PER_H / 1000.0, "arcsec/s": 1.0}
 _VRW = {"m/s/sqrt(h)": 1.0, "m/s/sqrt(s)": 60.0, "m/s^2/sqrt(hz)": 60.0, "g/sqrt(hz)": 60.0 * G0,
         "mg/sqrt(hz)": 60e-3 * G0, "ug/sqrt(hz)": 60e-6 * G0, "ft/s/sqrt(h)": 0.3048}
 _ACC_B = {"m/s^2": 1.0, "g": G0, "mg": 1e-3 * G0, "ug": 1e-6 * G0, "mm/s^2": 1e-3}
@@ -355,7 +355,7 @@ def readings_from_noise_fit(noise, kind: str = "gyro") -> dict:
 
 #: An accelerometer fit whose terms still carry the gyro unit labels holds m/s^2 in place of deg/h (the internal unit
 #: of a specific force): deg/sqrt(h) = (deg/h) sqrt(h) -> (m/s^2) sqrt(h) = 3600 m/s/sqrt(h); deg/h -> m/s^2.
-_GYRO_LABEL_AS_ACCEL = {"deg/sqrt(h)": (3600.0, "m/s/sqrt(h)"), "deg/h": (1.0, "m/s^2")}
+_GYRO_LABEL_AS_ACCEL = {"deg/sqrt(h)": (S_PER_H, "m/s/sqrt(h)"), "deg/h": (1.0, "m/s^2")}
 
 
 def _accel_in_place_of_deg_h(readings: dict) -> dict:

@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .errors import ConfigError
+from .units import S_PER_H
 
 __all__ = ["TemperatureSummary", "temperature_summary", "summary_line", "EDGE_FRACTION"]
 
@@ -99,7 +100,7 @@ def temperature_summary(temperature_c, dt_s: float) -> TemperatureSummary:
     k = max(1, int(round(EDGE_FRACTION * n)))
     start, end = float(np.mean(x[:k])), float(np.mean(x[-k:]))
     if n > 1:
-        t_h = (np.arange(n) - (n - 1) / 2.0) * (dt / 3600.0)     # centred: no cancellation
+        t_h = (np.arange(n) - (n - 1) / 2.0) * (dt / S_PER_H)     # centred: no cancellation
         slope = float(np.dot(t_h, x - x.mean()) / np.dot(t_h, t_h))
     else:
         slope = 0.0
@@ -119,5 +120,5 @@ def summary_line(summary: TemperatureSummary | dict) -> str:
     """
     s = summary.to_dict() if isinstance(summary, TemperatureSummary) else dict(summary)
     return (f"temperature {s['min_c']:.2f} to {s['max_c']:.2f} deg C (range {s['range_c']:.2f}), "
-            f"drift {s['change_c']:+.2f} deg C over {s['duration_s'] / 3600.0:.3g} h "
+            f"drift {s['change_c']:+.2f} deg C over {s['duration_s'] / S_PER_H:.3g} h "
             f"(slope {s['slope_c_per_h']:+.3f} deg C/h)")

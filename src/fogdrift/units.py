@@ -11,6 +11,10 @@ Conversions happen only on the way in (:mod:`fogdrift.io`) and on the way out
 Name suffixes used across the package: ``_dph`` deg/h, ``_dps`` deg/s, ``_s`` seconds,
 ``_hz`` hertz, ``_deg`` degrees, ``_dprh`` deg/sqrt(h), ``_dph2`` deg/h^2,
 ``_dphrh`` deg/h^1.5 (= deg/h/sqrt(h)), ``_urad`` microradian, ``_arcsec`` arcsecond.
+
+The unit relations themselves live here and only here: 1 h = 3600 s (:data:`S_PER_H`), 1 min = 60 s
+(:data:`S_PER_MIN`), 1 deg = pi/180 rad (:data:`RAD_PER_DEG`, :data:`DEG_PER_RAD`) and 1 deg = 3600 arcsec
+(:data:`ARCSEC_PER_DEG`).  Every other module names them instead of writing the number.
 """
 
 from __future__ import annotations
@@ -23,6 +27,11 @@ import numpy as np
 from .errors import ConfigError
 
 __all__ = [
+    "S_PER_H",
+    "S_PER_MIN",
+    "RAD_PER_DEG",
+    "DEG_PER_RAD",
+    "ARCSEC_PER_DEG",
     "QUANTITIES",
     "INTERNAL_UNITS",
     "STANDARD_GRAVITY_MPS2",
@@ -50,12 +59,29 @@ __all__ = [
     "temperature_offset_to_c",
 ]
 
+#: Seconds per hour, 1 h = 3600 s.  Rates are kept in deg/h while time is in seconds, so this is the factor between
+#: a per-second and a per-hour figure (deg/s -> deg/h, deg/h^2 -> (deg/h)/s) and the length of a one-hour horizon.
+S_PER_H = 3600.0
+
+#: Seconds per minute, 1 min = 60 s (a time stamp or record length given in minutes).
+S_PER_MIN = 60.0
+
+#: Radians per degree, pi / 180: multiply an angle (or rate) in degrees by it to get radians (the SI exports).
+RAD_PER_DEG = math.pi / 180.0
+
+#: Degrees per radian, 180 / pi: multiply an angle (or rate) in radians by it to get degrees (rad/s, rad/h inputs).
+#: Its own rounding of 180 / pi, not ``1 / RAD_PER_DEG``, so the tables below keep their values.
+DEG_PER_RAD = 180.0 / math.pi
+
+#: Arcseconds per degree, 1 deg = 3600 arcsec (the same number as :data:`S_PER_H`, a different fact: an angle).
+ARCSEC_PER_DEG = 3600.0
+
 #: WGS-84 Earth rotation rate 7.2921150e-5 rad/s expressed in deg/h (method notes §6).
-EARTH_RATE_DPH = 7.2921150e-5 * 180.0 / math.pi * 3600.0
+EARTH_RATE_DPH = 7.2921150e-5 * DEG_PER_RAD * S_PER_H
 
 #: One arcsecond in microradians, 1e6 pi / (180 * 3600) = 4.8481368.  Note that 1 (deg/h) s = 1/3600 deg
 #: = 1 arcsec, so a quantization coefficient in the Allan-law units (rate deg/h, tau s) is in arcsec.
-URAD_PER_ARCSEC = 1e6 * math.pi / (180.0 * 3600.0)
+URAD_PER_ARCSEC = 1e6 * math.pi / (180.0 * ARCSEC_PER_DEG)
 
 #: sqrt(2 ln 2 / pi) = 0.664282: the flat Allan deviation of flicker rate noise in units of the bias
 #: instability B (IEEE Std 952-1997 Annex C; method notes 2.2).  The read-off sigma_min = 0.6643 B.
@@ -64,17 +90,17 @@ B_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)
 #: Multiply a rate in the key's unit by the value to get deg/h.
 RATE_UNITS: dict[str, float] = {
     "deg/h": 1.0,
-    "deg/s": 3600.0,
-    "rad/s": 180.0 / math.pi * 3600.0,
-    "rad/h": 180.0 / math.pi,
+    "deg/s": S_PER_H,
+    "rad/s": DEG_PER_RAD * S_PER_H,
+    "rad/h": DEG_PER_RAD,
     "arcsec/s": 1.0,  # 1 arcsec/s = 1/3600 deg per 1/3600 h = 1 deg/h
 }
 
 #: Multiply an angle increment per sample in the key's unit by the value, then divide by
 #: the sample interval in seconds, to get deg/h.  (1 arcsec per second = 1 deg/h.)
 INCREMENT_UNITS: dict[str, float] = {
-    "deg": 3600.0,
-    "rad": 180.0 / math.pi * 3600.0,
+    "deg": S_PER_H,
+    "rad": DEG_PER_RAD * S_PER_H,
     "arcsec": 1.0,
 }
 

@@ -24,6 +24,7 @@ from .._util import fmt_number
 from ..errors import ConfigError
 from ..io import file_sha256
 from ..io._checks import check_path
+from ..units import S_PER_H
 from ._app import (JsonOpt, OutOpt, app, check_plausible, console, echo_record, fitted_table, progress, run,
                    say, warn, with_load_options)
 
@@ -128,7 +129,7 @@ def _model_text(comps, kind: str = "gyro") -> str:
     for c in comps:
         k = c["kind"]
         if k == "white":
-            parts.append(f"VRW {3600 * c['arw_dprh']:.3g} m/s/√h" if accel else f"N {c['arw_dprh']:.3g} deg/√h")
+            parts.append(f"VRW {S_PER_H * c['arw_dprh']:.3g} m/s/√h" if accel else f"N {c['arw_dprh']:.3g} deg/√h")
         elif k == "random_walk":
             parts.append(f"K {c['rrw_dphrh']:.3g} (m/s²)/√h" if accel else f"K {c['rrw_dphrh']:.3g} deg/h^1.5")
         elif k == "gauss_markov":

@@ -18,6 +18,7 @@ from ..evaluation.artefacts import artefact_check
 from ..evaluation.heading import heading_errors
 from ..evaluation.verdicts import adev_caveat, artefact_verdict, heading_verdict, headline_verdict
 from ..interrupt import checkpoint
+from ..units import S_PER_H
 from ..models import model_spec
 from ..output import OutputDir, active, atomic_path
 from ..report.files import write_json
@@ -100,7 +101,7 @@ def compensate_file(bundle, path, out_dir, *, model=None, bias="keep", unit=None
                     accept_rate=False, columns=None, time_column="auto", rate_hz=None, time_unit=None, format=None,
                     reader_options=None, temperature=None, gaps="error", apply_unit=None, chunk_samples=DEFAULT_CHUNK,
                     formats=FORMATS, figures=True, heading=True, artefacts=True,
-                    calib_s=300.0, step_s=300.0, horizons_s=(60.0, 600.0, 3600.0), max_model_rate_samples=1 << 23,
+                    calib_s=300.0, step_s=300.0, horizons_s=(60.0, 600.0, S_PER_H), max_model_rate_samples=1 << 23,
                     segment=None, progress=None, flags=None) -> CompensationResult:
     """Compensate the log ``path`` with ``bundle`` and write the results to ``out_dir``.
 

@@ -56,6 +56,7 @@ from .._util import fmt_number
 from ..errors import ConfigError, InsufficientDataError
 from ..models.components import components_from_gmwm, components_from_noise_fit  # re-exported
 from ..models.statespace import check_components
+from ..units import DEG_PER_RAD, RAD_PER_DEG, S_PER_H
 
 __all__ = [
     "BANDS",
@@ -77,9 +78,9 @@ __all__ = [
 #: (name, nominal coverage, z): the 1-sigma band (68.27 %) and the 95 % band.
 BANDS = (("68 %", 0.6826894921370859, 1.0), ("95 %", 0.95, 1.959963984540054))
 
-_DEG_PER_URAD = 1e-6 * 180.0 / math.pi
+_DEG_PER_URAD = 1e-6 * DEG_PER_RAD
 #: Integration factor of the internal rate unit per second: deg/h * s -> deg (gyro), m/s^2 * s -> m/s (accel).
-_INTEGRATE = {"gyro": 1.0 / 3600.0, "accel": 1.0}
+_INTEGRATE = {"gyro": 1.0 / S_PER_H, "accel": 1.0}
 
 
 def _quantity(quantity) -> str:
@@ -112,10 +113,10 @@ def _component_variance_deg2(c: dict, h: np.ndarray, T: float) -> np.ndarray:
         n = c["arw_dprh"] / 60.0  # deg/sqrt(s)
         return n * n * (h + h * h / T)
     if kind == "random_walk":
-        k = c["rrw_dphrh"] / 216000.0  # deg/s^1.5
+        k = c["rrw_dphrh"] / S_PER_H**1.5  # deg/s^1.5
         return k * k * (h**3 / 3.0 + h * h * T / 3.0)
     if kind == "gauss_markov":
-        s2 = (c["sigma_dph"] / 3600.0) ** 2
+        s2 = (c["sigma_dph"] / S_PER_H) ** 2
         tc = c["tc_s"]
 
         def v(L):
@@ -130,7 +131,7 @@ def _component_variance_deg2(c: dict, h: np.ndarray, T: float) -> np.ndarray:
         q = c["q_urad"] * _DEG_PER_URAD
         return q * q * (1.0 + (1.0 + h / T) ** 2 + (h / T) ** 2)
     if kind == "ramp":
-        r = c["ramp_dph2"] / 3600.0**2  # deg/s^2
+        r = c["ramp_dph2"] / S_PER_H**2  # deg/s^2
         return (r * (h * h / 2.0 + h * T / 2.0)) ** 2
     raise ConfigError(f"unknown noise component kind {kind!r}")  # pragma: no cover - check_components refuses it
 
@@ -169,8 +170,8 @@ def angle_error_variance_deg2(components, horizons_s, t_cal_s, *, by_component: 
     h = _horizons(horizons_s)
     T = _t_cal(t_cal_s)
     parts = [_component_variance_deg2(c, h, T) for c in comps]
-    if _quantity(quantity) == "accel":  # the formulas carry (1/3600)^2 for deg/h -> deg/s; m/s^2 needs none
-        parts = [p * 3600.0**2 for p in parts]
+    if _quantity(quantity) == "accel":  # the formulas carry 1/S_PER_H^2 for deg/h -> deg/s; m/s^2 needs none
+        parts = [p * S_PER_H**2 for p in parts]
     total = np.sum(parts, axis=0) if parts else np.zeros_like(h)
     return (total, parts) if by_component else total
 
@@ -396,12 +397,12 @@ def random_walk_covering(components, horizon_s: float, t_cal_s: float, *, k_boun
     _, parts = angle_error_variance_deg2(comps, h, T, by_component=True)
     drift = sum(float(p[0]) for c, p in zip(comps, parts) if c["kind"] != "white")
     unit = h**3 / 3.0 + h * h * T / 3.0
-    k_eff = math.sqrt(max(drift, 0.0) / unit) * 216000.0
+    k_eff = math.sqrt(max(drift, 0.0) / unit) * S_PER_H**1.5
     k_alone = math.sqrt(sum(c["rrw_dphrh"] ** 2 for c in comps if c["kind"] == "random_walk"))
     ratio = k_eff / k_alone if k_alone > 0 else None
     accel = _quantity(quantity) == "accel"
     # SI: gyro K [deg/h^1.5] -> rad/s^1.5 = rad/s^2/sqrt(Hz); accel K [(m/s^2)/sqrt(h)] -> m/s^2.5 = m/s^3/sqrt(Hz)
-    si = k_eff / 60.0 if accel else k_eff / 216000.0 * math.pi / 180.0
+    si = k_eff / 60.0 if accel else k_eff / S_PER_H**1.5 * RAD_PER_DEG
     ku = "(m/s^2)/sqrt(h)" if accel else "deg/h^1.5"
     kb = None if k_bound_dphrh is None or not k_bound_dphrh > 0 else float(k_bound_dphrh)
     to_bound = None if kb is None or ratio is not None else k_eff / kb

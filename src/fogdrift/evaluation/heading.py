@@ -34,13 +34,14 @@ import numpy as np
 
 from ..errors import ConfigError, FogdriftError, InsufficientDataError
 from ..models.causal_predictor import causal_weights
+from ..units import S_PER_H
 from .verdicts import diverges, independent_subset
 
 __all__ = ["HORIZONS_S", "CONSTANT_BIAS", "HeadingRow", "HeadingResult", "heading_errors", "heading_row",
            "angle_error_deg"]
 
 #: Default forecast horizons [s].
-HORIZONS_S = (60.0, 600.0, 3600.0)
+HORIZONS_S = (60.0, 600.0, S_PER_H)
 #: Label of the reference compensator (window-mean bias, no drift model).
 CONSTANT_BIAS = "constant bias"
 
@@ -57,7 +58,7 @@ def angle_error_deg(rate_dph, bias_dph, forecast_dph, dt_s) -> np.ndarray:
     """
     resid = np.asarray(rate_dph, dtype=np.float64) - bias_dph - np.asarray(forecast_dph, dtype=np.float64)
     with np.errstate(over="ignore", invalid="ignore"):
-        return np.cumsum(resid) * (dt_s / 3600.0)
+        return np.cumsum(resid) * (dt_s / S_PER_H)
 
 
 @dataclass(frozen=True)

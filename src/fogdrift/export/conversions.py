@@ -31,6 +31,11 @@ import math
 from ..errors import ConfigError
 from ..noise.processes import process, processes
 from ..noise.processes.gauss_markov import gm_avar_dph2
+from ..units import ARCSEC_PER_DEG, RAD_PER_DEG, S_PER_H
+# DEG (one degree in radians) and G0 (standard gravity [m/s^2], the "g" of mg / ug): the units module's
+# constants under the names this module exports
+from ..units import RAD_PER_DEG as DEG
+from ..units import STANDARD_GRAVITY_MPS2 as G0
 
 __all__ = [
     "DEG", "G0", "MGAL", "GM_FLICKER_SIGMA", "GM_PEAK_X",
@@ -39,9 +44,6 @@ __all__ = [
     "single_gm_from_flicker", "UNIT_TABLE", "SI_UNITS", "si_unit", "vins_white", "vins_walk", "gm_rematch",
 ]
 
-DEG = math.pi / 180.0
-#: Standard gravity [m/s^2] (CGPM 1901), the "g" of mg / ug.
-G0 = 9.80665
 #: One milligal in m/s^2.
 MGAL = 1e-5
 #: x = tau/T_c at the Allan-variance peak of a first-order Gauss-Markov process, and the peak value in sigma^2
@@ -61,7 +63,7 @@ def arw_to_density(arw_deg_rth: float) -> float:
     >>> f"{arw_to_density(0.15):.4g}"   # 0.15 deg/sqrt(h) = 0.15 * 0.0174533 / 60
     '4.363e-05'
     """
-    return float(arw_deg_rth) * DEG / 60.0
+    return float(arw_deg_rth) * RAD_PER_DEG / 60.0
 
 
 def density_to_arw(density_rad: float) -> float:
@@ -72,7 +74,7 @@ def density_to_arw(density_rad: float) -> float:
     >>> round(density_to_arw(4.3633e-5), 4)
     0.15
     """
-    return float(density_rad) * 60.0 / DEG
+    return float(density_rad) * 60.0 / RAD_PER_DEG
 
 
 def vrw_to_density(vrw_mps_rth: float) -> float:
@@ -108,7 +110,7 @@ def rrw_to_density(rrw_deg_h15: float) -> float:
     >>> f"{rrw_to_density(10.0):.4g}"
     '8.08e-07'
     """
-    return float(rrw_deg_h15) * DEG / 3600.0 / 60.0
+    return float(rrw_deg_h15) * RAD_PER_DEG / S_PER_H / 60.0
 
 
 def white_discrete(density: float, rate_hz: float) -> float:
@@ -233,25 +235,25 @@ def _rate(rate_hz) -> float:
 #: (a Gauss-Markov 1-sigma or any rate), q_c (Markov driving density, IEEE-952 C.6).
 UNIT_TABLE: dict[tuple[str, str], tuple[str, float]] = {
     # gyro
-    ("N", "deg/sqrt(h)"): ("gyro", DEG / 60.0),
+    ("N", "deg/sqrt(h)"): ("gyro", RAD_PER_DEG / 60.0),
     ("N", "rad/s/sqrt(Hz)"): ("gyro", 1.0),
     ("N", "rad/sqrt(s)"): ("gyro", 1.0),
-    ("N", "deg/s/sqrt(Hz)"): ("gyro", DEG),
-    ("N", "deg/h/sqrt(Hz)"): ("gyro", DEG / 3600.0),
-    ("N", "deg/h*sqrt(s)"): ("gyro", DEG / 3600.0),
-    ("K", "deg/h^1.5"): ("gyro", DEG / 216000.0),
-    ("K", "deg/h/sqrt(h)"): ("gyro", DEG / 216000.0),
+    ("N", "deg/s/sqrt(Hz)"): ("gyro", RAD_PER_DEG),
+    ("N", "deg/h/sqrt(Hz)"): ("gyro", RAD_PER_DEG / S_PER_H),
+    ("N", "deg/h*sqrt(s)"): ("gyro", RAD_PER_DEG / S_PER_H),
+    ("K", "deg/h^1.5"): ("gyro", RAD_PER_DEG / S_PER_H**1.5),
+    ("K", "deg/h/sqrt(h)"): ("gyro", RAD_PER_DEG / S_PER_H**1.5),
     ("K", "rad/s^2/sqrt(Hz)"): ("gyro", 1.0),
     ("K", "rad/s^1.5"): ("gyro", 1.0),
-    ("B", "deg/h"): ("gyro", DEG / 3600.0),
-    ("B", "deg/s"): ("gyro", DEG),
+    ("B", "deg/h"): ("gyro", RAD_PER_DEG / S_PER_H),
+    ("B", "deg/s"): ("gyro", RAD_PER_DEG),
     ("B", "rad/s"): ("gyro", 1.0),
     ("Q", "urad"): ("gyro", 1e-6),
-    ("Q", "arcsec"): ("gyro", DEG / 3600.0),
+    ("Q", "arcsec"): ("gyro", RAD_PER_DEG / ARCSEC_PER_DEG),
     ("Q", "rad"): ("gyro", 1.0),
-    ("R", "deg/h^2"): ("gyro", DEG / 3600.0 ** 2),
+    ("R", "deg/h^2"): ("gyro", RAD_PER_DEG / S_PER_H ** 2),
     ("R", "rad/s^2"): ("gyro", 1.0),
-    ("q_c", "deg/h/sqrt(s)"): ("gyro", DEG / 3600.0),
+    ("q_c", "deg/h/sqrt(s)"): ("gyro", RAD_PER_DEG / S_PER_H),
     # accelerometer (IEEE Std 1293 units and SI)
     ("N", "m/s/sqrt(h)"): ("accel", 1.0 / 60.0),
     ("N", "m/s^2/sqrt(Hz)"): ("accel", 1.0),
@@ -263,20 +265,20 @@ UNIT_TABLE: dict[tuple[str, str], tuple[str, float]] = {
     ("K", "m/s^2/sqrt(s)"): ("accel", 1.0),
     ("K", "m/s^2.5"): ("accel", 1.0),
     ("K", "m/s^2/sqrt(h)"): ("accel", 1.0 / 60.0),
-    ("K", "m/s/h^1.5"): ("accel", 1.0 / 216000.0),
-    ("K", "m/s/h/sqrt(h)"): ("accel", 1.0 / 216000.0),
+    ("K", "m/s/h^1.5"): ("accel", 1.0 / S_PER_H**1.5),
+    ("K", "m/s/h/sqrt(h)"): ("accel", 1.0 / S_PER_H**1.5),
     ("K", "ug/sqrt(s)"): ("accel", G0 * 1e-6),
     ("B", "m/s^2"): ("accel", 1.0),
     ("B", "ug"): ("accel", G0 * 1e-6),
     ("B", "mg"): ("accel", G0 * 1e-3),
     ("B", "g"): ("accel", G0),
     ("B", "mGal"): ("accel", MGAL),
-    ("B", "m/s/h"): ("accel", 1.0 / 3600.0),
+    ("B", "m/s/h"): ("accel", 1.0 / S_PER_H),
     ("Q", "m/s"): ("accel", 1.0),
     ("Q", "mm/s"): ("accel", 1e-3),
     ("R", "m/s^3"): ("accel", 1.0),
-    ("R", "m/s^2/h"): ("accel", 1.0 / 3600.0),
-    ("R", "m/s/h^2"): ("accel", 1.0 / 3600.0 ** 2),
+    ("R", "m/s^2/h"): ("accel", 1.0 / S_PER_H),
+    ("R", "m/s/h^2"): ("accel", 1.0 / S_PER_H ** 2),
     ("q_c", "m/s^2/sqrt(s)"): ("accel", 1.0),
 }
 

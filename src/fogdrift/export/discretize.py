@@ -27,14 +27,13 @@ import numpy as np
 from ..errors import ConfigError
 from ..models.statespace import check_components, component_densities, components_from_allan, state_space
 from ..noise.terms import TERM_TABLE, TERMS
-from ..units import URAD_PER_ARCSEC
-from .conversions import DEG
+from ..units import RAD_PER_DEG, S_PER_H, URAD_PER_ARCSEC
 from .model import ChannelModel
 
 __all__ = ["van_loan", "channel_components", "continuous_model", "discrete_model", "COMPONENT_RATE_UNIT"]
 
 #: Rate unit of a channel's statespace components, and its value in SI.
-COMPONENT_RATE_UNIT = {"gyro": ("deg/h", DEG / 3600.0), "accel": ("m/s^2", 1.0)}
+COMPONENT_RATE_UNIT = {"gyro": ("deg/h", RAD_PER_DEG / S_PER_H), "accel": ("m/s^2", 1.0)}
 
 
 def van_loan(F, Qc, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -168,7 +167,7 @@ def discrete_model(ch: ChannelModel, rate_hz: float) -> dict:
         elif k == "gauss_markov":
             terms_si.append({"kind": k, "sigma": c["sigma_dph"] * scale, "unit": si_rate, "tc_s": c["tc_s"]})
         else:
-            terms_si.append({"kind": k, "slope_sigma": c["ramp_dph2"] / 3600.0 * scale, "unit": f"{si_rate}/s"})
+            terms_si.append({"kind": k, "slope_sigma": c["ramp_dph2"] / S_PER_H * scale, "unit": f"{si_rate}/s"})
     return {
         "rate_unit": si_rate,
         "continuous_terms": terms_si,

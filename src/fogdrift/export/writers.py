@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 
 from .._util import fmt_number
 from ..errors import FogdriftError
-from .conversions import DEG, MGAL, gm_discrete, gm_rematch, vins_walk, vins_white, walk_discrete, white_discrete
+from ..units import RAD_PER_DEG, S_PER_H
+from .conversions import MGAL, gm_discrete, gm_rematch, vins_walk, vins_white, walk_discrete, white_discrete
 from .discretize import discrete_model
 from .model import ChannelModel, bias_gm, describe, resolve
 
@@ -366,7 +367,7 @@ def write_kfgins(ctx: ExportContext) -> str:
               "# scale factor): each bias one first-order Gauss-Markov, ONE correlation time for all of them; a random",
               "# walk K has no place in it", "imunoise:"]
     body = []
-    for quantity, key, factor, unit in (("gyro", "arw", 60.0 / DEG, "deg/sqrt(h)"), ("accel", "vrw", 60.0, "m/s/sqrt(h)")):
+    for quantity, key, factor, unit in (("gyro", "arw", 60.0 / RAD_PER_DEG, "deg/sqrt(h)"), ("accel", "vrw", 60.0, "m/s/sqrt(h)")):
         if ctx.channels(quantity):
             vals, ls = _vector(ctx, quantity, "N", "  # ", unit, factor, "white")
             vals, pad = _three(ctx, "kf-gins", quantity, vals, [c.name for c in ctx.channels(quantity)], "  # ")
@@ -375,13 +376,13 @@ def write_kfgins(ctx: ExportContext) -> str:
             ls, d = _placeholder(ctx, "kf-gins", quantity, [key], "  # ")
             body += ls + [f"  {key}: {_list([d[key]] * 3)}  # [{unit}] NOT MEASURED"]
     gms = {}
-    for quantity, sigma_unit, sigma_factor in (("gyro", "deg/h", 3600.0 / DEG), ("accel", "mGal", 1.0 / MGAL)):
+    for quantity, sigma_unit, sigma_factor in (("gyro", "deg/h", S_PER_H / RAD_PER_DEG), ("accel", "mGal", 1.0 / MGAL)):
         if ctx.channels(quantity):
             _, _, ls = _gm_vectors(ctx, quantity, "  # ", sigma_factor, sigma_unit, 1.0, "s")
             gms[quantity] = ([bias_gm(ch, ctx.missing)[0] for ch in ctx.channels(quantity)], ls)
     tcs = [g.tc_s for q in gms for g in gms[q][0]]
     tc = _geomean(tcs) if tcs else None
-    for quantity, key, unit, factor in (("gyro", "gbstd", "deg/h", 3600.0 / DEG), ("accel", "abstd", "mGal", 1.0 / MGAL)):
+    for quantity, key, unit, factor in (("gyro", "gbstd", "deg/h", S_PER_H / RAD_PER_DEG), ("accel", "abstd", "mGal", 1.0 / MGAL)):
         if quantity not in gms:
             ls, d = _placeholder(ctx, "kf-gins", quantity, [key], "  # ")
             body += ls + [f"  {key}: {_list([d[key]] * 3)}  # [{unit}] NOT MEASURED"]
@@ -405,7 +406,7 @@ def write_kfgins(ctx: ExportContext) -> str:
         per = "; ".join(f"{_QWORD[q]} " + ", ".join(f"{fmt(g.tc_s)}" for g in gms[q][0]) + " s" for q in gms)
         body += [f"  # corrtime: KF-GINS takes one correlation time for all six biases (and the scale factors): the "
                  f"geometric mean of the axes' T_c ({per}), each axis's sigma re-matched to it above",
-                 f"  corrtime: {fmt(tc / 3600.0)}  # [h]"]
+                 f"  corrtime: {fmt(tc / S_PER_H)}  # [h]"]
         spread = max(tcs) / min(tcs)
         if spread > 2.0:
             ctx.note(f"kf-gins: the axes' bias correlation times span a factor {spread:.3g}; KF-GINS takes one "
@@ -458,7 +459,7 @@ def write_gnss_ins_sim(ctx: ExportContext) -> str:
               "accel_b, accel_b_stability, accel_vrw (b_corr optional: infinite = white bias); pathgen.py applies arw and",
               f"{pre}vrw as continuous densities (per sample / sqrt(dt)); b_stability is the 1-sigma of a first-order "
               "Gauss-Markov bias with correlation time b_corr (bias_drift)", "import numpy as np", "", "imu_err = {"]
-    for quantity, pfx, nunit, nfac, bunit, bfac in (("gyro", "gyro", "deg/sqrt(h)", 60.0 / DEG, "deg/h", 3600.0 / DEG),
+    for quantity, pfx, nunit, nfac, bunit, bfac in (("gyro", "gyro", "deg/sqrt(h)", 60.0 / RAD_PER_DEG, "deg/h", S_PER_H / RAD_PER_DEG),
                                                     ("accel", "accel", "m/s/sqrt(h)", 60.0, "m/s^2", 1.0)):
         nkey = f"{pfx}_{'arw' if pfx == 'gyro' else 'vrw'}"
         lines += ["    # constant bias: not a noise term (removed by calibration); 0 = a calibrated sensor",

@@ -23,13 +23,13 @@ from __future__ import annotations
 import dataclasses
 
 from ..noise.quantity import restate_text
-from ..units import URAD_PER_ARCSEC
+from ..units import S_PER_H, URAD_PER_ARCSEC
 
 __all__ = ["express_gmwm", "GMWM_ACCEL_UNITS", "UG_PER_MPS2"]
 
 #: key -> (accelerometer unit, factor from the gyro number).
 GMWM_ACCEL_UNITS = {
-    "N_dprh": ("m/s/sqrt(h)", 3600.0),
+    "N_dprh": ("m/s/sqrt(h)", S_PER_H),
     "K_dphrh": ("m/s^2/sqrt(h)", 1.0),
     "R_dph2": ("m/s^2/h", 1.0),
     "Q_urad": ("m/s", 1.0 / URAD_PER_ARCSEC),

@@ -32,6 +32,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..noise.processes import processes
+from ..units import S_PER_H
 from .statespace import check_components, components_from_allan, flicker_as_gauss_markov
 
 __all__ = ["components_from_noise_fit", "components_from_gmwm", "gmwm_ieee"]
@@ -128,7 +129,7 @@ def components_from_gmwm(ieee, *, ramp: str = "state") -> tuple[list[dict], list
     k_dphrh = float(t["K_dphrh"].value) if "K_dphrh" in t else None
     if "R_dph2" in t and ramp == "random_walk":
         r_dph2 = float(t["R_dph2"].value)
-        k_s = math.sqrt((k_dphrh or 0.0) ** 2 / 3600.0 + 1.5 * (r_dph2 / 3600.0) ** 2 * tau_range("ramp")[1])
+        k_s = math.sqrt((k_dphrh or 0.0) ** 2 / S_PER_H + 1.5 * (r_dph2 / S_PER_H) ** 2 * tau_range("ramp")[1])
         k_dphrh = 60.0 * k_s
         notes.append("ramp R folded into the random walk with its Allan variance at the longest fitted tau")
     if "N_dprh" in t:

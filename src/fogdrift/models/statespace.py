@@ -56,6 +56,7 @@ from ..noise.processes import TableView, component_specs, power_law_names, proce
 from ..noise.processes.flicker import flicker_as_gauss_markov
 from ..noise.processes.gauss_markov import gm_avar_dph2
 from ..noise.terms import TERMS
+from ..units import S_PER_H
 
 __all__ = [
     "COMPONENT_KINDS",
@@ -545,4 +546,4 @@ def forecast_uncertainty(ss: StateSpace, h: int, state=None):
     rate_var = np.empty(int(h))
     angle_var = np.empty(int(h))
     _kernels()["forecast"](ss.F, ss.Q, ss.H, float(ss.r), float(ss.dt_s), x, P, mean, rate_var, angle_var)
-    return mean, np.sqrt(np.maximum(rate_var, 0.0)), np.sqrt(np.maximum(angle_var, 0.0)) / 3600.0
+    return mean, np.sqrt(np.maximum(rate_var, 0.0)), np.sqrt(np.maximum(angle_var, 0.0)) / S_PER_H

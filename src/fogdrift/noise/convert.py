@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from ..errors import ConfigError
-from ..units import URAD_PER_ARCSEC
+from ..units import S_PER_H, URAD_PER_ARCSEC
 from .terms import TERM_TABLE, TERMS, laws_of
 
 __all__ = ["coefficients_from_A", "paper_table1_from_A"]
@@ -84,10 +84,10 @@ def paper_table1_from_A(A) -> dict[str, float]:
     """
     a = _check_A(A)
     return {
-        "Q": 1e6 * 3600.0 * math.pi * math.sqrt(3.0 * a[0]) / 180.0,
+        "Q": 1e6 * S_PER_H * math.pi * math.sqrt(3.0 * a[0]) / 180.0,  # as printed (the degree factor split around the sqrt)
         "N": math.sqrt(a[1]) / 60.0,
         "B": math.sqrt(a[2]) / 0.6643,
         "K": 60.0 * math.sqrt(3.0 * a[3]),
-        "R": 3600.0 * math.sqrt(2.0 * a[4]),
+        "R": S_PER_H * math.sqrt(2.0 * a[4]),
         "Q_is_wrong": 1.0,
     }

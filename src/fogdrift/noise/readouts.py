@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..units import B_FACTOR, URAD_PER_ARCSEC
+from ..units import B_FACTOR, S_PER_H, URAD_PER_ARCSEC
 from .terms import ALL_TERMS, DISPLAY_UNITS, TERM_UNITS, TERMS
 
 __all__ = ["Readout", "slope_readouts"]
@@ -24,9 +24,9 @@ __all__ = ["Readout", "slope_readouts"]
 #: term -> (slope of sigma, tau [s] at which the line is read, factor to the reported unit, unit)
 _READ = {
     "Q": (-1.0, math.sqrt(3.0), URAD_PER_ARCSEC, TERM_UNITS["Q"]),
-    "N": (-0.5, 3600.0, 1.0, TERM_UNITS["N"]),
-    "K": (0.5, 3.0 * 3600.0, 1.0, TERM_UNITS["K"]),
-    "R": (1.0, math.sqrt(2.0) * 3600.0, 1.0, TERM_UNITS["R"]),
+    "N": (-0.5, S_PER_H, 1.0, TERM_UNITS["N"]),
+    "K": (0.5, 3.0 * S_PER_H, 1.0, TERM_UNITS["K"]),
+    "R": (1.0, math.sqrt(2.0) * S_PER_H, 1.0, TERM_UNITS["R"]),
 }
 
 

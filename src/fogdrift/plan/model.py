@@ -20,7 +20,12 @@ import numpy as np
 from .. import documents
 from ..errors import ConfigError
 from ..noise.terms import TERM_TABLE, all_terms, laws_of
+<<<<<<< HEAD
 from ..spec import norm_unit
+=======
+from ..spec import _norm_unit
+from ..units import ARCSEC_PER_DEG, DEG_PER_RAD, S_PER_H, S_PER_MIN, URAD_PER_ARCSEC
+>>>>>>> hunits
 
 __all__ = ["PlanModel", "parse_model", "parse_targets", "parse_length", "model_from_fit", "read_model_file",
            "DEFAULT_TARGETS", "PLANNED_TERMS", "fmt_length"]
@@ -31,20 +36,21 @@ PLANNED_TERMS = ("Q", "N", "B", "K", "R")
 #: Default relative 95 % half-width per term (a term is planned only when the model holds it).
 DEFAULT_TARGETS = {"Q": 0.25, "N": 0.05, "B": 0.10, "K": 0.25, "R": 0.25}
 
-_DEG_PER_RAD = 180.0 / math.pi
 # normalised unit text (fogdrift.spec's spelling rules) -> factor to the term's reported unit
 _UNITS = {
-    "Q": {"urad": 1.0, "rad": 1e6, "mrad": 1e3, "arcsec": TERM_TABLE["Q"].to_unit, "deg": 3600 * 4.84813681109536},
+    "Q": {"urad": 1.0, "rad": 1e6, "mrad": 1e3, "arcsec": TERM_TABLE["Q"].to_unit,
+          "deg": ARCSEC_PER_DEG * URAD_PER_ARCSEC},
     "N": {"deg/sqrt(h)": 1.0, "deg/h/sqrt(hz)": 1 / 60, "deg/sqrt(s)": 60.0, "deg/s/sqrt(hz)": 60.0,
-          "rad/sqrt(s)": 60.0 * _DEG_PER_RAD, "rad/s/sqrt(hz)": 60.0 * _DEG_PER_RAD, "rad/sqrt(h)": _DEG_PER_RAD},
-    "B": {"deg/h": 1.0, "deg/s": 3600.0, "rad/s": 3600.0 * _DEG_PER_RAD, "rad/h": _DEG_PER_RAD, "mdeg/s": 3.6},
-    "K": {"deg/h^1.5": 1.0, "deg/h/sqrt(h)": 1.0, "deg/h^(3/2)": 1.0, "deg/s^1.5": 3600.0**1.5,
-          "deg/s/sqrt(s)": 3600.0**1.5, "deg/s^2/sqrt(hz)": 3600.0**1.5, "rad/s^1.5": 3600.0**1.5 * _DEG_PER_RAD,
-          "rad/s/sqrt(s)": 3600.0**1.5 * _DEG_PER_RAD, "rad/s^2/sqrt(hz)": 3600.0**1.5 * _DEG_PER_RAD},
-    "R": {"deg/h^2": 1.0, "deg/h/h": 1.0, "deg/s^2": 3600.0**2, "rad/s^2": 3600.0**2 * _DEG_PER_RAD},
+          "rad/sqrt(s)": 60.0 * DEG_PER_RAD, "rad/s/sqrt(hz)": 60.0 * DEG_PER_RAD, "rad/sqrt(h)": DEG_PER_RAD},
+    "B": {"deg/h": 1.0, "deg/s": S_PER_H, "rad/s": S_PER_H * DEG_PER_RAD, "rad/h": DEG_PER_RAD,
+          "mdeg/s": S_PER_H / 1000.0},
+    "K": {"deg/h^1.5": 1.0, "deg/h/sqrt(h)": 1.0, "deg/h^(3/2)": 1.0, "deg/s^1.5": S_PER_H**1.5,
+          "deg/s/sqrt(s)": S_PER_H**1.5, "deg/s^2/sqrt(hz)": S_PER_H**1.5, "rad/s^1.5": S_PER_H**1.5 * DEG_PER_RAD,
+          "rad/s/sqrt(s)": S_PER_H**1.5 * DEG_PER_RAD, "rad/s^2/sqrt(hz)": S_PER_H**1.5 * DEG_PER_RAD},
+    "R": {"deg/h^2": 1.0, "deg/h/h": 1.0, "deg/s^2": S_PER_H**2, "rad/s^2": S_PER_H**2 * DEG_PER_RAD},
 }
-_TIME = {"s": 1.0, "sec": 1.0, "min": 60.0, "m": 60.0, "h": 3600.0, "hr": 3600.0, "hour": 3600.0, "hours": 3600.0,
-         "d": 86400.0, "day": 86400.0, "days": 86400.0}
+_TIME = {"s": 1.0, "sec": 1.0, "min": S_PER_MIN, "m": S_PER_MIN, "h": S_PER_H, "hr": S_PER_H, "hour": S_PER_H,
+         "hours": S_PER_H, "d": 86400.0, "day": 86400.0, "days": 86400.0}
 _NUM = r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"
 
 
@@ -206,9 +212,9 @@ def fmt_length(seconds) -> str:
     if s < 120:
         return f"{s:.3g} s"
     if s < 7200:
-        return f"{s / 60:.3g} min"
+        return f"{s / S_PER_MIN:.3g} min"
     if s < 3 * 86400:
-        return f"{s / 3600:.3g} h"
+        return f"{s / S_PER_H:.3g} h"
     return f"{s / 86400:.3g} d"
 
 

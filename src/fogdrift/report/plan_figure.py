@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..units import S_PER_H
 from .figures import pyplot, save_figure
 
 __all__ = ["plot_plan"]
@@ -17,7 +18,7 @@ def plot_plan(plan, path) -> Path:
     """Write the plan figure (PNG) of :class:`fogdrift.plan.Plan` to ``path``."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
-    L = np.asarray(plan.grid["length_s"], dtype=float) / 3600.0
+    L = np.asarray(plan.grid["length_s"], dtype=float) / S_PER_H
     for i, (t, w) in enumerate(plan.grid["width"].items()):
         w = 100.0 * np.asarray(w, dtype=float)
         color = f"C{i}"
@@ -27,13 +28,13 @@ def plot_plan(plan, path) -> Path:
             continue
         ax.axhline(100.0 * r["target"], color=color, ls=":", lw=0.9)
         if r["target_s"] is not None:
-            ax.plot([r["target_s"] / 3600.0], [100.0 * r["target"]], "o", color=color, mfc="none")
+            ax.plot([r["target_s"] / S_PER_H], [100.0 * r["target"]], "o", color=color, mfc="none")
         mc = r.get("mc")
         if mc and mc.get("median_width") is not None and math.isfinite(mc["median_width"]):
-            ax.plot([mc["n_samples"] * plan.model.dt_s / 3600.0], [100.0 * mc["median_width"]], "x", color=color,
+            ax.plot([mc["n_samples"] * plan.model.dt_s / S_PER_H], [100.0 * mc["median_width"]], "x", color=color,
                     label=f"{t} Monte-Carlo median ({len(plan.seeds)} seeds)")
     if plan.at_length:
-        ax.axvline(plan.at_length["length_s"] / 3600.0, color="0.5", ls="--", lw=0.9, label="--length")
+        ax.axvline(plan.at_length["length_s"] / S_PER_H, color="0.5", ls="--", lw=0.9, label="--length")
     ax.set_xlabel("record length [h]")
     ax.set_ylabel("95 % half-width [% of value]")
     ax.set_title(f"fogdrift plan: {plan.model.text()} at {1 / plan.model.dt_s:g} Hz", fontsize=8)

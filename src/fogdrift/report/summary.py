@@ -15,6 +15,7 @@ from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
 from ..noise import TERM_TABLE
 from ..noise.terms import DISPLAY_UNITS, TERMS
 from ..spec import B_COMPARED, analysis_judgements, judgement_line  # noqa: F401 (analysis_judgements: re-export)
+from ..units import S_PER_H
 from .screen import screen_summary
 from .tables import _fmt, noise_row, shaped_cell, term_text
 
@@ -40,7 +41,7 @@ def _duration(seconds) -> str:
         return "–"
     s = float(seconds)
     if s >= 7200:
-        return f"{s:.6g} s ({s / 3600:.3g} h)"
+        return f"{s:.6g} s ({s / S_PER_H:.3g} h)"
     if s >= 120:
         return f"{s:.6g} s ({s / 60:.3g} min)"
     return f"{s:.6g} s"

@@ -17,13 +17,14 @@ from ..pipeline import AnalysisConfig, model_factor, run_analysis
 from ..plausibility import check_record
 from ..report import write_report
 from ..spec import analysis_judgements
+from ..units import S_PER_H
 
 from .allan import Screened, screen
 
 __all__ = ["AnalyzeRun", "Prepared", "prepare_analyze", "run_analyze", "write_analyze", "HEADING_DEFAULTS"]
 
 #: The heading evaluation's defaults: calibration window and origin spacing [s], free-run horizons [s].
-HEADING_DEFAULTS = {"calib_s": 300.0, "step_s": 60.0, "horizons_s": (60.0, 600.0, 3600.0)}
+HEADING_DEFAULTS = {"calib_s": 300.0, "step_s": 60.0, "horizons_s": (60.0, 600.0, S_PER_H)}
 
 
 @dataclass

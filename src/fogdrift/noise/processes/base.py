@@ -296,7 +296,5 @@ IEEE_952 = "IEEE Std 952-1997 Annex C; method notes 2.2-2.3"
 IEEE_1293 = ("IEEE Std 1293-2018 (accelerometers) Annex on the Allan variance: the same laws as IEEE Std 952-1997 "
              "Annex C with specific force [m/s^2] in place of rate; term names per IEEE Std 528-2019")
 SIM_EXACT = "exact for fogdrift.simulate signals"
-#: sqrt(3600 s / h): N[(deg/h) sqrt(s)] = 60 N[deg/sqrt(h)], K[(deg/h)/sqrt(s)] = K[deg/h^1.5] / 60.
+#: sqrt(1 h / 1 s) = sqrt(S_PER_H): N[(deg/h) sqrt(s)] = 60 N[deg/sqrt(h)], K[(deg/h)/sqrt(s)] = K[deg/h^1.5] / 60.
 SQRT_H = 60.0
-#: One degree in radians (the exports' SI factors).
-DEG = math.pi / 180.0

@@ -20,9 +20,9 @@ import math
 import numpy as np
 
 from ...errors import ConfigError
-from ...units import B_FACTOR, STANDARD_GRAVITY_MPS2
+from ...units import B_FACTOR, RAD_PER_DEG, S_PER_H, STANDARD_GRAVITY_MPS2
 from .gauss_markov import gm_avar_dph2
-from .base import DEG, IEEE_952, IEEE_1293, LatentSpec, NoiseProcess, TermLaw, TermSpec
+from .base import IEEE_952, IEEE_1293, LatentSpec, NoiseProcess, TermLaw, TermSpec
 
 __all__ = ["PROCESS", "flicker_wv_factor", "flicker_noise", "flicker_as_gauss_markov", "B_FLAT_WV"]
 
@@ -231,6 +231,6 @@ PROCESS = NoiseProcess(
     psd=lambda x, f: float(x) ** 2 / (2.0 * math.pi * np.asarray(f, dtype=np.float64)),
     simulate=simulate, sim_kwarg="bias_instability_dph", sim_stream=2,
     to_components=to_components, component_rank=3,
-    si={"gyro": ("rad/s", DEG / 3600.0), "accel": ("m/s^2", STANDARD_GRAVITY_MPS2 * 1e-6)},
+    si={"gyro": ("rad/s", RAD_PER_DEG / S_PER_H), "accel": ("m/s^2", STANDARD_GRAVITY_MPS2 * 1e-6)},
     source=TERM.source,
 )

@@ -15,8 +15,9 @@ import math
 import numpy as np
 
 from ...errors import ConfigError
+from ...units import RAD_PER_DEG, S_PER_H
 from ..covariance import expected_variance
-from .base import DEG, ComponentSpec, LatentSpec, NoiseProcess
+from .base import ComponentSpec, LatentSpec, NoiseProcess
 
 __all__ = ["PROCESS", "ar1_wv", "markov_shape", "gm_avar_dph2"]
 
@@ -201,6 +202,6 @@ PROCESS = NoiseProcess(
     component=ComponentSpec("gauss_markov", ("tc_s", "sigma_dph"),
                             "first-order Gauss-Markov state: correlation time [s], 1-sigma [deg/h]", _densities),
     to_components=to_components, component_rank=5,
-    si={"gyro": ("rad/s", DEG / 3600.0), "accel": ("m/s^2", 1.0)},
+    si={"gyro": ("rad/s", RAD_PER_DEG / S_PER_H), "accel": ("m/s^2", 1.0)},
     source=SHAPED["source"],
 )

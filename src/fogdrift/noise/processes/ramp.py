@@ -13,12 +13,13 @@ import math
 
 import numpy as np
 
-from .base import DEG, IEEE_952, IEEE_1293, ComponentSpec, LatentSpec, NoiseProcess, TermLaw, TermSpec
+from ...units import RAD_PER_DEG, S_PER_H
+from .base import IEEE_952, IEEE_1293, ComponentSpec, LatentSpec, NoiseProcess, TermLaw, TermSpec
 
 TERM = TermSpec("R", "rate ramp", 2, 0.5, "(deg/h)/s", "deg/h^2", "_dph2", "R [deg/h²]",
-                3600.0, None, IEEE_952 + "; 1/s = 3600/h")
+                S_PER_H, None, IEEE_952 + "; 1/s = 3600/h")
 ACCEL_TERM = TermSpec("R", "acceleration ramp", 2, 0.5, "(m/s^2)/s", "m/s^2/h", "_mps2_ph", "R [m/s²/h]",
-                      3600.0, None, IEEE_1293 + "; 1/s = 3600/h")
+                      S_PER_H, None, IEEE_1293 + "; 1/s = 3600/h")
 
 LAWS = {
     "adev": TermLaw(2, (0.5,), source=TERM.source + "; exact for fogdrift.simulate signals"),
@@ -39,19 +40,19 @@ def _latent_simulate(theta, n, rng):
 
 
 def _densities(c, out):
-    out["ramps"].append(c["ramp_dph2"] / 3600.0)
+    out["ramps"].append(c["ramp_dph2"] / S_PER_H)
 
 
 def to_components(A, ctx):
     """Rate ramp ``R^2 / 2 = A`` -> one ``ramp`` component [deg/h^2] (used with ``ramp="state"``)."""
-    return [{"kind": "ramp", "ramp_dph2": 3600.0 * math.sqrt(2.0 * A)}] if A > 0 else []
+    return [{"kind": "ramp", "ramp_dph2": S_PER_H * math.sqrt(2.0 * A)}] if A > 0 else []
 
 
 LATENT = LatentSpec(
     "DR", "drift (rate ramp)", ("omega",), ("rate per sample",),
     wv=lambda th, tau: th[0] ** 2 * np.asarray(tau, dtype=np.float64) ** 2 / 16.0,
     sdf=None,
-    ieee=lambda th, dt: {"R_dph2": th[0] / dt * 3600.0},
+    ieee=lambda th, dt: {"R_dph2": th[0] / dt * S_PER_H},
     simulate=_latent_simulate, aliases=("RAMP",),
 )
 
@@ -62,6 +63,6 @@ PROCESS = NoiseProcess(
                             "rate ramp R [deg/h^2]: a ramp state with a random constant slope of 1-sigma R",
                             _densities),
     to_components=to_components, component_rank=4,
-    si={"gyro": ("rad/s^2", DEG / 3600.0 ** 2), "accel": ("m/s^3", 1.0 / 3600.0)},
+    si={"gyro": ("rad/s^2", RAD_PER_DEG / S_PER_H ** 2), "accel": ("m/s^3", 1.0 / S_PER_H)},
     slope_rule=True, source=TERM.source,
 )

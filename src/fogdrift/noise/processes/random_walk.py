@@ -13,7 +13,8 @@ import math
 
 import numpy as np
 
-from .base import (DEG, IEEE_952, IEEE_1293, SIM_EXACT, SQRT_H, ComponentSpec, LatentSpec, NoiseProcess, TermLaw,
+from ...units import RAD_PER_DEG, S_PER_H
+from .base import (IEEE_952, IEEE_1293, SIM_EXACT, SQRT_H, ComponentSpec, LatentSpec, NoiseProcess, TermLaw,
                    TermSpec)
 
 TERM = TermSpec("K", "rate random walk", 1, 1.0 / 3.0, "(deg/h)/sqrt(s)", "deg/h^1.5", "_dphrh",
@@ -74,6 +75,6 @@ PROCESS = NoiseProcess(
     component=ComponentSpec("random_walk", ("rrw_dphrh",), "rate random walk K [deg/h^1.5], one random-walk state",
                             _densities),
     to_components=to_components, component_rank=2,
-    si={"gyro": ("rad/s^2/sqrt(Hz)", DEG / 216000.0), "accel": ("m/s^3/sqrt(Hz)", 1.0 / 60.0)},
+    si={"gyro": ("rad/s^2/sqrt(Hz)", RAD_PER_DEG / S_PER_H**1.5), "accel": ("m/s^3/sqrt(Hz)", 1.0 / 60.0)},
     slope_rule=True, source=TERM.source,
 )

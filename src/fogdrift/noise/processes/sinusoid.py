@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import ConfigError
-from .base import DEG, NoiseProcess
+from ...units import RAD_PER_DEG, S_PER_H
+from .base import NoiseProcess
 
 __all__ = ["PROCESS", "sinusoid_shape", "periodic_shape"]
 
@@ -83,6 +84,6 @@ def periodic_shape(tau_s, lines, dt_s, statistic="adev", *, envelope=False) -> n
 
 PROCESS = NoiseProcess(
     "S", "sinusoid", shaped=SHAPED, shape=periodic_shape,
-    si={"gyro": ("rad/s", DEG / 3600.0), "accel": ("m/s^2", 1.0)},
+    si={"gyro": ("rad/s", RAD_PER_DEG / S_PER_H), "accel": ("m/s^2", 1.0)},
     source=SHAPED["source"],
 )

@@ -11,7 +11,8 @@ import math
 
 import numpy as np
 
-from .base import (DEG, IEEE_952, IEEE_1293, SIM_EXACT, SQRT_H, ComponentSpec, LatentSpec, NoiseProcess, TermLaw,
+from ...units import RAD_PER_DEG
+from .base import (IEEE_952, IEEE_1293, SIM_EXACT, SQRT_H, ComponentSpec, LatentSpec, NoiseProcess, TermLaw,
                    TermSpec)
 
 TERM = TermSpec("N", "angle random walk", -1, 1.0, "(deg/h) sqrt(s)", "deg/sqrt(h)", "_dprh", "N [deg/√h]",
@@ -61,6 +62,6 @@ PROCESS = NoiseProcess(
     component=ComponentSpec("white", ("arw_dprh",),
                             "white rate noise (angle random walk N [deg/sqrt(h)]), measurement noise", _densities),
     to_components=to_components, component_rank=0,
-    si={"gyro": ("rad/s/sqrt(Hz)", DEG / 60.0), "accel": ("m/s^2/sqrt(Hz)", 1.0 / 60.0)},
+    si={"gyro": ("rad/s/sqrt(Hz)", RAD_PER_DEG / 60.0), "accel": ("m/s^2/sqrt(Hz)", 1.0 / 60.0)},
     source=TERM.source,
 )
