@@ -33,7 +33,7 @@ CASES = [
 ]
 #: JSON keys whose values depend on the run, not on the method (wall-clock seconds, paths, versions).
 VOLATILE = {"wall_s", "elapsed_s", "fit_seconds", "seconds", "created", "created_utc", "started_utc", "finished_utc",
-            "out", "output", "out_dir", "fogdrift_version", "versions", "duration_s_wall"}
+            "out", "output", "out_dir", "fogdrift_version", "versions", "duration_s_wall", "seal_sha256"}
 #: Significant digits a float is compared to: the last bits of a BLAS reduction depend on its thread count and the
 #: CPU, not on the method.
 DIGITS = 12

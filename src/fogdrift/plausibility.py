@@ -64,13 +64,8 @@ import numpy as np
 from ._util import fmt_number
 from .errors import ConfigError, FogdriftWarning, render_options
 from .health import health_findings
-<<<<<<< HEAD
 from .allan.sums import AllanSums
-from .units import EARTH_RATE_DPH, STANDARD_GRAVITY_MPS2, parse_unit
-=======
-from .pipeline_sums import AllanSums
 from .units import EARTH_RATE_DPH, S_PER_H, STANDARD_GRAVITY_MPS2, parse_unit
->>>>>>> hunits
 
 __all__ = [
     "Finding",

@@ -20,12 +20,8 @@ import numpy as np
 from .. import documents
 from ..errors import ConfigError
 from ..noise.terms import TERM_TABLE, all_terms, laws_of
-<<<<<<< HEAD
 from ..spec import norm_unit
-=======
-from ..spec import _norm_unit
 from ..units import ARCSEC_PER_DEG, DEG_PER_RAD, S_PER_H, S_PER_MIN, URAD_PER_ARCSEC
->>>>>>> hunits
 
 __all__ = ["PlanModel", "parse_model", "parse_targets", "parse_length", "model_from_fit", "read_model_file",
            "DEFAULT_TARGETS", "PLANNED_TERMS", "fmt_length"]
