@@ -123,3 +123,19 @@ def test_the_headline_holds_no_value_where_no_model_fits(demo_run):
     assert all(rows[t].startswith(("–", "n/e")) or (rows[t].startswith("≈") and "read-out" in rows[t])
                for t in terms), rows
     assert rows["selected noise model"].startswith("no model fits (best candidate ")
+
+
+def test_the_demo_console_fits_40_rows_of_80_columns(bundled_path, tmp_path):
+    """``make demo``'s console (three axes, the demo protocol) in at most 40 rows of an 80-column terminal, long
+    lines counted as the rows they wrap to; progress lines are transient on a terminal and go to stderr."""
+    res = runner.invoke(app, ["analyze", str(bundled_path), "--unit", "deg/h", "--models", "ar,persistence", *DEMO,
+                              "--out", str(tmp_path / "demo")], env={"COLUMNS": "80"})
+    assert res.exit_code == 0, res.output
+    lines = [ln.rstrip() for ln in res.stdout.splitlines()]
+    rows = sum(max(1, -(-len(ln) // 80)) for ln in lines)
+    assert rows <= 40, "\n".join(lines)
+    verdicts = [ln for ln in lines if ln.startswith("  [")]
+    assert [v.split("] ")[1][:3] for v in verdicts] == ["gx:", "gy:", "gz:"]
+    assert all(len(v) <= 160 for v in verdicts)  # two rows each at most
+    screen = [ln for ln in lines if ln.startswith(("  gx: ", "  gy: ", "  gz: "))]
+    assert len(screen) == 3 and all(len(ln) <= 80 for ln in screen)

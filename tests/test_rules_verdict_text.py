@@ -388,3 +388,24 @@ def test_artefact_sentence_counts_only_gains_below_09_and_missing_gains_as_kept(
         "gz: B removes > 10 % of injected rate at 0.01 Hz (no Allan improvement claimed there)."]
     assert v.data == {"A": {"flagged_hz": [], "removes_over_10pct_hz": []},
                       "B": {"flagged_hz": [], "removes_over_10pct_hz": [0.01]}}
+
+
+def test_the_short_headline_says_the_same_verdict_with_the_same_numbers():
+    """The console's short form (Verdict.short): the outcome's numbers of the long sentence, without the protocol
+    the console's heading states; never stored (to_dict is the long form)."""
+    rows = []
+    for h, rms, ar in ((60.0, 1.0, 1.2), (600.0, 8.0, 1.125)):
+        rows += [_row("constant bias", h, rms, 1.0), _row("AR(p)", h, rms * ar, ar, 5, 25)]
+    none = headline_verdict(_heading(rows, (60.0, 600.0)))
+    assert none.short == "gx: no model gains 5 % or more at 60 / 600 s (constant bias: 1 / 8 deg RMS); worse: AR(p)."
+    assert "short" not in none.to_dict() and none.to_dict()["lines"] == none.lines
+    mixed = headline_verdict(_heading(TWO, (60.0, 600.0)), FLAGGED)
+    assert mixed.short == ("gx: Kalman -25 % at 600 s (6 vs 8 deg RMS, better at 20 of 30 non-overlapping origins) "
+                           "but removes real rate near 0.001, 0.002 Hz (artefact check).")
+    clean = headline_verdict(_heading(TWO, (60.0, 600.0)), CLEAN)
+    assert clean.short.startswith("gx: Kalman -25 % at 600 s (6 vs 8 deg RMS") and clean.short.endswith(
+        "; worse nowhere; artefact check clean.")
+    few = headline_verdict(_heading([heading_row("constant bias", np.ones(9), np.ones(9), horizon_s=60.0,
+                                                 step_s=60.0)], (60.0,), step=60.0), min_origins=10)
+    assert few.short.startswith("gx: cannot judge: 9 non-overlapping origin(s) at 60 s, 10 needed")
+    assert headline_verdict(None, axis="gx", reason="--no-heading").short == ""  # the long line is short already

@@ -152,10 +152,10 @@ def segment_lines(name, screen, *, compact: bool = False) -> list[str]:
             return [f"{name}: stationary (no disturbance found); the noise fit uses the whole record"]
         cover = sum(d["end_s"] - d["start_s"] for d in ivs) / (n * dt)
         peak = max((d.get("peak") or 0.0 for d in ivs), default=0.0)
-        fitted = (f"noise fit: the quiet {sum(b - a for a, b in used) * dt:.4g} of {n * dt:.4g} s" if used
+        fitted = (f"noise fit: quiet {sum(b - a for a, b in used) * dt:.4g} of {n * dt:.4g} s" if used
                   else "noise fit: the whole record, disturbance included")
         return [f"{name}: disturbed {100 * cover:.0f} % ({len(ivs)} interval{'s' if len(ivs) != 1 else ''}, peak "
-                f"{peak:.2g}x quiet); {fitted}"]
+                f"{peak:.2g}x); {fitted}"]
     if len(ivs) > MAX_LISTED:  # disturbed throughout: one line, the intervals are in the JSON
         kinds = {}
         for d in ivs:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 from typing import Annotated, Optional
@@ -151,8 +152,24 @@ def analyze(
         say(f"report: {path.resolve()}{'  (+ report.pdf)' if pdf else ''}  ({result.wall_s:.1f} s); every table "
             "there, in analysis.json, or with --details")
         say(f"bundle: {bundle.path} (apply it: fogdrift compensate {bundle.path} LOG --unit {record.input_unit}); "
-            f"compensated test block: {', '.join(p.name for p in comp)} (deg/h)")
+            f"compensated test block: {_file_pattern([p.name for p in comp], list(record.axis_names))} (deg/h)")
         r.print_json(r.out.path / "analysis.json")
+
+
+def _file_pattern(names: list, axes: list) -> str:
+    """``compensated_test_<axis>.csv (gx, gy)`` for one file per axis named alike, else the names.
+
+    >>> _file_pattern(["compensated_test_gx.csv", "compensated_test_gy.csv"], ["gx", "gy"])
+    'compensated_test_<axis>.csv (gx, gy)'
+    >>> _file_pattern(["a.csv"], ["gx"])
+    'a.csv'
+    """
+    if len(names) < 2 or len(names) != len(axes) or axes[0] not in names[0]:
+        return ", ".join(names)
+    head, _, tail = names[0].partition(axes[0])
+    if any(n != f"{head}{a}{tail}" for n, a in zip(names, axes)):
+        return ", ".join(names)
+    return f"{head}<axis>{tail} ({', '.join(axes)})"
 
 
 def _match_axes(record, other, path):
@@ -282,7 +299,7 @@ def print_summary(result, record, *, evaluated: bool, apply_name: str = "") -> N
     keep = [[row[0]] + [_stacked(_terse(c)) for c in row[1:]] for row in keep]
     console.print(fitted_table(f"Noise of the original output: {headers[0]}, 95 % intervals",
                                [""] + [h.replace("axis ", "") for h in headers[1:]], keep))
-    say("  – (< x): not in the model, x its 95 % bound; n/e: not estimable (the report says why)", style="dim")
+    say("  – (< x): not in the model, x its 95 % bound; n/e: not estimable (see report)", style="dim")
     for res, name in ((result, ""), (getattr(result, "apply_to", None), apply_name)):
         if res is None:
             continue

@@ -604,7 +604,7 @@ def headline_verdict(heading=None, artefacts=None, *, axis: str = "", reason: st
                 f"non-overlapping origins at {_horizon_list(judged)} s after a {heading.calib_s:g}-s calibration "
                 f"(constant bias leaves {rms} deg RMS" + (f"; worse: {', '.join(sorted(worse))}" if worse else "")
                 + ").")
-        short = (f"{axis}: no model gains {100 * material:.0f} % at {' / '.join(f'{h:g}' for h in judged)} s "
+        short = (f"{axis}: no model gains {100 * material:.0f} % or more at {' / '.join(f'{h:g}' for h in judged)} s "
                  f"(constant bias: {rms} deg RMS)" + (f"; worse: {', '.join(sorted(worse))}" if worse else "") + ".")
         return Verdict("headline", [line], {"outcome": "none", "model": None, **data}, short)
 
