@@ -417,6 +417,30 @@ def test_damaged_results_give_one_line_errors(tmp_path, cut):
         assert "\n" not in str(exc)
 
 
+@pytest.mark.parametrize("field, bad", [("value", -0.1), ("lo95", -1e-9), ("hi95", float("inf")), ("value", "0.15"),
+                                        ("value", True)])
+def test_a_negative_or_non_finite_coefficient_is_refused_naming_file_axis_and_term(tmp_path, field, bad):
+    """A result edited by hand or written by another tool: N = -0.1 (or an infinite bound, a string) never reaches
+    a filter's configuration; the one-line error names the file, the axis, the term and the field."""
+    doc = json.loads(_gyro_result(tmp_path).read_text())
+    doc["axes"][1]["noise"]["terms"]["N"][field] = bad
+    p = tmp_path / "edited.json"
+    p.write_text(json.dumps(doc).replace("Infinity", "1e999"))  # strict JSON has no infinity: a huge number
+    with pytest.raises(DataFormatError, match=r"edited\.json: axis 'gy': N " + field) as exc:
+        build_context([p])
+    assert "\n" not in str(exc.value) and ">= 0" in str(exc.value)
+    res = runner.invoke(app, ["export", "--gyro", str(p), "--target", "kalibr", "--out", str(tmp_path / "k")])
+    assert res.exit_code != 0 and not (tmp_path / "k").exists()  # nothing written
+
+
+def test_a_zero_coefficient_and_zero_lower_bound_are_accepted(tmp_path):
+    doc = json.loads(_gyro_result(tmp_path).read_text())
+    doc["axes"][1]["noise"]["terms"]["K"].update(value=0.0, lo95=0.0)
+    p = tmp_path / "zero.json"
+    p.write_text(json.dumps(doc))
+    assert build_context([p]).gyro[1].terms["K"].value == 0.0
+
+
 @pytest.mark.parametrize("term, unit, quantity, factor", [
     ("N", "deg/√h", "gyro", D / 60), ("N", "(deg/h)·sqrt(s)", "gyro", D / 3600), ("N", "µg/√Hz", "accel", G * 1e-6),
     ("N", "(m/s^2)/sqrt(Hz)", "accel", 1.0), ("N", "m/s/√hr", "accel", 1 / 60), ("K", "deg/h/√h", "gyro", D / 216000),

@@ -17,6 +17,7 @@ The quantity comes from the units the result file states for its terms, never fr
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from dataclasses import dataclass, field
@@ -182,7 +183,22 @@ def _f(x):
     return None if x is None else float(x)
 
 
-def _term(name, value, lo, hi, unit, status, reason, source) -> TermValue:
+def _coefficient(x, what: str, where: str, *, positive: bool = False):
+    """``x`` as a float, or None; anything else than a finite number >= 0 (> 0 with ``positive``) is refused: a
+    noise coefficient, interval end, correlation time or rate written by hand or by another tool must not reach a
+    filter's configuration as a negative or infinite number."""
+    if x is None:
+        return None
+    ok = isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and (x > 0 if positive
+                                                                                            else x >= 0)
+    if not ok:
+        raise DataFormatError(f"{where}: {what} = {x!r} is not a finite number {'> 0' if positive else '>= 0'}; a "
+                              "result file holds only such values (re-run the fit that wrote it)")
+    return float(x)
+
+
+def _term(name, value, lo, hi, unit, status, reason, source, *, where: str = "the result") -> TermValue:
+    value, lo, hi = (_coefficient(x, f"{name} {k}", where) for x, k in ((value, "value"), (lo, "lo95"), (hi, "hi95")))
     si, si_unit, how = to_si(value, name, unit)
     return TermValue(name=name, value=_f(value), lo95=_f(lo), hi95=_f(hi), unit=str(unit), status=status,
                      reason=reason, si=si, si_lo95=to_si(lo, name, unit)[0], si_hi95=to_si(hi, name, unit)[0],
@@ -210,6 +226,8 @@ def _allan_channel(ax: dict, record: dict, path: str) -> ChannelModel:
     sel = "+".join(noise.get("selected") or []) or "none"
     fit = noise.get("fit") or {}
     no_fit = noise.get("no_fit") is not None
+    where = f"{path}: axis {ax.get('name')!r}"
+    term = functools.partial(_term, where=where)
     terms = {}
     for name in TERMS:
         t = noise["terms"].get(name)
@@ -220,7 +238,7 @@ def _allan_channel(ax: dict, record: dict, path: str) -> ChannelModel:
         if no_fit:
             reason = (f"no model fits the record (best candidate {sel}, chi2_red {fit.get('chi2_red', math.nan):.3g}): "
                       "the coefficient is no result" + (f"; {reason}" if reason else ""))
-        terms[name] = _term(name, t.get("value"), t.get("lo95"), t.get("hi95"), t.get("unit", ""), status, reason,
+        terms[name] = term(name, t.get("value"), t.get("lo95"), t.get("hi95"), t.get("unit", ""), status, reason,
                             f"allan fit: {name} (selected model {sel}, fit {fit.get('quality', '?')})")
     b_min = noise.get("b_min") or {}
     b_tau = _f(b_min.get("tau_s"))
@@ -228,7 +246,7 @@ def _allan_channel(ax: dict, record: dict, path: str) -> ChannelModel:
     if "B" in terms and not terms["B"].has_estimate and b_min.get("value") is not None and not no_fit:
         # no flicker term in the model: the IEEE reading at the ADEV minimum is the bias instability
         bound = bool(b_min.get("bound_only"))
-        terms["B"] = _term("B", None if bound else b_min["value"], b_min.get("lo95"), b_min.get("hi95"),
+        terms["B"] = term("B", None if bound else b_min["value"], b_min.get("lo95"), b_min.get("hi95"),
                            b_min.get("unit", terms["B"].unit), "absent" if bound else "resolved",
                            b_min.get("rule", "") if bound else "",
                            "allan fit: B_min, " + str(b_min.get("rule", "min of the fitted ADEV / 0.664")))
@@ -240,14 +258,15 @@ def _allan_channel(ax: dict, record: dict, path: str) -> ChannelModel:
         # sigma = q_c sqrt(T_c/2) is in the rate unit of q_c (IEEE-952 C.6)
         q_unit = str(m.get("q_unit", mt.get("unit", "")))
         factor = to_si(1.0, "q_c", q_unit)[0]
-        gms.append(GaussMarkov(sigma_si=float(m["sigma_dph"]) * factor, tc_s=float(m["tc_s"]),
+        gms.append(GaussMarkov(sigma_si=_coefficient(m["sigma_dph"], "M sigma", where) * factor,
+                               tc_s=_coefficient(m["tc_s"], "M tc_s", where, positive=True),
                                tc_lo95_s=_f(m.get("tc_lo95_s")), tc_hi95_s=_f(m.get("tc_hi95_s")),
                                source="allan fit: M (exponentially correlated, IEEE-952 C.6)"))
     quality = f"chi2_red {fit.get('chi2_red', math.nan):.3g}, {fit.get('quality', '?')}"
     return ChannelModel(name=str(ax.get("name")), quantity=_quantity(terms, f"{path}: axis {ax.get('name')}"),
                         method="allan", terms=terms, gms=gms, b_tau_s=b_tau, b_is_flicker=b_flicker,
                         tau_range_s=(_f(fit.get("tau_min_s")), _f(fit.get("tau_max_s"))),
-                        rate_hz=float(record.get("fs_hz") or 1.0 / float(noise.get("dt_s"))),
+                        rate_hz=_rate_hz(record, noise, path),
                         fit=("no model fits; best candidate " if no_fit else "model ") + f"{sel} ({quality})",
                         no_fit=no_fit, source_file=str(path), sha256=str(record.get("sha256", "")))
 
@@ -264,29 +283,31 @@ def _gmwm_channel(ax: dict, record: dict, path: str) -> ChannelModel:
     gyro = quantity_of_unit("N", n_unit) != "accel"
     unit_default = ({"N": "deg/sqrt(h)", "K": "deg/h^1.5", "R": "deg/h^2", "Q": "urad", "B": "deg/h"} if gyro else
                     {"N": "m/s/sqrt(h)", "K": "m/s^2/sqrt(s)", "R": "m/s^3", "Q": "m/s", "B": "m/s^2"})
+    where = f"{path}: axis {ax.get('name')!r}"
+    term = functools.partial(_term, where=where)
     terms = {}
     for name, key in _GMWM_KEYS.items():
         t = ie["terms"].get(key)
         if name == "B" and t is None:
             bh = ie.get("b_headline") or {}
             if bh.get("value_dph") is not None:
-                terms["B"] = _term("B", bh["value_dph"], bh.get("lo95_dph"), bh.get("hi95_dph"), unit_default["B"],
+                terms["B"] = term("B", bh["value_dph"], bh.get("lo95_dph"), bh.get("hi95_dph"), unit_default["B"],
                                    "resolved", "", f"gmwm {model}: B, {bh.get('label', '')}")
             else:
-                terms["B"] = _term("B", None, 0.0, bh.get("bound_dph"), unit_default["B"], "absent",
+                terms["B"] = term("B", None, 0.0, bh.get("bound_dph"), unit_default["B"], "absent",
                                    bh.get("reason", "no bias-instability reading"),
                                    f"gmwm {model}: B, {bh.get('label', '')}")
             continue
         if t is None:
             bound, why = (_rw_bound_from_wv(ax.get("wvar")) if name == "K" and gyro else (None, ""))
-            terms[name] = _term(name, None, None if bound is None else 0.0, bound, unit_default[name], "absent",
+            terms[name] = term(name, None, None if bound is None else 0.0, bound, unit_default[name], "absent",
                                 f"not in the GMWM model {model}"
                                 + (f"; {why}" if why else " (GMWM gives no upper bound for a term it leaves out)"),
                                 f"gmwm {model}: {name}")
             continue
         lo = t.get("lo95")
         unit = "deg/h^1.5" if t.get("unit") == "deg/h/sqrt(h)" else t.get("unit", unit_default[name])
-        terms[name] = _term(name, t.get("value"), lo, t.get("hi95"), unit,
+        terms[name] = term(name, t.get("value"), lo, t.get("hi95"), unit,
                             "resolved" if lo is not None and lo > 0 else "unresolved",
                             "" if lo is not None and lo > 0 else "its 95 % interval reaches 0",
                             f"gmwm {model}: {name} (component {t.get('component', '?')})")
@@ -294,7 +315,8 @@ def _gmwm_channel(ax: dict, record: dict, path: str) -> ChannelModel:
     for g in ie.get("gm") or []:
         tc, sg = g["tc_s"], g["sigma_gm_dph"]
         f = to_si(1.0, "sigma", sg.get("unit", "deg/h"))[0]
-        gms.append(GaussMarkov(sigma_si=sg["value"] * f, tc_s=tc["value"],
+        gms.append(GaussMarkov(sigma_si=_coefficient(sg["value"], "GM sigma", where) * f,
+                               tc_s=_coefficient(tc["value"], "GM tc_s", where, positive=True),
                                sigma_lo95_si=None if sg.get("lo95") is None else sg["lo95"] * f,
                                sigma_hi95_si=None if sg.get("hi95") is None else sg["hi95"] * f,
                                tc_lo95_s=tc.get("lo95"), tc_hi95_s=tc.get("hi95"),
@@ -306,9 +328,21 @@ def _gmwm_channel(ax: dict, record: dict, path: str) -> ChannelModel:
                         method="gmwm", terms=terms, gms=gms, b_tau_s=_f(bh.get("tau_s")),
                         b_is_flicker=ie["terms"].get("B_dph") is not None,
                         tau_range_s=(_f(tr[0]), _f(tr[1])),
-                        rate_hz=float(record.get("fs_hz") or 1.0 / float(ie.get("dt_s"))),
+                        rate_hz=_rate_hz(record, ie, path),
                         fit=f"GMWM model {model} (J-test p = {jp:.2g})" if jp is not None else f"GMWM model {model}",
                         source_file=str(path), sha256=str(record.get("sha256", "")))
+
+
+def _rate_hz(record: dict, fit: dict, path) -> float:
+    """The sample rate [Hz] of the record a result describes: its ``fs_hz``, else 1 / the fit's ``dt_s``."""
+    fs = record.get("fs_hz")
+    if fs is not None:
+        return _coefficient(fs, "record fs_hz", str(path), positive=True)
+    dt = _coefficient(fit.get("dt_s"), "dt_s", str(path), positive=True)
+    if dt is None:
+        raise DataFormatError("the result says no sample rate (record 'fs_hz' or the fit's 'dt_s'); expected the "
+                              "allan.json or noise.json of a fogdrift run", path=path)
+    return 1.0 / dt
 
 
 def _rw_bound_from_wv(wv) -> tuple[float | None, str]:
