@@ -330,6 +330,22 @@ def test_decimal_comma_not_shown_in_first_row_is_a_located_error(tmp_path):
     assert "decimal comma" in str(e) and str(e).endswith("expected a number, got '0,01'")
 
 
+def test_thousands_separators_are_refused_never_read_as_decimal_commas(tmp_path):
+    """Tab-separated counts "1,137": beside a decimal point ("0.01") they are thousands separators, refused at the
+    cell (read as 1.137 before); without any decimal point they could be either, refused at the first data row."""
+    p = write(tmp_path, "c.tsv", "t_s\tgx\n0.00\t1,137\n0.01\t1,582\n0.02\t998\n")
+    with pytest.raises(DataFormatError) as ei:
+        load(p)
+    assert (ei.value.line, ei.value.column) == (2, "gx") and "thousands separator" in str(ei.value)
+    q = write(tmp_path, "d.tsv", "t\tgx\n0\t1,137\n1\t1,582\n")
+    with pytest.raises(DataFormatError) as ei:
+        load(q, time_column=0)
+    assert ei.value.line == 2 and "'1,137'" in str(ei.value) and "(1137)" in str(ei.value) and "(1.137)" in str(ei.value)
+    # a decimal comma that is no thousands group ("0,010" starts with 0, "1,5" has one decimal) stays a decimal comma
+    r = write(tmp_path, "e.tsv", "t\tgx\n0,010\t1,137\n0,020\t1,5\n")
+    assert_array_equal(load(r, time_column=0).rate_dph[:, 0], [1.137, 1.5])
+
+
 @pytest.mark.parametrize("eol", ["\n", "\r\n", "\r", "mixed"])
 def test_line_endings(tmp_path, eol):
     lines = ["# c", "t,x", "0,1", "0.5,2", "1,3"]

@@ -37,6 +37,10 @@ _DELIMITERS = {
 _DELIM_NAMES = {",": "comma", ";": "semicolon", "\t": "tab", None: "whitespace"}
 #: A cell written with a decimal comma: "1,5", "-0,25e-3".
 _DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$|^[+-]?\d+,\d*([eE][+-]?\d+)?$")
+#: A number written with thousands separators: "1,137", "-12,345,678" (a first group of 1-3 digits, not 0).  Such a
+#: cell reads as a decimal comma too: where every comma cell of the first data row has this shape, the file is
+#: refused rather than read as 1.137 or 1137 by guess.
+_GROUPED = re.compile(r"^[+-]?[1-9]\d{0,2}(,\d{3})+$")
 #: Errors of the text layers while streaming (decoding never fails: errors="replace").
 _STREAM_ERRORS = (OSError, EOFError, zlib.error)
 #: Rows the line-by-line scan collects as Python floats before packing them into a float64 block.
@@ -277,7 +281,9 @@ class TextTable(Table):
 
     def _non_numeric(self, cell: str, lineno: int, j: int) -> DataFormatError:
         hint = ""
-        if not self.decimal_comma and _DECIMAL_COMMA.match(cell):
+        if not self.decimal_comma and _GROUPED.match(cell):
+            hint = " (a thousands separator: write the number without it)"
+        elif not self.decimal_comma and _DECIMAL_COMMA.match(cell):
             hint = (" (a decimal comma: read only when the separator is not a comma and the first data row "
                     "has one; write decimal points)")
         return DataFormatError(f"non-numeric value{hint}; expected a number, got {cell!r}",
@@ -323,7 +329,7 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
     refuse_foreign(head, p)
     probe = TextTable(p, names=[], named=False, units=[], header_line=0, delimiter=None, n_fields=0,
                       is_gz=gzip_magic, decimal_comma=False)
-    content, first_lineno, lineno, skipped = [], 0, 0, 0
+    content, lines_of, first_lineno, lineno, skipped = [], [], 0, 0, 0
     preamble = max_preamble_bytes()
     try:
         with probe.stream() as fh:
@@ -331,6 +337,7 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
                 s = _strip_comment(raw)
                 if s:
                     content.append(s)
+                    lines_of.append(lineno)
                     first_lineno = first_lineno or lineno
                     if len(content) == 2:
                         break
@@ -356,8 +363,16 @@ def open_table(path: Path, *, delimiter=None) -> TextTable:
     else:
         is_header = not (_fits(first, delim, False) or (delim != "," and _fits(first, delim, True)))
     data_line = second if is_header else first
-    decimal_comma = (data_line is not None and delim != ","
-                     and any(_DECIMAL_COMMA.match(f.strip()) for f in _split(data_line, delim)))
+    cells = [] if data_line is None else [f.strip() for f in _split(data_line, delim)]
+    commas = [c for c in cells if _DECIMAL_COMMA.match(c)]
+    # a decimal comma only where no cell of the row has a decimal point ("0.01<TAB>1,137" holds a thousands
+    # separator, not two decimal marks)
+    decimal_comma = delim != "," and bool(commas) and not any("." in c for c in cells)
+    if decimal_comma and all(_GROUPED.match(c) for c in commas):
+        raise DataFormatError(
+            f"cells such as {commas[0]!r} read as a decimal comma ({commas[0].replace(',', '.')}) or as a thousands "
+            f"separator ({commas[0].replace(',', '')}); expected numbers with one meaning: write decimal points and "
+            "no thousands separators", path=p, line=lines_of[1] if is_header else lines_of[0])
     fields = [f.strip() for f in _split(first, delim)]
     check_columns(len(fields), p, "columns (fields in the first line)")
     common = dict(delimiter=delim, n_fields=len(fields), is_gz=gzip_magic, decimal_comma=decimal_comma)
