@@ -75,6 +75,37 @@ def test_hdf5_contiguous_float64_is_memory_mapped(tmp_path, rng):
     assert isinstance(base, np.memmap)       # a view of the file, not a copy
 
 
+def test_hdf5_external_link_reads_the_target_file_not_the_linking_one(tmp_path, rng):
+    """A dataset behind an external link lives in another file: it was memory-mapped from the linking file at the
+    target's offset (a record of the linking file's other bytes, exit 0); it is read through h5py."""
+    x = 60.0 * rng.normal(size=(4000, 1))
+    with h5py.File(tmp_path / "target.h5", "w") as f:
+        f.create_dataset("pad", data=np.arange(3000.0))  # the target's offset differs from any in the linking file
+        f.create_dataset("gyro", data=x).attrs["units"] = "deg/h"
+    with h5py.File(tmp_path / "link.h5", "w") as f:
+        f.create_dataset("other", data=np.full(8000, 1e4))
+        f["gyro"] = h5py.ExternalLink("target.h5", "/gyro")
+    rec = load(tmp_path / "link.h5", rate_hz=100.0, reader_options={"dataset": "gyro"})
+    assert_array_equal(rec.rate_dph, x)
+
+
+def test_hdf5_virtual_dataset_with_a_missing_source_is_refused(tmp_path, rng):
+    """h5py reads the part of a virtual dataset whose source file is missing as its fill value (zeros)."""
+    x = rng.normal(size=2000)
+    with h5py.File(tmp_path / "part1.h5", "w") as f:
+        f.create_dataset("a", data=x[:1000])
+    layout = h5py.VirtualLayout(shape=(2000,), dtype="f8")
+    layout[:1000] = h5py.VirtualSource("part1.h5", "a", shape=(1000,))
+    layout[1000:] = h5py.VirtualSource("part2.h5", "a", shape=(1000,))
+    with h5py.File(tmp_path / "v.h5", "w") as f:
+        f.create_virtual_dataset("gz", layout, fillvalue=0.0).attrs["units"] = "deg/h"
+    with pytest.raises(DataFormatError, match=r"v\.h5:/gz: virtual dataset /gz: its source file 'part2\.h5'"):
+        load(tmp_path / "v.h5", rate_hz=100.0)
+    with h5py.File(tmp_path / "part2.h5", "w") as f:  # every source present: read as written
+        f.create_dataset("a", data=x[1000:])
+    assert_array_equal(load(tmp_path / "v.h5", rate_hz=100.0).rate_dph[:, 0], x)
+
+
 def test_hdf5_compound_dataset(tmp_path, rng):
     rows = np.zeros(200, dtype=[("time", "<f8"), ("wx", "<f4"), ("wz", ">f8")])
     rows["time"] = np.arange(200) * 0.5

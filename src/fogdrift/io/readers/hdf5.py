@@ -82,8 +82,27 @@ class HDF5Table(Table):
         return f"HDF5 {self.what}, {n_rows} samples x {len(self.names)} columns{left}"
 
 
+def _check_storage(path: Path, ds) -> None:
+    """Refuse a virtual dataset one of whose source files is missing: h5py reads the missing part as the fill value
+    (zeros), a silent wrong record.  Data behind an external link or in another file is read through h5py (never
+    memory-mapped from ``path``); the SHA-256 stays that of ``path``."""
+    if not getattr(ds, "is_virtual", False):
+        return
+    base = Path(ds.file.filename).parent
+    for vs in ds.virtual_sources():
+        if vs.file_name in (".", ""):
+            continue
+        src = Path(vs.file_name)
+        src = src if src.is_absolute() else base / src
+        if not src.is_file():
+            raise DataFormatError(f"virtual dataset {ds.name}: its source file {vs.file_name!r} (dataset "
+                                  f"{vs.dset_name}) is missing; h5py would read that part as zeros; expected every "
+                                  "source file beside the file", path=path, column=ds.name)
+
+
 def _item(path: Path, ds, name: str) -> list[ArrayItem]:
     """ArrayItems of one dataset (a compound dataset gives one 1-D item per numeric field)."""
+    _check_storage(path, ds)
     src = ds.name
     units_attr = _attr(ds, UNIT_ATTRS)
     if ds.dtype.names:
@@ -103,10 +122,15 @@ def _item(path: Path, ds, name: str) -> list[ArrayItem]:
 
 
 def _memmap(path: Path, ds):
-    """A read-only memory map of a contiguous, unfiltered, native float64 dataset, else None."""
+    """A read-only memory map of a contiguous, unfiltered, native float64 dataset stored in ``path`` itself, else
+    None (a dataset reached through an external link lives in another file; external raw storage and virtual
+    datasets have no offset in ``path``)."""
     try:
+        if (getattr(ds, "is_virtual", False) or ds.external
+                or not Path(ds.file.filename).resolve().samefile(Path(path).resolve())):
+            return None
         offset = ds.id.get_offset()
-    except PARSER_ERRORS:
+    except (*PARSER_ERRORS, OSError):
         return None
     if offset is None or ds.chunks is not None or ds.dtype != np.dtype("<f8") or ds.size == 0:
         return None
