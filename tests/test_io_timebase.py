@@ -8,7 +8,8 @@ import pytest
 
 from fogdrift.errors import DataFormatError
 from fogdrift.io import load
-from fogdrift.io.load import DT_TOLERANCE, JITTER_TOLERANCE, SHORT_STEP_FACTOR
+from fogdrift.io.load import (DT_TOLERANCE, GRID_DRIFT_FRACTION, GRID_DRIFT_INTERVALS, JITTER_TOLERANCE,
+                              SHORT_STEP_FACTOR)
 
 
 def _write(path, t, seed=0):
@@ -57,6 +58,37 @@ def test_a_span_that_does_not_match_n_dt_is_refused(tmp_path):
     t = np.r_[0.0, np.cumsum(np.r_[np.full(4000, 0.01), np.full(2000, 0.0104)])]
     e = _err(_write(tmp_path / "a.csv", t))
     assert "time column spans" in str(e) and "+1.33 %" in str(e)
+
+
+def test_blocks_at_other_rates_that_pass_every_step_check_are_refused(tmp_path):
+    """100 Hz stretches with blocks at 125 Hz and 80 Hz between them, balanced so that the span matches n dt: the
+    median step is dt with no deviation, no step is short (0.8 dt) or a gap (1.25 dt), yet the stamps run 1.25 s
+    off the uniform grid -- the samples of a 125-Hz block are not 0.01 s apart."""
+    steps = []
+    for _ in range(6):
+        steps += [0.01] * 2000 + [0.008] * 625 + [0.01] * 2000 + [0.0125] * 500
+    t = np.r_[0.0, np.cumsum(steps)]
+    e = _err(_write(tmp_path / "a.csv", t))
+    assert "uniform grid" in str(e) and "125 sample intervals" in str(e) and "rate changes within the log" in str(e)
+    # where the stamps are farthest off: after a 125-Hz block, before the 80-Hz block brings them back
+    assert 2000 + 625 <= (e.line - 2) % 5125 <= 2000 + 625 + 2000
+
+
+def test_a_drifting_oscillator_and_accumulated_jitter_pass(tmp_path):
+    # 300 ppm quadratic drift of the sample clock over 2e5 samples: 0.075 % of the span off a straight line
+    i = np.arange(200_000)
+    t = i * 0.01 * (1 + 3e-4 * (i / i[-1]) ** 2)
+    assert load(_write(tmp_path / "a.csv", t), unit="deg/h").n_samples == i.size
+    # the threshold: just inside passes, just outside is refused (the larger of 20 intervals and 0.1 % of the span)
+    n, dt = 20_000, 0.01
+    bump = np.sin(np.pi * np.arange(n) / (n - 1))  # 0 at both ends: the span is n dt exactly
+    limit = max(GRID_DRIFT_INTERVALS * dt, GRID_DRIFT_FRACTION * (n - 1) * dt)
+    for k, ok in ((0.95, True), (1.05, False)):
+        path = _write(tmp_path / f"b{k}.csv", np.arange(n) * dt + k * limit * bump)
+        if ok:
+            assert load(path, unit="deg/h").n_samples == n
+        else:
+            assert "uniform grid" in str(_err(path))
 
 
 def test_the_thresholds_are_the_documented_ones(tmp_path):

@@ -625,16 +625,16 @@ def headline_verdict(heading=None, artefacts=None, *, axis: str = "", reason: st
             for x in worse[best]))
     if best in flagged:
         buts.append(f"removes real rate near {', '.join(f'{f:g}' for f in flagged[best])} Hz (artefact check)")
-    gain = (f"{axis}: {best} -{100 * (1 - r.ratio_to_bias):.0f} % at {h:g} s ({_f(r.rms_deg)} vs "
-            f"{_f(base[h].rms_deg)} deg RMS, {judgements[(best, h)].counts()})")
+    gained = (f"{axis}: {best} -{100 * (1 - r.ratio_to_bias):.0f} % at {h:g} s ({_f(r.rms_deg)} vs "
+              f"{_f(base[h].rms_deg)} deg RMS, {judgements[(best, h)].counts()})")
     if buts:
         line = what + " but " + " and ".join(buts) + "."
-        short = gain + " but " + " and ".join(buts) + "."
+        short = gained + " but " + " and ".join(buts) + "."
         outcome = "mixed"
     else:
         check = "artefact check not run" if artefacts is None else "artefact check clean"
         line = what + f" and worsens it at no judged horizon ({', '.join(f'{x:g}' for x in judged)} s); {check}."
-        short = gain + f"; worse nowhere; {check}."
+        short = gained + f"; worse nowhere; {check}."
         outcome = "reduces"
     return Verdict("headline", [line], {"outcome": outcome, "model": best, "horizon_s": h,
                                         "ratio_to_bias": r.ratio_to_bias, **data}, short)

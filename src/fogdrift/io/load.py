@@ -32,7 +32,8 @@ from .record import GyroRecord
 from .registry import reader_by_name, select_reader
 
 __all__ = ["load", "load_segments", "time_unit_of_name", "TIME_COLUMN_NAMES", "GAP_FACTOR", "DT_TOLERANCE",
-           "SHORT_STEP_FACTOR", "JITTER_TOLERANCE", "check_load_options"]
+           "SHORT_STEP_FACTOR", "JITTER_TOLERANCE", "GRID_DRIFT_INTERVALS", "GRID_DRIFT_FRACTION",
+           "check_load_options"]
 
 #: Column names (compared case-insensitively) that ``time_column="auto"`` takes as time; so does one of the
 #: first, third or last with a time-unit suffix (``t_ms``, ``time_us``, ``timestamp_ns``).
@@ -45,6 +46,13 @@ DT_TOLERANCE = 0.01
 SHORT_STEP_FACTOR = 0.7
 #: Largest spread of the time steps (median absolute deviation / sample interval) of a uniform grid.
 JITTER_TOLERANCE = 0.05
+#: Largest departure of the time stamps of a gap-free stretch from the straight line through its first and last
+#: stamp: the larger of ``GRID_DRIFT_INTERVALS`` sample intervals (delivery jitter of a logger that stamps on
+#: receipt) and ``GRID_DRIFT_FRACTION`` of the stretch (an oscillator's drift with temperature, ~100 ppm).  Blocks
+#: at other sample rates whose steps pass the spread and span checks (10 s at 125 Hz, 10 s at 80 Hz between
+#: 100 Hz stretches) run seconds off that line.
+GRID_DRIFT_INTERVALS = 20.0
+GRID_DRIFT_FRACTION = 1e-3
 #: A unit the file states, in words, by ``Table.format`` (else "declared by the file": HDF5/.mat attributes, miniSEED).
 _SAID = {"text": "declared in the header", "bag": "declared by the message definition"}.get
 
@@ -746,6 +754,29 @@ def _check_uniform(table: Table, t: np.ndarray, steps: np.ndarray, dt: float, t_
                 f"time column spans {span:.6g} s from {table.row_ref(a)} to {table.row_ref(b - 1)}, but its "
                 f"{b - a} samples at {dt:.10g} s span {grid:.6g} s ({100 * (span / grid - 1):+.3g} %); expected "
                 f"agreement within {100 * DT_TOLERANCE:g} %; " + _UNIFORM_HINT, row=b - 1, col=t_idx)
+        k, dev = _grid_departure(t[a:b])
+        limit = max(GRID_DRIFT_INTERVALS * dt, GRID_DRIFT_FRACTION * span)
+        if abs(dev) > limit:
+            i = a + k
+            raise table.error(
+                f"time stamps run {abs(dev):.6g} s ({abs(dev) / dt:.3g} sample intervals) {'ahead of' if dev > 0 else 'behind'} "
+                f"a uniform grid{table.at(i)} (the straight line from {table.row_ref(a)} to {table.row_ref(b - 1)}); "
+                f"expected within {limit:.3g} s: the sample rate changes within the log (blocks at other rates "
+                "whose steps each look regular); " + _UNIFORM_HINT, row=i, col=t_idx)
+
+
+def _grid_departure(t: np.ndarray, chunk: int = 1 << 20) -> tuple[int, float]:
+    """``(k, d)``: the sample whose stamp lies farthest from the straight line through the first and last stamp,
+    and its signed distance [s] (computed in chunks: no second array the size of the record)."""
+    n = t.shape[0]
+    slope = float(t[-1] - t[0]) / (n - 1)
+    best_k, best = 0, 0.0
+    for a in range(0, n, chunk):
+        seg = t[a:a + chunk] - (t[0] + slope * np.arange(a, min(a + chunk, n), dtype=np.float64))
+        j = int(np.argmax(np.abs(seg)))
+        if abs(seg[j]) > abs(best):
+            best_k, best = a + j, float(seg[j])
+    return best_k, best
 
 
 def _check_time(table: Table, t: np.ndarray, t_idx, dt_user, split: bool):

@@ -15,7 +15,7 @@ from ..lifting import MODES, get_wavelet
 from ..models import MODEL_NAMES, model_spec
 from ..noise.terms import TERM_TABLE
 from ..outliers import OUTLIER_ACTIONS
-from ..units import check_rate_hz
+from ..units import check_rate_hz, earth_rate_projection_dph
 
 __all__ = ["AnalysisConfig", "check_options"]
 
