@@ -171,3 +171,50 @@ def test_importing_the_package_and_the_pipeline_imports_no_model_module():
     mods = _imports_after("import fogdrift.models, fogdrift.pipeline\nfogdrift.models.MODEL_NAMES")
     assert "jax" not in mods
     assert not {"fogdrift.models.grey", "fogdrift.models.ar", "fogdrift.models.elman"} & mods
+
+
+# ---- hyper-parameters declared once (ModelParam rows): CLI, settings, build, rule ---------------------------------
+@pytest.mark.parametrize("spec", [s for s in MODELS if s.params], ids=lambda s: s.name)
+def test_every_declared_parameter_is_a_constructor_keyword_with_a_default(spec):
+    sig = inspect.signature(spec.load().__init__).parameters
+    for p in spec.params:
+        assert p.name in sig and sig[p.name].default is not inspect.Parameter.empty, (spec.name, p.name)
+        assert p.kind in (int, float, str) and p.help
+
+
+def test_a_declared_parameter_goes_from_the_command_line_to_the_model():
+    from fogdrift.models import check_model_params, parse_model_params
+
+    mp = parse_model_params(["GM11.shift_margin=2", "elman.patience=7"])
+    assert mp == {"gm11": {"shift_margin": 2.0}, "elman": {"patience": 7}}
+    assert isinstance(mp["gm11"]["shift_margin"], float) and isinstance(mp["elman"]["patience"], int)
+    cfg = AnalysisConfig(models=("gm11", "elman"), model_params=mp).validate()
+    assert build_model("gm11", cfg).shift_margin == 2.0 and build_model("elman", cfg).patience == 7
+    assert build_model("gm11", AnalysisConfig()).shift_margin == 1.0  # not set: the constructor's default
+    assert cfg.to_dict()["model_params"] == mp and "model_params" not in AnalysisConfig().to_dict()
+    assert check_model_params({"gm11": {"shift_margin": 3}}) == {"gm11": {"shift_margin": 3.0}}  # int as float
+
+
+@pytest.mark.parametrize("given, words", [
+    (["gm11.shift_margin=-1"], "GM11 shift_margin must be a finite number >= 0"),  # the model's own rule
+    (["elman.patience=0"], "patience must be an integer >= 1"),
+    (["gm11.shift_margin=abc"], "expected a number"),
+    (["gm11.window=3"], "declares no such parameter; settable: "),
+    (["gm11shift_margin=2"], "expected MODEL.NAME=VALUE"),
+    (["lstm.hidden=2"], "unknown drift model 'lstm'"),
+])
+def test_a_bad_declared_parameter_is_refused_before_any_data_with_its_flag(given, words):
+    from fogdrift.cli._app import FLAGS
+    from fogdrift.errors import render_options
+    from fogdrift.models import parse_model_params
+
+    with pytest.raises(ConfigError) as ei:
+        AnalysisConfig(model_params=parse_model_params(given)).validate()
+    assert words in str(ei.value) and "\n" not in str(ei.value)
+    shown = render_options(ei.value.args[0], FLAGS)  # what the CLI prints
+    assert shown.startswith("--param ") or "--models" in shown
+
+
+def test_a_parameter_of_a_model_not_run_is_refused():
+    with pytest.raises(ConfigError, match=r"gm11\.shift_margin is set but gm11 is not among the models run"):
+        AnalysisConfig(models=("ar",), model_params={"gm11": {"shift_margin": 2.0}}).validate()

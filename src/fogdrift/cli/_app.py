@@ -77,7 +77,7 @@ FLAGS = {
     "wavelet": "--wavelet", "mode": "--mode", "terms": "--terms", "fit_taus": "--fit-taus",
     "tau_range_s": "--fit-taus", "taus": "--taus", "estimator": "--estimator", "statistic": "--statistic",
     "models": "--models", "latitude_deg": "--latitude", "earth_axes": "--earth-axis", "outliers": "--outliers",
-    "lags": "--lags", "hidden": "--hidden", "epochs": "--epochs", "training": "--training", "seed": "--seed",
+    "lags": "--lags", "hidden": "--hidden", "epochs": "--epochs", "training": "--training", "seed": "--seed", "model_params": "--param",
     "apply_unit": "--apply-unit", "axis_map": "--axis-map", "accept_rate": "--accept-rate", "bias": "--bias",
     "model": "--model", "chunk_samples": "--chunk", "out": "--out", "pdf": "--pdf",
     "method": "--method", "noise_method": "--noise-method", "scales": "--scales", "levels": "--scales",

@@ -10,13 +10,15 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import ConfigError
+from ..models.registry import parse_model_params
 from ._app import (gyro_only, EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutliersOpt, OutOpt,
                    SegmentsOpt, StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_plausible, console,
                    csv_list, echo_record, fitted_table, parse_fit_taus, parse_level, parse_taus, parse_terms,
                    print_screen, progress, run, say, with_load_options)
 from ._spec import SpecOpt, print_judgements, read_spec_option
 from ._tables import metrics_table, noise_table
-from .model import ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, SeedOpt, TrainingOpt, model_axes_text
+from .model import (ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, ParamOpt, SeedOpt, TrainingOpt,
+                    model_axes_text)
 
 DEFAULT_OUT = Path("out/analyze")
 
@@ -43,6 +45,7 @@ def analyze(
     epochs: EpochsOpt = 2000,
     seed: SeedOpt = 0,
     training: TrainingOpt = "bptt",
+    param: ParamOpt = None,
     wavelet: WaveletOpt = "db2",
     level: LevelOpt = "4",
     mode: ModeOpt = "symmetric",
@@ -114,7 +117,7 @@ def analyze(
                              terms=term_list, statistic=statistic, outliers=outliers, latitude_deg=latitude,
                              earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), train_fraction=train_fraction,
                              val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window,
-                             noise_method=noise_method).validate()
+                             noise_method=noise_method, model_params=parse_model_params(param)).validate()
         hs = parse_heading_options(calibration, origin_step, horizons)
         if apply_to is not None and not apply_to.is_file():
             raise ConfigError(f"--apply-to {apply_to}: no such file")

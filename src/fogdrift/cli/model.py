@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Optional
 
 import typer
 
@@ -13,6 +13,7 @@ from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, 
 from ._tables import metrics_table
 
 from ..models import MODEL_NAMES, describe_models
+from ..models.registry import describe_params, parse_model_params
 
 #: Default of --models: every registered model, in report order.
 ALL_MODELS = ",".join(MODEL_NAMES)
@@ -24,6 +25,9 @@ LagsOpt = Annotated[int, typer.Option("--lags", help="Input lags p of Elman/grey
 EpochsOpt = Annotated[int, typer.Option("--epochs", help="Maximum training epochs (early stopping on validation).")]
 SeedOpt = Annotated[int, typer.Option("--seed", help="Random seed.")]
 TrainingOpt = Annotated[str, typer.Option("--training", help="bptt (Adam) or bp (classic traingdx).")]
+ParamOpt = Annotated[Optional[list[str]], typer.Option(
+    "--param", help="A drift model's hyper-parameter, MODEL.NAME=VALUE, repeatable (default: the model's own): "
+    + describe_params() + ".")]
 
 
 def model_axes_text(model_axes, record) -> str:
@@ -50,6 +54,7 @@ def model(
     epochs: EpochsOpt = 2000,
     seed: SeedOpt = 0,
     training: TrainingOpt = "bptt",
+    param: ParamOpt = None,
     wavelet: WaveletOpt = "db2",
     level: LevelOpt = "4",
     mode: ModeOpt = "symmetric",
@@ -66,7 +71,7 @@ def model(
              expect=("metrics.json",)) as r:
         cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
                              training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
-                             model_rate_hz=model_rate or None).validate()
+                             model_rate_hz=model_rate or None, model_params=parse_model_params(param)).validate()
         record = load.load()
         gyro_only(record, "model")
         factor = check_model_rate(record, cfg)

@@ -22,7 +22,8 @@ from __future__ import annotations
 from . import registry as _registry
 from .base import FORMAT_VERSION, DriftModel, check_series, load_model
 from .persistence import Persistence
-from .registry import MODEL_NAMES, MODELS, ModelSpec, build_model, describe_models, model_class, model_spec
+from .registry import (MODEL_NAMES, MODELS, ModelParam, ModelSpec, build_model, check_model_params, declared_params,
+                       describe_models, model_class, model_spec, parse_model_params)
 
 __all__ = [
     "DriftModel",
@@ -33,6 +34,10 @@ __all__ = [
     "MODELS",
     "MODEL_NAMES",
     "ModelSpec",
+    "ModelParam",
+    "declared_params",
+    "parse_model_params",
+    "check_model_params",
     "model_spec",
     "model_class",
     "build_model",

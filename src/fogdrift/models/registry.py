@@ -9,8 +9,11 @@ same rows serve :func:`build_model` (name -> unfitted model), :func:`~fogdrift.m
 is the report order.
 
 Adding a model is one new module (a :class:`~fogdrift.models.DriftModel` subclass) plus one row
-here; the contract tests (``tests/test_model_contract.py``) then run over it. This module
-imports nothing from the model modules and nothing heavy (no NumPy, no JAX).
+here; the contract tests (``tests/test_model_contract.py``) then run over it. A hyper-parameter users may set
+is one :class:`ModelParam` in the row's ``params``: it becomes ``--param MODEL.NAME=VALUE`` on ``analyze`` and
+``model``, ``AnalysisConfig.model_params`` in the library and fleets, with the constructor's default and the
+model's own ``_validate`` as its rule (nothing else to edit). This module imports nothing from the model
+modules and nothing heavy (no NumPy, no JAX).
 """
 
 from __future__ import annotations
@@ -23,6 +26,11 @@ from ..errors import ConfigError
 
 __all__ = [
     "ModelSpec",
+    "ModelParam",
+    "declared_params",
+    "parse_model_params",
+    "check_model_params",
+    "describe_params",
     "MODELS",
     "MODEL_NAMES",
     "model_spec",
@@ -32,6 +40,28 @@ __all__ = [
     "class_for_file",
     "file_class_names",
 ]
+
+
+@dataclass(frozen=True)
+class ModelParam:
+    """A hyper-parameter of a model that users may set, declared once.
+
+    Its default is the model constructor's, its rule the model's own ``_validate`` (called on the value before
+    any data is read); the declaration adds only how a command-line value is read and one line of help.
+
+    Attributes
+    ----------
+    name : str
+        The constructor keyword.
+    kind : type
+        ``int``, ``float`` or ``str``: how ``--param MODEL.NAME=VALUE`` reads VALUE.
+    help : str
+        One line for CLI help, with its unit.
+    """
+
+    name: str
+    kind: type
+    help: str
 
 
 @dataclass(frozen=True)
@@ -55,6 +85,8 @@ class ModelSpec:
         ``settings.<attribute>`` as ``<keyword>``.
     fixed : tuple of (str, object)
         Constructor keywords with a fixed value.
+    params : tuple of ModelParam
+        Hyper-parameters users may set by name (:func:`parse_model_params`, ``AnalysisConfig.model_params``).
     """
 
     name: str
@@ -64,6 +96,7 @@ class ModelSpec:
     description: str
     settings: tuple = ()
     fixed: tuple = ()
+    params: tuple = ()
 
     def load(self) -> type:
         """Import ``module`` and return the class (later calls hit the import cache)."""
@@ -72,16 +105,25 @@ class ModelSpec:
 
 _RECURRENT = (("lags", "lags"), ("hidden", "hidden"), ("activation", "activation"), ("training", "training"),
               ("epochs", "epochs"), ("seed", "seed"))
+_RECURRENT_PARAMS = (
+    ModelParam("patience", int, "early stopping: epochs without a better validation loss before training stops"),
+    ModelParam("learning_rate", float, "step size of the optimiser (default: the training scheme's own)"),
+    ModelParam("weight_decay", float, "L2 penalty on the weights (AdamW), >= 0"),
+    ModelParam("window", int, "truncated-BPTT window [samples]"),
+)
 
 #: The registry, in report order.
 MODELS: tuple[ModelSpec, ...] = (
     ModelSpec("grey-elman", "fogdrift.models.elman", "GreyElman", "grey-Elman",
-              "Elman network on the AGO of the drift, restored by IAGO (Tang et al. 2012)", _RECURRENT),
+              "Elman network on the AGO of the drift, restored by IAGO (Tang et al. 2012)", _RECURRENT,
+              params=_RECURRENT_PARAMS),
     ModelSpec("elman", "fogdrift.models.elman", "Elman", "Elman",
-              "Elman recurrent network on the last `lags` drift samples", _RECURRENT),
+              "Elman recurrent network on the last `lags` drift samples", _RECURRENT, params=_RECURRENT_PARAMS),
     ModelSpec("gm11", "fogdrift.models.grey", "GM11", "GM(1,1)",
               "rolling GM(1,1) grey model over the last `gm_window` samples", (("window", "gm_window"),),
-              (("mode", "rolling"),)),
+              (("mode", "rolling"),),
+              params=(ModelParam("shift_margin", float, "margin [x the series' spread] of the automatic shift "
+                                 "that keeps the accumulated series positive"),)),
     ModelSpec("ar", "fogdrift.models.ar", "AR", "AR(p)",
               "least-squares AR(p) with intercept, p = `lags`", (("order", "lags"),)),
     ModelSpec("kalman", "fogdrift.models.kalman", "Kalman", "Kalman",
@@ -122,6 +164,103 @@ def model_spec(name: str) -> ModelSpec:
 def model_class(name: str) -> type:
     """The model class of a name, imported now (e.g. ``model_class("ar")`` imports only :mod:`fogdrift.models.ar`)."""
     return model_spec(name).load()
+
+
+def declared_params() -> list[tuple[str, ModelParam]]:
+    """``[(model name, ModelParam), ...]`` of every row, in registry order."""
+    return [(spec.name, p) for spec in MODELS for p in spec.params]
+
+
+def describe_params() -> str:
+    """The settable hyper-parameters in one line for CLI help, models sharing a declaration named together.
+
+    Examples
+    --------
+    >>> describe_params().split("; ")[-1]  # doctest: +ELLIPSIS
+    'gm11.shift_margin (float): margin [x the series' spread] of the automatic shift ...'
+    """
+    groups: dict = {}
+    for model, p in declared_params():
+        groups.setdefault(p, []).append(model)
+    return "; ".join(f"{'|'.join(models)}.{p.name} ({p.kind.__name__}): {p.help}" for p, models in groups.items())
+
+
+def _param(model: str, name: str) -> tuple[ModelSpec, ModelParam]:
+    spec = model_spec(model)
+    for p in spec.params:
+        if p.name == name:
+            return spec, p
+    known = ", ".join(f"{m}.{q.name}" for m, q in declared_params()) or "none"
+    raise ConfigError(f"{{opt:model_params}} {model}.{name}: {spec.name} declares no such parameter; "
+                      f"settable: {known}")
+
+
+def parse_model_params(assignments) -> dict:
+    """``["gm11.shift_margin=2", ...]`` (``--param``) as ``{"gm11": {"shift_margin": 2.0}}``, each VALUE read by
+    its declaration's kind; unchecked otherwise (:func:`check_model_params` applies the models' rules).
+
+    Examples
+    --------
+    >>> parse_model_params(["gm11.shift_margin=2", "elman.patience=50"])
+    {'gm11': {'shift_margin': 2.0}, 'elman': {'patience': 50}}
+    >>> parse_model_params(["elman.patience=5.5"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fogdrift.errors.ConfigError: model_params= elman.patience=5.5: expected an integer; got '5.5'
+    """
+    out: dict = {}
+    for text in assignments or ():
+        key, eq, value = str(text).partition("=")
+        model, dot, name = key.strip().partition(".")
+        if not (eq and dot and model and name):
+            raise ConfigError(f"{{opt:model_params}} {text!r}: expected MODEL.NAME=VALUE, e.g. gm11.shift_margin=2")
+        spec, p = _param(model, name.strip())
+        raw = value.strip()
+        try:
+            val = p.kind(raw)
+        except ValueError:
+            what = {int: "an integer", float: "a number"}.get(p.kind, p.kind.__name__)
+            raise ConfigError(f"{{opt:model_params}} {spec.name}.{p.name}={raw}: expected {what}; got {raw!r}") \
+                from None
+        out.setdefault(spec.name, {})[p.name] = val
+    return out
+
+
+def check_model_params(model_params, models=None) -> dict:
+    """``{model: {name: value}}`` with canonical model names, every parameter declared, of its kind and accepted
+    by the model's own ``_validate`` (the model is built with it, nothing fitted); ``models``: the models run,
+    when given a parameter of another model is refused (it would silently do nothing).
+
+    Raises
+    ------
+    ConfigError
+        An unknown model or parameter, a value of the wrong kind, a value the model's rule refuses.
+    """
+    if model_params is None:
+        return {}
+    if not isinstance(model_params, Mapping):
+        raise ConfigError(f"{{opt:model_params}} must map model names to {{parameter: value}}; got {model_params!r}")
+    run = None if models is None else {model_spec(m).name for m in models}
+    out: dict = {}
+    for model, values in model_params.items():
+        if not isinstance(values, Mapping):
+            raise ConfigError(f"{{opt:model_params}} {model!r} must map parameter names to values; got {values!r}")
+        for name, value in values.items():
+            spec, p = _param(model, str(name))
+            if run is not None and spec.name not in run:
+                raise ConfigError(f"{{opt:model_params}} {spec.name}.{p.name} is set but {spec.name} is not among "
+                                  f"the models run ({{opt:models}}: {', '.join(sorted(run))})")
+            ok = (isinstance(value, p.kind) or (p.kind is float and isinstance(value, int))) \
+                and not isinstance(value, bool)
+            if not ok:
+                raise ConfigError(f"{{opt:model_params}} {spec.name}.{p.name} must be {p.kind.__name__}; got {value!r}")
+            value = p.kind(value)
+            try:
+                spec.load()(**{p.name: value})._validate()
+            except ConfigError as exc:
+                raise ConfigError(f"{{opt:model_params}} {spec.name}.{p.name}={value!r}: {exc}") from None
+            out.setdefault(spec.name, {})[p.name] = value
+    return out
 
 
 def build_model(name: str, settings=None, progress=None):
@@ -166,6 +305,9 @@ def build_model(name: str, settings=None, progress=None):
             except (KeyError, AttributeError):
                 raise ConfigError(f"model {spec.name!r} needs the setting {attribute!r}; "
                                   f"{type(settings).__name__} has none") from None
+    if settings is not None:
+        mp = settings.get("model_params") if isinstance(settings, Mapping) else getattr(settings, "model_params", None)
+        kwargs.update((mp or {}).get(spec.name, {}))
     if progress is not None and "progress" in cls._param_names():
         kwargs["progress"] = progress
     return cls(**kwargs)

@@ -12,7 +12,7 @@ from ..allan import ESTIMATORS, STATISTICS
 from ..allan.grid import MAX_TAUS
 from ..errors import ConfigError
 from ..lifting import MODES, get_wavelet
-from ..models import MODEL_NAMES, model_spec
+from ..models import MODEL_NAMES, check_model_params, model_spec
 from ..noise.terms import TERM_TABLE
 from ..outliers import OUTLIER_ACTIONS
 from ..units import check_rate_hz, earth_rate_projection_dph
@@ -65,6 +65,10 @@ class AnalysisConfig:
         model selection on the Haar wavelet variance of the native-rate record (:mod:`fogdrift.gmwm.analysis`),
         which the report shows as the noise table; the Kalman drift model then identifies its noise components
         by a GMWM fit of its training block too (:class:`fogdrift.models.kalman.Kalman` ``noise_method``).
+    model_params : dict
+        ``{model: {parameter: value}}``: the hyper-parameters a model row declares settable
+        (:func:`fogdrift.models.declared_params`; CLI ``--param MODEL.NAME=VALUE``), each checked by the model's
+        own rule; empty (default): the constructors' defaults.
     """
 
     model_rate_hz: float | None = 1.0
@@ -91,6 +95,7 @@ class AnalysisConfig:
     fit_tau_s: tuple = (None, None)
     outliers: str = "warn"
     noise_method: str = "allan"
+    model_params: dict = field(default_factory=dict)
 
     def validate(self) -> "AnalysisConfig":
         """Check every setting; return the config with canonical model names (``self`` is never modified).
@@ -175,10 +180,15 @@ class AnalysisConfig:
             raise ConfigError(f"{{opt:level}} must be an integer >= 1 or 'auto', got {self.level!r}")
         _check_taus(self.taus)
         _check_fit_taus(self.fit_tau_s)
-        return self if models == tuple(self.models) else dataclasses.replace(self, models=models)
+        model_params = check_model_params(self.model_params, models)
+        if models == tuple(self.models) and model_params == self.model_params:
+            return self
+        return dataclasses.replace(self, models=models, model_params=model_params)
 
     def to_dict(self) -> dict:
         d = asdict(self)
+        if not d["model_params"]:  # the default: results written before the field existed read the same
+            del d["model_params"]
         d["models"] = list(self.models)
         d["terms"] = None if self.terms is None else list(self.terms)
         d["fit_tau_s"] = list(self.fit_tau_s)
