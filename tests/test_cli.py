@@ -97,3 +97,28 @@ def test_model_command_small(bundled_path, tmp_path):
     doc = json.loads((tmp_path / "metrics.json").read_text())
     assert set(doc["axes"][0]["metrics_paper_target"]) >= {"persistence"}
     assert any(p.suffix == ".json" for p in (tmp_path / "models").iterdir())
+
+
+def test_the_first_run_says_it_compiles_the_kernels_once_at_a_terminal(tmp_path, monkeypatch, capsys):
+    """The first run on a machine compiles numba's kernels (the wait of a first `make demo`): a user at a terminal
+    is told so, once; with a cached kernel, off a terminal or for `export` (no kernel), nothing is said."""
+    from fogdrift.cli import _app
+
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setattr(type(_app.err_console), "is_terminal", property(lambda self: True))
+    empty = tmp_path / "pkg"
+    (empty / "allan" / "__pycache__").mkdir(parents=True)
+    assert _app.first_run_note("allan", root=empty) is True
+    assert "first run here: compiling the numerical kernels" in capsys.readouterr().err
+    assert _app.first_run_note("export", root=empty) is False
+    (empty / "allan" / "__pycache__" / "_kernels._sq2_py-97.py311.nbi").write_bytes(b"")
+    assert _app.first_run_note("allan", root=empty) is False
+    cache = tmp_path / "numba-cache"
+    cache.mkdir()
+    (cache / "k.nbi").write_bytes(b"")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(cache))
+    assert _app.first_run_note("allan", root=tmp_path / "none") is False  # NUMBA_CACHE_DIR holds one
+    monkeypatch.setattr(type(_app.err_console), "is_terminal", property(lambda self: False))
+    monkeypatch.delenv("NUMBA_CACHE_DIR")
+    assert _app.first_run_note("allan", root=tmp_path / "none") is False  # a log or a pipe: not said
+    assert capsys.readouterr().err == ""

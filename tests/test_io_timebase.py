@@ -8,8 +8,8 @@ import pytest
 
 from fogdrift.errors import DataFormatError
 from fogdrift.io import load
-from fogdrift.io.load import (DT_TOLERANCE, GRID_DRIFT_FRACTION, GRID_DRIFT_INTERVALS, JITTER_TOLERANCE,
-                              SHORT_STEP_FACTOR)
+from fogdrift.io.timebase import (DT_TOLERANCE, GRID_DRIFT_FRACTION, GRID_DRIFT_INTERVALS, JITTER_TOLERANCE,
+                                  SHORT_STEP_FACTOR)
 
 
 def _write(path, t, seed=0):

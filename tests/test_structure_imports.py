@@ -172,7 +172,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift": (ROOT, ("fogdrift.errors",)),
     "fogdrift.cli": (CLI + "; main() takes SIGINT over before importing anything (cli/__init__ docstring)", (
         "fogdrift.cli._app", "fogdrift.interrupt")),
-    "fogdrift.cli._app": (CLI, ("fogdrift.pipeline", "fogdrift.segments")),
+    "fogdrift.cli._app": (CLI, ("fogdrift.pipeline",)),
     "fogdrift.cli._spec": (CLI, ("fogdrift.report",)),
     "fogdrift.cli._tables": (CLI, ("fogdrift.noise.terms", "fogdrift.report")),
     "fogdrift.cli.allan": (CLI, ("fogdrift.pipeline", "fogdrift.report", "fogdrift.workflows.allan")),
@@ -180,6 +180,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
         "fogdrift.evaluation.verdicts", "fogdrift.pipeline",
         "fogdrift.report", "fogdrift.report.pdf", "fogdrift.report.summary",
         "fogdrift.workflows.analyze")),
+    "fogdrift.cli._screen": (CLI, ("fogdrift.segments",)),
     "fogdrift.cli.batch": (CLI, ("fogdrift.fleet", "fogdrift.fleet.commands", "fogdrift.fleet.summary")),
     "fogdrift.cli.compensate": (CLI, ("fogdrift.compensate", "fogdrift.evaluation")),
     "fogdrift.cli.consistency": (CLI, ("fogdrift.evaluation.consistency", "fogdrift.models.statespace",

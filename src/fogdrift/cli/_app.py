@@ -443,6 +443,7 @@ def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool
             if missing:  # as mkdir -p, and said (once the folder is known to be usable): a typo shows in this line
                 say(f"--out {out}: creating its parent folder {missing[0]}", style="dim")
             outdir.expect(*expect)
+            first_run_note(command)
             try:
                 with outdir:
                     yield Run(outdir, bool(json_out))
@@ -778,21 +779,19 @@ def fitted_table(title, headers, rows) -> Group:
     return Group(*parts)
 
 
+def first_run_note(command: str, root: Path | None = None) -> bool:
+    """Tell a user at a terminal, once, that this run compiles the numerical kernels (numba's cache holds none of
+    the package yet: no ``*.nbi`` beside the modules or under ``NUMBA_CACHE_DIR``); returns whether it was said."""
+    root = Path(__file__).resolve().parents[1] if root is None else Path(root)
+    places = [root] + ([Path(os.environ["NUMBA_CACHE_DIR"])] if os.environ.get("NUMBA_CACHE_DIR") else [])
+    if command == "export" or not err_console.is_terminal or any(next(p.glob("**/*.nbi"), None) for p in places
+                                                                  if p.is_dir()):
+        return False
+    err_console.print(Text("first run here: compiling the numerical kernels for this machine (once, up to a minute;"
+                           " later runs read them from the cache)", style="dim"), soft_wrap=True)
+    return True
+
+
 def print_table(title, headers, rows) -> None:
     """Print :func:`fitted_table` on stdout (nothing under --json)."""
     console.print(fitted_table(title, headers, rows))
-
-
-def print_screen(record, findings, screens, gmwm=None, compact=False) -> None:
-    """Print what a workflow found before its fit: each plausibility finding as a warning (one line each), then
-    each axis's record screen (what disturbs it, where, what the fit uses).  ``gmwm``: the segment plan, to say
-    that GMWM fits the longest segment."""
-    from ..segments import segment_lines
-
-    for finding in findings:
-        warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
-    for name in record.axis_names:
-        for line in segment_lines(name, screens[name], compact=compact):
-            if gmwm is not None and gmwm[name] and line.endswith("fits it all") and len(gmwm[name]) > 1:
-                line += "; GMWM: the longest of them"
-            say(f"  {line}", style=None if screens[name]["stationary"] else "yellow")

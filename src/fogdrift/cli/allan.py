@@ -6,8 +6,9 @@ from pathlib import Path
 
 from ..temperature import summary_line
 from ._app import (EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, SegmentsOpt, StatisticOpt, TausOpt, TermsOpt,
-                   app, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, print_screen, progress,
+                   app, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, progress,
                    run, with_load_options)
+from ._screen import print_screen
 from ._tables import noise_table, print_noise_notes, relabel_note
 from ._spec import SpecOpt, print_spec_for_allan, read_spec_option
 

@@ -14,7 +14,8 @@ from ..models.registry import parse_model_params
 from ._app import (gyro_only, EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutliersOpt, OutOpt,
                    SegmentsOpt, StatisticOpt, TausOpt, TermsOpt, WaveletOpt, app, check_plausible, console,
                    csv_list, echo_record, fitted_table, parse_fit_taus, parse_level, parse_taus, parse_terms,
-                   print_screen, progress, run, say, with_load_options)
+                   progress, run, say, with_load_options)
+from ._screen import print_screen
 from ._spec import SpecOpt, print_judgements, read_spec_option
 from ._tables import metrics_table, noise_table
 from .model import (ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, ParamOpt, SeedOpt, TrainingOpt,

@@ -20,8 +20,9 @@ import typer
 
 from ..errors import ConfigError
 from ..spec import readings_from_gmwm
-from ._app import (JsonOpt, OutOpt, SegmentsOpt, app, console, echo_record, fitted_table, print_screen, progress, run,
+from ._app import (JsonOpt, OutOpt, SegmentsOpt, app, console, echo_record, fitted_table, progress, run,
                    say, with_load_options)
+from ._screen import print_screen
 from ._tables import noise_table, print_noise_notes
 # (the --spec helpers live in the light cli._spec; imported here under their old names too)
 from ._spec import SpecOpt, channel_kinds, print_spec_comparison, print_spec_for_allan, read_spec_option  # noqa: F401

@@ -88,7 +88,8 @@ Everything else (column choice, time checks, gaps, unit conversion, the record) 
 """
 
 from .hashing import file_sha256
-from .load import DT_TOLERANCE, GAP_FACTOR, TIME_COLUMN_NAMES, load, load_segments, time_unit_of_name
+from .load import TIME_COLUMN_NAMES, load, load_segments, time_unit_of_name
+from .timebase import DT_TOLERANCE, GAP_FACTOR
 from .record import GyroRecord, block_average, decimation_factor, from_array
 
 __all__ = [

@@ -29,7 +29,8 @@ from ..signal import Channel, Sampling, SignalDescription
 from ..units import TIME_UNITS, check_dt_s, parse_unit, valid_units
 from ._checks import check_path
 from .hashing import file_sha256
-from .load import DT_TOLERANCE, GAP_FACTOR, JITTER_TOLERANCE, SHORT_STEP_FACTOR, _interval_option
+from .load import _interval_option
+from .timebase import DT_TOLERANCE, GAP_FACTOR, JITTER_TOLERANCE, SHORT_STEP_FACTOR
 from .readers._columns import unit_list
 from .readers.base import require
 from .readers.hdf5 import UNIT_ATTRS
@@ -389,9 +390,9 @@ def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None
 
     The columns are ``col0, col1, ...`` as for :func:`fogdrift.io.load`.  A time column is used only when named
     (``time_column``; ``"auto"`` finds none in an array); its steps are checked as the rows stream by the rules
-    of :func:`fogdrift.io.load` (:data:`~fogdrift.io.load.SHORT_STEP_FACTOR`,
-    :data:`~fogdrift.io.load.GAP_FACTOR`, :data:`~fogdrift.io.load.JITTER_TOLERANCE` on the first
-    :data:`HEAD_STEPS` steps, the span against ``(n - 1) dt`` within :data:`~fogdrift.io.load.DT_TOLERANCE`).
+    of :func:`fogdrift.io.load` (:data:`~fogdrift.io.timebase.SHORT_STEP_FACTOR`,
+    :data:`~fogdrift.io.timebase.GAP_FACTOR`, :data:`~fogdrift.io.timebase.JITTER_TOLERANCE` on the first
+    :data:`HEAD_STEPS` steps, the span against ``(n - 1) dt`` within :data:`~fogdrift.io.timebase.DT_TOLERANCE`).
 
     Parameters
     ----------
