@@ -417,8 +417,10 @@ def signal_block(result, record, fig_dir) -> str:
 
 
 def spectrum_block(result, record, fig_dir) -> str:
-    """Section ``spectrum``: Fig. 2, the output's spectrum."""
-    return _img(plot_spectrum(record, fig_dir / "fig2_spectrum.png"))
+    """Section ``spectrum``: Fig. 2, the output's spectrum as the workflow computed it (each axis's ``spectrum``;
+    ``""`` when the result holds none)."""
+    shown = [ax for ax in result.axes if getattr(ax, "spectrum", None) is not None]
+    return _img(plot_spectrum(shown, fig_dir / "fig2_spectrum.png")) if shown else ""
 
 
 def temperature_block(result, record, fig_dir) -> str:
