@@ -1,6 +1,7 @@
 """The report only renders what the workflow computed: Fig. 2 is drawn from each axis's ``spectrum`` (the Welch PSD
 of :func:`fogdrift.noise.spectral.welch_psd`, taken by :func:`fogdrift.pipeline.run_analysis`), labelled in the
-channel's unit; the report runs no Welch of its own."""
+channel's unit, and the temperature line is the result's ``record["temperature"]``; neither runs an estimator at
+render time."""
 
 from __future__ import annotations
 
@@ -14,7 +15,9 @@ from fogdrift.io import from_array
 from fogdrift.noise.spectral import welch_psd
 from fogdrift.pipeline import AnalysisConfig, AxisSpectrum, run_analysis
 from fogdrift.report import figures
-from fogdrift.report.html import spectrum_block
+from fogdrift.report import temperature as report_temperature
+from fogdrift.report.html import spectrum_block, temperature_block
+from fogdrift.temperature import summary_line, temperature_summary
 
 
 def _forbid_welch(monkeypatch):
@@ -69,3 +72,18 @@ def test_a_gyro_and_an_accelerometer_get_one_panel_each(tmp_path, monkeypatch, y
 def test_a_result_without_spectra_draws_no_fig2(tmp_path, ylabels):
     assert spectrum_block(NS(axes=[NS(name="gz", spectrum=None)]), None, tmp_path) == ""
     assert ylabels == [] and not (tmp_path / "fig2_spectrum.png").exists()
+
+
+def test_the_temperature_line_is_the_results_not_recomputed(tmp_path, monkeypatch):
+    temp = 20.0 + 0.01 * np.arange(200)
+    rec = from_array(np.zeros((200, 1)), dt_s=0.1, axis_names=["gz"])
+    rec = type(rec)(**{**rec.__dict__, "temperature_c": temp})
+    stored = temperature_summary(temp, rec.dt_s).to_dict()
+
+    def fail(*args, **kwargs):
+        raise AssertionError("the report summarised the temperature itself")
+
+    monkeypatch.setattr(report_temperature, "temperature_summary", fail)
+    html = temperature_block(NS(record={"temperature": stored}), rec, tmp_path)
+    assert summary_line(stored) in html and (tmp_path / "fig_temperature.png").is_file()
+    assert temperature_block(NS(record={"temperature": None}), rec, tmp_path) == ""
