@@ -528,3 +528,23 @@ def test_export_of_what_fogdrift_allan_writes_for_an_accelerometer(tmp_path):
     assert d["accelerometer_noise_density"] == pytest.approx(n_max / 60.0, rel=1e-5, abs=0)
     assert d["accelerometer_random_walk"] == pytest.approx(k_max / 60.0, rel=1e-5, abs=0)
     assert d["accelerometer_random_walk"] == pytest.approx(walk, rel=0.35)  # the simulated one, in SI
+
+
+def test_export_reads_an_allan_run_in_memory_as_the_round_trip_of_its_document_did():
+    """``fogdrift export LOG`` hands its Allan fit to export as the result object (``AllanRun.to_dict()``, the
+    allan.json document), with no JSON round trip: the channels are those the round-tripped document gave, and
+    numpy numbers count as numbers."""
+    from fogdrift._util import json_default
+    from fogdrift.io import from_array
+    from fogdrift.pipeline import AnalysisConfig, run_allan
+    from fogdrift.simulate import simulate
+    from fogdrift.workflows.allan import AllanRun
+
+    rec = from_array(simulate(2**14, 0.01, arw_dprh=0.1, seed=1), dt_s=0.01, axis_names=["gz"])
+    cfg = AnalysisConfig()
+    run = AllanRun(rec, cfg, run_allan(rec, cfg))
+    want = channels_from_result(json.loads(json.dumps(run.to_dict(), default=json_default)), "log.csv")
+    assert channels_from_result(run, "log.csv") == want
+    doc = run.to_dict()
+    doc["axes"][0]["noise"]["terms"]["N"]["value"] = np.float32(doc["axes"][0]["noise"]["terms"]["N"]["value"])
+    assert channels_from_result(doc, "log.csv")[0].terms["N"].value == pytest.approx(want[0].terms["N"].value)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.signal import butter, lfilter, welch
 
-from fogdrift.errors import ConfigError, DataFormatError
+from fogdrift.errors import ConfigError, DataFormatError, InsufficientDataError
 from fogdrift.noise import spectral as sp
 from fogdrift.noise.spectral import analyse_spectrum, sinusoid_avar
 from fogdrift.simulate import simulate
@@ -290,3 +290,20 @@ def test_nperseg_gives_at_least_32_segments_and_a_bounded_length():
         nper = sp._nperseg(n)
         assert nper & (nper - 1) == 0 and 64 <= nper <= 65536
         assert (n - nper) // (nper // 2) + 1 >= 32 or nper == 64
+
+
+@pytest.mark.parametrize("n", [5_000, 40, 2])
+def test_welch_psd_is_one_scipy_welch_of_the_whole_record(n):
+    """The PSD the workflow hands to the report (Fig. 2) is the line search's Welch: one scipy.signal.welch call
+    on the mean-removed record with the segment length of :func:`analyse_spectrum` (the whole of a record shorter
+    than one segment)."""
+    x = 3.0 + np.random.default_rng(n).standard_normal(n)
+    f, p = sp.welch_psd(x, 0.01)
+    nper = min(sp._nperseg(n), n)
+    f_ref, p_ref = welch(x - x.mean(), fs=100.0, window="hann", nperseg=nper, noverlap=nper // 2)
+    np.testing.assert_allclose(f, f_ref, rtol=1e-15)
+    np.testing.assert_allclose(p, p_ref, rtol=1e-9, atol=1e-15 * float(p_ref.max()))
+    with pytest.raises(InsufficientDataError):
+        sp.welch_psd([1.0], 0.01)
+    with pytest.raises(ConfigError):
+        sp.welch_psd(x, 0.0)

@@ -186,7 +186,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.cli.consistency": (CLI, ("fogdrift.evaluation.consistency", "fogdrift.models.statespace",
                                        "fogdrift.workflows.consistency")),
     "fogdrift.cli.export": (CLI, ("fogdrift.export", "fogdrift.export.model", "fogdrift.export.targets",
-        "fogdrift.pipeline", "fogdrift.report")),
+        "fogdrift.pipeline", "fogdrift.workflows.allan")),
     "fogdrift.cli.model": (CLI, ("fogdrift.bundle", "fogdrift.cli.separate", "fogdrift.evaluation",
         "fogdrift.pipeline", "fogdrift.report")),
     "fogdrift.cli.noise": (CLI, ("fogdrift.gmwm.analysis", "fogdrift.gmwm.quantity", "fogdrift.noise.periodic", "fogdrift.noise.quantity", "fogdrift.report",

@@ -5,13 +5,11 @@ imuSensor, gnss-ins-sim and a complete JSON (:mod:`fogdrift.export`), from saved
 from __future__ import annotations
 
 import dataclasses
-import json
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
 
-from .._util import json_default
 from ..errors import ConfigError
 from ._app import FLAGS, app, check_plausible, echo_record, progress, run, say, warn, with_load_options
 
@@ -70,18 +68,17 @@ def export(
         channels = []
         if log is not None:
             from ..pipeline import AnalysisConfig, run_allan
-            from ..report import write_allan_outputs
+            from ..workflows.allan import AllanRun, write_allan
 
             opts = dataclasses.replace(load, file=log)
             record = opts.load()
             echo_record(opts, record)
             check_plausible(record)
-            with progress("export", record.axis_names) as (allan_cb, _):
-                results = run_allan(record, AnalysisConfig(), progress=allan_cb)
-            doc = json.loads(json.dumps({"source": record.source, "record": record.metadata(),
-                                         "axes": [a.to_dict() for a in results]}, default=json_default))
-            channels = channels_from_result(doc, str(log))
-            write_allan_outputs(results, record, r.out.path)
+            cfg = AnalysisConfig()
+            with progress("export", record.axis_names) as (allan_cb, _):  # the whole record: no screen, no segments
+                fit = AllanRun(record, cfg, run_allan(record, cfg, progress=allan_cb))
+            channels = channels_from_result(fit, str(log))
+            write_allan(fit, r.out.path)
         ctx = build_context(gyro, accel, results=result, channels=channels, rate_hz=update_rate, missing=missing,
                             topic=rostopic)
         texts = {n: render(n, ctx) for n in chosen}  # everything is rendered before any file is written

@@ -20,6 +20,7 @@ from __future__ import annotations
 import functools
 import json
 import math
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -189,8 +190,8 @@ def _coefficient(x, what: str, where: str, *, positive: bool = False):
     filter's configuration as a negative or infinite number."""
     if x is None:
         return None
-    ok = isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and (x > 0 if positive
-                                                                                            else x >= 0)
+    ok = isinstance(x, numbers.Real) and not isinstance(x, bool) and math.isfinite(x) and (x > 0 if positive
+                                                                                           else x >= 0)
     if not ok:
         raise DataFormatError(f"{where}: {what} = {x!r} is not a finite number {'> 0' if positive else '>= 0'}; a "
                               "result file holds only such values (re-run the fit that wrote it)")
@@ -364,13 +365,15 @@ def _rw_bound_from_wv(wv) -> tuple[float | None, str]:
                f"({scale:.4g} s), all of it taken as random walk")
 
 
-def channels_from_result(data: dict, path="result", *, expect: str | None = None) -> list[ChannelModel]:
-    """Every axis of a loaded result as a :class:`ChannelModel`.
+def channels_from_result(data, path="result", *, expect: str | None = None) -> list[ChannelModel]:
+    """Every axis of a result as a :class:`ChannelModel`.
 
     Parameters
     ----------
-    data : dict
-        From :func:`load_result`.
+    data : dict or result object
+        A loaded result file (:func:`load_result`), or a result in memory whose ``to_dict()`` is that document
+        (:class:`fogdrift.workflows.allan.AllanRun`), read as it is: NaN stays NaN where the file holds ``null``
+        (the file is strict JSON), and numpy numbers count as numbers.
     path : str
         For messages.
     expect : {"gyro", "accel", None}
@@ -381,6 +384,8 @@ def channels_from_result(data: dict, path="result", *, expect: str | None = None
     DataFormatError
         An axis without a noise model, units that do not say one quantity, or the wrong quantity.
     """
+    if hasattr(data, "to_dict"):
+        data = data.to_dict()
     record = data.get("record") or {}
     out = []
     for ax in data["axes"]:

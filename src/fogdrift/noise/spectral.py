@@ -58,7 +58,7 @@ from ..units import check_dt_s
 from ._spectral_null import _null_and_critical
 from .distributions import chi2_median
 
-__all__ = ["SpectralLine", "PeriodicComponent", "SpectrumSummary", "analyse_spectrum", "sinusoid_avar",
+__all__ = ["SpectralLine", "PeriodicComponent", "SpectrumSummary", "analyse_spectrum", "welch_psd", "sinusoid_avar",
            "MIN_SAMPLES"]
 
 #: Fewest samples analysed; a shorter record gets an empty summary with the reason.
@@ -303,6 +303,20 @@ def _welch(x: np.ndarray, fs_hz: float, nperseg: int, chunk_samples: int = 1 << 
         acc = p * j if acc is None else acc + p * j
         done += j
     return f, acc / n_seg, n_seg
+
+
+def welch_psd(x, dt_s) -> tuple[np.ndarray, np.ndarray]:
+    """The one-sided Welch PSD of a record, as :func:`analyse_spectrum` takes it: ``(f_hz, psd)``, ``psd`` in
+    (unit of ``x``)^2/Hz, the mean removed, Hann segments of :func:`_nperseg` samples (all of a record shorter
+    than that) at 50 % overlap, computed chunk by chunk.
+
+    >>> f, p = welch_psd(np.random.default_rng(0).standard_normal(2**14), 0.01)
+    >>> f.size, float(f[-1]), round(float(p[1:].mean()) * 50.0, 1)  # white noise of variance 1 at 100 Hz
+    (257, 50.0, 1.0)
+    """
+    dt = check_dt_s(dt_s)
+    x = check_series(x, "x", min_length=2)
+    return _welch(x, 1.0 / dt, min(_nperseg(x.size), x.size), offset=x.mean())[:2]
 
 
 #: Samples per block of :func:`_variance`: a record up to this length is one block (the result is then

@@ -47,7 +47,7 @@ from ..models import MODEL_NAMES, Persistence  # registry order = report order
 from ..models import build_model as make_model  # make_model(name, cfg, progress=None)
 from ..noise import express_quantity, fit_noise
 from ..noise.periodic import null_taus, periodic_content
-from ..noise.spectral import analyse_spectrum
+from ..noise.spectral import analyse_spectrum, welch_psd
 from ..outliers import treat_outliers
 from ..allan.sums import CHUNKED_MIN_SAMPLES, AllanSums  # noqa: F401 (re-exported)
 from .config import AnalysisConfig, check_options
@@ -55,6 +55,7 @@ from .results import (
     AllanAxis,
     AnalysisAxis,
     AnalysisResult,
+    AxisSpectrum,
     CompensatedSignal,
     ModelAxis,
     SeparationAxis,
@@ -68,6 +69,7 @@ __all__ = [
     "SeparationAxis",
     "ModelAxis",
     "CompensatedSignal",
+    "AxisSpectrum",
     "AnalysisAxis",
     "AnalysisResult",
     "MODEL_NAMES",
@@ -520,7 +522,8 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
         ma = _fit_axis_models(name, rate, rec_m.dt_s, lvl_cfg, bias, earth, progress,
                               fitted=None if fitted_from is None else _fitted_models_for(name, fitted_from),
                               factor=factor)
-        axes.append(AnalysisAxis(name, original, sep, ma, _table2(ma, lvl_cfg), gmwm=gmwm))
+        spectrum = AxisSpectrum(*welch_psd(record.axis(name), record.dt_s), record.signal.channel(name).internal_unit)
+        axes.append(AnalysisAxis(name, original, sep, ma, _table2(ma, lvl_cfg), gmwm=gmwm, spectrum=spectrum))
     applied = None
     if apply_to is not None:
         applied = run_analysis(apply_to, cfg, progress=progress, fitted_from=axes, factor=apply_to_factor)

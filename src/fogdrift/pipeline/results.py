@@ -23,7 +23,8 @@ if TYPE_CHECKING:  # result types of other stages, for the annotations only (no 
     from ..outliers import OutlierReport
     from .config import AnalysisConfig
 
-__all__ = ["AllanAxis", "SeparationAxis", "ModelAxis", "CompensatedSignal", "AnalysisAxis", "AnalysisResult"]
+__all__ = ["AllanAxis", "SeparationAxis", "ModelAxis", "CompensatedSignal", "AxisSpectrum", "AnalysisAxis",
+           "AnalysisResult"]
 
 
 
@@ -155,6 +156,16 @@ class ModelAxis:
         }
 
 
+@dataclass(frozen=True)
+class AxisSpectrum:
+    """The Welch PSD of one axis's rate as analysed (native rate, whole record;
+    :func:`fogdrift.noise.spectral.welch_psd`): what the report draws as Fig. 2.  Not part of the JSON."""
+
+    f_hz: np.ndarray
+    psd: np.ndarray  # one-sided [(unit)^2/Hz]
+    unit: str  # the channel's internal unit (fogdrift.units.INTERNAL_UNITS): "deg/h" or "m/s^2"
+
+
 @dataclass
 class AnalysisAxis:
     """Everything :func:`run_analysis` finds for one axis."""
@@ -166,6 +177,7 @@ class AnalysisAxis:
     table2: list  # CompensatedSignal rows, test block at the modelling rate
     evaluation: AxisEvaluation | None = None  # compensation evidence (fogdrift.evaluation.evaluated_analysis)
     gmwm: GmwmAxis | None = None  # GMWM noise model of the native-rate record (noise_method "gmwm")
+    spectrum: AxisSpectrum | None = field(default=None, repr=False, compare=False)  # not in to_dict
 
     def to_dict(self) -> dict:
         return {

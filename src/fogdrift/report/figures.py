@@ -315,22 +315,28 @@ def plot_signal(record, path, split_s=None) -> Path:
     return save_figure(fig, path)
 
 
-@_styled
-def plot_spectrum(record, path) -> Path:
-    """Fig. 2: Welch power spectral density of every axis."""
-    from scipy.signal import welch
+def _power_unit(unit: str) -> str:
+    """The unit of a PSD of a series in ``unit``: ``"deg/h"`` -> ``"(deg/h)²/Hz"``, ``"m/s^2"`` -> ``"(m/s²)²/Hz"``."""
+    return f"({unit.replace('^2', '²')})²/Hz"
 
+
+@_styled
+def plot_spectrum(axes, path) -> Path:
+    """Fig. 2: the Welch power spectral density of every axis, as the workflow computed it (each axis's
+    ``spectrum``, :class:`fogdrift.pipeline.AxisSpectrum`; the DC bin left out), one panel per unit (a gyro's in
+    (deg/h)²/Hz, an accelerometer's in (m/s²)²/Hz)."""
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(FIG_WIDTH_IN, 4.8))
-    for name in record.axis_names:
-        x = np.asarray(record.axis(name), dtype=float)
-        f, p = welch(x - x.mean(), fs=record.fs_hz, nperseg=min(len(x), 4096))
-        ax.loglog(f[1:], p[1:], lw=1.0, label=literal(name))
-    ax.set_xlabel("f [Hz]")
-    ax.set_ylabel("PSD [(deg/h)²/Hz]")
-    ax.set_title("Spectrum of the output (Fig. 2)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+    units = list(dict.fromkeys(ax.spectrum.unit for ax in axes))
+    fig, axs = plt.subplots(len(units), 1, figsize=(FIG_WIDTH_IN, 4.8 if len(units) == 1 else 7.6), squeeze=False)
+    for ax, unit in zip(axs[:, 0], units):
+        for a in axes:
+            if a.spectrum.unit == unit:
+                ax.loglog(a.spectrum.f_hz[1:], a.spectrum.psd[1:], lw=1.0, label=literal(a.name))
+        ax.set_xlabel("f [Hz]")
+        ax.set_ylabel(f"PSD [{_power_unit(unit)}]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+    axs[0, 0].set_title("Spectrum of the output (Fig. 2)")
     _place(fig)
     return save_figure(fig, path)
 

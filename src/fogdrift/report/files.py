@@ -11,7 +11,7 @@ from ..noise import TERM_TABLE
 from ..output import atomic_path
 from .figures import _safe, plot_allan, plot_dynamic_adev, plot_models, plot_residuals, plot_separation, plot_separation_allan
 
-__all__ = ["write_json", "write_allan_outputs", "write_separation_outputs", "write_model_outputs"]
+__all__ = ["write_json", "allan_document", "write_allan_outputs", "write_separation_outputs", "write_model_outputs"]
 
 
 def write_json(obj, path, *, indent: int | None = 2, sort_keys: bool = False) -> Path:
@@ -49,11 +49,16 @@ def _write_rows_csv(path, header, rows) -> Path:
     return path
 
 
+def allan_document(allan_axes, record) -> dict:
+    """The ``allan.json`` document of a record's Allan analysis: ``source``, ``record`` (its metadata) and ``axes``
+    (each axis's ``to_dict()``), before the strict-JSON writing (:func:`write_json`)."""
+    return {"source": record.source, "record": record.metadata(), "axes": [a.to_dict() for a in allan_axes]}
+
+
 def write_allan_outputs(allan_axes, record, out_dir) -> dict:
-    """``allan.json``, ``allan.csv`` (curve of every axis, with units) and ``allan.png``."""
+    """``allan.json`` (:func:`allan_document`), ``allan.csv`` (curve of every axis, with units) and ``allan.png``."""
     out = Path(out_dir)
-    write_json({"source": record.source, "record": record.metadata(),
-                "axes": [a.to_dict() for a in allan_axes]}, out / "allan.json")
+    write_json(allan_document(allan_axes, record), out / "allan.json")
     rows = []
     for a in allan_axes:
         r = a.allan

@@ -19,7 +19,7 @@ from pathlib import Path
 from ..evaluation.verdicts import CONSTANT_BIAS_LABEL, judge, table2_marks
 from ..models.registry import MODELS
 from ..output import atomic_path
-from ..temperature import summary_line, temperature_summary
+from ..temperature import summary_line
 from .figures import (_safe, plot_allan, plot_dynamic_adev, plot_models, plot_residuals, plot_separation,
                       plot_separation_allan, plot_signal, plot_spectrum)
 from .files import write_json
@@ -417,22 +417,24 @@ def signal_block(result, record, fig_dir) -> str:
 
 
 def spectrum_block(result, record, fig_dir) -> str:
-    """Section ``spectrum``: Fig. 2, the output's spectrum."""
-    return _img(plot_spectrum(record, fig_dir / "fig2_spectrum.png"))
+    """Section ``spectrum``: Fig. 2, the output's spectrum as the workflow computed it (each axis's ``spectrum``;
+    ``""`` when the result holds none)."""
+    shown = [ax for ax in result.axes if getattr(ax, "spectrum", None) is not None]
+    return _img(plot_spectrum(shown, fig_dir / "fig2_spectrum.png")) if shown else ""
 
 
 def temperature_block(result, record, fig_dir) -> str:
-    """Section ``temperature``: rate and temperature against time, with the temperature's range and drift, when
-    the log carries one (``""`` otherwise)."""
-    temp = getattr(record, "temperature_c", None)
-    if temp is None:
+    """Section ``temperature``: rate and temperature against time, with the temperature's range and drift (the
+    result's ``record["temperature"]``, summarised when the record was read), when the log carries one (``""``
+    otherwise)."""
+    summary = (result.record or {}).get("temperature")
+    if getattr(record, "temperature_c", None) is None or summary is None:
         return ""
-
-    line = summary_line(temperature_summary(temp, record.dt_s))
+    line = summary_line(summary)
     return (f'<h3>Temperature</h3><p class="note">{_e(line)}. The noise fit and the drift models use the '
             "rate only, not the temperature: a drift that follows this temperature history need not repeat "
             "under another.</p>"
-            + _img(plot_rate_and_temperature(record, fig_dir / "fig_temperature.png")))
+            + _img(plot_rate_and_temperature(record, fig_dir / "fig_temperature.png", summary=summary)))
 
 
 def render_report(result, record, fig_dir, *, sensor=None, evaluated=True, generated=None, spec=None) -> str:
@@ -476,7 +478,7 @@ def write_report(result, record, out_dir, apply_record=None, *, sensor=None, eva
     ``evaluated`` False says in the report that the heading-error evaluation was skipped on purpose
     (``analyze --no-heading``); ``sensor`` names the sensor on the first screen; ``spec`` (``analyze --spec``:
     ``{"limits": parsed spec, "judgements": [Judgement, ...], "source": file name}``, the judgements the caller
-    made, :func:`fogdrift.report.summary.analysis_judgements`) puts the datasheet verdicts on the first screen and
+    made, :func:`fogdrift.spec.analysis_judgements`) puts the datasheet verdicts on the first screen and
     under ``report_summary.spec`` (:func:`fogdrift.report.summary.spec_summary`).
     """
     out = Path(out_dir)

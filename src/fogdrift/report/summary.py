@@ -14,13 +14,13 @@ import numpy as np
 from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
 from ..noise import TERM_TABLE
 from ..noise.terms import DISPLAY_UNITS, TERMS
-from ..spec import B_COMPARED, analysis_judgements, judgement_line  # noqa: F401 (analysis_judgements: re-export)
+from ..spec import B_COMPARED, judgement_line
 from ..units import S_PER_H
 from .screen import screen_summary
 from .tables import _fmt, noise_row, shaped_cell, term_text
 
 __all__ = ["HEADLINE_TERMS", "OUTCOME_LABELS", "SPEC_LABELS", "SPEC_OUTCOMES", "recording_rows", "noise_headline",
-           "verdict_items", "cannot_support", "summary_dict", "analysis_judgements", "spec_summary"]
+           "verdict_items", "cannot_support", "summary_dict", "spec_summary"]
 
 #: Terms of the headline table, in the order an engineer reads them (white noise first, quantization last).
 HEADLINE_TERMS = ("N", "B", "K", "R", "Q")

@@ -28,7 +28,7 @@ def _decimated(x: np.ndarray, n_out: int) -> np.ndarray:
     return x[: nb * k].reshape((nb, k) + x.shape[1:]).mean(axis=1)
 
 
-def plot_rate_and_temperature(record, path) -> Path:
+def plot_rate_and_temperature(record, path, *, summary=None) -> Path:
     """Rate of every axis (top panels) and the temperature (bottom panel) against time, written as PNG.
 
     Parameters
@@ -37,6 +37,9 @@ def plot_rate_and_temperature(record, path) -> Path:
         A record with ``temperature_c`` (deg C); rates in deg/h.
     path : str or Path
         Output PNG.
+    summary : TemperatureSummary or dict, optional
+        The temperature's range and drift as already summarised (the report passes the result's
+        ``record["temperature"]``); None: summarised here from ``record.temperature_c``.
 
     Returns
     -------
@@ -78,7 +81,7 @@ def plot_rate_and_temperature(record, path) -> Path:
     ax.set_ylabel("T [°C]")
     ax.set_xlabel("t [s]")
     ax.grid(alpha=0.3)
-    ax.set_title(summary_line(temperature_summary(temp, record.dt_s)), fontsize=8)
+    ax.set_title(summary_line(temperature_summary(temp, record.dt_s) if summary is None else summary), fontsize=8)
     if k > 1:
         fig.suptitle(f"Rate and temperature (block means of {k} samples)", fontsize=9)
     path = Path(path)

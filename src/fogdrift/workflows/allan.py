@@ -17,6 +17,7 @@ from ..pipeline import AnalysisConfig
 from ..pipeline import run_allan as _fit
 from ..plausibility import check_record
 from ..report import write_allan_outputs
+from ..report.files import allan_document
 from ..segments import plan_segments
 
 __all__ = ["AllanRun", "Screened", "screen", "run_allan", "write_allan"]
@@ -44,6 +45,11 @@ class AllanRun:
     findings: list = field(default_factory=list)
     segments: dict = field(default_factory=dict)
     screens: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """The ``allan.json`` document (:func:`fogdrift.report.files.allan_document`): what :func:`write_allan` writes
+        and what :func:`fogdrift.export.model.channels_from_result` reads."""
+        return allan_document(self.results, self.record)
 
 
 @dataclass
