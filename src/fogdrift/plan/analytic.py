@@ -34,18 +34,21 @@ may never reach a target below it at any length, which the plan says.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
+from scipy.integrate import quad
 from scipy.optimize import nnls
-from scipy.stats import chi2, t as student_t
+from scipy.stats import chi2, ncx2, t as student_t
 
 from ..allan.grid import tau_grid
 from ..noise.context import FitContext
 from ..noise.terms import TERM_TABLE, all_terms, laws_of
 from .model import PLANNED_TERMS as PLANNED
 
-__all__ = ["analytic_widths", "expected_inflation", "PLAUSIBLE_DELTA", "IC_PENALTY", "BOUND_FRACTION"]
+__all__ = ["analytic_widths", "expected_inflation", "width_spread", "PLAUSIBLE_DELTA", "IC_PENALTY",
+           "BOUND_FRACTION"]
 
 #: The Allan fit's plausible-model window and IC penalty per term (:func:`fogdrift.noise.fit_noise` defaults).
 PLAUSIBLE_DELTA = 6.0
@@ -73,7 +76,38 @@ def expected_inflation(dof: int) -> float:
     return float(chi2.cdf(k, k) + 1.0 - chi2.cdf(k, k + 2))
 
 
-def analytic_widths(model, n_samples) -> dict:
+@functools.lru_cache(maxsize=256)
+def _inflation_log_var(dof: int) -> float:
+    """``Var[ln sqrt(max(1, X / dof))]`` for ``X ~ chi2_dof``: the record-to-record scatter the misfit widening adds
+    to the log of a width."""
+    k = max(int(dof), 1)
+
+    def moment(p):
+        return quad(lambda x: (0.5 * math.log(x / k)) ** p * chi2.pdf(x, k), k, math.inf, limit=200)[0]
+
+    m1 = moment(1)
+    return max(moment(2) - m1 * m1, 0.0)
+
+
+def width_spread(z: float, dof: int) -> float:
+    """Standard deviation of the log of a term's relative width from record to record [ln units].
+
+    Two parts, taken independent: the estimate the width is relative to scatters by ``sd(ln value) = 1 / (2 z)``
+    (the coefficient is ``sqrt(A)``, ``z = A / sd(A)``), and the fit widens each record's interval by its own
+    ``sqrt(max(1, chi2_red))`` (``chi2_red ~ chi2_dof / dof``, the same assumption as :func:`expected_inflation`).
+
+    Examples
+    --------
+    >>> round(width_spread(math.inf, 1000), 4) < round(width_spread(math.inf, 10), 4)
+    True
+    >>> round(width_spread(5.0, 10) ** 2 - width_spread(math.inf, 10) ** 2, 6)
+    0.01
+    """
+    v = (0.5 / z) ** 2 if z > 0 and math.isfinite(z) else (0.0 if z > 0 else math.inf)
+    return math.sqrt(v + _inflation_log_var(dof))
+
+
+def analytic_widths(model, n_samples, share=None) -> dict:
     """Expected 95 % interval of every model term for a record of ``n_samples`` samples at ``model.dt_s``.
 
     Parameters
@@ -82,6 +116,10 @@ def analytic_widths(model, n_samples) -> dict:
         The model (its ``tau_min_s``: the first fitted tau [s]; its ``bounds``: terms the pilot only bounded).
     n_samples : int
         Record length [samples].
+    share : float, optional
+        None: the median record.  A share ``p`` (e.g. 0.8): a model one term smaller joins the union when at least
+        ``1 - p`` of the records find it plausible (its IC gap is then random: ``Q ~ chi2_1(lambda)``, noncentral,
+        with ``lambda`` its ``Q`` at the expected curve), the union of the ``p``-th record.
 
     Returns
     -------
@@ -94,7 +132,7 @@ def analytic_widths(model, n_samples) -> dict:
     """
     names = model.terms
     A = model.law_coefficients()
-    out = _widths(names, A, int(n_samples), float(model.dt_s), model.tau_min_s)
+    out = _widths(names, A, int(n_samples), float(model.dt_s), model.tau_min_s, share)
     for e, bound in (getattr(model, "bounds", None) or {}).items():
         if e in names or e not in PLANNED or not bound > 0:
             continue
@@ -102,7 +140,7 @@ def analytic_widths(model, n_samples) -> dict:
         Ae[all_terms().index(e)] = (BOUND_FRACTION * bound / TERM_TABLE[e].to_unit) ** 2 * \
             laws_of("adev")[e].scale(float(model.dt_s))
         alt = _widths(tuple(t for t in PLANNED if t in names or t == e), Ae, int(n_samples), float(model.dt_s),
-                      model.tau_min_s)
+                      model.tau_min_s, share)
         for t in names:
             o, a = out[t], alt[t]
             o["rel_lo"], o["rel_hi"] = min(o["rel_lo"], a["rel_lo"]), max(o["rel_hi"], a["rel_hi"])
@@ -113,7 +151,7 @@ def analytic_widths(model, n_samples) -> dict:
     return out
 
 
-def _widths(names, A, n, dt, tau_min_s=None) -> dict:
+def _widths(names, A, n, dt, tau_min_s=None, share=None) -> dict:
     """:func:`analytic_widths` of the model ``names`` with Allan-law coefficients ``A`` (all columns)."""
     m = tau_grid(n, dt, "octave").astype(np.float64)
     if tau_min_s is not None:
@@ -158,7 +196,7 @@ def _widths(names, A, n, dt, tau_min_s=None) -> dict:
             # the plausible models that lack a term of the model (a K the length cannot yet tell from 0): t fitted
             # there (non-negative least squares on the expected curve) is biased, and the fit's union holds it
             for lo_s, hi_s in _smaller_plausible(Xall, yw, [col[u] for u in names], col[t],
-                                                 [col[e] for e in extras], IC_PENALTY * k, d):
+                                                 [col[e] for e in extras], IC_PENALTY * k, d, share):
                 lo_a, hi_a = min(lo_a, lo_s), max(hi_a, hi_s)
         # resolved: every plausible model needs t -- the model without t, or with t replaced by an absent term,
         # is out of the plausible window at the expected curve
@@ -173,19 +211,26 @@ def _widths(names, A, n, dt, tau_min_s=None) -> dict:
     return out
 
 
-def _smaller_plausible(Xall, yw, cols, ct, extras, ic_true, d):
+def _smaller_plausible(Xall, yw, cols, ct, extras, ic_true, d, share=None):
     """95 % intervals ``(lo, hi)`` of column ``ct`` in the models one term smaller than the true one (columns
     ``cols``) that keep it and are plausible at the expected curve (IC ``Q + 2 k`` within :data:`PLAUSIBLE_DELTA`
     of the true model's ``ic_true``).  Each is fitted by non-negative least squares in the whitened metric (its
     ``A_t`` is biased: it takes up part of the dropped term); its interval is ``A_t +- d sd_t``, widened on one
-    side by the models one absent column (of ``extras``) larger, as the true model's."""
+    side by the models one absent column (of ``extras``) larger, as the true model's.  ``share``: see
+    :func:`analytic_widths`."""
     out = []
     for u in cols:
         if u == ct:
             continue
         sub = [c for c in cols if c != u]
         coef, res = nnls(Xall[:, sub], yw)
-        if res**2 + IC_PENALTY * len(sub) - ic_true > PLAUSIBLE_DELTA or not np.all(coef > 0):
+        if not np.all(coef > 0):
+            continue
+        gap = IC_PENALTY * len(sub) - ic_true  # the IC the smaller model saves in penalty (-2)
+        if share is None:
+            if res**2 + gap > PLAUSIBLE_DELTA:
+                continue
+        elif ncx2.cdf(PLAUSIBLE_DELTA - gap, 1, res**2) < 1.0 - share:
             continue
         j = sub.index(ct)
         c_t = float(coef[j])

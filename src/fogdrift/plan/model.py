@@ -63,8 +63,8 @@ class PlanModel:
     taus no term describes (an output filter, correlated samples, a spectral line); the same sensor's longer
     record shows them again, so the plan fits from the pilot's first fitted tau.
     ``bounds``: term -> 95 % upper bound [reported unit] of the long-tau terms (:data:`LONG_TAU_TERMS`) the pilot
-    could only bound (absent from its model); the plan adds each at :data:`BOUND_FRACTION` of its bound as a plausible alternative
-    (:mod:`.analytic`).
+    could only bound (absent from its model); the plan adds each at
+    :data:`~fogdrift.plan.analytic.BOUND_FRACTION` of its bound as a plausible alternative (:mod:`.analytic`).
     """
 
     coefficients: dict
