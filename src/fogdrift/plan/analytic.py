@@ -58,9 +58,6 @@ IC_PENALTY = 2.0
 #: (in the coefficient): the middle of what the pilot allows (docs/plan.md, "From a pilot").
 BOUND_FRACTION = 0.5
 
-#: Take the plausible models that lack a term of the model into the union (the fit does).
-SMALLER_MODELS = True
-
 
 def expected_inflation(dof: int) -> float:
     """``E[max(1, X / dof)]`` for ``X ~ chi2_dof``: the mean widening of the fit's profile threshold.
@@ -132,7 +129,8 @@ def analytic_widths(model, n_samples, share=None) -> dict:
     """
     names = model.terms
     A = model.law_coefficients()
-    out = _widths(names, A, int(n_samples), float(model.dt_s), model.tau_min_s, share)
+    tau_min = getattr(model, "tau_min_s", None)
+    out = _widths(names, A, int(n_samples), float(model.dt_s), tau_min, share)
     for e, bound in (getattr(model, "bounds", None) or {}).items():
         if e in names or e not in PLANNED or not bound > 0:
             continue
@@ -140,7 +138,7 @@ def analytic_widths(model, n_samples, share=None) -> dict:
         Ae[all_terms().index(e)] = (BOUND_FRACTION * bound / TERM_TABLE[e].to_unit) ** 2 * \
             laws_of("adev")[e].scale(float(model.dt_s))
         alt = _widths(tuple(t for t in PLANNED if t in names or t == e), Ae, int(n_samples), float(model.dt_s),
-                      model.tau_min_s, share)
+                      tau_min, share)
         for t in names:
             o, a = out[t], alt[t]
             o["rel_lo"], o["rel_hi"] = min(o["rel_lo"], a["rel_lo"]), max(o["rel_hi"], a["rel_hi"])
@@ -192,12 +190,11 @@ def _widths(names, A, n, dt, tau_min_s=None, share=None) -> dict:
                 lo_a = min(lo_a, a - d * sd_e)
             else:
                 hi_a = max(hi_a, a + d * sd_e)
-        if SMALLER_MODELS:
-            # the plausible models that lack a term of the model (a K the length cannot yet tell from 0): t fitted
-            # there (non-negative least squares on the expected curve) is biased, and the fit's union holds it
-            for lo_s, hi_s in _smaller_plausible(Xall, yw, [col[u] for u in names], col[t],
-                                                 [col[e] for e in extras], IC_PENALTY * k, d, share):
-                lo_a, hi_a = min(lo_a, lo_s), max(hi_a, hi_s)
+        # the plausible models that lack a term of the model (a K the length cannot yet tell from 0): t fitted
+        # there (non-negative least squares on the expected curve) is biased, and the fit's union holds it
+        for lo_s, hi_s in _smaller_plausible(Xall, yw, [col[u] for u in names], col[t], [col[e] for e in extras],
+                                             IC_PENALTY * k, d, share):
+            lo_a, hi_a = min(lo_a, lo_s), max(hi_a, hi_s)
         # resolved: every plausible model needs t -- the model without t, or with t replaced by an absent term,
         # is out of the plausible window at the expected curve
         rest = [col[u] for u in names if u != t]

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from statistics import NormalDist
 
 import numpy as np
 
@@ -24,7 +25,7 @@ _STEP = 2.0**0.5  # grid of record lengths: half an octave
 
 #: Share of records that must reach the target width at ``share_s`` (the median record reaches it at ``target_s``).
 RECORD_SHARE = 0.8
-_Z_SHARE = 0.8416212335729143  # standard normal quantile of RECORD_SHARE
+_Z_SHARE = NormalDist().inv_cdf(RECORD_SHARE)  # the width's log spread is taken normal
 
 
 def crossing(x, y, level):
@@ -57,7 +58,7 @@ class Plan:
     ``terms``: term -> ``target`` (width asked), ``resolved_s`` (length from which the median record resolves it),
     ``target_s`` (length at which its expected width reaches the target; None: not within
     :data:`MAX_LENGTH_S`), ``share_s`` (length at which :data:`RECORD_SHARE` of the records reach it: the width's
-    record-to-record log spread, :func:`~fogdrift.plan.analytic.width_spread`, taken normal), ``floor_width``
+    record-to-record log spread, :func:`~fogdrift.plan.analytic.width_spread`, taken log-normal), ``floor_width``
     (width at :data:`MAX_LENGTH_S`), ``mc`` (Monte-Carlo at ``target_s``: median width, fractions, coverage, seeds,
     and ``length_s``, the length the measured width implies) and ``mc_share`` (Monte-Carlo at ``share_s``).
     ``grid``: the analytic curve (``length_s`` and each term's width). ``at_length``: what ``length_s`` supports.

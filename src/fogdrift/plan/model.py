@@ -234,8 +234,9 @@ def fmt_length(seconds) -> str:
 def model_from_fit(noise, dt_s, source="pilot") -> PlanModel:
     """The model of an Allan fit (:class:`fogdrift.noise.NoiseFit`): every term of the selected model with a value
     > 0, the fit's first fitted tau (``tau_min_s``: the short taus it left out stay out of the plan) and the
-    95 % upper bound of every planned term it could only bound (``bounds``: in the plan's union of models, see
-    :mod:`fogdrift.plan.analytic`); terms the pilot could not estimate are named in the notes (with their bound)."""
+    95 % upper bound of every long-tau term (:data:`LONG_TAU_TERMS`) not in its model (``bounds``: in the plan's
+    union of models, see :mod:`fogdrift.plan.analytic`); terms the pilot could not estimate are named in the notes
+    (with their bound)."""
     coefs, notes, bounds = {}, [], {}
     for t in PLANNED_TERMS:
         term = noise.terms.get(t)
@@ -246,8 +247,9 @@ def model_from_fit(noise, dt_s, source="pilot") -> PlanModel:
             if term.status != "resolved":
                 notes.append(f"{t} from the pilot is {term.status} ({term.value:.3g} {term.unit}, 95 % interval "
                              f"reaches 0): planned at its estimate")
-        elif term.hi95 is not None and term.hi95 > 0 and term.status == "absent" and t in LONG_TAU_TERMS:
-            bounds[t] = float(term.hi95)
+        elif term.hi95 is not None and t in LONG_TAU_TERMS:
+            if math.isfinite(term.hi95) and term.hi95 > 0:
+                bounds[t] = float(term.hi95)
             notes.append(f"{t} is not in the pilot's model (< {term.hi95:.3g} {term.unit}): not planned (state "
                          "it with --model to plan for it); the widths allow for it at half that bound")
     fit_tau = getattr(noise, "fit_tau_s", None)
