@@ -11,7 +11,7 @@ import pytest
 
 from fogdrift.errors import ConfigError
 from fogdrift.plan import make_plan, parse_length, parse_model, parse_targets
-from fogdrift.plan.analytic import analytic_widths, expected_inflation
+from fogdrift.plan.analytic import analytic_widths, expected_inflation, width_spread
 from fogdrift.plan.core import _mc_length, crossing
 from fogdrift.plan.montecarlo import summarise
 
@@ -77,6 +77,14 @@ def test_expected_inflation_by_hand():
     assert expected_inflation(8) == pytest.approx(np.maximum(1, x).mean(), abs=3e-3)
 
 
+def test_width_spread_by_hand():
+    # sd of ln sqrt(max(1, X / 8)), X ~ chi2_8, by simulation; the estimate's part adds (1 / (2 z))^2
+    rng = np.random.default_rng(1)
+    g = 0.5 * np.log(np.maximum(1.0, rng.chisquare(8, 400_000) / 8))
+    assert width_spread(math.inf, 8) == pytest.approx(g.std(), abs=2e-3)
+    assert width_spread(4.0, 8) ** 2 == pytest.approx(g.var() + 1 / 64, abs=1e-3)
+
+
 def test_crossing_log_log_interpolation():
     # y = 1/sqrt(x): falls to 0.25 at x = 16, from the grid points 4 and 64
     assert crossing([4.0, 64.0], [0.5, 0.125], 0.25) == pytest.approx(16.0)
@@ -122,6 +130,56 @@ def test_rate_random_walk_is_not_resolved_on_a_short_record():
     assert long_["K"]["resolved"]
 
 
+# -- a plan from a pilot's fit ------------------------------------------------------------------------------------
+def _pilot_fit():
+    """The Allan fit of ADIS16405 session 1, axis gy, first 120 000 samples at 100 Hz (its figures, rounded)."""
+    from types import SimpleNamespace
+
+    from fogdrift.noise.result import NoiseTerm
+
+    terms = {"Q": NoiseTerm("Q", None, "urad", 0.0, 61.3, "absent", ""),
+             "N": NoiseTerm("N", 2.537, "deg/sqrt(h)", 2.409, 2.678, "resolved", ""),
+             "B": NoiseTerm("B", 45.95, "deg/h", 0.0, 61.27, "unresolved", ""),
+             "K": NoiseTerm("K", None, "deg/h^1.5", 0.0, 718.3, "absent", ""),
+             "R": NoiseTerm("R", None, "deg/h^2", 0.0, 2795.0, "absent", "")}
+    return SimpleNamespace(terms=terms, selected=("N", "B"), fit_tau_s=np.array([0.16, 0.32, 0.64]))
+
+
+def test_a_pilot_plan_fits_from_the_pilots_first_tau():
+    """The pilot's fit left out the taus below 0.16 s (correlated samples): the plan's fit starts there too, and
+    N, best known at the short taus, is wider.  Measured on ADIS16405 session 1 gy (docs/plan.md): N at 10^6
+    samples +-2.5 % from 0.01 s, +-3.8 % from 0.16 s; the full session's fit gives +-3.4 %."""
+    from dataclasses import replace
+
+    from fogdrift.plan import model_from_fit
+
+    m = model_from_fit(_pilot_fit(), 0.01)
+    assert m.tau_min_s == pytest.approx(0.16) and any("0.16 s" in n for n in m.notes)
+    here = analytic_widths(replace(m, bounds={}), 10**6)
+    everywhere = analytic_widths(replace(m, tau_min_s=None, bounds={}), 10**6)
+    assert here["_fit"]["tau_min_s"] == pytest.approx(0.16) and everywhere["_fit"]["tau_min_s"] == pytest.approx(0.01)
+    assert here["N"]["rel_width"] > 1.3 * everywhere["N"]["rel_width"]
+
+
+def test_a_pilot_plan_allows_for_the_long_tau_terms_the_pilot_only_bounded():
+    """K and R were only bounded by the 20-min pilot: the plan's union holds the model with each at half its
+    bound, so B (which K's rise competes with) is wider; Q is not carried (the pilot's short taus bound it as well
+    as the full record will).  Measured on gy: B at 10^6 samples +-13.9 % without, +-22.6 % with; the full
+    session's fit (N+B+K) gives +-24.9 %."""
+    from dataclasses import replace
+
+    from fogdrift.plan import model_from_fit
+    from fogdrift.plan.analytic import BOUND_FRACTION
+
+    m = model_from_fit(_pilot_fit(), 0.01)
+    assert set(m.bounds) == {"K", "R"} and m.bounds["K"] == pytest.approx(718.3) and BOUND_FRACTION == 0.5
+    with_b = analytic_widths(m, 10**6)
+    without = analytic_widths(replace(m, bounds={}), 10**6)
+    assert with_b["B"]["rel_width"] > 1.4 * without["B"]["rel_width"]
+    assert with_b["N"]["rel_width"] >= without["N"]["rel_width"]
+    assert m.to_dict()["bounds"]["K"]["hi95"] == pytest.approx(718.3)
+
+
 # -- analytic against Monte-Carlo, and the planner's honesty ------------------------------------------------------
 SEEDS = 12
 
@@ -133,16 +191,14 @@ def mems_plan():
 
 
 def test_analytic_and_monte_carlo_lengths_agree(mems_plan):
+    # measured (12 seeds, 10 Hz MEMS): N to +-5 % planned at 22.3 min, the Monte-Carlo width implies 22.2 min
     r = mems_plan.terms["N"]
     assert r["mc"]["length_s"] == pytest.approx(r["target_s"], rel=0.25)
-    # B: measured (12 seeds, 10 Hz MEMS, B to +-25 %): the Monte-Carlo width implies ~1.45x the analytic length
-    # (the real fit's B interval is ~15 % wider than the linearised one); a guard here, the 25 % goal below
-    r = mems_plan.terms["B"]
-    assert r["mc"]["length_s"] == pytest.approx(r["target_s"], rel=0.7)
 
 
-@pytest.mark.xfail(strict=True, reason="measured gap (docs/plan.md): with seeds 1-12 the Monte-Carlo B width at the planned length is +-30 %, not +-25 % (at 1 h both give +-29 %: partly the seeds' scatter)")
 def test_analytic_and_monte_carlo_lengths_agree_for_b_within_25_percent(mems_plan):
+    # measured (12 seeds): B to +-25 % planned at 97.6 min, Monte-Carlo median +-25.9 %, implies 107 min (+10 %);
+    # the plan without the smaller plausible models in its union gives 85.6 min, where the seeds imply 2.1 h (+47 %)
     r = mems_plan.terms["B"]
     assert r["mc"]["length_s"] == pytest.approx(r["target_s"], rel=0.25)
 
@@ -153,10 +209,43 @@ def test_recording_the_planned_length_gives_the_promised_width_and_coverage(mems
     for t in ("N", "B"):
         mc = mems_plan.terms[t]["mc"]
         assert mc["n_seeds"] == SEEDS and mc["resolved_fraction"] >= 0.9
-        # N: as promised; B: the known ~15 % optimism of the analytic width (see above) plus the seeds' scatter
-        assert mc["median_width"] <= (1.15 if t == "N" else 1.3) * mems_plan.terms[t]["target"], t
+        # the seeds' scatter of the median: ~3 % of the width for N, ~5 % for B (48-seed spread)
+        assert mc["median_width"] <= (1.1 if t == "N" else 1.15) * mems_plan.terms[t]["target"], t
         assert mc["coverage"] >= 0.75, t
     assert mems_plan.seeds == list(range(1, SEEDS + 1))
+
+
+def test_the_length_for_most_records_is_checked_by_monte_carlo(mems_plan):
+    """``share_s``: the length at which 80 % of the records reach the target (the width's record-to-record spread
+    from the estimate's scatter and the misfit widening, the union of the models at least 20 % of the records find
+    plausible).  Measured with 48 seeds (docs/plan.md): N 44.8 min, 45 of 48 reach +-5 %; B 2.24 h, 36 of 48 reach
+    +-25 %."""
+    for t in ("N", "B"):
+        r = mems_plan.terms[t]
+        assert r["share"] == 0.8 and 1.05 * r["target_s"] < r["share_s"] < 2.5 * r["target_s"], t
+        ms = r["mc_share"]
+        assert ms["n_seeds"] == SEEDS and ms["met_fraction"] >= 7 / 12, t
+        assert ms["met_fraction"] >= r["mc"]["met_fraction"], t
+    assert "80 % of records: " in mems_plan.lines()[1]
+
+
+def test_the_share_union_holds_models_some_records_find_plausible():
+    """RLG-like gyro at 1 Hz, 1 612 647 samples (18.7 d): the model without K is just outside the plausible window
+    at the expected curve, so the median record's union drops it (B +-19.7 %), but more than 20 % of records find
+    it plausible, and the 80 % width keeps it (+-23.8 % before the spread).  Measured: 24 seeds there give a median
+    of +-24.1 %."""
+    m = parse_model("N=0.003 deg/sqrt(h), B=0.004 deg/h, K=0.002 deg/h^1.5", 1.0)
+    median, most = analytic_widths(m, 1_612_647), analytic_widths(m, 1_612_647, share=0.8)
+    assert median["B"]["rel_width"] < 0.21 and most["B"]["rel_width"] > 0.23
+
+
+def test_b_interval_holds_the_plausible_model_without_k():
+    """At 85.6 min K is not resolved, so the fit's union holds the model N+B (K dropped), whose B takes up part of
+    K's rise.  Measured: the 48-seed Monte-Carlo median B width there is +-27.8 % (seeds 1-48); the plan gives
+    +-26.4 % with that model in its union and +-25.1 % (9.7 % optimistic) without it."""
+    w = analytic_widths(parse_model(MEMS, 0.1), 51361)["B"]
+    assert 0.26 <= w["rel_width"] <= 0.278
+    assert not analytic_widths(parse_model(MEMS, 0.1), 51361)["K"]["resolved"]
 
 
 def test_stated_length_verdicts_match_the_monte_carlo(mems_plan):

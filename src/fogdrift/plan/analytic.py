@@ -12,12 +12,21 @@ fitted, the median record's interval):
   fit's profile threshold and its expected widening for misfit), widened to the union over the models one absent
   term larger (always plausible at the expected curve: the information criterion ``IC = Q + 2 k`` rises by at most
   2, inside the plausible window of 6): the absent term may only grow from zero, so one side widens, the side of
-  the sign of its correlation with ``A_k``;
+  the sign of its correlation with ``A_k``, and to the union over the models one term *smaller* (another term of
+  the model dropped) that are plausible at the expected curve (a term the length cannot yet tell from zero): their
+  ``A_k`` is fitted by non-negative least squares on the expected curve (biased: it takes up part of the dropped
+  term) and gets its own ``+- d sd_k``, widened on one side by the absent terms as above;
 * the coefficient is ``sqrt(A)``-like, so its interval relative to the value is ``[sqrt(A_lo), sqrt(A_hi)] /
   sqrt(A)`` and the reported relative width is the half-width ``(hi - lo) / 2``;
 * the term is **resolved** when its interval excludes zero and no model without it is plausible: the model
   without it, or with it replaced by one absent term, fitted to the expected curve (non-negative least squares
   in the whitened metric), is more than the plausible window (6) above in IC.
+
+A model from a pilot (:func:`fogdrift.plan.model.model_from_fit`) adds two things: the fit starts at the pilot's
+first fitted tau (``model.tau_min_s``: the short taus its fit left out, an output filter or correlated samples,
+stay out), and each long-tau term the pilot only bounded (``model.bounds``: B, K or R absent from its model) is
+a plausible alternative at :data:`BOUND_FRACTION` of its 95 % bound: every term's interval is the union over the
+model and the model plus that term, and resolved only in both.
 
 The allowance (2 % on every deviation, :mod:`fogdrift.noise.discrepancy`) puts a floor under every width: a term
 may never reach a target below it at any length, which the plan says.
@@ -25,22 +34,29 @@ may never reach a target below it at any length, which the plan says.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
+from scipy.integrate import quad
 from scipy.optimize import nnls
-from scipy.stats import chi2, t as student_t
+from scipy.stats import chi2, ncx2, t as student_t
 
 from ..allan.grid import tau_grid
 from ..noise.context import FitContext
-from ..noise.terms import all_terms
+from ..noise.terms import TERM_TABLE, all_terms, laws_of
 from .model import PLANNED_TERMS as PLANNED
 
-__all__ = ["analytic_widths", "expected_inflation", "PLAUSIBLE_DELTA", "IC_PENALTY"]
+__all__ = ["analytic_widths", "expected_inflation", "width_spread", "PLAUSIBLE_DELTA", "IC_PENALTY",
+           "BOUND_FRACTION"]
 
 #: The Allan fit's plausible-model window and IC penalty per term (:func:`fogdrift.noise.fit_noise` defaults).
 PLAUSIBLE_DELTA = 6.0
 IC_PENALTY = 2.0
+
+#: A term the pilot could only bound enters the plan's union of models at this fraction of its 95 % upper bound
+#: (in the coefficient): the middle of what the pilot allows (docs/plan.md, "From a pilot").
+BOUND_FRACTION = 0.5
 
 
 def expected_inflation(dof: int) -> float:
@@ -57,26 +73,97 @@ def expected_inflation(dof: int) -> float:
     return float(chi2.cdf(k, k) + 1.0 - chi2.cdf(k, k + 2))
 
 
-def analytic_widths(model, n_samples) -> dict:
+@functools.lru_cache(maxsize=256)
+def _inflation_log_var(dof: int) -> float:
+    """``Var[ln sqrt(max(1, X / dof))]`` for ``X ~ chi2_dof``: the record-to-record scatter the misfit widening adds
+    to the log of a width."""
+    k = max(int(dof), 1)
+
+    def moment(p):
+        return quad(lambda x: (0.5 * math.log(x / k)) ** p * chi2.pdf(x, k), k, math.inf, limit=200)[0]
+
+    m1 = moment(1)
+    return max(moment(2) - m1 * m1, 0.0)
+
+
+def width_spread(z: float, dof: int) -> float:
+    """Standard deviation of the log of a term's relative width from record to record [ln units].
+
+    Two parts, taken independent: the estimate the width is relative to scatters by ``sd(ln value) = 1 / (2 z)``
+    (the coefficient is ``sqrt(A)``, ``z = A / sd(A)``), and the fit widens each record's interval by its own
+    ``sqrt(max(1, chi2_red))`` (``chi2_red ~ chi2_dof / dof``, the same assumption as :func:`expected_inflation`).
+
+    Examples
+    --------
+    >>> round(width_spread(math.inf, 1000), 4) < round(width_spread(math.inf, 10), 4)
+    True
+    >>> round(width_spread(5.0, 10) ** 2 - width_spread(math.inf, 10) ** 2, 6)
+    0.01
+    """
+    v = (0.5 / z) ** 2 if z > 0 and math.isfinite(z) else (0.0 if z > 0 else math.inf)
+    return math.sqrt(v + _inflation_log_var(dof))
+
+
+def analytic_widths(model, n_samples, share=None) -> dict:
     """Expected 95 % interval of every model term for a record of ``n_samples`` samples at ``model.dt_s``.
 
-    Returns ``{term: {"rel_lo", "rel_hi", "rel_width", "z", "resolved"}}`` (interval ends relative to the true
-    value, relative half-width, ``A / sd``) and ``"_fit"``: ``{"tau_min_s", "tau_max_s", "n_taus", "dof"}``.
-    A record too short for ``len(terms) + 1`` taus gives every term ``rel_width = inf``.
+    Parameters
+    ----------
+    model : PlanModel
+        The model (its ``tau_min_s``: the first fitted tau [s]; its ``bounds``: terms the pilot only bounded).
+    n_samples : int
+        Record length [samples].
+    share : float, optional
+        None: the median record.  A share ``p`` (e.g. 0.8): a model one term smaller joins the union when at least
+        ``1 - p`` of the records find it plausible (its IC gap is then random: ``Q ~ chi2_1(lambda)``, noncentral,
+        with ``lambda`` its ``Q`` at the expected curve), the union of the ``p``-th record.
+
+    Returns
+    -------
+    dict
+        ``{term: {"rel_lo", "rel_hi", "rel_width", "z", "delta_ic", "resolved"}}`` (interval ends relative to the
+        true value, relative half-width, ``A / sd``) and ``"_fit"``: ``{"tau_min_s", "tau_max_s", "n_taus",
+        "dof"}``.  With ``bounds``, every term's interval is the union over the model and the model plus each
+        bounded term at :data:`BOUND_FRACTION` of its bound, and resolved only if resolved in all of them.  A
+        record too short for ``len(terms) + 1`` taus gives every term ``rel_width = inf``.
     """
-    n = int(n_samples)
-    dt = float(model.dt_s)
     names = model.terms
+    A = model.law_coefficients()
+    tau_min = getattr(model, "tau_min_s", None)
+    out = _widths(names, A, int(n_samples), float(model.dt_s), tau_min, share)
+    for e, bound in (getattr(model, "bounds", None) or {}).items():
+        if e in names or e not in PLANNED or not bound > 0:
+            continue
+        Ae = A.copy()
+        Ae[all_terms().index(e)] = (BOUND_FRACTION * bound / TERM_TABLE[e].to_unit) ** 2 * \
+            laws_of("adev")[e].scale(float(model.dt_s))
+        alt = _widths(tuple(t for t in PLANNED if t in names or t == e), Ae, int(n_samples), float(model.dt_s),
+                      tau_min, share)
+        for t in names:
+            o, a = out[t], alt[t]
+            o["rel_lo"], o["rel_hi"] = min(o["rel_lo"], a["rel_lo"]), max(o["rel_hi"], a["rel_hi"])
+            o["resolved"] = bool(o["resolved"] and a["resolved"])
+            o["z"] = min(o["z"], a["z"])
+            o["delta_ic"] = min(o.get("delta_ic", math.inf), a.get("delta_ic", math.inf))
+            o["rel_width"] = (o["rel_hi"] - o["rel_lo"]) / 2.0 if o["resolved"] else math.inf
+    return out
+
+
+def _widths(names, A, n, dt, tau_min_s=None, share=None) -> dict:
+    """:func:`analytic_widths` of the model ``names`` with Allan-law coefficients ``A`` (all columns)."""
     m = tau_grid(n, dt, "octave").astype(np.float64)
+    if tau_min_s is not None:
+        m = m[m * dt >= float(tau_min_s) * (1.0 - 1e-9)]
     tau = m * dt
     k = len(names)
-    out = {"_fit": {"tau_min_s": float(tau[0]), "tau_max_s": float(tau[-1]), "n_taus": int(m.size),
+    out = {"_fit": {"tau_min_s": float(tau[0]) if tau.size else math.nan,
+                    "tau_max_s": float(tau[-1]) if tau.size else math.nan, "n_taus": int(m.size),
                     "dof": int(m.size - k)}}
     if m.size <= k:
         for t in names:
-            out[t] = {"rel_lo": 0.0, "rel_hi": math.inf, "rel_width": math.inf, "z": 0.0, "resolved": False}
+            out[t] = {"rel_lo": 0.0, "rel_hi": math.inf, "rel_width": math.inf, "z": 0.0, "delta_ic": 0.0,
+                      "resolved": False}
         return out
-    A = model.law_coefficients()
     probe = FitContext(tau, m, np.ones_like(tau), np.full_like(tau, 2.0), n, dt, "adev", names)
     mu = probe.X @ A
     ctx = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", names)
@@ -103,6 +190,11 @@ def analytic_widths(model, n_samples) -> dict:
                 lo_a = min(lo_a, a - d * sd_e)
             else:
                 hi_a = max(hi_a, a + d * sd_e)
+        # the plausible models that lack a term of the model (a K the length cannot yet tell from 0): t fitted
+        # there (non-negative least squares on the expected curve) is biased, and the fit's union holds it
+        for lo_s, hi_s in _smaller_plausible(Xall, yw, [col[u] for u in names], col[t], [col[e] for e in extras],
+                                             IC_PENALTY * k, d, share):
+            lo_a, hi_a = min(lo_a, lo_s), max(hi_a, hi_s)
         # resolved: every plausible model needs t -- the model without t, or with t replaced by an absent term,
         # is out of the plausible window at the expected curve
         rest = [col[u] for u in names if u != t]
@@ -113,6 +205,42 @@ def analytic_widths(model, n_samples) -> dict:
         hi = math.sqrt(hi_a / a)
         out[t] = {"rel_lo": lo, "rel_hi": hi, "rel_width": (hi - lo) / 2.0 if resolved else math.inf, "z": z,
                   "delta_ic": float(dq), "resolved": resolved}
+    return out
+
+
+def _smaller_plausible(Xall, yw, cols, ct, extras, ic_true, d, share=None):
+    """95 % intervals ``(lo, hi)`` of column ``ct`` in the models one term smaller than the true one (columns
+    ``cols``) that keep it and are plausible at the expected curve (IC ``Q + 2 k`` within :data:`PLAUSIBLE_DELTA`
+    of the true model's ``ic_true``).  Each is fitted by non-negative least squares in the whitened metric (its
+    ``A_t`` is biased: it takes up part of the dropped term); its interval is ``A_t +- d sd_t``, widened on one
+    side by the models one absent column (of ``extras``) larger, as the true model's.  ``share``: see
+    :func:`analytic_widths`."""
+    out = []
+    for u in cols:
+        if u == ct:
+            continue
+        sub = [c for c in cols if c != u]
+        coef, res = nnls(Xall[:, sub], yw)
+        if not np.all(coef > 0):
+            continue
+        gap = IC_PENALTY * len(sub) - ic_true  # the IC the smaller model saves in penalty (-2)
+        if share is None:
+            if res**2 + gap > PLAUSIBLE_DELTA:
+                continue
+        elif ncx2.cdf(PLAUSIBLE_DELTA - gap, 1, res**2) < 1.0 - share:
+            continue
+        j = sub.index(ct)
+        c_t = float(coef[j])
+        sd = math.sqrt(max(float(_cov(Xall[:, sub])[j, j]), 0.0))
+        lo, hi = c_t - d * sd, c_t + d * sd
+        for e in extras:
+            ce = _cov(Xall[:, sub + [e]])
+            sd_e = math.sqrt(max(float(ce[j, j]), 0.0))
+            if ce[j, -1] < 0:
+                lo = min(lo, c_t - d * sd_e)
+            else:
+                hi = max(hi, c_t + d * sd_e)
+        out.append((lo, hi))
     return out
 
 

@@ -6,21 +6,26 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from statistics import NormalDist
 
 import numpy as np
 
 from ..errors import ConfigError
 from ..noise.terms import TERM_TABLE
-from .analytic import analytic_widths
+from .analytic import analytic_widths, width_spread
 from .model import fmt_length
 from .montecarlo import MC_MAX_SAMPLES, simulate_fits, summarise
 
-__all__ = ["Plan", "make_plan", "MAX_LENGTH_S", "crossing"]
+__all__ = ["Plan", "make_plan", "MAX_LENGTH_S", "RECORD_SHARE", "crossing"]
 
 #: Longest record the planner looks at [s] (30 days).
 MAX_LENGTH_S = 30 * 86400.0
 _MIN_SAMPLES = 64
 _STEP = 2.0**0.5  # grid of record lengths: half an octave
+
+#: Share of records that must reach the target width at ``share_s`` (the median record reaches it at ``target_s``).
+RECORD_SHARE = 0.8
+_Z_SHARE = NormalDist().inv_cdf(RECORD_SHARE)  # the width's log spread is taken normal
 
 
 def crossing(x, y, level):
@@ -52,8 +57,10 @@ class Plan:
 
     ``terms``: term -> ``target`` (width asked), ``resolved_s`` (length from which the median record resolves it),
     ``target_s`` (length at which its expected width reaches the target; None: not within
-    :data:`MAX_LENGTH_S`), ``floor_width`` (width at :data:`MAX_LENGTH_S`), ``mc`` (Monte-Carlo at ``target_s``:
-    median width, fractions, coverage, seeds, and ``length_s``, the length the measured width implies).
+    :data:`MAX_LENGTH_S`), ``share_s`` (length at which :data:`RECORD_SHARE` of the records reach it: the width's
+    record-to-record log spread, :func:`~fogdrift.plan.analytic.width_spread`, taken log-normal), ``floor_width``
+    (width at :data:`MAX_LENGTH_S`), ``mc`` (Monte-Carlo at ``target_s``: median width, fractions, coverage, seeds,
+    and ``length_s``, the length the measured width implies) and ``mc_share`` (Monte-Carlo at ``share_s``).
     ``grid``: the analytic curve (``length_s`` and each term's width). ``at_length``: what ``length_s`` supports.
     """
 
@@ -85,6 +92,11 @@ class Plan:
                      f"allowance keeps it at ±{100 * r['floor_width']:.3g} % or wider)"
                      if math.isfinite(r["floor_width"]) else f"{t} to {w}: not resolved within "
                      f"{fmt_length(MAX_LENGTH_S)}")
+            if r.get("share_s") is not None:
+                s += f"; {100 * RECORD_SHARE:.0f} % of records: {fmt_length(r['share_s'])}"
+                ms = r.get("mc_share")
+                if ms:
+                    s += f" ({round(ms['met_fraction'] * ms['n_seeds'])} of {ms['n_seeds']} seeds reach {w} there)"
             if r["resolved_s"] is not None:
                 s += f"; {t} resolved from {fmt_length(r['resolved_s'])}"
             out.append(s)
@@ -160,6 +172,11 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
             "tau_max_s": [c["_fit"]["tau_max_s"] for c in curves],
             "width": {t: [c[t]["rel_width"] for c in curves] for t in model.terms},
             "z": {t: [c[t]["z"] for c in curves] for t in model.terms}}
+    # the width RECORD_SHARE of the records stay within: the union of that share's record, times the spread
+    shared = [analytic_widths(model, n, share=RECORD_SHARE) for n in ns] if targets else curves
+    grid["width_share"] = {t: [c[t]["rel_width"] * math.exp(_Z_SHARE * width_spread(c[t]["z"], c["_fit"]["dof"]))
+                               if math.isfinite(c[t]["rel_width"]) else math.inf for c in shared]
+                           for t in model.terms}
     terms = {}
     seeds = list(range(seed0, seed0 + int(monte_carlo)))
     notes = []
@@ -176,7 +193,8 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
                 resolved_s = crossing(lengths[i - 1:i + 1], zz[i - 1:i + 1], 1.0) or resolved_s
         target_s = crossing(lengths, w, target)
         r = {"target": target, "unit": TERM_TABLE[t].unit, "value": model.coefficients[t],
-             "resolved_s": resolved_s, "target_s": target_s, "floor_width": w[-1]}
+             "resolved_s": resolved_s, "target_s": target_s, "share": RECORD_SHARE,
+             "share_s": crossing(lengths, grid["width_share"][t], target), "floor_width": w[-1]}
         if target_s is not None:
             j = min(range(len(lengths)), key=lambda k: abs(math.log(lengths[k] / target_s)))
             r["tau_range_s"] = [curves[j]["_fit"]["tau_min_s"], curves[j]["_fit"]["tau_max_s"]]
@@ -191,6 +209,10 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
                 mc["length_s"] = _mc_length(target_s, mc["median_width"], target, lengths, w)
                 mc["n_samples"] = n
                 r["mc"] = mc
+            n = None if r["share_s"] is None else int(round(r["share_s"] / dt))
+            if n is not None and n <= MC_MAX_SAMPLES:
+                fits = simulate_fits(model, n, seeds, workers=workers)
+                r["mc_share"] = dict(summarise(model, fits, {t: target})[t], n_samples=n)
         terms[t] = r
     at = None
     if length_s is not None:

@@ -29,6 +29,11 @@ __all__ = ["PlanModel", "parse_model", "parse_targets", "parse_length", "model_f
 #: Terms the planner handles (the built-in power laws; S and M are not planned).
 PLANNED_TERMS = ("Q", "N", "B", "K", "R")
 
+#: Terms whose Allan variance does not fall with tau (flat or rising): a longer record sees them at taus a pilot
+#: never reached, so a pilot's bound on them is only an extrapolation (Q falls faster than white noise: the
+#: pilot's short taus already bound it as well as the longer record will).
+LONG_TAU_TERMS = ("B", "K", "R")
+
 #: Default relative 95 % half-width per term (a term is planned only when the model holds it).
 DEFAULT_TARGETS = {"Q": 0.25, "N": 0.05, "B": 0.10, "K": 0.25, "R": 0.25}
 
@@ -52,12 +57,22 @@ _NUM = r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"
 
 @dataclass(frozen=True)
 class PlanModel:
-    """A gyro noise model to plan for: ``coefficients`` term -> value in its reported unit (> 0), ``dt_s`` [s]."""
+    """A gyro noise model to plan for: ``coefficients`` term -> value in its reported unit (> 0), ``dt_s`` [s].
+
+    ``tau_min_s`` [s]: the shortest tau the fit will use (None: ``dt_s``).  A pilot's Allan fit leaves out the short
+    taus no term describes (an output filter, correlated samples, a spectral line); the same sensor's longer
+    record shows them again, so the plan fits from the pilot's first fitted tau.
+    ``bounds``: term -> 95 % upper bound [reported unit] of the long-tau terms (:data:`LONG_TAU_TERMS`) the pilot
+    could only bound (absent from its model); the plan adds each at
+    :data:`~fogdrift.plan.analytic.BOUND_FRACTION` of its bound as a plausible alternative (:mod:`.analytic`).
+    """
 
     coefficients: dict
     dt_s: float
     source: str = "stated"
     notes: tuple = field(default_factory=tuple)
+    tau_min_s: float | None = None
+    bounds: dict = field(default_factory=dict)
 
     @property
     def terms(self) -> tuple:
@@ -83,6 +98,8 @@ class PlanModel:
     def to_dict(self) -> dict:
         return {"dt_s": self.dt_s, "sample_rate_hz": 1.0 / self.dt_s, "source": self.source,
                 "terms": {t: {"value": float(self.coefficients[t]), "unit": TERM_TABLE[t].unit} for t in self.terms},
+                "tau_min_s": self.tau_min_s,
+                "bounds": {t: {"hi95": float(v), "unit": TERM_TABLE[t].unit} for t, v in self.bounds.items()},
                 "notes": list(self.notes)}
 
 
@@ -96,8 +113,8 @@ def _check_dt(dt_s) -> float:
     return dt
 
 
-def _make(coefs: dict, dt_s, source, notes=()) -> PlanModel:
-    model = PlanModel(dict(coefs), _check_dt(dt_s), source, tuple(notes))
+def _make(coefs: dict, dt_s, source, notes=(), tau_min_s=None, bounds=None) -> PlanModel:
+    model = PlanModel(dict(coefs), _check_dt(dt_s), source, tuple(notes), tau_min_s, dict(bounds or {}))
     if not model.terms:
         raise ConfigError("the model holds no noise term > 0 to plan for (Q, N, B, K or R)")
     return model
@@ -216,8 +233,11 @@ def fmt_length(seconds) -> str:
 
 def model_from_fit(noise, dt_s, source="pilot") -> PlanModel:
     """The model of an Allan fit (:class:`fogdrift.noise.NoiseFit`): every term of the selected model with a value
-    > 0; terms the pilot could not estimate are named in the notes (with their bound)."""
-    coefs, notes = {}, []
+    > 0, the fit's first fitted tau (``tau_min_s``: the short taus it left out stay out of the plan) and the
+    95 % upper bound of every long-tau term (:data:`LONG_TAU_TERMS`) not in its model (``bounds``: in the plan's
+    union of models, see :mod:`fogdrift.plan.analytic`); terms the pilot could not estimate are named in the notes
+    (with their bound)."""
+    coefs, notes, bounds = {}, [], {}
     for t in PLANNED_TERMS:
         term = noise.terms.get(t)
         if term is None:
@@ -227,10 +247,16 @@ def model_from_fit(noise, dt_s, source="pilot") -> PlanModel:
             if term.status != "resolved":
                 notes.append(f"{t} from the pilot is {term.status} ({term.value:.3g} {term.unit}, 95 % interval "
                              f"reaches 0): planned at its estimate")
-        elif term.hi95 is not None and t in ("B", "K", "R"):
-            notes.append(f"{t} is not in the pilot's model (< {term.hi95:.3g} {term.unit}): not planned; state it "
-                         "with --model to plan for it")
-    return _make(coefs, dt_s, source, notes)
+        elif term.hi95 is not None and t in LONG_TAU_TERMS:
+            if math.isfinite(term.hi95) and term.hi95 > 0:
+                bounds[t] = float(term.hi95)
+            notes.append(f"{t} is not in the pilot's model (< {term.hi95:.3g} {term.unit}): not planned (state "
+                         "it with --model to plan for it); the widths allow for it at half that bound")
+    fit_tau = getattr(noise, "fit_tau_s", None)
+    tau_min = float(fit_tau[0]) if fit_tau is not None and len(fit_tau) else None
+    if tau_min is not None and tau_min > float(dt_s) * (1 + 1e-9):
+        notes.append(f"the pilot's fit starts at tau = {tau_min:.3g} s (shorter taus left out): so does the plan")
+    return _make(coefs, dt_s, source, notes, tau_min, bounds)
 
 
 def _from_terms(d: dict, dt_s, source) -> PlanModel:

@@ -26,6 +26,10 @@ def plot_plan(plan, path) -> Path:
         r = plan.terms.get(t)
         if r is None:
             continue
+        w80 = 100.0 * np.asarray(plan.grid.get("width_share", {}).get(t, []), dtype=float)
+        if w80.size == L.size:  # the width four records in five stay within (drawn for the target terms)
+            ax.loglog(L, np.where(np.isfinite(w80), w80, np.nan), color=color, ls="--", lw=0.8,
+                      label=f"{t}, 80 % of records")
         ax.axhline(100.0 * r["target"], color=color, ls=":", lw=0.9)
         if r["target_s"] is not None:
             ax.plot([r["target_s"] / S_PER_H], [100.0 * r["target"]], "o", color=color, mfc="none")
