@@ -88,8 +88,8 @@ def test_real_adis_gz_is_a_fit_with_n_by_its_slope_and_no_fit_without_the_allowa
     assert fit.no_fit is None and n.status == "resolved"
     assert ro.tau_range_s is not None and abs(n.value / ro.value - 1) < 0.02
     assert n.lo95 <= ro.value <= n.hi95
-    identify = importlib.import_module("fogdrift.noise.identify")  # the module (the package re-exports the function)
-    monkeypatch.setattr(identify, "discrepancy_relcov", lambda tau: discrepancy_relcov(tau, dev_rel=0.0))
+    context = importlib.import_module("fogdrift.noise.context")  # the fit's covariance (FitContext.relcov)
+    monkeypatch.setattr(context, "discrepancy_relcov", lambda tau: discrepancy_relcov(tau, dev_rel=0.0))
     bare = analyse_allan("gz", x, rec.dt_s, AnalysisConfig().validate()).noise
     assert bare.no_fit is not None and bare.terms["N"].status == "no_fit"
     assert bare.terms["N"].hi95 >= ro.value  # a printed bound is never below the measured read-out

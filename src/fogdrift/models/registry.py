@@ -176,8 +176,8 @@ def describe_params() -> str:
 
     Examples
     --------
-    >>> describe_params().split("; ")[-1]  # doctest: +ELLIPSIS
-    'gm11.shift_margin (float): margin [x the series' spread] of the automatic shift ...'
+    >>> print(describe_params().split("; ")[-1])  # doctest: +ELLIPSIS
+    gm11.shift_margin (float): margin [x the series' spread] of the automatic shift ...
     """
     groups: dict = {}
     for model, p in declared_params():
