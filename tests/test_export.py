@@ -484,6 +484,14 @@ def test_bias_gm_is_the_slowest_of_flicker_and_markov(tmp_path):
     ax["noise"]["shaped"]["M"]["tc_s"] = 500.0
     g, how = bias_gm(channels_from_result(doc, "g")[0], "bound")
     assert g.tc_s == 500.0 and g.sigma_si == pytest.approx(0.6124 * D / 3600) and "slowest" in how
+    # a flicker term not resolved from zero does not displace the fitted Markov term, however slow its GM
+    ax["noise"]["shaped"]["M"]["tc_s"] = 3.0
+    ax["noise"]["terms"]["B"].update(lo95=0.0, status="unresolved")
+    g, how = bias_gm(channels_from_result(doc, "g")[0], "bound")
+    assert g.tc_s == 3.0 and "slowest" in how
+    ax["noise"]["selected"] = ["N", "B", "K"]  # without the Markov term, the unresolved flicker is the bias
+    g, how = bias_gm(channels_from_result(doc, "g")[0], "bound")
+    assert g.tc_s == pytest.approx(100.0 / 1.8926, rel=1e-4, abs=0) and "matched to B" in how
 
 
 def test_gmwm_accelerometer_result(tmp_path):

@@ -474,10 +474,14 @@ def bias_gm(ch: ChannelModel, policy: str) -> tuple[GaussMarkov, str]:
     The slowest of the model's Gauss-Markov terms (GMWM GMs, the Allan fit's M: short correlation times are coloured
     measurement noise, the slowest is the bias wander) and, when the model has a flicker term B, the single GM whose
     Allan peak equals its floor at tau_B (:func:`~fogdrift.export.conversions.single_gm_from_flicker`).  With neither,
-    that GM is made from the B reading (the ADEV minimum), B resolved under ``policy``.
+    that GM is made from the B reading (the ADEV minimum), B resolved under ``policy``.  A flicker term whose 95 %
+    interval reaches 0 (status ``unresolved``: the model without it describes the curve about as well) does not
+    displace a fitted Gauss-Markov term: a small flicker beside a Markov hump would otherwise become the filter's
+    bias, with the hump's variance lost (seen in the gnss-ins-sim round trip, tests/test_export_roundtrip.py).
     """
     cands = [(g, f"the model's slowest Gauss-Markov term ({g.source}): sigma and T_c as fitted") for g in ch.gms]
-    if ch.b_is_flicker and ch.terms["B"].has_estimate:
+    b = ch.terms["B"]
+    if ch.b_is_flicker and b.has_estimate and not (cands and b.status == "unresolved"):
         cands.append(_gm_from_b(ch, resolve(ch, "B", policy)))
     if cands:
         return max(cands, key=lambda c: c[0].tc_s)
