@@ -154,10 +154,11 @@ def test_npy_stream_needs_a_unit_and_checks_the_time_base(bundle, tmp_path):
     compensate_file(bundle, tmp_path / "r.npy", tmp_path / "o2",
                     **_kw(rate_hz=1.0, unit="deg/s", axis_map="col0=gz", chunk_samples=77))
     np.testing.assert_allclose(_read(tmp_path / "o2")["compensated"][:, 0], 45.0 - b / 3600.0, atol=1e-13)
-    # a time column whose rate halves after 300 samples (1 s -> 2 s steps): refused, naming the sample
+    # a time column whose rate halves after 300 samples (1 s -> 2 s steps): refused at opening, before any work,
+    # by its span (the last stamp is read first)
     t = np.concatenate([np.arange(300.0), 300.0 + 2 * np.arange(200.0)])
     np.save(tmp_path / "t.npy", np.column_stack([t, x]))
-    with pytest.raises(DataFormatError, match="time step at sample 301 is 2.0 s"):
+    with pytest.raises(DataFormatError, match=r"time column spans 698 s, but its 500 samples at 1 s span 499 s"):
         compensate_file(bundle, tmp_path / "t.npy", tmp_path / "o3",
                         **_kw(unit="deg/h", time_column="col0", axis_map="col1=gz", chunk_samples=128))
     assert not (tmp_path / "o3" / "compensated.csv").exists()
@@ -306,9 +307,16 @@ def test_stream_time_rules_each_on_its_own_case(tmp_path):
     with pytest.raises(DataFormatError, match=r"scatter by 10 %"):
         _stream(tmp_path, t)
     # 300 steps of 1 s then 199 of 1.4 s: median 1, no scatter (most steps are exact), no gap (1.4 < 1.5), but the
-    # span 300 + 199 x 1.4 = 578.6 s against (500 - 1) x 1 = 499 s: refused when the stream reaches the end
+    # span 300 + 199 x 1.4 = 578.6 s against (500 - 1) x 1 = 499 s: refused at opening (the last stamp is read first)
     t = np.cumsum(np.r_[0.0, np.ones(300), np.full(199, 1.4)])
     with pytest.raises(DataFormatError, match=r"spans 578.6 s, but its 500 samples at 1 s span 499 s"):
+        _stream(tmp_path, t)
+    # blocks at 1.25 s and 0.8 s steps between 1-s stretches, balanced to the same span: every step passes, the span
+    # matches, but the stamps run off the straight line from the first to the last: refused in the stream where they
+    # first pass the limit (20 intervals: 300 + 81 x 1.25 against 381)
+    t = np.cumsum(np.r_[0.0, np.tile(np.r_[np.ones(300), np.full(100, 1.25), np.ones(300), np.full(125, 0.8)], 4)])
+    with pytest.raises(DataFormatError, match=r"time stamps run 20.25 s \(20.2 sample intervals\) ahead of a uniform "
+                                              r"grid at sample 381"):
         _stream(tmp_path, t)
     # a rate given that disagrees with the time column by more than 1 %
     with pytest.raises(DataFormatError, match="disagrees with the given sample interval"):

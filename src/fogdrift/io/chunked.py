@@ -30,7 +30,8 @@ from ..units import TIME_UNITS, check_dt_s, parse_unit, valid_units
 from ._checks import check_path
 from .hashing import file_sha256
 from .load import _interval_option
-from .timebase import DT_TOLERANCE, GAP_FACTOR, JITTER_TOLERANCE, SHORT_STEP_FACTOR
+from .timebase import (DT_TOLERANCE, GAP_FACTOR, GRID_DRIFT_FRACTION, GRID_DRIFT_INTERVALS, JITTER_TOLERANCE,
+                       SHORT_STEP_FACTOR)
 from .readers._columns import unit_list
 from .readers.base import require
 from .readers.hdf5 import UNIT_ATTRS
@@ -392,7 +393,8 @@ def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None
     (``time_column``; ``"auto"`` finds none in an array); its steps are checked as the rows stream by the rules
     of :func:`fogdrift.io.load` (:data:`~fogdrift.io.timebase.SHORT_STEP_FACTOR`,
     :data:`~fogdrift.io.timebase.GAP_FACTOR`, :data:`~fogdrift.io.timebase.JITTER_TOLERANCE` on the first
-    :data:`HEAD_STEPS` steps, the span against ``(n - 1) dt`` within :data:`~fogdrift.io.timebase.DT_TOLERANCE`).
+    :data:`HEAD_STEPS` steps, the span against ``(n - 1) dt`` within :data:`~fogdrift.io.timebase.DT_TOLERANCE` at
+    opening, every stamp near the straight line from the first to the last, :data:`~fogdrift.io.timebase.GRID_DRIFT_INTERVALS`).
 
     Parameters
     ----------
@@ -491,6 +493,17 @@ def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None
                                   f"(median absolute deviation of the first {steps.size} steps); expected a uniform "
                                   f"grid within {100 * JITTER_TOLERANCE:g} %", path=p, column=tcol)
         notes.append(f"sample interval {dt:.10g} s from the time column {tcol} (median of the first steps)")
+        # the last stamp, read now: the span is checked before any work and gives the straight line from the first
+        # to the last stamp that every chunk's stamps must stay near (fogdrift.io.timebase, the same rules)
+        t_last = float(np.asarray(read(rows - 1, rows)[:, t_idx], dtype=np.float64)[0]) * t_scale
+        span, grid = t_last - t0, (rows - 1) * dt
+        if rows > 2 and abs(span - grid) > DT_TOLERANCE * grid:
+            raise DataFormatError(
+                f"time column spans {span:.6g} s, but its {rows} samples at {dt:.10g} s span "
+                f"{grid:.6g} s ({100 * (span / grid - 1):+.3g} %); expected agreement within "
+                f"{100 * DT_TOLERANCE:g} %", path=p, column=tcol)
+        slope = span / (rows - 1)
+        drift_limit = max(GRID_DRIFT_INTERVALS * dt, GRID_DRIFT_FRACTION * span)
     check_dt_s(dt, "the sample interval")
     scale = float(spec.scale_to_internal(dt))
 
@@ -522,13 +535,15 @@ def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None
                         f"{SHORT_STEP_FACTOR} and {GAP_FACTOR} intervals: no gap, no rate change)", path=p,
                         column=tcol)
                 prev_t = float(t[-1])
-                if hi == rows and rows > 2:
-                    span, grid = prev_t - t0, (rows - 1) * dt
-                    if abs(span - grid) > DT_TOLERANCE * grid:
-                        raise DataFormatError(
-                            f"time column spans {span:.6g} s, but its {rows} samples at {dt:.10g} s span "
-                            f"{grid:.6g} s ({100 * (span / grid - 1):+.3g} %); expected agreement within "
-                            f"{100 * DT_TOLERANCE:g} %", path=p, column=tcol)
+                dev = t - (t0 + np.arange(lo, hi, dtype=np.float64) * slope)
+                off = np.abs(dev) > drift_limit
+                if off.any():
+                    k = int(np.argmax(off))
+                    raise DataFormatError(
+                        f"time stamps run {abs(float(dev[k])):.6g} s ({abs(float(dev[k])) / dt:.3g} sample intervals) "
+                        f"{'ahead of' if dev[k] > 0 else 'behind'} a uniform grid at sample {lo + k} (the straight line "
+                        f"from the first to the last stamp); expected within {drift_limit:.3g} s: the sample rate "
+                        "changes within the log", path=p, column=tcol)
             yield t, x
 
     names = tuple(f"col{j}" for j in r_idx)
