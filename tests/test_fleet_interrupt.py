@@ -260,7 +260,10 @@ def _ctrl_c_batch(tmp_path: Path, moment, group: bool = False) -> tuple[str, Pat
         else:
             proc.send_signal(signal.SIGINT)
         proc.wait(timeout=120)  # a hang guard only (measured 0.06-0.3 s)
-        left = [(pid, cmd) for pid, cmd in _live_processes(proc.pid) if "resource_tracker" not in cmd]
+        # a process whose command line reads empty has already released its memory: it is exiting (Linux empties
+        # /proc/PID/cmdline when the exiting task drops its address space, before the zombie state); the loop
+        # below waits for it to end like every other
+        left = [(pid, cmd) for pid, cmd in _live_processes(proc.pid) if cmd and "resource_tracker" not in cmd]
         assert left == [], left
         deadline = time.monotonic() + 120  # a hang guard only
         while _live_processes(proc.pid) and time.monotonic() < deadline:
