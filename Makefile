@@ -24,7 +24,7 @@ venv: $(STAMP)
 DEMO_ARGS := --unit deg/h --train-fraction 0.4 --val-fraction 0.1 --calibration 150 --origin-step 30 --horizons 30,60
 
 demo: $(STAMP)
-	mkdir -p $(dir $(OUT))
+	@mkdir -p $(dir $(OUT))
 	$(BIN)/fogdrift analyze $(DATA) $(DEMO_ARGS) --out $(OUT)
 
 test: $(STAMP)
