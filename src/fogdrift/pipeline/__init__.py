@@ -206,13 +206,19 @@ def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, sp
 
 
 def _treated_record(record, cfg: AnalysisConfig):
-    """The record with outliers clipped or replaced per ``cfg.outliers`` (unchanged for "warn"), and the reports."""
-    data = np.array(record.rate_dph, dtype=np.float64)
-    reports = {}
+    """The record with outliers clipped or replaced per ``cfg.outliers`` (unchanged for "warn"), and the reports.
+
+    The float64 copy of the table is made only when an axis was treated (8 bytes per sample and axis)."""
+    reports, treated = {}, {}
     for k, name in enumerate(record.axis_names):
-        data[:, k], reports[name] = treat_outliers(data[:, k], cfg.outliers)
-    if cfg.outliers == "warn" or not any(r.count for r in reports.values()):
+        y, reports[name] = treat_outliers(record.rate_dph[:, k], cfg.outliers)
+        if cfg.outliers != "warn" and reports[name].count:
+            treated[k] = y
+    if not treated:
         return record, reports
+    data = np.array(record.rate_dph, dtype=np.float64)
+    for k, y in treated.items():
+        data[:, k] = y
     note = f"outliers {cfg.outliers}: " + ", ".join(f"{n} {r.count}" for n, r in reports.items())
     return dataclasses.replace(record, rate_dph=data, notes=tuple(record.notes) + (note,)), reports
 
