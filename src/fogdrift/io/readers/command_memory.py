@@ -22,7 +22,7 @@ from .limits import ENV_MEMORY, format_bytes, memory_budget
 __all__ = ["FIXED_BYTES", "COMMAND_BYTES_PER_SAMPLE", "command_memory_need", "check_command_memory",
            "check_records_memory"]
 
-#: The fixed part [bytes]: the interpreter and the libraries (270-358 MB peak RSS at 10^6 samples), raised to the
+#: The fixed part [bytes]: the interpreter and the libraries (277-342 MB peak RSS at 10^6 samples), raised to the
 #: upper envelope just below 2^24 samples, where the Allan sums still go through an in-memory angle array
 #: (:data:`fogdrift.allan.sums.CHUNKED_MIN_SAMPLES`; ``noise`` 757 MB at 1.6 x 10^7 samples), so that the estimate
 #: is above every measured peak (10^6, 10^7, 1.6 x 10^7, 10^8 samples).
@@ -36,9 +36,9 @@ COMMAND_BYTES_PER_SAMPLE: dict[str, float] = {
     "allan": 11.5,       # 11.42 measured
     "separate": 11.0,    # 10.94
     "model": 12.0,       # 11.60
-    "noise": 12.0,       # 11.57
-    "analyze": 11.0,     # 10.79 (--models persistence,ar --no-heading)
-    "consistency": 16.5,  # 16.19 per counted sample (10^8 training + 10^8 held-out)
+    "noise": 12.0,       # 11.65
+    "analyze": 11.5,     # 11.07 (--models persistence,ar --no-heading)
+    "consistency": 12.5,  # 12.15 per counted sample (10^8 training + 10^8 held-out)
 }
 
 
