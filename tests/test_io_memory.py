@@ -189,3 +189,131 @@ def test_drop_mapped_pages_ignores_plain_arrays():
     a = np.ones((10, 2))
     _checks.drop_mapped_pages(a)
     assert a.sum() == 20.0
+
+
+# ---------------------------------------------------------------- a command's memory need against the budget
+
+from fogdrift.errors import ResourceLimitError  # noqa: E402
+from fogdrift.io.readers import command_memory as cm  # noqa: E402
+from fogdrift.io.readers import limits  # noqa: E402
+
+
+@pytest.mark.parametrize("command", sorted(cm.COMMAND_BYTES_PER_SAMPLE))
+def test_the_need_grows_with_the_samples_and_counts_every_axis(command):
+    ns = [0, 1, 10**4, 10**6, 10**7, 10**8, 10**9]
+    needs = [cm.command_memory_need(command, n) for n in ns]
+    assert needs[0] == cm.FIXED_BYTES and all(b > a for a, b in zip(needs, needs[1:]))
+    for axes in (2, 3, 6):  # a record of k axes costs k times the per-sample part (a missing factor fails)
+        assert cm.command_memory_need(command, 10**7, axes) - cm.FIXED_BYTES == \
+            axes * (cm.command_memory_need(command, 10**7, 1) - cm.FIXED_BYTES)
+    # the constants as measured: at 10^8 samples every command is above the 10^8-sample float64 record (0.8 GB)
+    assert cm.command_memory_need(command, 10**8) > cm.FIXED_BYTES + 8 * 10**8
+
+
+def test_the_refusal_names_the_need_the_budget_and_the_variable(monkeypatch):
+    need = cm.command_memory_need("analyze", 10**8, 3)
+    monkeypatch.setenv(limits.ENV_MEMORY, str(need - 1))
+    with pytest.raises(ResourceLimitError) as ei:
+        cm.check_command_memory("analyze", 10**8, 3, path="x.npy")
+    msg = str(ei.value)
+    assert ei.value.limit == "FOGDRIFT_MAX_MEMORY" and "\n" not in msg and msg.startswith("x.npy")
+    assert f"needs about {limits.format_bytes(need)}" in msg and "3 axes" in msg
+    assert f"memory budget {limits.format_bytes(need - 1)} (FOGDRIFT_MAX_MEMORY)" in msg
+    monkeypatch.setenv(limits.ENV_MEMORY, str(need))
+    cm.check_command_memory("analyze", 10**8, 3)  # at the budget: allowed
+    monkeypatch.setenv(limits.ENV_MEMORY, "0")
+    cm.check_command_memory("analyze", 10**12, 6)  # 0: no limit
+
+
+def test_every_record_a_command_holds_is_counted(monkeypatch):
+    from fogdrift.io import from_array
+
+    train = from_array(np.zeros((1000, 2)), dt_s=0.01, axis_names=["gx", "gy"])
+    held = from_array(np.zeros((3000, 1)), dt_s=0.01, axis_names=["gx"])
+    need = cm.command_memory_need("consistency", 4000, 2)
+    monkeypatch.setenv(limits.ENV_MEMORY, str(need - 1))
+    cm.check_records_memory("consistency", train)  # the training log alone fits
+    with pytest.raises(ResourceLimitError, match="4000 samples x 2 axes"):
+        cm.check_records_memory("consistency", train, held)
+    monkeypatch.setenv(limits.ENV_MEMORY, str(need))
+    cm.check_records_memory("consistency", train, None, held)
+
+
+def test_the_workflows_refuse_before_any_work(monkeypatch):
+    """The check comes first: the plausibility check (the first work of every workflow) is never reached."""
+    from fogdrift import pipeline
+    from fogdrift.io import from_array
+    from fogdrift.workflows import allan, analyze, noise
+
+    def no_work(*a, **k):
+        raise AssertionError("work started before the memory check")
+
+    monkeypatch.setattr(allan, "check_record", no_work)
+    monkeypatch.setattr(analyze, "check_record", no_work)
+    monkeypatch.setattr(pipeline, "treat_outliers", no_work)
+    monkeypatch.setattr(pipeline, "_model_record", no_work)
+    rec = from_array(np.zeros((5000, 1)), dt_s=0.01, axis_names=["gz"])
+    monkeypatch.setenv(limits.ENV_MEMORY, str(cm.FIXED_BYTES))  # the fixed part fits, no record does
+    for call in (lambda: allan.run_allan(rec), lambda: noise.run_noise(rec), lambda: analyze.run_analyze(rec),
+                 lambda: pipeline.run_allan(rec), lambda: pipeline.run_separation(rec),
+                 lambda: pipeline.run_models(rec), lambda: pipeline.run_analysis(rec)):
+        with pytest.raises(ResourceLimitError, match="FOGDRIFT_MAX_MEMORY"):
+            call()
+
+
+@pytest.mark.parametrize("command", ["allan", "noise", "analyze", "separate", "model", "consistency", "export"])
+def test_a_command_over_the_budget_is_one_line_and_writes_nothing(tmp_path, monkeypatch, command):
+    from typer.testing import CliRunner
+
+    from fogdrift.cli import app
+
+    p = tmp_path / "g.npy"
+    np.save(p, np.random.default_rng(0).standard_normal(20_000))  # float64: memory-mapped, the reader needs nothing
+    out = tmp_path / "o"
+    monkeypatch.setenv(limits.ENV_MEMORY, str(cm.FIXED_BYTES))  # above the reader's need, below the command's
+    args = [command, str(p), "--unit", "deg/h", "--rate", "100", "--out", str(out)]
+    if command == "consistency":
+        args += ["--held-out", str(p)]
+    result = CliRunner().invoke(app, args)
+    text = [ln for ln in result.output.splitlines() if ln.strip() and ln.startswith("error:")]
+    assert result.exit_code == 1 and "Traceback" not in result.output, result.output
+    assert len(text) == 1 and "FOGDRIFT_MAX_MEMORY" in text[0] and "refused before any work" in text[0], result.output
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_consistency_counts_its_held_out_logs_before_the_fit(monkeypatch):
+    from fogdrift.io import from_array
+    from fogdrift.workflows import consistency
+
+    def no_work(*a, **k):
+        raise AssertionError("the fit started before the memory check")
+
+    monkeypatch.setattr(consistency, "model_components", no_work)
+    train = from_array(np.zeros((10**5, 1)), dt_s=0.01, axis_names=["gz"])
+    held = [from_array(np.zeros((10**5, 1)), dt_s=0.01, axis_names=["gz"]) for _ in range(2)]
+    need = cm.command_memory_need("consistency", 3 * 10**5)
+    assert need - 1 > cm.command_memory_need("allan", 10**5)  # the training log's fit alone would fit
+    monkeypatch.setenv(limits.ENV_MEMORY, str(need - 1))
+    with pytest.raises(ResourceLimitError, match="consistency on 300000 samples"):
+        consistency.run_consistency(train, held)
+
+
+#: Peak RSS [kB, /usr/bin/time -v] measured on one-axis float32 .npy logs (bench/RESULTS.md, "Memory of every command
+#: at 10^8 samples (issue 36)"); consistency read the log twice (training and held-out), so its samples count twice.
+MEASURED_KB = {
+    "allan": {10**6: 287_620, 10**7: 523_404, 16 * 10**6: 716_592, 10**8: 1_391_876},
+    "separate": {10**6: 333_916, 10**7: 523_028, 16 * 10**6: 717_168, 10**8: 1_391_724},
+    "model": {10**6: 270_588, 10**7: 523_508, 16 * 10**6: 717_076, 10**8: 1_392_000},
+    "noise": {10**6: 287_856, 10**7: 546_052, 16 * 10**6: 739_360, 10**8: 1_414_612},
+    "analyze": {10**6: 322_956, 10**7: 524_236, 16 * 10**6: 717_716, 10**8: 1_392_968},
+    "consistency": {2 * 10**6: 284_248, 2 * 10**7: 573_032, 32 * 10**6: 767_920, 2 * 10**8: 2_632_956},
+}
+
+
+@pytest.mark.parametrize("command", sorted(MEASURED_KB))
+def test_the_estimate_is_above_every_measured_peak_and_not_far_above_at_the_largest(command):
+    assert set(MEASURED_KB) == set(cm.COMMAND_BYTES_PER_SAMPLE)
+    for n, kb in MEASURED_KB[command].items():
+        assert cm.command_memory_need(command, n) >= kb * 1024, (command, n)
+    n, kb = max(MEASURED_KB[command].items())
+    assert cm.command_memory_need(command, n) <= 1.3 * kb * 1024  # conservative, not wildly so

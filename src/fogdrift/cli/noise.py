@@ -184,7 +184,7 @@ def noise(
             echo_record(load, record)
             # the checks before either fit (plausibility, the record screen); GMWM (one wavelet variance) fits the
             # longest quiet segment of a disturbed axis, the Allan cross-check pools the quiet segments
-            screened = screen(record, segments)
+            screened = screen(record, segments, command="noise")
             print_screen(record, screened.findings, screened.screens, gmwm=screened.segments)
             with progress("noise", record.axis_names):
                 done = run_noise(record, model=model, levels=scales, robust=robust, screened=screened)

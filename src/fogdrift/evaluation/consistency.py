@@ -232,13 +232,33 @@ def observed_angle_errors_deg(rate_dph, dt_s, t_cal_s, horizons_s, *, step_s=Non
                                     needed=need, got=int(y.size))
     if not np.all(np.isfinite(y)):
         raise ConfigError("the held-out rate has non-finite samples")
-    c = np.concatenate([[0.0], np.cumsum(y - np.median(y))])  # centred: the cumulative sum stays small
+    c = _centred_angle(y)
     origins = np.arange(m, y.size - int(k.max()) + 1, s)
     bias = (c[origins] - c[origins - m]) / m
     errors = np.empty((origins.size, k.size))
     for j, kk in enumerate(k):
         errors[:, j] = (c[origins + kk] - c[origins] - kk * bias) * (dt * _INTEGRATE[_quantity(quantity)])
     return origins * dt, errors
+
+
+def _centred_angle(y: np.ndarray, block: int = 1 << 20) -> np.ndarray:
+    """``[0, cumsum(y - median(y))]`` (centred: the cumulative sum stays small), accumulated a block at a time into
+    one output array: the same sequential sums bit for bit, without two more 8-bytes-per-sample temporaries.
+
+    >>> y = np.random.default_rng(0).standard_normal(1000)
+    >>> np.array_equal(_centred_angle(y, 64), np.concatenate([[0.0], np.cumsum(y - np.median(y))]))
+    True
+    """
+    med = np.median(y)
+    c = np.empty(y.size + 1)
+    c[0] = 0.0
+    for a in range(0, y.size, block):
+        seg = c[a + 1:a + 1 + block]
+        np.subtract(y[a:a + block], med, out=seg)
+        if a:
+            seg[0] = c[a] + seg[0]  # the running sum carried into the block, as cumsum adds it
+        np.cumsum(seg, out=seg)
+    return c
 
 
 def inflation_factor(ratio_abs, coverage: float, z: float) -> tuple[float, float, float]:

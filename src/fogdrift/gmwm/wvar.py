@@ -47,7 +47,7 @@ import numpy as np
 from scipy import stats
 
 from .._util import check_series
-from ..allan import allan_variance
+from ..allan.sums import AllanSums
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
 from ..units import check_dt_s, rate_scale_to_dph
 
@@ -363,9 +363,14 @@ def haar_coefficients(x, levels):
 def _classical_nu2(x: np.ndarray, dt: float, levels: int) -> np.ndarray:
     """Classical WV of levels 1..J as half the overlapping Allan variance at ``m = 2^(j-1)``
     (exact identity, [GMWM]_ §9.2): the second-difference sums have one home, the compiled
-    kernels of :mod:`fogdrift.allan` (compensated phase, parallel blocks)."""
-    m = np.left_shift(1, np.arange(levels)).astype(np.float64)
-    return allan_variance(x, dt, taus=m * dt, estimator="overlapping", noise_alpha=0).avar_dph2 / 2.0
+    kernels of :mod:`fogdrift.allan` (compensated phase, parallel blocks), taken through
+    :class:`~fogdrift.allan.sums.AllanSums` as :func:`fogdrift.allan.allan_variance` takes them below
+    :data:`~fogdrift.allan.sums.CHUNKED_MIN_SAMPLES` samples (the same values) and out of core above it
+    (no 8-bytes-per-sample angle array; equal to 1e-12 relative)."""
+    sums = AllanSums(x, dt, "adev", "overlapping")
+    m = sums.grid(np.left_shift(1, np.arange(levels)).astype(np.float64) * dt)
+    sums.compute((m,))
+    return sums.result(m, 0).avar_dph2 / 2.0
 
 
 def _acvs_variance(w: np.ndarray) -> float:

@@ -41,6 +41,7 @@ from ..allan.ci import periodic_alpha
 from ..errors import ConfigError, FogdriftWarning, InsufficientDataError
 from ..interrupt import checkpoint  # a stop point between stages/axes/models; reports the stage to listeners
 from ..io import file_sha256, record as _record
+from ..io.readers.command_memory import check_records_memory
 from ..lifting import causal_drift, choose_level, get_wavelet, level_scan, separate
 from ..metrics import evaluate, p0
 from ..models import MODEL_NAMES, Persistence  # registry order = report order
@@ -206,13 +207,19 @@ def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, sp
 
 
 def _treated_record(record, cfg: AnalysisConfig):
-    """The record with outliers clipped or replaced per ``cfg.outliers`` (unchanged for "warn"), and the reports."""
-    data = np.array(record.rate_dph, dtype=np.float64)
-    reports = {}
+    """The record with outliers clipped or replaced per ``cfg.outliers`` (unchanged for "warn"), and the reports.
+
+    The float64 copy of the table is made only when an axis was treated (8 bytes per sample and axis)."""
+    reports, treated = {}, {}
     for k, name in enumerate(record.axis_names):
-        data[:, k], reports[name] = treat_outliers(data[:, k], cfg.outliers)
-    if cfg.outliers == "warn" or not any(r.count for r in reports.values()):
+        y, reports[name] = treat_outliers(record.rate_dph[:, k], cfg.outliers)
+        if cfg.outliers != "warn" and reports[name].count:
+            treated[k] = y
+    if not treated:
         return record, reports
+    data = np.array(record.rate_dph, dtype=np.float64)
+    for k, y in treated.items():
+        data[:, k] = y
     note = f"outliers {cfg.outliers}: " + ", ".join(f"{n} {r.count}" for n, r in reports.items())
     return dataclasses.replace(record, rate_dph=data, notes=tuple(record.notes) + (note,)), reports
 
@@ -295,7 +302,10 @@ def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | No
     check's, :func:`fogdrift.plausibility.check_record` ``sums=``), reused where they hold the analysed array.
 
     ``segments``: axis name -> ``[(start, stop), ...]`` quiet segments to fit instead of the whole record (None or a
-    missing name: the whole record); ``screens``: axis name -> the record screen's dict, kept on the result."""
+    missing name: the whole record); ``screens``: axis name -> the record screen's dict, kept on the result.
+    The memory need is held to the budget first (:func:`fogdrift.io.readers.command_memory.check_records_memory`).
+    """
+    check_records_memory("allan", record)
     cfg = (cfg or AnalysisConfig()).validate()
     out = []
     for name in record.axis_names:
@@ -311,7 +321,9 @@ def run_separation(record, cfg: AnalysisConfig | None = None, *, factor: int | N
     """Lifting separation of every axis (whole record, at the modelling rate) with Allan tables.
 
     ``factor``: the block-average factor to the modelling rate when already decided (:func:`model_factor`).
+    The memory need is held to the budget first (:func:`fogdrift.io.readers.command_memory.check_records_memory`).
     """
+    check_records_memory("separate", record)
     cfg = (cfg or AnalysisConfig()).validate()
     rec = _model_record(record, cfg, factor)
     out = []
@@ -437,7 +449,9 @@ def run_models(record, cfg: AnalysisConfig | None = None, progress=None, *, fact
     """Fit every configured drift model on every axis (training block) and evaluate on the test block.
 
     ``factor``: the block-average factor to the modelling rate when already decided (:func:`model_factor`).
+    The memory need is held to the budget first (:func:`fogdrift.io.readers.command_memory.check_records_memory`).
     """
+    check_records_memory("model", record)
     cfg = (cfg or AnalysisConfig()).validate()
     _check_earth_axes(record, cfg)
     factor = model_factor(record, cfg) if factor is None else int(factor)
@@ -493,6 +507,8 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
     (:func:`fogdrift.screen.plan_segments`; None: the whole record, no screen), as for :func:`run_allan`.
     """
     t_start = time.perf_counter()
+    if fitted_from is None:  # the memory need of both records, before any work (apply_to runs inside this call)
+        check_records_memory("analyze", record, apply_to)
     cfg = (cfg or AnalysisConfig()).validate()
     _check_earth_axes(record, cfg)
     factor = model_factor(record, cfg) if factor is None else int(factor)

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
+from ..io.readers.command_memory import check_records_memory
 from ..pipeline import AnalysisConfig
 from ..pipeline import run_allan as _fit
 from ..plausibility import check_record
@@ -64,9 +65,11 @@ class Screened:
     sums: dict = field(default_factory=dict, repr=False)
 
 
-def screen(record, segments="auto") -> Screened:
+def screen(record, segments="auto", *, command: str = "allan") -> Screened:
     """The checks every workflow makes before its fit (a command may call it first to print them, then hand the
-    result to the workflow's ``screened=``)."""
+    result to the workflow's ``screened=``).  First of all, ``command``'s memory need for the record is held to
+    the memory budget (:func:`fogdrift.io.readers.command_memory.check_records_memory`: one line, no work done)."""
+    check_records_memory(command, record)
 
     sums: dict = {}
     findings = list(check_record(record, sums=sums))

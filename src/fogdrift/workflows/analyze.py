@@ -13,6 +13,7 @@ from ..bundle import write_bundle
 from ..compensate.holdout import write_compensated_test_block
 from ..evaluation import evaluated_analysis
 from ..evaluation import evaluations as evaluations_of
+from ..io.readers.command_memory import check_records_memory
 from ..pipeline import AnalysisConfig, model_factor, run_analysis
 from ..plausibility import check_record
 from ..report import write_report
@@ -77,10 +78,11 @@ class Prepared:
 def prepare_analyze(record, config=None, *, apply_to=None, segments="auto") -> Prepared:
     """Decide the modelling factors (a modelling rate that does not divide a record's rate is refused here, before
     any work) and screen the record; :func:`run_analyze` takes the result as ``prepared=``."""
+    check_records_memory("analyze", record, apply_to)
     cfg = (config or AnalysisConfig()).validate()
     factor = model_factor(record, cfg)
     other = None if apply_to is None else model_factor(apply_to, cfg)
-    return Prepared(cfg, factor, other, screen(record, segments))
+    return Prepared(cfg, factor, other, screen(record, segments, command="analyze"))
 
 
 def run_analyze(record, config=None, *, apply_to=None, heading=True, calib_s=HEADING_DEFAULTS["calib_s"],

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import ConfigError
+from ..io.readers.command_memory import check_records_memory
 from ..evaluation.consistency import (check_consistency, components_from_gmwm, components_from_noise_fit,
                                       random_walk_covering, reduced_model, verdict_line)
 from ..pipeline import AnalysisConfig
@@ -113,6 +114,7 @@ def run_consistency(record, held_out, *, method="allan", components=None, calibr
     held_out_names : sequence of str
         Their file names, for messages and the JSON.
     """
+    check_records_memory("consistency", record, *held_out)
     full, notes, k_bounds, source = model_components(record, method=method, components=components,
                                                      source_name=source_name, progress=progress)
     kinds = {c.name: channel_kind(c.quantity) for c in record.signal.channels}

@@ -10,6 +10,7 @@ from ..errors import InsufficientDataError
 from ..evaluation.gmwm_vs_allan import compare_with_allan
 from ..gmwm.analysis import analyse_gmwm
 from ..gmwm.quantity import express_gmwm
+from ..io.readers.command_memory import check_records_memory
 from ..report.gmwm import write_gmwm_outputs
 from ..pipeline import AnalysisConfig, run_allan
 from ..segments import longest_segment
@@ -60,7 +61,8 @@ def run_noise(record, *, model="auto", levels=None, robust=False, segments="auto
         Called with no argument after each axis.
     """
 
-    sc = screened if screened is not None else screen(record, segments)
+    check_records_memory("noise", record)
+    sc = screened if screened is not None else screen(record, segments, command="noise")
     segs, screens = sc.segments, sc.screens
     axes = []
     for name in record.axis_names:

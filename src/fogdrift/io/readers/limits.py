@@ -12,9 +12,9 @@ Environment variable         Limit                                              
 ``FOGDRIFT_MAX_ROWS``        lines of a text file, rows of an array, raw binary records      1000000000
 ``FOGDRIFT_MAX_EXPANSION``   decompressed bytes per stored byte (gzip text, ``.npz``           50
                              members, HDF5/MATLAB arrays), beyond the first 16 MiB
-``FOGDRIFT_MAX_MEMORY``      bytes of the float64 table a reader builds (``2G``, ``512M``)     half the machine's
-                                                                                             memory (or of the
-                                                                                             process's RLIMIT_AS)
+``FOGDRIFT_MAX_MEMORY``      bytes of the float64 table a reader builds (``2G``, ``512M``);    half the machine's
+                             and a command's estimated peak for the record it read             memory (or of the
+                             (:mod:`fogdrift.io.readers.command_memory`)                       process's RLIMIT_AS)
 ``FOGDRIFT_MAX_COLUMNS``     columns of a table: text fields, array columns, ``.npz``          1024
                              members, datasets (each a possible axis)
 ``FOGDRIFT_MAX_PREAMBLE``    bytes of comment or blank lines before a text file's header       16 MiB
