@@ -58,7 +58,7 @@ def test_importing_the_pipeline_loads_no_gmwm():
 def test_importing_the_noise_fit_loads_no_scipy_stats():
     """Issue 35: the noise fit's chi-squared and t quantiles come from scipy.special (noise.distributions), so
     importing the pipeline, the noise package or the Allan noise identification does not load scipy.stats (0.3-0.6 s).
-    (A command that computes the spectrum still loads it: scipy.signal's welch imports scipy.stats itself.)"""
+    The spectrum's Welch is written on scipy.fft: scipy.signal (which loads scipy.stats itself) stays out too."""
     mods = _modules("import fogdrift.pipeline, fogdrift.noise.identify, fogdrift.noise.spectral")
     assert "fogdrift.noise.identify" in mods
     assert "scipy.stats" not in mods
@@ -87,6 +87,9 @@ def test_allan_command_loads_no_gmwm(small_npy, tmp_path):
     mods = _modules("from fogdrift.cli import main\nmain()", argv)
     assert "fogdrift.cli.allan" in mods
     assert _gmwm(mods) == []
+    # the command reads the spectrum (noise.spectral's Welch on scipy.fft) without scipy.signal's 0.9 s of imports
+    assert "fogdrift.noise.spectral" in mods and "scipy.fft" in mods
+    assert "scipy.signal" not in mods and "scipy.stats" not in mods
 
 
 def test_run_freezes_the_imported_objects_only_while_the_command_runs(tmp_path):
