@@ -73,11 +73,11 @@ def read_fleet_table(path) -> tuple[list[dict], Path]:
     if p.is_dir():
         if not (p / SUMMARY_NAME).is_file():
             raise DataFormatError(f"{{opt:fleet}} {p}: no {SUMMARY_NAME} in this folder (give a fogdrift batch "
-                                  "output folder or its fleet table)", path=p)
+                                  "output folder or its fleet table)")
         p = p / SUMMARY_NAME
     if not p.is_file():
         raise DataFormatError(f"{{opt:fleet}} {p}: no such file (give a fogdrift batch output folder or its "
-                              f"{SUMMARY_NAME})", path=p)
+                              f"{SUMMARY_NAME})")
     suffix = p.suffix.lower()
     try:
         if suffix == ".csv":
@@ -87,11 +87,11 @@ def read_fleet_table(path) -> tuple[list[dict], Path]:
             pq = require("pyarrow.parquet", "fleet", "reading the batch fleet table (Parquet)")
             rows = pq.read_table(p).to_pylist()
     except (OSError, ValueError, UnicodeDecodeError) as exc:
-        raise DataFormatError(f"{{opt:fleet}} {p}: not a readable fleet table ({type(exc).__name__}: {exc})",
-                              path=p) from exc
+        raise DataFormatError(f"{{opt:fleet}} {p}: not a readable fleet table ({type(exc).__name__}: {exc})"
+                              ) from exc
     except Exception as exc:  # pyarrow's own errors (ArrowInvalid is a ValueError; others are not)
         if type(exc).__module__.startswith("pyarrow"):
-            raise DataFormatError(f"{{opt:fleet}} {p}: not a readable Parquet fleet table ({exc})", path=p) from exc
+            raise DataFormatError(f"{{opt:fleet}} {p}: not a readable Parquet fleet table ({exc})") from exc
         raise
     return rows, p
 
@@ -332,20 +332,21 @@ class FleetPlan:
                 elif r["spread_units"] is None:
                     parts.append(f"to {w}: more than {MAX_UNITS} units")
                 else:
-                    parts.append(f"to {w}: {r['spread_units']} units")
+                    parts.append(f"to {w}: {r['spread_units']} units{_range(r['spread_units_range'])}")
             if r["mean_target"] is not None:
                 w = f"±{100 * r['mean_target']:.3g} %"
                 m = r["mean_units"]
                 parts.append(f"type mean ({_g(r['mean'])} {u}) to {w}: "
-                             + (f"{m} units" if m is not None else f"more than {MAX_UNITS} units"))
+                             + (f"{m} units" if m is not None else f"more than {MAX_UNITS} units")
+                             + _range(r["mean_units_range"]))
             out.append(head + (" " + "; ".join(parts) if parts else ""))
         if self.units is not None:
             bits = []
             for t, r in self.terms.items():
                 a = r["at_units"]
                 sw = ("not resolved" if not math.isfinite(a["spread_width"]) else
-                      f"±{100 * a['spread_width']:.2g} %")
-                bits.append(f"{t} spread {sw}, mean ±{100 * a['mean_width']:.2g} %")
+                      f"±{100 * a['spread_width']:.3g} %")
+                bits.append(f"{t} spread {sw}, mean ±{100 * a['mean_width']:.3g} %")
             out.append(f"a fleet of {self.units} units gives " + "; ".join(bits))
         return out
 
@@ -363,6 +364,13 @@ class FleetPlan:
             "lines": self.lines()})
 
 
+def _range(ends) -> str:
+    if not ends:
+        return ""
+    a, b = (str(e) if e is not None else f">{MAX_UNITS}" for e in ends)
+    return f" ({a}–{b} over the pilot's 95 % range)" if a != b else ""
+
+
 def _g(x) -> str:
     return f"{x:.3g}" if x is not None and math.isfinite(x) else "n/a"
 
@@ -377,6 +385,22 @@ def _clean(x):
     if isinstance(x, float) and not math.isfinite(x):
         return None
     return x
+
+
+def _ranges(r, grid):
+    """Units needed at the two ends of the pilot's own 95 % intervals: the spread's over ``between_sd_95``
+    (``[at the upper end, at the lower end]``; None: more than :data:`MAX_UNITS` or not resolved), the mean's over
+    the chi-square interval of the total SD (``[at the lower end, at the upper end]``)."""
+    w2 = r["within_sd"] ** 2
+    spread = None
+    if r["spread_target"] is not None and r["resolved"]:
+        spread = [units_needed(spread_width(grid, w2 / (b * b + w2)) if b > 0 else np.full(grid.size, np.inf),
+                               r["spread_target"]) for b in reversed(r["between_sd_95"])]
+    mean = None
+    if r["mean_target"] is not None and r["mean"] != 0:
+        ends = sd_interval(r["sd"], r["n"])
+        mean = [units_needed(mean_width(grid, float(e) / abs(r["mean"])), r["mean_target"]) for e in ends]
+    return spread, mean
 
 
 def make_fleet_plan(pilot: FleetPilot, spread_targets: dict, mean_targets: dict, units: int | None = None,
@@ -429,6 +453,10 @@ def make_fleet_plan(pilot: FleetPilot, spread_targets: dict, mean_targets: dict,
         r["spread_units"] = (units_needed(sw, r["spread_target"]) if r["spread_target"] is not None
                              and r["resolved"] else None)
         r["mean_units"] = units_needed(mw, r["mean_target"]) if r["mean_target"] is not None else None
+        r["spread_units_range"], r["mean_units_range"] = _ranges(r, grid)
+        if r["resolved"] and r["within_share"] > 0.5 and r["spread_target"] is not None:
+            notes.append(f"{t}: the units' own errors are {100 * r['within_share']:.0f} % of the scatter's variance; "
+                         "longer records per unit (fogdrift plan on one unit's log) need fewer units")
         lo, _ = sd_interval(1.0, grid, r["within_share"])
         r["spread_resolved_units"] = units_needed(-lo, -1e-12) if r["resolved"] else None
         if units is not None:
