@@ -220,7 +220,7 @@ def test_cli_plan_fleet(tmp_path):
     (["--fleet", "nowhere/summary.parquet"], "--fleet nowhere/summary.parquet: no such file"),
     (["--fleet", str(FIXTURE), "--target", "K:25%"], "--fleet K: 2 unit(s) of 15"),
     (["--fleet", str(FIXTURE), "--units", "1"], "--units must be between 2"),
-    (["--fleet", str(FIXTURE), "--model", "N=1 deg/sqrt(h)"], "drop the pilot FILE, --model"),
+    (["--fleet", str(FIXTURE), "--model", "N=1 deg/sqrt(h)"], "drop the pilot FILE, --model, --length"),
     (["--units", "5"], "give --fleet")])
 def test_cli_plan_fleet_refusals_are_one_line(tmp_path, args, words):
     from typer.testing import CliRunner

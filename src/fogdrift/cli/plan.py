@@ -58,7 +58,7 @@ def plan(
     with run("plan", out, default_out=DEFAULT_OUT, inputs=[load.file, fleet, model if model and model.strip().lower().endswith(".json") else None], json_out=json_out,
              expect=("plan.json",) if fleet is not None else ("plan.json", "plan.png")) as r:
         if fleet is not None or units is not None or mean_target is not None:
-            return _fleet_plan(r, fleet, load.file, model, target, mean_target, units, axis, length)
+            return _fleet_plan(r, fleet, load.file, model, target, mean_target, units, axis, length, monte_carlo)
         from ..plan import make_plan, parse_length, parse_model, parse_targets, read_model_file
         from ..report import write_json
         from ..report.plan_figure import plot_plan
@@ -123,7 +123,7 @@ def _pilot_model(load, axis):
 
 
 
-def _fleet_plan(r, fleet, file, model, target, mean_target, units, axis, length):
+def _fleet_plan(r, fleet, file, model, target, mean_target, units, axis, length, monte_carlo):
     """``--fleet``: units of the type to record (:mod:`fogdrift.plan.fleet`); writes plan.json with a ``fleet``
     section."""
     from ..plan.fleet import fleet_pilot, make_fleet_plan, parse_fleet_targets, read_fleet_table
@@ -132,9 +132,9 @@ def _fleet_plan(r, fleet, file, model, target, mean_target, units, axis, length)
     if fleet is None:
         raise ConfigError("{opt:units} and {opt:mean_target} plan a fleet: give {opt:fleet} (a fogdrift batch "
                           "output folder or its summary.parquet)")
-    if file is not None or model is not None or length is not None:
-        raise ConfigError("{opt:fleet} plans from the fleet table alone; drop the pilot FILE, {opt:model} and "
-                          "{opt:length}")
+    if file is not None or model is not None or length is not None or monte_carlo:
+        raise ConfigError("{opt:fleet} plans from the fleet table alone; drop the pilot FILE, {opt:model}, "
+                          "{opt:length} and {opt:monte_carlo}")
     rows, path = read_fleet_table(fleet)
     pilot = fleet_pilot(rows, source=str(path), axis=axis)
     spread, mean = parse_fleet_targets(target, mean_target, tuple(pilot.terms))
