@@ -192,7 +192,7 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
     "fogdrift.cli.noise": (CLI, ("fogdrift.gmwm.analysis", "fogdrift.gmwm.quantity", "fogdrift.noise.periodic", "fogdrift.noise.quantity", "fogdrift.report",
         "fogdrift.report.gmwm", "fogdrift.workflows.allan", "fogdrift.workflows.noise")),
     "fogdrift.cli.separate": (CLI, ("fogdrift.pipeline", "fogdrift.report")),
-    "fogdrift.cli.plan": (CLI, ("fogdrift.pipeline", "fogdrift.plan", "fogdrift.report", "fogdrift.report.plan_figure")),
+    "fogdrift.cli.plan": (CLI, ("fogdrift.pipeline", "fogdrift.plan", "fogdrift.plan.fleet", "fogdrift.report", "fogdrift.report.plan_figure")),
     "fogdrift.fleet.commands": (BATCH, ("fogdrift.evaluation.verdicts",
         "fogdrift.pipeline", "fogdrift.workflows.allan",
         "fogdrift.workflows.analyze", "fogdrift.workflows.noise")),

@@ -86,6 +86,7 @@ FLAGS = {
     "fit_tau_s": "--fit-taus", "format": "--format", "horizons": "--horizons", "calibration": "--calibration",
     "origin_step": "--origin-step", "spec": "--spec", "segments": "--segments",
     "target": "--target", "length": "--length", "monte_carlo": "--monte-carlo", "workers": "--workers", "axis": "--axis",
+    "fleet": "--fleet", "units": "--units", "mean_target": "--mean-target",
 }
 
 #: The reader options of the ``READERS`` table (fogdrift.io.registry), each once: every one is a flag of every

@@ -40,14 +40,25 @@ def plan(
     monte_carlo: Annotated[int, typer.Option("--monte-carlo", help="Seeds of the Monte-Carlo check at each "
                            "planned length (0: analytic only).")] = 0,
     workers: Annotated[int, typer.Option("--workers", help="Processes for the Monte-Carlo.")] = 1,
-    axis: Annotated[Optional[str], typer.Option("--axis", help="Pilot axis (default: the first gyro axis).")] = None,
+    axis: Annotated[Optional[str], typer.Option("--axis", help="Pilot axis (default: the first gyro axis); with "
+                    "--fleet, plan this axis's units alone (default: the gyro axes pooled).")] = None,
+    fleet: Annotated[Optional[Path], typer.Option("--fleet", help="Plan a fleet instead: a fogdrift batch output "
+                     "folder (or its summary.parquet, or a CSV of its columns) as the pilot units; says how many "
+                     "units give each term's between-unit SD to --target (default 25 %) and the type's mean to "
+                     "--mean-target (default 10 %).")] = None,
+    units: Annotated[Optional[int], typer.Option("--units", help="With --fleet: the widths a fleet of M units "
+                     "gives.")] = None,
+    mean_target: Annotated[Optional[str], typer.Option("--mean-target", help="With --fleet: relative 95 % "
+                           "half-width of the type's mean per term, e.g. \"N:5%,B:10%\".")] = None,
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
 ):
     """How long must I record?  The length at which each term is resolved and reaches its target 95 % width
     (Allan fit; analytic, checked by Monte-Carlo); writes plan.json and plan.png."""
-    with run("plan", out, default_out=DEFAULT_OUT, inputs=[load.file, model if model and model.strip().lower().endswith(".json") else None], json_out=json_out,
-             expect=("plan.json", "plan.png")) as r:
+    with run("plan", out, default_out=DEFAULT_OUT, inputs=[load.file, fleet, model if model and model.strip().lower().endswith(".json") else None], json_out=json_out,
+             expect=("plan.json",) if fleet is not None else ("plan.json", "plan.png")) as r:
+        if fleet is not None or units is not None or mean_target is not None:
+            return _fleet_plan(r, fleet, load.file, model, target, mean_target, units, axis, length, monte_carlo)
         from ..plan import make_plan, parse_length, parse_model, parse_targets, read_model_file
         from ..report import write_json
         from ..report.plan_figure import plot_plan
@@ -110,3 +121,32 @@ def _pilot_model(load, axis):
         f" samples, Allan fit {'+'.join(fit.selected)}")
     return model_from_fit(fit, dt, source=f"pilot {Path(str(record.source)).name} axis {names[0]}")
 
+
+
+def _fleet_plan(r, fleet, file, model, target, mean_target, units, axis, length, monte_carlo):
+    """``--fleet``: units of the type to record (:mod:`fogdrift.plan.fleet`); writes plan.json with a ``fleet``
+    section."""
+    from ..plan.fleet import fleet_pilot, make_fleet_plan, parse_fleet_targets, read_fleet_table
+    from ..report import write_json
+
+    if fleet is None:
+        raise ConfigError("{opt:units} and {opt:mean_target} plan a fleet: give {opt:fleet} (a fogdrift batch "
+                          "output folder or its summary.parquet)")
+    if file is not None or model is not None or length is not None or monte_carlo:
+        raise ConfigError("{opt:fleet} plans from the fleet table alone; drop the pilot FILE, {opt:model}, "
+                          "{opt:length} and {opt:monte_carlo}")
+    rows, path = read_fleet_table(fleet)
+    pilot = fleet_pilot(rows, source=str(path), axis=axis)
+    spread, mean = parse_fleet_targets(target, mean_target, tuple(pilot.terms))
+    p = make_fleet_plan(pilot, spread, mean, units, explicit=bool(target or mean_target))
+    say(f"pilot fleet: {path} ({pilot.n_rows} units{', axes ' + ', '.join(pilot.axes) if pilot.axes else ''})")
+    for line in p.lines():
+        say(line)
+    for note in p.notes:
+        say(f"  {note}", style="yellow")
+    say("  widths are 95 % half-widths relative to the value; spread: the between-unit SD with the units' own "
+        "errors taken out; units recorded as the pilot's were", style="dim")
+    out = write_json({"fogdrift_result": "plan", "estimator": "fleet (fogdrift batch table)",
+                      "fleet": p.to_dict()}, r.out.path / "plan.json")
+    r.wrote()
+    r.print_json(out)

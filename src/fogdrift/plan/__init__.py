@@ -3,6 +3,7 @@ stated interval width (issue 34).
 
 :mod:`.model` (the model, targets and lengths, parsed), :mod:`.analytic` (expected widths from the fit's own
 covariance laws), :mod:`.montecarlo` (simulated records through the real fit), :mod:`.core` (the plan).
+:mod:`.fleet` (how many units of a type to record for its spread and mean, a batch fleet table as the pilot).
 GMWM is not planned yet.
 """
 
