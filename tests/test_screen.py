@@ -124,3 +124,26 @@ def test_romy_teleseism_is_named_on_each_axis(axis):
     assert first.peak > 5
     assert r.quiet_segments[0][0] == 0 and r.quiet_segments[0][1] >= 400  # the pre-event part
     assert r.quiet_segments[0][1] <= 690
+
+
+@pytest.mark.parametrize("batch", [1 << 20, 100])
+def test_the_quiet_variogram_is_the_direct_mean_of_squared_differences(monkeypatch, batch):
+    """The null law's variogram (FFT, windows transformed in batches) against the definition, by hand: gamma(k) =
+    sum over the used windows of sum_i (x_{i+k} - x_i)^2 / 2, over the number of pairs, each window's first L
+    samples with its mean removed (the mean cancels in a difference, so the plain samples serve)."""
+    import fogdrift.screen as sc
+
+    monkeypatch.setattr(sc, "VARIOGRAM_BATCH_VALUES", batch)  # 100 values: one window per batch
+    rng = np.random.default_rng(11)
+    y = np.cumsum(rng.standard_normal(5003)) * 0.1 + rng.standard_normal(5003) + 40.0
+    L, M = 37, 5003 // 37
+    edges = (np.arange(M + 1) * y.size) // M
+    use = rng.random(M) > 0.3
+    num, cnt = np.zeros(L), np.zeros(L)
+    for j in np.flatnonzero(use):
+        x = y[edges[j]: edges[j] + L]
+        for k in range(L):
+            d = x[k:] - x[: L - k]
+            num[k] += float(d @ d)
+            cnt[k] += L - k
+    np.testing.assert_allclose(sc._variogram(y, edges, use, L), num / (2.0 * cnt), rtol=1e-9, atol=1e-12)

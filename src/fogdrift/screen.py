@@ -282,24 +282,34 @@ def _windows(y: np.ndarray, L: int):
     return edges, s, mu
 
 
+#: Values (windows x FFT length) per batch of :func:`_variogram`: the windows are transformed together, a batch at a
+#: time, so that memory stays bounded (about 8 MB per temporary) whatever the record length.
+VARIOGRAM_BATCH_VALUES = 1 << 20
+
+
 def _variogram(y: np.ndarray, edges: np.ndarray, use: np.ndarray, L: int) -> np.ndarray:
-    """gamma(k) = mean (x_{i+k} - x_i)^2 / 2 for k < L, pooled over the windows ``use``."""
-    num = np.zeros(L)
-    cnt = np.zeros(L)
+    """gamma(k) = mean (x_{i+k} - x_i)^2 / 2 for k < L, pooled over the windows ``use``.
+
+    Per window (its first ``L`` samples, mean removed): ``sum_i (x_{i+k} - x_i)^2 = sum_{i>=k} x_i^2 +
+    sum_{i<=L-1-k} x_i^2 - 2 sum_i x_i x_{i+k}``, the last by FFT (zero-padded to ``nfft >= 2 L``); the windows
+    are transformed a batch at a time (:data:`VARIOGRAM_BATCH_VALUES`) and their sums added in window order.
+    """
     nfft = 1 << int(math.ceil(math.log2(2 * L)))
-    for j in np.flatnonzero(use):
-        x = y[edges[j]:edges[j] + L]
-        x = x - x.mean()
-        f = np.fft.rfft(x, nfft)
-        c = np.fft.irfft(f * np.conj(f), nfft)[:L]  # sum_i x_i x_{i+k}
-        q = np.cumsum(x * x)
-        tot = q[-1]
-        k = np.arange(L)
-        head = tot - np.r_[0.0, q[:-1]][k]          # sum_{i >= k} x_i^2
-        tail = q[L - 1 - k]                           # sum_{i <= L-1-k} x_i^2
-        num += head + tail - 2.0 * c
-        cnt += L - k
-    return num / (2.0 * cnt)
+    k = np.arange(L)
+    rows = np.flatnonzero(use)
+    num = np.zeros(L)
+    per = max(1, VARIOGRAM_BATCH_VALUES // nfft)
+    for a in range(0, rows.size, per):
+        x = y[edges[rows[a:a + per]][:, None] + k[None, :]]
+        x = x - x.mean(axis=1, keepdims=True)
+        f = np.fft.rfft(x, nfft, axis=1)
+        c = np.fft.irfft(f * np.conj(f), nfft, axis=1)[:, :L]  # sum_i x_i x_{i+k}
+        q = np.cumsum(x * x, axis=1)
+        head = q[:, -1:] - np.concatenate([np.zeros((q.shape[0], 1)), q[:, :-1]], axis=1)  # sum_{i >= k} x_i^2
+        tail = q[:, L - 1 - k]                                                            # sum_{i <= L-1-k} x_i^2
+        for r in head + tail - 2.0 * c:
+            num += r
+    return num / (2.0 * (rows.size * (L - k).astype(np.float64)))
 
 
 def _null_weights(gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
