@@ -258,3 +258,26 @@ def test_auto_alpha_uses_each_statistics_slopes():
         assert np.mean(r.noise_alpha[:-2] == 2) >= 0.8, (statistic, r.noise_alpha)
     assert_array_equal(allan_variance(y, 1.0, statistic="mdev", noise_alpha="conservative").noise_alpha.shape,
                        allan_variance(y, 1.0, statistic="mdev").m.shape)
+
+
+def test_local_slopes_are_each_windows_least_squares_slope():
+    """The local log-log slope behind the auto alpha (prefix sums over searchsorted windows, O(n_tau)) against
+    np.polyfit over each window by hand: taus within a factor 2 (the 3 nearest where that leaves fewer than 2),
+    on an unsorted dense grid, an octave grid and a sparse one."""
+    from fogdrift.allan.ci import alpha_from_slope, local_slopes
+
+    rng = np.random.default_rng(5)
+    for m in (rng.permutation(np.arange(1.0, 3001.0)), 2.0 ** np.arange(12), np.array([1.0, 10, 100, 1e3, 3e3])):
+        x = np.log(m * 0.01)
+        y = 0.5 * np.log((1.0 / m + 1e-4 * m) * np.exp(0.05 * rng.standard_normal(m.size)))
+        want = []
+        for xi in x:
+            sel = np.abs(x - xi) <= math.log(2.0) * (1 + 1e-9)
+            if sel.sum() < 2:
+                sel = np.isin(np.arange(x.size), np.argsort(np.abs(x - xi))[:3])
+            want.append(np.polyfit(x[sel], y[sel], 1)[0])
+        assert_allclose(local_slopes(x, y), want, rtol=0, atol=1e-10)
+    # the alpha rule on those slopes: white FM (slope -1/2) -> 0, random walk (+1/2) -> -2, white PM (-1) -> +2
+    tau = np.arange(1.0, 2001.0)
+    for power, alpha in ((-1.0, 0), (1.0, -2), (-2.0, 2)):
+        assert set(alpha_from_slope(tau, tau**power, {2: -1.0, 0: -0.5, -1: 0.0, -2: 0.5}, (2, 0, -1, -2)).tolist()) == {alpha}
