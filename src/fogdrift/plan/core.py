@@ -1,6 +1,6 @@
 """The plan: for each target term, the record length at which the Allan fit resolves it and at which its 95 %
 interval reaches the requested relative half-width (analytic, :mod:`.analytic`), checked by Monte-Carlo
-(:mod:`.montecarlo`); and what a record of a stated length supports."""
+(:mod:`.montecarlo`), the same for the GMWM (:mod:`.gmwm`); and what a record of a stated length supports."""
 
 from __future__ import annotations
 
