@@ -1,5 +1,5 @@
-"""``fogdrift plan``: how long to record, for the Allan fit and the GMWM (``--estimator``).  From a pilot log (the Allan fit of one gyro axis, as ``fogdrift allan``)
-or a stated model (``--model "N=0.15 deg/sqrt(h), B=0.5 deg/h"`` with ``--rate``, or a fogdrift JSON), the record
+"""``fogdrift plan``: how long to record, for the Allan fit and the GMWM (``--estimator``).  From a pilot log (the
+Allan fit of one gyro axis, as ``fogdrift allan``) or a stated model (``--model "N=0.15 deg/sqrt(h), B=0.5 deg/h"`` with ``--rate``, or a fogdrift JSON), the record
 length at which each target term is resolved and reaches its requested 95 % width, checked by Monte-Carlo
 (``--monte-carlo N`` seeds; ``--rate``: the sample rate of the record to plan, with a stated model); ``--length`` says what a record of that length supports."""
 
