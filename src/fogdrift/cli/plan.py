@@ -1,5 +1,5 @@
-"""``fogdrift plan``: how long to record.  From a pilot log (the Allan fit of one gyro axis, as ``fogdrift allan``)
-or a stated model (``--model "N=0.15 deg/sqrt(h), B=0.5 deg/h"`` with ``--rate``, or a fogdrift JSON), the record
+"""``fogdrift plan``: how long to record, for the Allan fit and the GMWM (``--estimator``).  From a pilot log (the
+Allan fit of one gyro axis, as ``fogdrift allan``) or a stated model (``--model "N=0.15 deg/sqrt(h), B=0.5 deg/h"`` with ``--rate``, or a fogdrift JSON), the record
 length at which each target term is resolved and reaches its requested 95 % width, checked by Monte-Carlo
 (``--monte-carlo N`` seeds; ``--rate``: the sample rate of the record to plan, with a stated model); ``--length`` says what a record of that length supports."""
 
@@ -40,6 +40,9 @@ def plan(
     monte_carlo: Annotated[int, typer.Option("--monte-carlo", help="Seeds of the Monte-Carlo check at each "
                            "planned length (0: analytic only).")] = 0,
     workers: Annotated[int, typer.Option("--workers", help="Processes for the Monte-Carlo.")] = 1,
+    estimator: Annotated[str, typer.Option("--estimator", help="Estimator(s) to plan for: both (default), allan "
+                         "(the Allan fit, as fogdrift allan) or gmwm (the GMWM of the model's latent processes, "
+                         "as fogdrift noise --method gmwm --model WN+RW+FLICKER ...).")] = "both",
     axis: Annotated[Optional[str], typer.Option("--axis", help="Pilot axis (default: the first gyro axis); with "
                     "--fleet, plan this axis's units alone (default: the gyro axes pooled).")] = None,
     fleet: Annotated[Optional[Path], typer.Option("--fleet", help="Plan a fleet instead: a fogdrift batch output "
@@ -54,7 +57,7 @@ def plan(
     json_out: JsonOpt = False,
 ):
     """How long must I record?  The length at which each term is resolved and reaches its target 95 % width
-    (Allan fit; analytic, checked by Monte-Carlo); writes plan.json and plan.png."""
+    (Allan fit and GMWM; analytic, checked by Monte-Carlo); writes plan.json and plan.png."""
     with run("plan", out, default_out=DEFAULT_OUT, inputs=[load.file, fleet, model if model and model.strip().lower().endswith(".json") else None], json_out=json_out,
              expect=("plan.json",) if fleet is not None else ("plan.json", "plan.png")) as r:
         if fleet is not None or units is not None or mean_target is not None:
@@ -71,6 +74,9 @@ def plan(
         if workers < 1 or workers > 64:
             raise ConfigError(f"{{opt:workers}} must be between 1 and 64; got {workers}")
         length_s = None if length is None else parse_length(length)
+        est = {"both": ("allan", "gmwm"), "allan": ("allan",), "gmwm": ("gmwm",)}.get(str(estimator).strip().lower())
+        if est is None:
+            raise ConfigError(f"{{opt:estimator}} must be both, allan or gmwm; got {estimator!r}")
         if model is not None:
             if model.strip().lower().endswith(".json"):
                 m = read_model_file(model, None if rate is None else 1.0 / rate, axis)
@@ -84,7 +90,7 @@ def plan(
         say(f"model: {m.text()} at {1 / m.dt_s:g} Hz ({m.source})")
         for note in m.notes:
             say(f"  {note}", style="yellow")
-        p = make_plan(m, targets, length_s=length_s, monte_carlo=monte_carlo, workers=workers)
+        p = make_plan(m, targets, length_s=length_s, monte_carlo=monte_carlo, workers=workers, estimators=est)
         for line in p.lines():
             say(line)
         for note in p.notes[: len(p.notes) - len(m.notes)]:

@@ -63,7 +63,7 @@ from .starts import bounds as _bounds
 from .starts import starts as _starts
 from .wvar import WvarResult, haar_wvar
 
-__all__ = ["GMWMFit", "GMWM", "gmwm_fit", "Whitener"]
+__all__ = ["GMWMFit", "GMWM", "gmwm_fit", "Whitener", "fit_covariance", "sandwich"]
 
 _Z95 = 1.959963984540054
 
@@ -327,8 +327,13 @@ class _Problem:
         return np.clip(np.asarray(z0, dtype=np.float64), self.lo + 1e-6, self.hi - 1e-6)
 
 
-def _sandwich(A, whitener: Whitener, V):
-    """Cov(z) and the WIC penalty from the Jacobian A = d nu / d z (J x p)."""
+def sandwich(A, whitener: Whitener, V):
+    """Cov(z) of the GMWM's free parameters ``z = log theta`` and the WIC penalty.
+
+    ``A``: the Jacobian ``d nu / d z`` (J x p) [(deg/h)^2]; ``whitener``: the weighting ``Omega``; ``V``: the
+    covariance of the WV estimates [(deg/h)^4].  ``Cov(z) = (A' Omega A)^-1 A' Omega V Omega A (A' Omega A)^-1``
+    (``(A' V^-1 A)^-1`` when ``Omega = V^-1``); a direction the scales do not identify gets infinite variance.
+    """
     WA = whitener(A)
     u, s, vt = np.linalg.svd(WA, full_matrices=False)
     good = s > s[0] * 1e-12 if s.size and s[0] > 0 else np.zeros_like(s, dtype=bool)
@@ -385,15 +390,28 @@ def _scale_index(wvar: WvarResult, scales) -> np.ndarray:
     return idx
 
 
-def _model_V(model: LatentModel, theta, wv: WvarResult, idx, allowance=True) -> np.ndarray:
-    """Covariance of the WV estimates at ``idx`` under the model: the sampling covariance plus (``allowance``)
-    the model-discrepancy allowance (:mod:`fogdrift.noise.discrepancy`, the same one the Allan fit uses)."""
-    tau = wv.tau_samples[idx]
-    V = model_wvar_covariance(model, theta, tau, wv.n_coef[idx]) / wv.efficiency
+def fit_covariance(model, theta, tau_samples, n_coef, *, efficiency=1.0, allowance=True) -> np.ndarray:
+    """The covariance the GMWM weights and forms its standard errors with [(deg/h)^4], (J, J).
+
+    The model's sampling covariance of the Haar WV estimates at ``tau_samples`` [samples] with ``n_coef``
+    coefficients each (:func:`~fogdrift.gmwm.covariance.model_wvar_covariance`), divided by the estimator's
+    ``efficiency`` (1 for the classical WV), plus (``allowance``) the model-discrepancy allowance
+    (:mod:`fogdrift.noise.discrepancy`, the same one the Allan fit uses).  ``model``: string or
+    :class:`~fogdrift.gmwm.processes.LatentModel`; ``theta``: its natural parameters.
+    """
+    mdl = parse_model(model)
+    tau = np.asarray(tau_samples)
+    V = model_wvar_covariance(mdl, theta, tau, np.asarray(n_coef)) / efficiency
     if not allowance:
         return V
-    nu = model.wv(theta, tau.astype(np.float64))
+    nu = mdl.wv(np.asarray(theta, dtype=np.float64), tau.astype(np.float64))
     return V + discrepancy_relcov(tau) * np.outer(nu, nu)
+
+
+def _model_V(model: LatentModel, theta, wv: WvarResult, idx, allowance=True) -> np.ndarray:
+    """Covariance of the WV estimates at ``idx`` under the model (:func:`fit_covariance` of ``wv``'s scales)."""
+    return fit_covariance(model, theta, wv.tau_samples[idx], wv.n_coef[idx], efficiency=wv.efficiency,
+                          allowance=allowance)
 
 
 def _j_statistic(mdl: LatentModel, theta, wv: WvarResult, idx, resid) -> float:
@@ -510,7 +528,7 @@ def _finish(wv: WvarResult, mdl: LatentModel, idx, theta1, q1, sols1, W1, ok1, *
     theta = mdl.sort_gm(np.exp(z))
     z = np.log(theta)
     A = prob.jac_nu(z)
-    cov, penalty = _sandwich(A, Wf, Vf)
+    cov, penalty = sandwich(A, Wf, Vf)
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
     nu_fit = mdl.wv(theta, tau)
     sd = np.sqrt(np.diag(Vf))

@@ -1,10 +1,10 @@
-"""``fogdrift plan``: how long must a record be for the Allan fit to resolve each noise term and to reach a
-stated interval width (issue 34).
+"""``fogdrift plan``: how long must a record be for the Allan fit and the GMWM to resolve each noise term and to
+reach a stated interval width (issue 34).
 
-:mod:`.model` (the model, targets and lengths, parsed), :mod:`.analytic` (expected widths from the fit's own
-covariance laws), :mod:`.montecarlo` (simulated records through the real fit), :mod:`.core` (the plan).
+:mod:`.model` (the model, targets and lengths, parsed), :mod:`.analytic` (expected widths from the Allan fit's own
+covariance laws), :mod:`.montecarlo` (simulated records through the real fit), :mod:`.gmwm` (the same for the
+GMWM of the model's latent processes), :mod:`.core` (the plan).
 :mod:`.fleet` (how many units of a type to record for its spread and mean, a batch fleet table as the pilot).
-GMWM is not planned yet.
 """
 
 from .core import MAX_LENGTH_S, Plan, make_plan

@@ -1,6 +1,6 @@
 """The plan: for each target term, the record length at which the Allan fit resolves it and at which its 95 %
 interval reaches the requested relative half-width (analytic, :mod:`.analytic`), checked by Monte-Carlo
-(:mod:`.montecarlo`); and what a record of a stated length supports."""
+(:mod:`.montecarlo`), the same for the GMWM (:mod:`.gmwm`); and what a record of a stated length supports."""
 
 from __future__ import annotations
 
@@ -13,10 +13,14 @@ import numpy as np
 from ..errors import ConfigError
 from ..noise.terms import TERM_TABLE
 from .analytic import analytic_widths, width_spread
+from .gmwm import gmwm_widths, simulate_gmwm_fits
 from .model import fmt_length
 from .montecarlo import MC_MAX_SAMPLES, simulate_fits, summarise
 
-__all__ = ["Plan", "make_plan", "MAX_LENGTH_S", "RECORD_SHARE", "crossing"]
+__all__ = ["Plan", "make_plan", "MAX_LENGTH_S", "RECORD_SHARE", "crossing", "ESTIMATORS"]
+
+#: The estimators a plan is made for: the Allan fit (:mod:`.analytic`) and the GMWM (:mod:`.gmwm`).
+ESTIMATORS = ("allan", "gmwm")
 
 #: Longest record the planner looks at [s] (30 days).
 MAX_LENGTH_S = 30 * 86400.0
@@ -62,6 +66,9 @@ class Plan:
     (width at :data:`MAX_LENGTH_S`), ``mc`` (Monte-Carlo at ``target_s``: median width, fractions, coverage, seeds,
     and ``length_s``, the length the measured width implies) and ``mc_share`` (Monte-Carlo at ``share_s``).
     ``grid``: the analytic curve (``length_s`` and each term's width). ``at_length``: what ``length_s`` supports.
+    With the GMWM among ``estimators``, each term also holds ``gmwm``: ``target_s``, ``resolved_s``,
+    ``floor_width`` and ``mc`` as above for the GMWM (:mod:`.gmwm`; no ``share_s``), and ``grid["gmwm_width"]``
+    its curve.
     """
 
     model: object
@@ -71,34 +78,68 @@ class Plan:
     at_length: dict | None = None
     seeds: list = field(default_factory=list)
     notes: list = field(default_factory=list)
+    estimators: tuple = ESTIMATORS
+
+    def _mc_text(self, mc) -> str:
+        s = (f"Monte-Carlo {mc['n_seeds']} seeds at that length: median ±{100 * mc['median_width']:.3g} %"
+             if math.isfinite(mc["median_width"]) else
+             f"Monte-Carlo {mc['n_seeds']} seeds at that length: resolved in fewer than half")
+        s += f", coverage {100 * mc['coverage']:.0f} %"
+        if mc.get("length_s"):
+            s += f" (implies {fmt_length(mc['length_s'])})"
+        return s
+
+    def _gmwm_text(self, t, g, w, head: bool) -> str:
+        """The GMWM's part of a term's line (``head``: the line starts with it)."""
+        name = f"GMWM {g['model']}" if head else "GMWM"
+        if g["target_s"] is not None:
+            s = f"{fmt_length(g['target_s'])} ({name})"
+        elif math.isfinite(g["floor_width"]):
+            s = f"not within {fmt_length(MAX_LENGTH_S)} ({name}: ±{100 * g['floor_width']:.3g} % or wider)"
+        else:
+            s = f"not resolved within {fmt_length(MAX_LENGTH_S)} ({name})"
+        return s
+
+    def _gmwm_tail(self, t, g) -> str:
+        s = ""
+        if g.get("mc"):
+            s += f"; GMWM {self._mc_text(g['mc'])}"
+        if g["resolved_s"] is not None:
+            s += f"; {t} resolved from {fmt_length(g['resolved_s'])} (GMWM)"
+        return s
 
     def lines(self) -> list[str]:
         """The first-screen lines: one per target term, then the stated length's."""
         out = []
         for t, r in self.terms.items():
             w = f"±{100 * r['target']:.3g} %"
+            g = r.get("gmwm")
+            if "allan" not in self.estimators:
+                out.append(f"{t} to {w}: {self._gmwm_text(t, g, w, True)}" + self._gmwm_tail(t, g))
+                continue
             if r["target_s"] is not None:
                 s = f"{t} to {w}: {fmt_length(r['target_s'])} (Allan fit)"
+                if g:
+                    s += ", " + self._gmwm_text(t, g, w, False)
                 mc = r.get("mc")
                 if mc:
-                    s += (f", Monte-Carlo {len(self.seeds)} seeds at that length: median ±{100 * mc['median_width']:.3g} %"
-                          if math.isfinite(mc["median_width"]) else
-                          f", Monte-Carlo {len(self.seeds)} seeds at that length: resolved in fewer than half")
-                    s += f", coverage {100 * mc['coverage']:.0f} %"
-                    if mc.get("length_s"):
-                        s += f" (implies {fmt_length(mc['length_s'])})"
+                    s += f"; Allan {self._mc_text(mc)}" if g else f", {self._mc_text(mc)}"
             else:
                 s = (f"{t} to {w}: not within {fmt_length(MAX_LENGTH_S)} (Allan fit; the model-discrepancy "
                      f"allowance keeps it at ±{100 * r['floor_width']:.3g} % or wider)"
                      if math.isfinite(r["floor_width"]) else f"{t} to {w}: not resolved within "
                      f"{fmt_length(MAX_LENGTH_S)}")
+                if g:
+                    s += ", " + self._gmwm_text(t, g, w, False)
             if r.get("share_s") is not None:
                 s += f"; {100 * RECORD_SHARE:.0f} % of records: {fmt_length(r['share_s'])}"
                 ms = r.get("mc_share")
                 if ms:
                     s += f" ({round(ms['met_fraction'] * ms['n_seeds'])} of {ms['n_seeds']} seeds reach {w} there)"
             if r["resolved_s"] is not None:
-                s += f"; {t} resolved from {fmt_length(r['resolved_s'])}"
+                s += f"; {t} resolved from {fmt_length(r['resolved_s'])}" + (" (Allan fit)" if g else "")
+            if g:
+                s += self._gmwm_tail(t, g)
             out.append(s)
         if self.at_length:
             L = self.at_length
@@ -122,7 +163,10 @@ class Plan:
                 return clean(x.item())
             return x
 
-        return clean({"fogdrift_result": "plan", "estimator": "allan fit (fogdrift allan)",
+        est = {"allan": "allan fit (fogdrift allan)", "gmwm": "GMWM of the true latent model (fogdrift noise "
+               "--method gmwm --model ...)"}
+        return clean({"fogdrift_result": "plan", "estimator": " and ".join(est[e] for e in self.estimators),
+                      "estimators": list(self.estimators),
                       "width": "relative 95 % half-width, (hi95 - lo95) / (2 value)",
                       "model": self.model.to_dict(),
                       "targets": self.targets, "terms": self.terms, "at_length": self.at_length,
@@ -153,9 +197,41 @@ def _mc_length(L, w_mc, target, grid_len, grid_w):
     return float(L * (target / w_mc) ** (1.0 / s))
 
 
-def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=1) -> Plan:
+def _gmwm_terms(model, targets, ns, lengths, seeds, workers, notes) -> tuple[dict, dict]:
+    """The GMWM's curve (term -> width per grid length) and, per target term, its ``target_s``,
+    ``resolved_s``, ``floor_width`` and Monte-Carlo (:mod:`.gmwm`)."""
+    dt = model.dt_s
+    curves = [gmwm_widths(model, n) for n in ns]
+    width = {t: [c[t]["rel_width"] for c in curves] for t in model.terms}
+    out = {}
+    for t, target in targets.items():
+        w = width[t]
+        resolved_s = crossing(lengths, [0.0 if c[t]["resolved"] else math.inf for c in curves], 0.0)
+        g = {"model": curves[0]["_fit"]["model"], "target_s": crossing(lengths, w, target),
+             "resolved_s": resolved_s, "floor_width": w[-1]}
+        if g["target_s"] is not None and seeds:
+            n = int(round(g["target_s"] / dt))
+            if n > MC_MAX_SAMPLES:
+                notes.append(f"GMWM Monte-Carlo of {t} skipped: {fmt_length(g['target_s'])} is {n} samples, beyond "
+                             f"the simulation limit of {MC_MAX_SAMPLES}")
+            else:
+                mc = summarise(model, simulate_gmwm_fits(model, n, seeds, workers=workers), {t: target})[t]
+                mc["length_s"] = _mc_length(g["target_s"], mc["median_width"], target, lengths, w)
+                mc["n_samples"] = n
+                g["mc"] = mc
+        out[t] = g
+    return width, out
+
+
+def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=1, estimators=ESTIMATORS) -> Plan:
     """Plan the record for ``model`` (:class:`~fogdrift.plan.model.PlanModel`) and ``targets`` (term -> relative
-    half-width).  ``monte_carlo``: seeds per checked length (0: analytic only); ``workers``: processes."""
+    half-width).  ``monte_carlo``: seeds per checked length (0: analytic only); ``workers``: processes;
+    ``estimators``: the ones planned for, of :data:`ESTIMATORS` (the Allan fit's analytic curve is always made:
+    the plan's grid and the stated length's reading use it; without ``"allan"`` its Monte-Carlo and lines are
+    left out)."""
+    estimators = tuple(e for e in ESTIMATORS if e in estimators)
+    if not estimators:
+        raise ConfigError(f"{{opt:estimator}} names no estimator; expected {', '.join(ESTIMATORS)} or both")
     for t in targets:
         if t not in model.terms:
             raise ConfigError(f"{{opt:target}}: the model has no {t} term to plan for")
@@ -198,7 +274,7 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
         if target_s is not None:
             j = min(range(len(lengths)), key=lambda k: abs(math.log(lengths[k] / target_s)))
             r["tau_range_s"] = [curves[j]["_fit"]["tau_min_s"], curves[j]["_fit"]["tau_max_s"]]
-        if target_s is not None and seeds:
+        if target_s is not None and seeds and "allan" in estimators:
             n = int(round(target_s / dt))
             if n > MC_MAX_SAMPLES:
                 notes.append(f"Monte-Carlo of {t} skipped: {fmt_length(target_s)} is {n} samples, beyond the "
@@ -214,6 +290,10 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
                 fits = simulate_fits(model, n, seeds, workers=workers)
                 r["mc_share"] = dict(summarise(model, fits, {t: target})[t], n_samples=n)
         terms[t] = r
+    if "gmwm" in estimators:
+        grid["gmwm_width"], g = _gmwm_terms(model, targets, ns, lengths, seeds, workers, notes)
+        for t in targets:
+            terms[t]["gmwm"] = g[t]
     at = None
     if length_s is not None:
         n = int(round(float(length_s) / dt))
@@ -224,7 +304,7 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
         at = {"length_s": float(length_s), "n_samples": n, "tau_max_s": c["_fit"]["tau_max_s"],
               "terms": {t: {"resolved": c[t]["resolved"], "rel_width": c[t]["rel_width"],
                             "rel_hi": c[t]["rel_hi"], "z": c[t]["z"]} for t in model.terms}}
-        if seeds and n <= MC_MAX_SAMPLES:
+        if seeds and n <= MC_MAX_SAMPLES and "allan" in estimators:
             fits = simulate_fits(model, n, seeds, workers=workers)
             at["mc"] = summarise(model, fits, {})
-    return Plan(model, dict(targets), terms, grid, at, seeds, notes + list(model.notes))
+    return Plan(model, dict(targets), terms, grid, at, seeds, notes + list(model.notes), estimators)
