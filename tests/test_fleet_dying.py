@@ -100,6 +100,54 @@ def test_the_kill_hook_is_inert_unless_set_and_naming_the_file(monkeypatch):
     fleet_tasks._test_kill(task)
 
 
+def test_a_cluster_left_without_workers_cancels_the_files_not_done(monkeypatch):
+    """The watch thread: no worker for NO_WORKERS_TIMEOUT_S -> the futures not done are cancelled (each then an
+    error row saying so); workers present -> nothing.  A stand-in client, no clock beyond the bounds."""
+    import threading
+
+    from fogdrift.fleet import runner
+
+    monkeypatch.setattr(runner, "WATCH_INTERVAL_S", 0.005)
+    monkeypatch.setattr(runner, "NO_WORKERS_TIMEOUT_S", 0.02)
+
+    class Future:
+        def __init__(self, done):
+            self._done = done
+
+        def done(self):
+            return self._done
+
+    class Client:
+        def __init__(self, workers):
+            self.workers, self.cancelled = workers, threading.Event()
+            self.which = None
+
+        def nthreads(self):
+            return self.workers
+
+        def cancel(self, futures, reason=None):
+            self.which = (futures, reason)
+            self.cancelled.set()
+
+    pending, finished = Future(False), Future(True)
+    empty = Client({})
+    watch = runner._Watch(empty, {pending: 0, finished: 1}, "Dask cluster at tcp://x:1")
+    assert empty.cancelled.wait(HANG_GUARD_S)
+    watch.stop()
+    assert empty.which == ([pending], "no-workers")
+    assert watch.reason == "the Dask cluster at tcp://x:1 had no worker for 0.02 s (all died, none restarted)"
+    row, = runner._error_rows(fleet_tasks.FileTask(path="/d/u.npy", file="u.npy", out_dir="/o/u.npy", rel_out="u.npy",
+                                                   command="allan", settings={}, settings_sha256="0" * 64),
+                              RuntimeError("cancelled"), runner._lost(RuntimeError("x"), "tcp://x:1", watch))
+    assert row["error"].startswith("not finished: the Dask cluster at tcp://x:1 had no worker for 0.02 s")
+    busy = Client({"tcp://w:1": 1})
+    watch = runner._Watch(busy, {pending: 0}, "local Dask cluster")
+    for _ in range(20):                               # some looks at a cluster with a worker: nothing cancelled
+        assert not busy.cancelled.wait(0.005)
+    watch.stop()
+    assert watch.reason is None
+
+
 @pytest.mark.slow
 def test_a_local_worker_killed_mid_file(tmp_path):
     """The worker running unit1 is SIGKILLed holding its folder's lock: unit1 fails with one line (not retried:

@@ -565,17 +565,11 @@ class _Watch:
         self._thread = threading.Thread(target=self._run, name="fogdrift-batch-watch", daemon=True)
         self._thread.start()
 
-    def _workers(self):
-        try:
-            return len(self.client.scheduler_info(n_workers=-1).get("workers", {}))
-        except TypeError:                      # an older distributed: no n_workers
-            return len(self.client.scheduler_info().get("workers", {}))
-
     def _run(self) -> None:
         idle = None
         while not self._stop.wait(WATCH_INTERVAL_S):
             try:
-                n = self._workers()
+                n = len(self.client.nthreads())
             except Exception:  # noqa: BLE001 -- a scheduler lost: its futures are cancelled by the client
                 return
             if n:
