@@ -101,8 +101,9 @@ def test_the_kill_hook_is_inert_unless_set_and_naming_the_file(monkeypatch):
 
 
 def test_a_cluster_left_without_workers_cancels_the_files_not_done(monkeypatch):
-    """The watch thread: no worker for NO_WORKERS_TIMEOUT_S -> the futures not done are cancelled (each then an
-    error row saying so); workers present -> nothing.  A stand-in client, no clock beyond the bounds."""
+    """The watch thread: no worker left for NO_WORKERS_TIMEOUT_S -> the futures not done are cancelled (each then
+    an error row saying so); workers present, or none yet (an adaptive cluster starting them) -> nothing.  A
+    stand-in client, no clock beyond the bounds."""
     import threading
 
     from fogdrift.fleet import runner
@@ -118,19 +119,21 @@ def test_a_cluster_left_without_workers_cancels_the_files_not_done(monkeypatch):
             return self._done
 
     class Client:
-        def __init__(self, workers):
-            self.workers, self.cancelled = workers, threading.Event()
+        def __init__(self, *workers):
+            self.workers, self.cancelled = list(workers), threading.Event()
             self.which = None
+            self.looks = 0
 
         def nthreads(self):
-            return self.workers
+            self.looks += 1
+            return self.workers.pop(0) if len(self.workers) > 1 else self.workers[0]
 
         def cancel(self, futures, reason=None):
             self.which = (futures, reason)
             self.cancelled.set()
 
     pending, finished = Future(False), Future(True)
-    empty = Client({})
+    empty = Client({"tcp://w:1": 1}, {})      # had a worker, then none
     watch = runner._Watch(empty, {pending: 0, finished: 1}, "Dask cluster at tcp://x:1")
     assert empty.cancelled.wait(HANG_GUARD_S)
     watch.stop()
@@ -140,12 +143,14 @@ def test_a_cluster_left_without_workers_cancels_the_files_not_done(monkeypatch):
                                                    command="allan", settings={}, settings_sha256="0" * 64),
                               RuntimeError("cancelled"), runner._lost(RuntimeError("x"), "tcp://x:1", watch))
     assert row["error"].startswith("not finished: the Dask cluster at tcp://x:1 had no worker for 0.02 s")
-    busy = Client({"tcp://w:1": 1})
-    watch = runner._Watch(busy, {pending: 0}, "local Dask cluster")
-    for _ in range(20):                               # some looks at a cluster with a worker: nothing cancelled
-        assert not busy.cancelled.wait(0.005)
-    watch.stop()
-    assert watch.reason is None
+    for workers in ({"tcp://w:1": 1}, {}):            # a worker all along; none yet: some looks, nothing cancelled
+        busy = Client(workers)
+        watch = runner._Watch(busy, {pending: 0}, "local Dask cluster")
+        deadline = time.monotonic() + HANG_GUARD_S
+        while busy.looks < 20 and time.monotonic() < deadline:
+            time.sleep(0.005)
+        watch.stop()
+        assert watch.reason is None and not busy.cancelled.is_set() and busy.looks >= 20
 
 
 @pytest.mark.slow

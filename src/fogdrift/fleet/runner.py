@@ -20,7 +20,7 @@ with one line and is not retried on the local cluster (:data:`ALLOWED_FAILURES`:
 other files; a re-run of the batch retries it and skips the finished ones); its dead worker's lock and temporary
 files are removed.  On an existing cluster the scheduler's own ``distributed.scheduler.allowed-failures``
 decides (Dask's default: 3 retries).  A lost scheduler fails every file not finished with one line each; a
-cluster left without a worker for :data:`NO_WORKERS_TIMEOUT_S` does the same.  Results are collected as they
+cluster whose workers have all gone (none restarted) for :data:`NO_WORKERS_TIMEOUT_S` does the same.  Results are collected as they
 finish (``progress``); the stages (the cluster starting, the files running, the summary being written) are
 announced at :func:`fogdrift.interrupt.checkpoint` (the CLI shows them).
 
@@ -70,7 +70,7 @@ STALE_LOCK_WAIT_S = 2.0
 #: Retries of a file whose worker process died, on the local cluster (distributed's ``allowed-failures``): none,
 #: the file fails with one line (a worker dies of the file it runs: memory, most often) and a re-run retries it.
 ALLOWED_FAILURES = 0
-#: Seconds a cluster may have no worker at all (all killed, none restarted) before the files not finished fail.
+#: Seconds a cluster may have no worker left (all died, none restarted) before the files not finished fail.
 NO_WORKERS_TIMEOUT_S = 60.0
 #: Seconds between two looks at the cluster's workers while files run.
 WATCH_INTERVAL_S = 1.0
@@ -553,7 +553,7 @@ def _copy(futures: dict) -> list:
 
 class _Watch:
     """A thread that looks at the cluster's workers every :data:`WATCH_INTERVAL_S` while the files run; after
-    :data:`NO_WORKERS_TIMEOUT_S` without any it cancels the futures not done (each becomes an error row saying
+    :data:`NO_WORKERS_TIMEOUT_S` without any, once it has had one, it cancels the futures not done (each becomes an error row saying
     so), so that a cluster whose workers all died cannot keep the batch waiting for ever."""
 
     def __init__(self, client, futures, where: str):
@@ -567,13 +567,14 @@ class _Watch:
 
     def _run(self) -> None:
         idle = None
+        seen = False    # a cluster that has had no worker yet may be starting them (an adaptive one): waited for
         while not self._stop.wait(WATCH_INTERVAL_S):
             try:
                 n = len(self.client.nthreads())
             except Exception:  # noqa: BLE001 -- a scheduler lost: its futures are cancelled by the client
                 return
-            if n:
-                idle = None
+            if n or not seen:
+                seen, idle = seen or bool(n), None
                 continue
             idle = idle if idle is not None else time.monotonic()
             if time.monotonic() - idle >= NO_WORKERS_TIMEOUT_S:
