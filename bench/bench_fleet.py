@@ -16,6 +16,12 @@ the wall times and the speed-up with the machine's description and load.
 Usage::
 
     python bench/bench_fleet.py [--files 20] [--samples 1e6] [--workers 2] [--dir /tmp/fogdrift_fleet]
+    python bench/bench_fleet.py --adis [--rounds 3]
+
+``--adis``: ``fogdrift batch`` (the command line, one process per run) on the five ADIS16405 sessions
+(``/work/shared/data/adis16405_static/adis16405_imu{1..5}.csv.gz --unit deg/s``), the default scheduler against
+``--scheduler serial`` and ``--scheduler local`` (the default before issue 35), in alternating order each round,
+the load average printed with every run.
 """
 
 from __future__ import annotations
@@ -57,18 +63,56 @@ def _generate(folder: Path, files: int, samples: int) -> list[Path]:
     return out
 
 
+ADIS = [f"/work/shared/data/adis16405_static/adis16405_imu{k}.csv.gz" for k in range(1, 6)]
+
+
+def _adis(rounds: int, root: Path) -> int:
+    """The default scheduler against serial and local on the five ADIS sessions, through the command line."""
+    import subprocess
+
+    print("machine:", json.dumps(_machine()), flush=True)
+    runs = {"default": [], "serial": ["--scheduler", "serial"], "local": ["--scheduler", "local"]}
+    times: dict[str, list[float]] = {k: [] for k in runs}
+    names = list(runs)
+    for r in range(rounds):
+        order = names[r % 3:] + names[:r % 3]
+        for name in order:
+            out = root / f"{name}{r}"
+            load = os.getloadavg()[0]
+            t0 = time.perf_counter()
+            proc = subprocess.run([sys.executable, "-m", "fogdrift", "batch", *ADIS, "--unit", "deg/s", *runs[name],
+                                   "--out", str(out)], capture_output=True, text=True)
+            wall = time.perf_counter() - t0
+            line = next((ln for ln in proc.stdout.splitlines() if " files on " in ln), proc.stderr[-300:])
+            times[name].append(wall)
+            print(f"round {r + 1} {name:8s} {wall:6.1f} s  load {load:.2f}->{os.getloadavg()[0]:.2f}  rc "
+                  f"{proc.returncode}  {line}", flush=True)
+            shutil.rmtree(out, ignore_errors=True)
+    print("\n| scheduler | runs [s] | median [s] |\n| --- | --- | --- |")
+    for name, ts in times.items():
+        print(f"| {name} | {' / '.join(f'{t:.1f}' for t in ts)} | {sorted(ts)[len(ts) // 2]:.1f} |")
+    ratios = [d / s for d, s in zip(times["default"], times["serial"])]
+    print(f"\ndefault / serial per round: {' '.join(f'{x:.2f}' for x in ratios)}; local / serial: "
+          f"{' '.join(f'{l / s:.2f}' for l, s in zip(times['local'], times['serial']))}; load after: {os.getloadavg()}")
+    return 0
+
+
 def main() -> int:
     ap = argparse.ArgumentParser()
+    ap.add_argument("--adis", action="store_true", help="the five ADIS sessions: default vs serial vs local")
+    ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--files", type=int, default=20)
     ap.add_argument("--samples", type=float, default=1e6)
     ap.add_argument("--workers", type=int, default=os.cpu_count())
     ap.add_argument("--dir", default="/tmp/fogdrift_fleet")
     ap.add_argument("--json")
     args = ap.parse_args()
-    from fogdrift.fleet import run_batch
-
     root = Path(args.dir)
     shutil.rmtree(root, ignore_errors=True)
+    if args.adis:
+        return _adis(args.rounds, root)
+    from fogdrift.fleet import run_batch
+
     t0 = time.perf_counter()
     files = _generate(root / "logs", args.files, int(args.samples))
     print(f"generated {len(files)} logs of {int(args.samples)} samples x 3 axes in {time.perf_counter() - t0:.1f} s",

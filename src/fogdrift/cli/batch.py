@@ -76,10 +76,13 @@ def batch(
     = None,
     command: Annotated[str, typer.Option("--command", help=_command_help())] = "allan",
     scheduler: Annotated[Optional[str], typer.Option(
-        "--scheduler", help="Dask scheduler address (tcp://host:8786) of an existing cluster; 'serial' for no Dask. "
-                            "Default: a local cluster of worker processes.")] = None,
+        "--scheduler", help="Dask scheduler address (tcp://host:8786) of an existing cluster; 'local' for a local "
+                            "cluster of worker processes; 'serial' for no Dask. Default: chosen by the work's size "
+                            "(serial below 268 MB of input, for one file or on one usable core; else local).")] = None,
     workers: Annotated[Optional[int], typer.Option("--workers", help="Worker processes of the local cluster "
-                                                                     "(default: the machine's cores).")] = None,
+                                                                     "(default: the usable cores, at most one per "
+                                                                     "file); given, the default is the local "
+                                                                     "cluster.")] = None,
     estimator: EstOpt = "overlapping",
     taus: TausOpt = "octave",
     terms: TermsOpt = "",

@@ -2,18 +2,27 @@
 
 Scheduling (``scheduler``):
 
-* ``None`` (default): a local Dask cluster of worker *processes*, one per core (``workers`` to change it),
-  one thread each; numeric libraries inside a worker get ``cores // workers`` threads so that workers do
-  not oversubscribe the machine.  The cluster listens on 127.0.0.1 only (its scheduler's HTTP server on a free
-  port: distributed's default 8787 may be another cluster's, and taking another port prints a warning).
+* ``None`` (default): chosen by the work's size (:mod:`fogdrift.fleet.schedule`): the serial loop for a small
+  batch (less input than a local cluster's start-up pays for, one file, or one usable core), else a local
+  cluster as with ``"local"``; an explicit ``workers`` asks for the local cluster.
+* ``"local"``: a local Dask cluster of worker *processes*, one per usable core but no more than the files
+  (``workers`` to change it), one thread each; numeric libraries inside a worker get ``cores // workers``
+  threads so that workers do not oversubscribe the machine.  The cluster listens on 127.0.0.1 only (its
+  scheduler's HTTP server on a free port: distributed's default 8787 may be another cluster's, and taking
+  another port prints a warning).
 * ``"tcp://HOST:8786"``: an existing cluster (``dask scheduler`` + ``dask worker`` on other machines); the
   workers need fogdrift installed and must see the input and output paths (a shared file system).
-* ``"serial"``: no Dask, a loop in this process (debugging; the benchmark's reference).
+* ``"serial"``: no Dask, a loop in this process.
 
 Each file is one task (:func:`fogdrift.fleet.tasks.run_file`); a task that fails, or a worker that dies,
-becomes an error row, never a crashed batch.  Results are collected as they finish (``progress``); the stages
-(the cluster starting, the files running, the summary being written) are announced at
-:func:`fogdrift.interrupt.checkpoint` (the CLI shows them).
+becomes an error row, never a crashed batch.  A file whose worker process dies (killed, out of memory) fails
+with one line and is not retried on the local cluster (:data:`ALLOWED_FAILURES`: the worker restarts for the
+other files; a re-run of the batch retries it and skips the finished ones); its dead worker's lock and temporary
+files are removed.  On an existing cluster the scheduler's own ``distributed.scheduler.allowed-failures``
+decides (Dask's default: 3 retries).  A lost scheduler fails every file not finished with one line each; a
+cluster whose workers have all gone (none restarted) for :data:`NO_WORKERS_TIMEOUT_S` does the same.  Results are collected as they
+finish (``progress``); the stages (the cluster starting, the files running, the summary being written) are
+announced at :func:`fogdrift.interrupt.checkpoint` (the CLI shows them).
 
 Outputs: the batch folder is a :class:`BatchOutputDir` (a :class:`fogdrift.output.OutputDir` that also
 counts the files whose folders are finished); each file's folder is its own ``OutputDir`` (written by the
@@ -46,6 +55,7 @@ from ..io.load import check_load_options
 from ..io.readers.base import require
 from ..output import LOCK, TMP_PREFIX, OutputDir, FolderLock, active, recover, remove_stale_temporaries
 from .commands import command_spec, spec_from_settings
+from .schedule import choose, usable_cores, work_bytes
 from .summary import COLUMNS, write_summary
 from .tasks import MANIFEST, FileTask, run_file
 
@@ -57,6 +67,13 @@ CONNECT_TIMEOUT_S = 20.0
 HTTP_ADDRESS = "127.0.0.1:0"
 #: Seconds to wait for killed workers' folder locks to die with them (the kernel drops a lock as its process exits).
 STALE_LOCK_WAIT_S = 2.0
+#: Retries of a file whose worker process died, on the local cluster (distributed's ``allowed-failures``): none,
+#: the file fails with one line (a worker dies of the file it runs: memory, most often) and a re-run retries it.
+ALLOWED_FAILURES = 0
+#: Seconds a cluster may have no worker left (all died, none restarted) before the files not finished fail.
+NO_WORKERS_TIMEOUT_S = 60.0
+#: Seconds between two looks at the cluster's workers while files run.
+WATCH_INTERVAL_S = 1.0
 
 #: File names written into the batch folder.
 SUMMARY = "summary.parquet"
@@ -201,23 +218,26 @@ def _folder(name: str) -> str:
 
 
 def _worker_env(n_workers: int) -> dict:
-    threads = str(max(1, (os.cpu_count() or 1) // max(1, n_workers)))
+    threads = str(max(1, usable_cores() // max(1, n_workers)))
     return {k: threads for k in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
 
 
-def _error_rows(task: FileTask, exc: BaseException) -> list[dict]:
+def _error_rows(task: FileTask, exc: BaseException, lost: str | None = None) -> list[dict]:
+    """The error row of a task whose result did not come back; ``lost``: why the cluster cancelled it."""
     if type(exc).__name__ == "KilledWorker":  # distributed: every worker that ran it died (memory, most often)
-        error = (f"KilledWorker: the worker process running {task.file} died, {_retries(exc)}(out of memory is the "
+        error = (f"KilledWorker: the worker process running {task.file} died{_retries(exc)} (out of memory is the "
                  "usual cause: run it alone, or with fewer --workers)")
+    elif lost:
+        error = f"not finished: {lost}; a re-run of the batch computes it (finished files are skipped)"
     else:
-        error = f"{type(exc).__name__}: {exc} (the task or its worker failed)"
+        error = f"{type(exc).__name__}: {' '.join(str(exc).split())} (the task or its worker failed)"
     return [{"file": task.file, "path": task.path, "command": task.command, "out_dir": task.rel_out,
              "settings_sha256": task.settings_sha256, "status": "error", "error": error, "wall_s": 0.0}]
 
 
 def _retries(exc: BaseException) -> str:
     m = re.search(r"on (\d+) different workers", str(exc))
-    return f"on {m.group(1)} workers in turn " if m else ""
+    return f", on {m.group(1)} workers in turn" if m and int(m.group(1)) > 1 else ""
 
 
 def run_batch(inputs, out_dir, *, command: str = "allan", settings: dict | None = None, pattern: str | None = None,
@@ -242,10 +262,12 @@ def run_batch(inputs, out_dir, *, command: str = "allan", settings: dict | None 
         columns); validated before any work.
     pattern : str, optional
         Glob for the files inside folders (``"*.csv.gz"``); also filters explicit files.
-    scheduler : None, "serial" or str
-        See the module docstring: local process cluster, in-process loop, or a scheduler address.
+    scheduler : None, "serial", "local" or str
+        See the module docstring: chosen by the work's size, in-process loop, local process cluster, or a
+        scheduler address.
     workers : int, optional
-        Workers of the local cluster (default: the machine's cores).
+        Workers of the local cluster (default: the usable cores, at most one per file); given, the default
+        scheduler is the local cluster.
     page : bool
         Write ``fleet.html``.
     progress : callable, optional
@@ -306,13 +328,15 @@ def _run(od, paths, spec, settings, scheduler, workers, page, progress, flags, t
         interrupt.check()
 
     interrupt.check()
-    if scheduler == "serial":
-        used = "serial (in-process loop)"
+    choice = choose(len(tasks), work_bytes(paths), usable_cores()) if scheduler is None and workers is None else None
+    if scheduler == "serial" or (choice is not None and not choice.dask):
+        used = "serial (in-process loop" + (f"; chosen: {choice.reason})" if choice else ")")
         interrupt.checkpoint(f"{len(tasks)} files, serial")
         for i, task in enumerate(tasks):
             done(i, run_file(task))
     else:
-        used = _run_dask(tasks, scheduler, workers, done)
+        used = _run_dask(tasks, None if scheduler == "local" else scheduler,
+                         workers or (choice.workers if choice else None), done)
     interrupt.checkpoint("writing " + " and ".join((SUMMARY,) + ((PAGE,) if page else ())))
     rows = [{name: row.get(name) for name, _, _ in COLUMNS} for i in range(len(tasks)) for row in results[i]]
     summary = write_summary(rows, out / SUMMARY)
@@ -399,9 +423,10 @@ def _ignore_sigint() -> bool:
 
 def _run_dask(tasks, scheduler, workers, done) -> str:
     distributed = require("distributed", "fleet", "running a batch on Dask")
-    cluster = client = None
+    cluster = client = watch = None
     before = None                                # local cluster: this process's children before it started
-    interrupted = False
+    interrupted = lost = False
+    dead = []                                    # tasks whose worker died: their folders' locks to remove
     muted = {}
     try:
         if scheduler:
@@ -413,7 +438,7 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
                     from None
             used = f"Dask cluster at {scheduler}"
         else:
-            n = int(workers or os.cpu_count() or 1)
+            n = int(workers or min(usable_cores(), len(tasks)) or 1)
             if n < 1:
                 raise ConfigError(f"workers must be >= 1; got {workers!r} in {{opt:workers}}")
             interrupt.checkpoint(f"starting a local Dask cluster of {n} worker processes")
@@ -424,44 +449,155 @@ def _run_dask(tasks, scheduler, workers, done) -> str:
                 before = set(_children())
                 cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                                    host="127.0.0.1", dashboard_address=HTTP_ADDRESS,
-                                                   silence_logs=logging.ERROR, env=_worker_env(n))
+                                                   silence_logs=logging.CRITICAL, env=_worker_env(n),
+                                                   scheduler_kwargs={"allowed_failures": ALLOWED_FAILURES})
                 client = distributed.Client(cluster)
                 client.run(_ignore_sigint)               # each worker process's main thread
             used = f"local Dask cluster, {n} worker processes"
         interrupt.checkpoint(f"{len(tasks)} files on the {used}")  # stops after a Ctrl-C while the cluster started
-        futures = {client.submit(run_file, t, pure=False, key=f"fogdrift-{i}-{t.settings_sha256[:8]}"): i
-                   for i, t in enumerate(tasks)}
-        for fut in distributed.as_completed(futures):
+        # no more tasks in the cluster than threads to run them: a worker then holds only the file it runs, and a
+        # worker that dies fails that file alone (distributed counts every task sent to a dead worker as one it ran)
+        futures: dict = {}
+        queue = iter(enumerate(tasks))
+
+        def submit() -> list:
+            new = []
+            while not lost and len(futures) - finished[0] < _slots(client):
+                i, t = next(queue, (None, None))
+                if t is None:
+                    break
+                new.append(client.submit(run_file, t, pure=False, key=f"fogdrift-{i}-{t.settings_sha256[:8]}"))
+                futures[new[-1]] = i
+            return new
+
+        finished = [0]
+        watch = _Watch(client, futures, f"Dask cluster at {scheduler}" if scheduler else "local Dask cluster")
+        running = distributed.as_completed(submit())
+        why = None
+        for fut in running:
             i = futures[fut]
+            finished[0] += 1
             try:
                 rows = fut.result()
             except Exception as exc:  # noqa: BLE001 -- a killed worker, a lost task: an error row
-                rows = _error_rows(tasks[i], exc)
+                why = _lost(exc, scheduler, watch) or why
+                lost = lost or why is not None
+                if lost and not muted:   # the client's reconnection attempts would log ERRORs: the rows say it
+                    muted = _mute_dask_logs()
+                if type(exc).__name__ == "KilledWorker":
+                    dead.append(tasks[i])
+                rows = _error_rows(tasks[i], exc, why)
             done(i, rows)
+            for new in submit():
+                running.add(new)
+        for i, t in queue:       # never sent: the cluster was lost first
+            done(i, _error_rows(t, RuntimeError("not started"), why))
     except KeyboardInterrupt:
         interrupted = True
-        # the in-process scheduler would log the gather the interruption cut short ("Couldn't gather keys")
-        # as an ERROR after the one interrupted: line; the batch is over, say nothing more
-        muted = {name: logging.getLogger(name).level for name in ("distributed", "tornado")}
-        for name in muted:
-            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
         raise
     finally:
+        if watch is not None:
+            watch.stop()
+        if interrupted and not muted:
+            # the in-process scheduler would log the gather the interruption cut short ("Couldn't gather keys"), a
+            # client that lost its scheduler its reconnection cut short, as an ERROR with a traceback after the
+            # batch's own lines; the batch is over, say nothing more
+            muted = _mute_dask_logs()
         with interrupt.shielded() if interrupted else contextlib.nullcontext():
-            _shut_down(client, cluster, before, tasks, interrupted)
+            _shut_down(client, cluster, before, tasks, interrupted, dead, quick=interrupted or lost)
         for name, level in muted.items():          # closed: a library caller's logging as it was
             logging.getLogger(name).setLevel(level)
     return used
 
 
-def _shut_down(client, cluster, before, tasks, interrupted: bool) -> None:
+def _slots(client) -> int:
+    """Tasks the cluster can run at once: its workers' threads (at least 1), asked at each result (a cluster may
+    grow or shrink while the batch runs)."""
+    try:
+        return max(1, sum(client.nthreads().values()))
+    except Exception:  # noqa: BLE001 -- a scheduler being lost: the futures say so
+        return 1
+
+
+def _mute_dask_logs() -> dict:
+    """Silence distributed's and tornado's loggers (each one: distributed's logging configuration gives some, like
+    ``distributed.client``, levels of their own); returns their levels as they were."""
+    manager = logging.Logger.manager
+    names = [n for n in list(manager.loggerDict) if n.split(".")[0] in ("distributed", "tornado")]
+    muted = {}
+    for name in names + ["distributed", "tornado"]:
+        log = logging.getLogger(name)
+        muted.setdefault(name, log.level)
+        log.setLevel(logging.CRITICAL + 1)
+    return muted
+
+
+def _lost(exc: BaseException, scheduler, watch) -> str | None:
+    """Why a task's future was cancelled under it (the scheduler lost, no worker left), or None."""
+    if watch.reason:
+        return watch.reason
+    if "scheduler-connection-lost" in str(exc) or type(exc).__name__ == "CommClosedError":
+        return f"the Dask scheduler {scheduler or '(local)'} was lost (its connection closed) before it finished"
+    return None
+
+
+def _copy(futures: dict) -> list:
+    """The keys of a dict another thread adds to (a copy taken while it grows is taken again)."""
+    for _ in range(100):
+        try:
+            return list(futures)
+        except RuntimeError:
+            continue
+    return []
+
+
+class _Watch:
+    """A thread that looks at the cluster's workers every :data:`WATCH_INTERVAL_S` while the files run; after
+    :data:`NO_WORKERS_TIMEOUT_S` without any, once it has had one, it cancels the futures not done (each becomes an error row saying
+    so), so that a cluster whose workers all died cannot keep the batch waiting for ever."""
+
+    def __init__(self, client, futures, where: str):
+        import threading
+
+        self.client, self.futures, self.where = client, futures, where
+        self.reason = None
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="fogdrift-batch-watch", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        idle = None
+        seen = False    # a cluster that has had no worker yet may be starting them (an adaptive one): waited for
+        while not self._stop.wait(WATCH_INTERVAL_S):
+            try:
+                n = len(self.client.nthreads())
+            except Exception:  # noqa: BLE001 -- a scheduler lost: its futures are cancelled by the client
+                return
+            if n or not seen:
+                seen, idle = seen or bool(n), None
+                continue
+            idle = idle if idle is not None else time.monotonic()
+            if time.monotonic() - idle >= NO_WORKERS_TIMEOUT_S:
+                self.reason = (f"the {self.where} had no worker for {NO_WORKERS_TIMEOUT_S:g} s "
+                               "(all died, none restarted)")
+                with contextlib.suppress(Exception):
+                    self.client.cancel([f for f in _copy(self.futures) if not f.done()], reason="no-workers")
+                return
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=5)
+
+
+def _shut_down(client, cluster, before, tasks, interrupted: bool, dead=(), quick: bool = False) -> None:
     """Close the client and the cluster; a local cluster leaves no process and no lock file behind.
 
     After an interruption its workers are killed first (their tasks cannot be stopped any other way), the
     cluster is closed without waiting, and the worker processes still there (a nanny may have started another)
     are killed too.  Every process the local cluster started (``before``: this process's children before it
     started; None for a ``tcp://`` scheduler, whose workers are not ours) has ended when this returns; then
-    the lock and temporary files the killed ones left in the files' folders are removed.  The watchdog of the
+    the lock and temporary files the killed ones, and the workers that died running ``dead`` (tasks), left in the
+    files' folders are removed.  ``quick``: close without waiting (an interruption, a lost scheduler).  The watchdog of the
     CLI waits for this (:func:`fogdrift.interrupt.shielded`), so a loaded machine does not cut it short.
     """
     killed = []
@@ -469,11 +605,13 @@ def _shut_down(client, cluster, before, tasks, interrupted: bool) -> None:
         if cluster is not None:
             _stop_restarts(cluster)
         killed += _end_processes(_children(exclude=before))
-    _close(client, cluster, quick=interrupted)
+    _close(client, cluster, quick=quick)
     if before is not None:
         killed += _end_processes(_children(exclude=before))  # a graceful close leaves none; a quick one may
     if killed:
         _remove_temporaries(tasks, killed=killed)
+    elif dead:
+        _remove_temporaries(list(dead))
 
 
 @contextlib.contextmanager

@@ -14,6 +14,8 @@ exceptions (a bug, memory) are not cached and write ``error.txt`` with the trace
 from __future__ import annotations
 
 import json
+import os
+import signal
 import time
 import traceback
 import warnings
@@ -33,6 +35,10 @@ __all__ = ["FileTask", "run_file", "load_record", "split_by_quantity", "MANIFEST
 
 #: Name of the per-file manifest, written last.
 MANIFEST = "batch.json"
+#: Test hook, inert unless set: ``FILE:PID`` makes the task of the batch file ``FILE`` (its display name) send
+#: SIGKILL to process ``PID`` (``self``: the worker process running it) once it holds its folder's lock, so that
+#: tests kill a worker or a scheduler mid-batch at an event, not a time (tests/test_fleet_dying.py).
+TEST_KILL_ENV = "FOGDRIFT_TEST_KILL"
 
 
 @dataclass(frozen=True)
@@ -121,6 +127,15 @@ def _warning_text(w, flags) -> str:
     return f"{w.category.__name__}: {render_options(str(w.message), flags)}"
 
 
+def _test_kill(task: FileTask) -> None:
+    """The :data:`TEST_KILL_ENV` hook (nothing unless the variable is set and names this task's file)."""
+    hook = os.environ.get(TEST_KILL_ENV)
+    if hook:
+        name, _, pid = hook.rpartition(":")
+        if name == task.file:
+            os.kill(os.getpid() if pid == "self" else int(pid), signal.SIGKILL)
+
+
 def run_file(task: FileTask) -> list[dict]:
     """Process one input; returns its summary rows (one per axis, or one error row).
 
@@ -142,6 +157,7 @@ def run_file(task: FileTask) -> list[dict]:
     caught = []
     notes = []
     with OutputDir(out, command=f"batch {task.command}", create_parents=True, protect=[task.path]) as od:
+        _test_kill(task)
         try:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
