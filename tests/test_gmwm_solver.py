@@ -144,6 +144,10 @@ def test_an_active_bound_is_held_as_least_squares_holds_it(model, theta, which, 
         assert np.all(x >= prob.lo) and np.all(x <= prob.hi)
         np.testing.assert_allclose(cost, res.cost, rtol=1e-10)
         np.testing.assert_allclose(x, res.x, atol=1e-5)
+        for budget in range(2, min(nfev, res.nfev) - 1):  # the path to it: the same steps off and along the bound
+            rb = _scipy(prob, z0, budget)
+            xb, cb, sb, nb = _compiled(prob, z0, budget)
+            np.testing.assert_allclose(xb, rb.x, rtol=0, atol=1e-7)
 
 
 def test_a_run_handed_back_undecided_is_solved_by_least_squares(monkeypatch):
