@@ -20,7 +20,13 @@ like any rounding.  The optima agree to the optimiser's tolerance (tested agains
 
 Whatever the compiled run cannot decide the way SciPy would (a non-finite residual at the start, a non-finite scaled
 Jacobian, a degenerate trust-region intersection, where SciPy raises) it reports as not done
-(``status == _FALLBACK``); the caller then runs ``least_squares`` itself, which decides as before.
+(``status == FALLBACK``); the caller then runs ``least_squares`` itself, which decides as before.
+
+Compilation: numba compiles the solver on its first use (about half a minute on a busy 2-core machine) and caches
+it beside this file; later processes load it in a fraction of a second.  The cache holds the WV kernel as it was
+when the solver was compiled (numba does not follow a callee into another module): after editing the kernel in
+:mod:`fogdrift.gmwm.processes`, touch this file so that the solver is compiled again
+(``tests/test_gmwm_solver.py``, which compares with ``least_squares`` on the live kernel, fails on a stale copy).
 """
 
 from __future__ import annotations
