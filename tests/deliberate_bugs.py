@@ -202,3 +202,40 @@ H_TESTS36 = [
 if __name__ == "__main__":
     BUGS[:] = H_TESTS36
     main()
+
+
+# H-lm (issue 35 deliverable 2: the compiled GMWM solver, gmwm/solver.py).  Each entry is one plausible one-line slip
+# in the port of SciPy's trust-region-reflective least squares and the test that must fail on it; each was applied
+# by hand when tests/test_gmwm_solver.py was written (the first two passed its first version: its far starts and the
+# budget-by-budget path to an active bound were added for them).
+H_TESTS35 = [
+    ("GMWM solver: Levenberg-Marquardt parameter not carried between trust-region tries",
+     "src/fogdrift/gmwm/solver.py", "            alpha *= delta / delta_new\n", "            alpha *= 1.0\n",
+     ["tests/test_gmwm_solver.py"]),
+    ("GMWM solver: the step that hits a bound not reflected",
+     "src/fogdrift/gmwm/solver.py", "            r_h[i] *= -1\n", "            r_h[i] *= 1\n",
+     ["tests/test_gmwm_solver.py"]),
+    ("GMWM solver: Jacobian scale not kept at its running maximum",
+     "src/fogdrift/gmwm/solver.py", "            scale_inv = np.maximum(np.sqrt(_col_sumsq(J)), scale_inv)\n",
+     "            scale_inv = np.sqrt(_col_sumsq(J))\n",
+     ["tests/test_gmwm_solver.py"]),
+    ("GMWM solver: no step back from the bound (theta = 1)",
+     "src/fogdrift/gmwm/solver.py", "        theta_step = th if th > 0.995 else 0.995\n", "        theta_step = 1.0\n",
+     ["tests/test_gmwm_solver.py"]),
+    ("GMWM solver: step to the bound by the nearer instead of the farther bound",
+     "src/fogdrift/gmwm/solver.py", "            steps[i] = _pmax((lb[i] - x[i]) / s[i], (ub[i] - x[i]) / s[i])\n",
+     "            steps[i] = min((lb[i] - x[i]) / s[i], (ub[i] - x[i]) / s[i])\n",
+     ["tests/test_gmwm_solver.py"]),
+    ("GMWM solver: scaled step not cut at the bound",
+     "src/fogdrift/gmwm/solver.py", "    p_h = p_h * p_stride\n", "    p_h = p_h * 1.0\n",
+     ["tests/test_gmwm_solver.py"]),
+    ("GMWM solver: trust region never grown",
+     "src/fogdrift/gmwm/solver.py", "                delta_new *= 2.0\n", "                delta_new *= 1.0\n",
+     ["tests/test_gmwm_solver.py"]),
+    ("GMWM solver: Coleman-Li scaling towards the wrong bound",
+     "src/fogdrift/gmwm/solver.py", "            v[i] = x[i] - lb[i]\n", "            v[i] = ub[i] - x[i]\n",
+     ["tests/test_gmwm_solver.py"]),
+]
+if __name__ == "__main__":
+    BUGS[:] = H_TESTS35
+    main()

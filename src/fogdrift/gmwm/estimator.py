@@ -2,7 +2,8 @@
 
 ``theta_hat = argmin_theta (nu_hat - nu(theta))^T Omega (nu_hat - nu(theta))`` ([GMWM2013]_;
 [GMWM]_ §3), computed as a Cholesky-whitened nonlinear least-squares problem
-(``scipy.optimize.least_squares``, trust-region reflective, tolerances 1e-12) in the free
+(trust-region reflective, tolerances 1e-12: the algorithm of ``scipy.optimize.least_squares``, run compiled by
+:mod:`fogdrift.gmwm.solver`, SciPy itself where that hands a run back) in the free
 parameters ``z = log(theta)`` (``log beta`` for a GM, so ``1 - phi`` is never formed).
 
 Weighting steps: step 1 with ``Omega_1 = diag(eta3_j / (2 nu_hat_j^2))`` (the eta3
@@ -59,6 +60,7 @@ from .covariance import model_wvar_covariance
 from .ieee import to_ieee
 from .processes import LatentModel, parse_model
 from .simulate import simulate_latent
+from .solver import FALLBACK, trf_solve
 from .starts import bounds as _bounds
 from .starts import starts as _starts
 from .wvar import WvarResult, haar_wvar
@@ -267,6 +269,10 @@ class _Problem:
         self.W = whitener
         self.lo, self.hi = _bounds(model, self.nu_hat, self.tau)
         self._ev = model.evaluator(self.tau)  # the WV and Jacobian at tau for the optimiser (_fun, _jac)
+        # the compiled solver's whitening: diagonal weights, or C^-1 (an empty array marks the other)
+        self._compiled = model._compiled_ok
+        self._w = whitener.w if whitener.C is None else np.empty(0)
+        self._cinv = np.empty((0, 0)) if whitener.C is None else np.ascontiguousarray(whitener.Cinv)
 
     # The optimiser's residuals and Jacobian (:meth:`solve`): the same values as :meth:`resid` and :meth:`jac`
     # (same operations: tested bit for bit), without their per-call overhead (argument conversion, validation of
@@ -311,6 +317,24 @@ class _Problem:
         return float(r @ r)
 
     def solve(self, z0, max_nfev=2000):
+        """Minimise Q from ``z0`` (clipped into the bounds): ``(z, q, converged)``.
+
+        The compiled trust-region-reflective solver (:func:`fogdrift.gmwm.solver.trf_solve`, the algorithm of
+        ``least_squares(method="trf", x_scale="jac")``); :meth:`solve_scipy` where it hands the run back undecided
+        (a start or step where SciPy raises) or the model has a registered process without a compiled kernel.
+        """
+        if self._compiled:
+            try:
+                x, cost, status, _ = trf_solve(self._ev, self._w, self._cinv, self.nu_hat, self.lo, self.hi,
+                                               self.clipped(z0), max_nfev)
+            except ValueError:  # an SVD that did not converge (numpy.linalg.LinAlgError): SciPy decides
+                status = FALLBACK
+            if status != FALLBACK:
+                return x, float(2.0 * cost), bool(status > 0)
+        return self.solve_scipy(z0, max_nfev)
+
+    def solve_scipy(self, z0, max_nfev=2000):
+        """:meth:`solve` by ``scipy.optimize.least_squares`` (trf, bounds, ``x_scale="jac"``, tolerances 1e-12)."""
         z0 = self.clipped(z0)
         with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)

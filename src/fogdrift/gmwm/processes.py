@@ -510,6 +510,13 @@ class WvEvaluator:
                      self._none, False)
         return self._total
 
+    def kernel_args(self) -> tuple:
+        """What a compiled caller passes to the kernel itself (:mod:`fogdrift.gmwm.solver`): ``(codes, starts, t,
+        half, flick, gm_beta, dr, n_comp)``; ``gm_beta`` the parameter index of each GM's ``beta`` (empty without a
+        GM), ``dr`` that of the drift slope (-1 without one), ``n_comp`` the number of components."""
+        gm = self._gm_beta if self._gm_beta is not None else np.empty(0, dtype=np.int64)
+        return (self._codes, self._starts, self._t, self._half, self._flick, gm, self._dr, self._comps.shape[0])
+
     def jac(self, theta) -> np.ndarray:
         """``d nu2(tau) / d log theta``, ``(n_tau, n_params)`` (a work array, see the class notes)."""
         if self._gm_beta is None:
