@@ -73,6 +73,9 @@ def test_the_gmwm_path_still_loads_it_on_use():
     assert "from ..gmwm.analysis import analyse_gmwm" in src.split("def run_analysis", 1)[1]
     mods = _modules("import fogdrift.pipeline\nfrom fogdrift.gmwm.analysis import analyse_gmwm")
     assert "fogdrift.gmwm.estimator" in mods
+    # GMWM's chi-squared and normal laws come from scipy.special (noise.distributions): no scipy.stats (1.2 s of
+    # a `fogdrift noise` profile); least_squares (scipy.optimize) is imported only by the fallback that calls it
+    assert "scipy.stats" not in mods
 
 
 @pytest.fixture(scope="module")

@@ -51,11 +51,12 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import linalg, optimize, stats
+from scipy import linalg
 from scipy.linalg import lapack
 
 from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError, NotFittedError
 from ..noise.discrepancy import discrepancy_relcov
+from ..noise.distributions import chi2_sf
 from .covariance import model_wvar_covariance
 from .ieee import to_ieee
 from .processes import LatentModel, parse_model
@@ -335,6 +336,8 @@ class _Problem:
 
     def solve_scipy(self, z0, max_nfev=2000):
         """:meth:`solve` by ``scipy.optimize.least_squares`` (trf, bounds, ``x_scale="jac"``, tolerances 1e-12)."""
+        from scipy import optimize  # only for the fallback: importing scipy.optimize costs a command ~0.5 s
+
         z0 = self.clipped(z0)
         with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
@@ -558,7 +561,7 @@ def _finish(wv: WvarResult, mdl: LatentModel, idx, theta1, q1, sols1, W1, ok1, *
     sd = np.sqrt(np.diag(Vf))
     df = J - mdl.n_params
     j_q = _j_statistic(mdl, theta, wv, idx, nu_hat - nu_fit)
-    jp = float(stats.chi2.sf(j_q, df)) if df > 0 and math.isfinite(j_q) else float("nan")
+    jp = float(chi2_sf(j_q, df)) if df > 0 and math.isfinite(j_q) else float("nan")
     at_bound = tuple(n for n, zi, lo, hi in zip(mdl.param_names, z, prob.lo, prob.hi)
                      if zi - lo < 1e-3 or hi - zi < 1e-3)
     boot_lo = boot_hi = None

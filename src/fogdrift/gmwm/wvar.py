@@ -44,11 +44,12 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy import stats
+from scipy.special import ndtr
 
 from .._util import check_series
 from ..allan.sums import AllanSums
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
+from ..noise.distributions import chi2_ppf
 from ..units import check_dt_s, rate_scale_to_dph
 
 __all__ = [
@@ -94,8 +95,8 @@ def eta3_ci(nu2, eta, level=0.95):
     eta = np.asarray(eta, dtype=np.float64)
     if nu2.ndim == 2 and eta.ndim == 1:
         eta = eta[:, None]
-    lo = eta * nu2 / stats.chi2.ppf(1.0 - a / 2.0, eta)
-    hi = eta * nu2 / stats.chi2.ppf(a / 2.0, eta)
+    lo = eta * nu2 / chi2_ppf(1.0 - a / 2.0, eta)
+    hi = eta * nu2 / chi2_ppf(a / 2.0, eta)
     return lo, hi
 
 
@@ -250,8 +251,8 @@ class WvarResult:
 # ----------------------------------------------------------------------------------------
 def _huber_terms(c: float):
     """delta(c) = E min(Z^2, c^2) and the Gaussian efficiency of Huber's proposal-2 scale."""
-    phi = stats.norm.pdf(c)
-    p_in = 2.0 * stats.norm.cdf(c) - 1.0  # P(|Z| < c)
+    phi = np.exp(-c**2 / 2.0) / np.sqrt(2 * np.pi)  # the standard normal density (as scipy's norm.pdf)
+    p_in = 2.0 * ndtr(c) - 1.0  # P(|Z| < c)
     e_z2_in = p_in - 2.0 * c * phi  # E[Z^2 1(|Z|<c)]
     delta = e_z2_in + c * c * (1.0 - p_in)
     # psi(z) = min(z^2, c^2) - delta; E psi^2 and E[z psi'(z)] = E[2 z^2 1(|z|<c)]
