@@ -204,8 +204,8 @@ if __name__ == "__main__":
     main()
 
 
-# Issue 35 item 5: the fused exact-ADEV kernel (src/fogdrift/allan/_kernels.py, _fused2_py and its helpers).  Each
-# entry is one plausible one-line bug in the carried block sum or the window bounds; tests/test_allan_fused.py
+# Issue 35 item 5: the fused exact-ADEV kernel (src/fogdrift/allan/_kernels.py, _fused2_py and its helpers).
+# Each entry is one plausible one-line bug in the carried block sum or the window bounds; tests/test_allan_fused.py
 # compares the kernel with the angle-array kernel bit for bit, so every one fails it (applied by hand: all caught).
 H_TESTS35_FUSED = [
     ("fused ADEV: the carried block sum misses the last sample before a window",
@@ -213,7 +213,8 @@ H_TESTS35_FUSED = [
      "        for i in range(((x - 1) // block) * block, x - 2):\n", ["tests/test_allan_fused.py"]),
     ("fused ADEV: a long-lag stream's carry starts one point early",
      "src/fogdrift/allan/_kernels.py", "            runs[l] = _run_before(y, mu, block, min(k0 + lags[l], n_phase))\n",
-     "            runs[l] = _run_before(y, mu, block, min(k0 + lags[l] - 1, n_phase))\n", ["tests/test_allan_fused.py"]),
+     "            runs[l] = _run_before(y, mu, block, min(k0 + lags[l] - 1, n_phase))\n",
+     ["tests/test_allan_fused.py"]),
     ("fused ADEV: the last start index of a long-lag tau dropped",
      "src/fogdrift/allan/_kernels.py",
      "                    kend = min(k0 + block, n_phase - 2 * m)\n                    if kend <= k0:\n",
