@@ -21,7 +21,7 @@ per-round ratios.  The fused and angle-array sums are checked equal bit for bit.
 on the same seeded data after loading the numba cache: the case of a script or a CLI run, where the angle
 array's 8 (N + 1) bytes are page-faulted in by that call (in the interleaved rounds above the process has
 freed and re-allocated such arrays before, which makes the angle-array path cheaper).  Wall time of the call,
-load, and the peak RSS of the process (``ru_maxrss``) are printed.
+load, and the peak RSS of the process (``VmHWM``) are printed.
 
 Usage::
 
@@ -89,6 +89,19 @@ def _timed(fn):
     return out, time.perf_counter() - t0, os.getloadavg()[0]
 
 
+def _peak_rss_gb() -> float:
+    """Peak RSS of this process's memory image in GB (``VmHWM``; ``ru_maxrss`` would carry the parent's peak
+    across fork and exec)."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024 / 1e9
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
+
+
 def _once(mode: str, n: int, dt: float) -> None:
     """One call in this (fresh) process: ``mode`` "array" (fused kernel off) or "fused"; prints one line."""
     from fogdrift.allan import _kernels as K
@@ -99,7 +112,7 @@ def _once(mode: str, n: int, dt: float) -> None:
     if mode == "array":
         K.fused_lags = lambda n_, m_: None
     r, wall, load = _timed(lambda: allan_variance(y, dt, taus="octave"))
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
+    rss = _peak_rss_gb()
     print(f"{mode} {wall:.3f} {load:.2f} {rss:.3f} {r.avar_dph2.sum()!r}", flush=True)
 
 
