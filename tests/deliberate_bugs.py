@@ -236,6 +236,26 @@ H_TESTS35 = [
      "src/fogdrift/gmwm/solver.py", "            v[i] = x[i] - lb[i]\n", "            v[i] = ub[i] - x[i]\n",
      ["tests/test_gmwm_solver.py"]),
 ]
+# Issue 35 item 5: the fused exact-ADEV kernel (src/fogdrift/allan/_kernels.py, _fused2_py and its helpers).
+# Each entry is one plausible one-line bug in the carried block sum or the window bounds; tests/test_allan_fused.py
+# compares the kernel with the angle-array kernel bit for bit, so every one fails it (applied by hand: all caught).
+H_TESTS35_FUSED = [
+    ("fused ADEV: the carried block sum misses the last sample before a window",
+     "src/fogdrift/allan/_kernels.py", "        for i in range(((x - 1) // block) * block, x - 1):\n",
+     "        for i in range(((x - 1) // block) * block, x - 2):\n", ["tests/test_allan_fused.py"]),
+    ("fused ADEV: a long-lag stream's carry starts one point early",
+     "src/fogdrift/allan/_kernels.py", "            runs[l] = _run_before(y, mu, block, min(k0 + lags[l], n_phase))\n",
+     "            runs[l] = _run_before(y, mu, block, min(k0 + lags[l] - 1, n_phase))\n",
+     ["tests/test_allan_fused.py"]),
+    ("fused ADEV: the last start index of a long-lag tau dropped",
+     "src/fogdrift/allan/_kernels.py",
+     "                    kend = min(k0 + block, n_phase - 2 * m)\n                    if kend <= k0:\n",
+     "                    kend = min(k0 + block, n_phase - 2 * m - 1)\n                    if kend <= k0:\n",
+     ["tests/test_allan_fused.py"]),
+    ("fused ADEV: the near window not refilled in the record's last block",
+     "src/fogdrift/allan/_kernels.py", "                if k0 + block < n_phase:\n",
+     "                if k0 + 2 * block < n_phase:\n", ["tests/test_allan_fused.py"]),
+]
 if __name__ == "__main__":
-    BUGS[:] = H_TESTS35
+    BUGS[:] = H_TESTS35 + H_TESTS35_FUSED
     main()

@@ -1,6 +1,6 @@
 """Compiled kernels of the Allan family (numba; compiled lazily on first use, cached on disk).
 
-Three kernels serve every statistic of :data:`fogdrift.allan.statistics.STATISTICS`:
+These kernels serve every statistic of :data:`fogdrift.allan.statistics.STATISTICS`:
 
 ``phase``
     the mean-removed angle ``p_0 = 0, p_k = sum_{i<k} (y_i - mean)`` by blocked, compensated
@@ -13,6 +13,12 @@ Three kernels serve every statistic of :data:`fogdrift.allan.statistics.STATISTI
     the second difference of m-point window sums ``W_k = sum_{i=k}^{k+m-1} p_i`` (modified
     Allan), stepped along the record by its third-difference increment and restarted at every
     block from a local reference point, so that rounding stays at the level of one block.
+``fused2``
+    the overlapping Allan block sums of ``diff2`` straight from the rate, for grids with few lags
+    of at least one block (octave, decade): the angle is rebuilt block by block, by the additions
+    of ``phase``, only where the operator reads it (the current block and one block-long window
+    per long lag), so the (N + 1)-point angle array is never stored or page-faulted in, and the
+    sums are those of ``phase`` + ``diff2`` bit for bit.
 
 The operators themselves (coefficients, averaging) are data in ``statistics.py``; these
 functions only evaluate them.  All kernels assume clean input (checked by the caller).
@@ -22,7 +28,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["phase_dph_samples", "operator_sums", "block_sums2", "threads_for", "OPERATORS", "BLOCK", "PARALLEL_MIN"]
+__all__ = ["phase_dph_samples", "operator_sums", "block_sums2", "allan_sums_fused", "fused_lags", "fused_part",
+           "threads_for", "OPERATORS", "BLOCK", "PARALLEL_MIN", "FUSED_MIN", "FUSED_MAX_LAGS"]
 
 #: Start indices per block of the ``diff`` kernel (also the unit of pairwise summation).
 BLOCK = 65536
@@ -37,18 +44,16 @@ WINDOW_BLOCK = 4096
 SUM_FASTMATH = frozenset({"reassoc", "contract"})
 
 prange = range  # replaced by numba.prange in _compiled()
-_sq2 = _sq3 = None  # replaced by the compiled helpers in _compiled()
+_sq2 = _sq3 = _fill = _run_before = None  # replaced by the compiled helpers in _compiled()
 _KERNELS: dict = {}
 
 
-def _phase_py(y, mu, out, block):  # pragma: no cover - runs compiled
-    """out[0] = 0, out[k] = sum_{i<k} (y[i] - mu). Clean input assumed.
+def _offsets_py(y, mu, block):  # pragma: no cover - runs compiled
+    """Angle at the start of every block of ``block`` samples: ``offsets[b] = sum_{i < b block} (y[i] - mu)``.
 
-    Blocked summation, parallel over blocks: each block's total is summed with 4 interleaved
-    accumulators, the block offsets are accumulated serially with Neumaier compensation, then each
-    block runs its own cumulative sum from its offset.  The rounding error of any out[k] is bounded
-    by about ``block * eps`` times the (mean-removed) magnitudes, not ``N * eps``: no cancellation
-    at 10^8 samples.
+    Each block's total is summed with 4 interleaved accumulators (blocks in parallel), the totals are
+    accumulated serially with Neumaier compensation.  Shared by :func:`_phase_py` and :func:`_fused2_py`, so
+    both reconstruct the same angle bit for bit.
     """
     n = y.size
     nb = (n + block - 1) // block
@@ -83,6 +88,18 @@ def _phase_py(y, mu, out, block):  # pragma: no cover - runs compiled
         else:
             c += (x - t) + s
         s = t
+    return offsets
+
+
+def _phase_py(y, mu, offsets, out, block):  # pragma: no cover - runs compiled
+    """out[0] = 0, out[k] = sum_{i<k} (y[i] - mu). Clean input assumed.
+
+    Blocked summation, parallel over blocks: each block runs its own cumulative sum from its offset
+    (:func:`_offsets_py`).  The rounding error of any out[k] is bounded by about ``block * eps`` times the
+    (mean-removed) magnitudes, not ``N * eps``: no cancellation at 10^8 samples.
+    """
+    n = y.size
+    nb = (n + block - 1) // block
     out[0] = 0.0
     for ib in prange(nb):
         lo = ib * block
@@ -180,6 +197,110 @@ def _block_sums2_py(a, b, c, k_first, s, block, out):  # pragma: no cover - runs
         out[j] = acc
 
 
+def _run_before_py(y, mu, block, x):  # pragma: no cover - runs compiled
+    """The running block sum of :func:`_phase_py` just before it adds ``y[x - 1]``: ``sum (y[i] - mu)`` over
+    ``i = b block .. x - 2``, ``b = (x - 1) // block`` (0 where x - 1 starts a block or x = 0)."""
+    run = 0.0
+    if x >= 1:
+        for i in range(((x - 1) // block) * block, x - 1):
+            run += y[i] - mu
+    return run
+
+
+def _fill_py(y, mu, offsets, block, x0, x1, out, o0, run):  # pragma: no cover - runs compiled
+    """Angle points ``p[x0 .. x1)`` into ``out[o0 ...]``, continuing the running block sum ``run``.
+
+    ``p[0] = 0`` and ``p[x] = offsets[b] + sum_{i = b block}^{x - 1} (y[i] - mu)``, ``b = (x - 1) // block``:
+    the additions of :func:`_phase_py` in its order, so every point equals its output bit for bit.  ``run`` is
+    the block sum before ``y[x0 - 1]`` (:func:`_run_before_py`); returns the one after ``y[x1 - 2]``, the
+    ``run`` of a call that continues at ``x1``.
+    """
+    x = x0
+    if x == 0:
+        out[o0] = 0.0
+        x = 1
+    while x < x1:
+        b = (x - 1) // block
+        if x - 1 == b * block:
+            run = 0.0
+        hi = min(x1, (b + 1) * block + 1)
+        base = offsets[b]
+        for i in range(x - 1, hi - 1):
+            run += y[i] - mu
+            out[o0 + i + 1 - x0] = base + run
+        x = hi
+    return run
+
+
+def _fused2_py(y, mu, offsets, ms, lags, slot_m, slot_2m, nblocks, block, nchunks):  # pragma: no cover
+    """The per-block sums of :func:`_diff2_py` (stride 1) computed from the rate, without the whole angle array.
+
+    For every block of start indices ``k0 = ib block .. k0 + block`` the angle is rebuilt where the Allan
+    operator ``(p[k+2m] - 2 p[k+m] + p[k])^2`` reads it: ``near`` holds ``p[k0 .. k0 + 2 block)`` (lags below
+    ``block``, slid by one block per step) and row ``l`` of ``far`` holds ``p[k0 + lags[l] .. + block)`` (one
+    stream over the rate per distinct lag of at least ``block``).  Each row is produced from the rate by
+    :func:`_fill_py` just before the taus whose lag 2m it is (``slot_2m[j] == l``; ``slot_m[j]`` is the row
+    of lag m or -1 for ``near``) consume it, so the row is still in cache.  The slices passed to the
+    vectorised :func:`_sq2_py` hold the same values and have the same lengths as in :func:`_diff2_py`,
+    so ``part`` is the same bit for bit.  The blocks are cut into ``nchunks`` contiguous runs in parallel;
+    each restarts its streams from the block offsets.  Reads the rate ``2 + len(lags)`` times, writes only
+    cache-sized buffers.
+    """
+    n_phase = y.size + 1
+    ntau = ms.size
+    nl = lags.size
+    part = np.zeros((nblocks, ntau))
+    per = (nblocks + nchunks - 1) // nchunks
+    for ic in prange(nchunks):
+        b0 = ic * per
+        b1 = min(nblocks, b0 + per)
+        if b0 >= b1:
+            continue
+        near = np.empty(2 * block)
+        far = np.empty(max(nl, 1) * block)
+        runs = np.zeros(max(nl, 1))
+        k0 = b0 * block
+        run_near = _fill(y, mu, offsets, block, k0, min(k0 + 2 * block, n_phase), near, 0,
+                         _run_before(y, mu, block, k0))
+        for l in range(nl):
+            runs[l] = _run_before(y, mu, block, min(k0 + lags[l], n_phase))
+        for ib in range(b0, b1):
+            k0 = ib * block
+            if ib > b0:
+                near[:block] = near[block:]
+                if k0 + block < n_phase:
+                    run_near = _fill(y, mu, offsets, block, k0 + block, min(k0 + 2 * block, n_phase), near,
+                                     block, run_near)
+            for j in range(ntau):
+                if slot_2m[j] >= 0:
+                    continue
+                m = ms[j]
+                kend = min(k0 + block, n_phase - 2 * m)
+                if kend > k0:
+                    ln = kend - k0
+                    part[ib, j] = _sq2(near[2 * m : 2 * m + ln], near[m : m + ln], near[0:ln])
+            for l in range(nl):
+                x0 = k0 + lags[l]
+                if x0 >= n_phase:
+                    continue
+                runs[l] = _fill(y, mu, offsets, block, x0, min(x0 + block, n_phase), far, l * block, runs[l])
+                for j in range(ntau):
+                    if slot_2m[j] != l:
+                        continue
+                    m = ms[j]
+                    kend = min(k0 + block, n_phase - 2 * m)
+                    if kend <= k0:
+                        continue
+                    ln = kend - k0
+                    sm = slot_m[j]
+                    if sm < 0:
+                        mid = near[m : m + ln]
+                    else:
+                        mid = far[sm * block : sm * block + ln]
+                    part[ib, j] = _sq2(far[l * block : l * block + ln], mid, near[0:ln])
+    return part
+
+
 def _diff3_py(p, ms, strides, block):  # pragma: no cover - runs compiled
     """As ``_diff2_py`` for the operator (-1, 3, -3, 1) (Hadamard):
     (p[k+3m] - 3 p[k+2m] + 3 p[k+m] - p[k])^2 over k < len(p) - 3m."""
@@ -274,11 +395,15 @@ def _compiled():
         # the helpers are module globals (None until here) that the kernels below call compiled
         globals()["_sq2"] = numba.njit(cache=True, fastmath=set(SUM_FASTMATH))(_sq2_py)
         globals()["_sq3"] = numba.njit(cache=True, fastmath=set(SUM_FASTMATH))(_sq3_py)
+        globals()["_fill"] = numba.njit(cache=True)(_fill_py)
+        globals()["_run_before"] = numba.njit(cache=True)(_run_before_py)
+        _KERNELS["offsets"] = numba.njit(cache=True, parallel=True)(_offsets_py)
         _KERNELS["phase"] = numba.njit(cache=True, parallel=True)(_phase_py)
         _KERNELS["diff2"] = numba.njit(cache=True, parallel=True)(_diff2_py)
         _KERNELS["diff3"] = numba.njit(cache=True, parallel=True)(_diff3_py)
         _KERNELS["window2"] = numba.njit(cache=True, parallel=True)(_window2_py)
         _KERNELS["block_sums2"] = numba.njit(cache=True, parallel=True)(_block_sums2_py)
+        _KERNELS["fused2"] = numba.njit(cache=True, parallel=True)(_fused2_py)
     return _KERNELS
 
 
@@ -316,9 +441,9 @@ def phase_dph_samples(y: np.ndarray) -> np.ndarray:
     """Angle in units of (deg/h) * dt with the mean removed: shape (N + 1,)."""
     mu = float(np.mean(y))
     p = np.empty(y.size + 1)
-    kern = _compiled()["phase"]
+    kern = _compiled()
     with threads_for(y.size):
-        kern(y, mu, p, BLOCK)
+        kern["phase"](y, mu, kern["offsets"](y, mu, BLOCK), p, BLOCK)
     return p
 
 
@@ -373,3 +498,86 @@ def block_sums2(a: np.ndarray, b: np.ndarray, c: np.ndarray, k_first: int, s: in
     kern = _compiled()["block_sums2"]
     with threads_for(c.size // max(int(s), 1)):
         kern(a, b, c, k_first, s, block, out)
+
+
+#: Smallest record (samples) for which :func:`allan_sums_fused` is used: below it the angle array fits in cache
+#: and the per-tau kernel is as fast.
+FUSED_MIN = 1 << 21
+
+#: Most distinct lags of at least :data:`BLOCK` (m or 2m) the fused kernel takes: each is one more read of the
+#: rate per pass and one block buffer (512 kB) per thread.  The octave grid has ``log2(N) - 15`` of them (10 at
+#: 10^8), the decade grid about 4 per decade; dense grids fall back to :func:`operator_sums`.
+FUSED_MAX_LAGS = 32
+
+#: Runs of blocks per thread in the fused kernel.  Each run restarts its streams (about ``(2 + lags) x BLOCK``
+#: extra additions, 0.1 % of a 10^8 record at 4 runs per thread); more runs than threads let the threads
+#: share the work when one of them is slowed by other processes.
+FUSED_CHUNKS = 4
+
+
+def fused_lags(n: int, m: np.ndarray):
+    """The distinct lags (m and 2m, at least :data:`BLOCK`) of the fused kernel, or None where it does not apply.
+
+    None: fewer than :data:`FUSED_MIN` samples or more than :data:`FUSED_MAX_LAGS` such lags.
+    """
+    m = np.asarray(m, dtype=np.int64)
+    if n < FUSED_MIN or m.size == 0 or int(m.min()) < 1 or 2 * int(m.max()) > n:
+        return None
+    lags = np.unique(np.concatenate([m, 2 * m]))
+    lags = lags[lags >= BLOCK]
+    return lags if lags.size <= FUSED_MAX_LAGS else None
+
+
+def fused_part(y: np.ndarray, m: np.ndarray, block: int, chunks: int) -> np.ndarray:
+    """The per-block sums of :func:`_fused2_py`, shape (n_blocks, n_tau), for any ``block`` and number of runs.
+
+    ``m`` (int64, ``1 <= m``, ``2 m <= len(y)``) may have any number of long lags here; :func:`allan_sums_fused`
+    calls it with :data:`BLOCK`.  Tests call it with short blocks, which give the same bits as :func:`_phase_py`
+    and :func:`_diff2_py` with that block.
+    """
+    import numba
+
+    m = np.ascontiguousarray(m, dtype=np.int64)
+    lags = np.unique(np.concatenate([m, 2 * m]))
+    lags = lags[lags >= block]
+    slot = {int(v): i for i, v in enumerate(lags)}
+    slot_m = np.array([slot.get(int(v), -1) for v in m], dtype=np.int64)
+    slot_2m = np.array([slot.get(int(2 * v), -1) for v in m], dtype=np.int64)
+    nblocks = (y.size + 1 - 2 * int(m.min()) + block - 1) // block
+    mu = float(np.mean(y))
+    kern = _compiled()
+    offsets = kern["offsets"](y, mu, block)
+    chunks = max(1, min(int(chunks), nblocks))
+    with numba.parallel_chunksize(1):
+        return kern["fused2"](y, mu, offsets, m, lags, slot_m, slot_2m, nblocks, block, chunks)
+
+
+def allan_sums_fused(y: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Overlapping Allan sums ``sum_{k=0}^{N-2m} (p[k+2m] - 2 p[k+m] + p[k])^2`` straight from the rate.
+
+    Parameters
+    ----------
+    y : ndarray of float64, shape (N,)
+        Rate [deg/h], finite (checked by the caller), contiguous.
+    m : ndarray of int64, shape (n_tau,)
+        Averaging factors with ``2 m <= N`` and :func:`fused_lags` not None.
+
+    Returns
+    -------
+    ndarray of float64, shape (n_tau,)
+        [(deg/h)^2 x samples^2], with ``p`` the mean-removed angle of :func:`phase_dph_samples`.  Equal bit
+        for bit to ``operator_sums(phase_dph_samples(y), m, 1, (1, -2, 1), False)``: the same angle points,
+        the same per-block sums (:func:`_fused2_py`), added the same way; the angle array (8 (N + 1) bytes)
+        is never stored.
+    """
+    import numba
+
+    m = np.ascontiguousarray(m, dtype=np.int64)
+    if fused_lags(y.size, m) is None:
+        raise ValueError("the fused Allan kernel needs at least FUSED_MIN samples and at most "
+                         "FUSED_MAX_LAGS long lags")
+    with threads_for((y.size + 1) * m.size):
+        threads = numba.get_num_threads()
+        # FUSED_CHUNKS runs per thread, handed out one at a time: a thread slowed by other work takes fewer
+        part = fused_part(y, m, BLOCK, FUSED_CHUNKS * threads if threads > 1 else 1)
+    return part.sum(axis=0)

@@ -26,7 +26,12 @@ inside each block of 65536 samples, block offsets accumulated with Neumaier comp
 rounding grows with the block length, not with N), and the squared differences are summed per
 block of start indices and the block sums added pairwise.  A 1e4 deg/h offset on unit noise
 changes the result by < 1e-9 relative (tested).  Extra memory is one float64 angle array of
-N + 1 points (plus the float64 copy of the input if it was not float64 already).
+N + 1 points (plus the float64 copy of the input if it was not float64 already), except for the
+overlapping Allan deviation on grids with few long lags (octave, decade; at least
+:data:`~fogdrift.allan._kernels.FUSED_MIN` samples): there one fused pass
+(:func:`~fogdrift.allan._kernels.allan_sums_fused`) rebuilds the angle block by block where the
+operator reads it and never stores it, with the same sums bit for bit (``progress`` is then
+called once, at the end).
 """
 
 from __future__ import annotations
@@ -186,6 +191,13 @@ def allan_variance(
     if progress is not None and not callable(progress):
         raise ConfigError(f"progress must be a callable(done, total) or None, got {progress!r}")
 
+    if stat.name == "adev" and estimator == "overlapping" and _kernels.fused_lags(n, m) is not None:
+        # every tau in one pass over the rate, the angle never stored; the same sums bit for bit
+        sums = _kernels.allan_sums_fused(y, m)
+        if progress is not None:
+            progress(m.size, m.size)
+        return result_from_sums(sums, n, m, strides, dt, statistic=stat.name, estimator=estimator,
+                                noise_alpha=noise_alpha)
     p = _kernels.phase_dph_samples(y)
     sums = np.empty(m.size)
     if progress is None:
