@@ -248,11 +248,13 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
             "tau_max_s": [c["_fit"]["tau_max_s"] for c in curves],
             "width": {t: [c[t]["rel_width"] for c in curves] for t in model.terms},
             "z": {t: [c[t]["z"] for c in curves] for t in model.terms}}
-    # the width RECORD_SHARE of the records stay within: the median record's times the spread of the fit's rules on
-    # linearised records (plan.spread), evaluated at the target length and again at the length it gives
+    # the width RECORD_SHARE of the records stay within: the union of the models that share of the records may
+    # find plausible, times the spread of the fit's rules on linearised records (plan.spread), evaluated at the
+    # target length and again at the length it gives
+    shared = [analytic_widths(model, n, share=RECORD_SHARE) for n in ns] if targets else curves
     grid["width_share"], spread = {}, {}
     for t, target in targets.items():
-        w = grid["width"][t]
+        w = [c[t]["rel_width"] for c in shared]
         at = crossing(lengths, w, target)
         ratio = math.inf
         for _ in range(2):
