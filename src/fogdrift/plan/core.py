@@ -180,6 +180,8 @@ def _grid_n(dt_s):
     while n <= n_max:
         out.append(int(round(n)))
         n *= _STEP
+    if out and out[-1] < n_max:  # the last point at MAX_LENGTH_S itself: "not within 30 d" means 30 d
+        out.append(n_max)
     return out
 
 
