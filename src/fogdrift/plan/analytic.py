@@ -9,7 +9,8 @@ fitted, the median record's interval):
 
 * ``Cov(A) = (X' V^-1 X)^-1`` over the model's terms;
 * the 95 % interval of ``A_k`` is ``A_k +- d sd_k`` with ``d^2 = t_{0.975, dof}^2 E[max(1, chi2_red)]`` (the
-  fit's profile threshold and its expected widening for misfit), widened to the union over the models one absent
+  fit's profile threshold and its expected widening for misfit; ``dof`` that of the model the fit selects, the
+  subset of least IC at the expected curve: a term the length cannot yet show is left out of it), widened to the union over the models one absent
   term larger (always plausible at the expected curve: the information criterion ``IC = Q + 2 k`` rises by at most
   2, inside the plausible window of 6): the absent term may only grow from zero, so one side widens, the side of
   the sign of its correlation with ``A_k``, and to the union over the models one term *smaller* (another term of
@@ -34,12 +35,10 @@ may never reach a target below it at any length, which the plan says.
 
 from __future__ import annotations
 
-import functools
 import itertools
 import math
 
 import numpy as np
-from scipy.integrate import quad
 from scipy.optimize import nnls
 from scipy.stats import chi2, ncx2, t as student_t
 
@@ -48,7 +47,7 @@ from ..noise.context import FitContext
 from ..noise.terms import TERM_TABLE, all_terms, laws_of
 from .model import PLANNED_TERMS as PLANNED
 
-__all__ = ["analytic_widths", "expected_inflation", "width_spread", "whitened", "PLAUSIBLE_DELTA", "IC_PENALTY",
+__all__ = ["analytic_widths", "expected_inflation", "whitened", "PLAUSIBLE_DELTA", "IC_PENALTY",
            "BOUND_FRACTION"]
 
 #: The Allan fit's plausible-model window and IC penalty per term (:func:`fogdrift.noise.fit_noise` defaults).
@@ -72,37 +71,6 @@ def expected_inflation(dof: int) -> float:
     """
     k = max(int(dof), 1)
     return float(chi2.cdf(k, k) + 1.0 - chi2.cdf(k, k + 2))
-
-
-@functools.lru_cache(maxsize=256)
-def _inflation_log_var(dof: int) -> float:
-    """``Var[ln sqrt(max(1, X / dof))]`` for ``X ~ chi2_dof``: the record-to-record scatter the misfit widening adds
-    to the log of a width."""
-    k = max(int(dof), 1)
-
-    def moment(p):
-        return quad(lambda x: (0.5 * math.log(x / k)) ** p * chi2.pdf(x, k), k, math.inf, limit=200)[0]
-
-    m1 = moment(1)
-    return max(moment(2) - m1 * m1, 0.0)
-
-
-def width_spread(z: float, dof: int) -> float:
-    """Standard deviation of the log of a term's relative width from record to record [ln units].
-
-    Two parts, taken independent: the estimate the width is relative to scatters by ``sd(ln value) = 1 / (2 z)``
-    (the coefficient is ``sqrt(A)``, ``z = A / sd(A)``), and the fit widens each record's interval by its own
-    ``sqrt(max(1, chi2_red))`` (``chi2_red ~ chi2_dof / dof``, the same assumption as :func:`expected_inflation`).
-
-    Examples
-    --------
-    >>> round(width_spread(math.inf, 1000), 4) < round(width_spread(math.inf, 10), 4)
-    True
-    >>> round(width_spread(5.0, 10) ** 2 - width_spread(math.inf, 10) ** 2, 6)
-    0.01
-    """
-    v = (0.5 / z) ** 2 if z > 0 and math.isfinite(z) else (0.0 if z > 0 else math.inf)
-    return math.sqrt(v + _inflation_log_var(dof))
 
 
 def analytic_widths(model, n_samples, share=None) -> dict:
