@@ -86,6 +86,15 @@ def test_crossing_log_log_interpolation():
     assert crossing([1.0, 2.0], [0.1, 0.05], 0.2) == 1.0
 
 
+def test_length_grid_ends_at_thirty_days():
+    """The half-octave grid from 64 samples stops at 24.3 d at 1 Hz; the last point is 30 d itself, so a length
+    between the two (the RLG-like B's 80 % length, 26.2 d) is found, not answered "not within 30 d"."""
+    from fogdrift.plan.core import MAX_LENGTH_S, _grid_n
+
+    ns = _grid_n(1.0)
+    assert ns[-1] == int(MAX_LENGTH_S) and ns[-2] < 0.85 * MAX_LENGTH_S and ns[0] == 64
+
+
 def test_mc_length_reads_the_local_slope():
     L = [100.0, 400.0, 1600.0]
     w = [0.2, 0.1, 0.05]  # slope -1/2
