@@ -9,7 +9,8 @@ fitted, the median record's interval):
 
 * ``Cov(A) = (X' V^-1 X)^-1`` over the model's terms;
 * the 95 % interval of ``A_k`` is ``A_k +- d sd_k`` with ``d^2 = t_{0.975, dof}^2 E[max(1, chi2_red)]`` (the
-  fit's profile threshold and its expected widening for misfit), widened to the union over the models one absent
+  fit's profile threshold and its expected widening for misfit; ``dof`` that of the model the fit selects, the
+  subset of least IC at the expected curve: a term the length cannot yet show is left out of it), widened to the union over the models one absent
   term larger (always plausible at the expected curve: the information criterion ``IC = Q + 2 k`` rises by at most
   2, inside the plausible window of 6): the absent term may only grow from zero, so one side widens, the side of
   the sign of its correlation with ``A_k``, and to the union over the models one term *smaller* (another term of
@@ -34,11 +35,10 @@ may never reach a target below it at any length, which the plan says.
 
 from __future__ import annotations
 
-import functools
+import itertools
 import math
 
 import numpy as np
-from scipy.integrate import quad
 from scipy.optimize import nnls
 from scipy.stats import chi2, ncx2, t as student_t
 
@@ -47,7 +47,7 @@ from ..noise.context import FitContext
 from ..noise.terms import TERM_TABLE, all_terms, laws_of
 from .model import PLANNED_TERMS as PLANNED
 
-__all__ = ["analytic_widths", "expected_inflation", "width_spread", "PLAUSIBLE_DELTA", "IC_PENALTY",
+__all__ = ["analytic_widths", "expected_inflation", "whitened", "PLAUSIBLE_DELTA", "IC_PENALTY",
            "BOUND_FRACTION"]
 
 #: The Allan fit's plausible-model window and IC penalty per term (:func:`fogdrift.noise.fit_noise` defaults).
@@ -71,37 +71,6 @@ def expected_inflation(dof: int) -> float:
     """
     k = max(int(dof), 1)
     return float(chi2.cdf(k, k) + 1.0 - chi2.cdf(k, k + 2))
-
-
-@functools.lru_cache(maxsize=256)
-def _inflation_log_var(dof: int) -> float:
-    """``Var[ln sqrt(max(1, X / dof))]`` for ``X ~ chi2_dof``: the record-to-record scatter the misfit widening adds
-    to the log of a width."""
-    k = max(int(dof), 1)
-
-    def moment(p):
-        return quad(lambda x: (0.5 * math.log(x / k)) ** p * chi2.pdf(x, k), k, math.inf, limit=200)[0]
-
-    m1 = moment(1)
-    return max(moment(2) - m1 * m1, 0.0)
-
-
-def width_spread(z: float, dof: int) -> float:
-    """Standard deviation of the log of a term's relative width from record to record [ln units].
-
-    Two parts, taken independent: the estimate the width is relative to scatters by ``sd(ln value) = 1 / (2 z)``
-    (the coefficient is ``sqrt(A)``, ``z = A / sd(A)``), and the fit widens each record's interval by its own
-    ``sqrt(max(1, chi2_red))`` (``chi2_red ~ chi2_dof / dof``, the same assumption as :func:`expected_inflation`).
-
-    Examples
-    --------
-    >>> round(width_spread(math.inf, 1000), 4) < round(width_spread(math.inf, 10), 4)
-    True
-    >>> round(width_spread(5.0, 10) ** 2 - width_spread(math.inf, 10) ** 2, 6)
-    0.01
-    """
-    v = (0.5 / z) ** 2 if z > 0 and math.isfinite(z) else (0.0 if z > 0 else math.inf)
-    return math.sqrt(v + _inflation_log_var(dof))
 
 
 def analytic_widths(model, n_samples, share=None) -> dict:
@@ -164,17 +133,15 @@ def _widths(names, A, n, dt, tau_min_s=None, share=None) -> dict:
             out[t] = {"rel_lo": 0.0, "rel_hi": math.inf, "rel_width": math.inf, "z": 0.0, "delta_ic": 0.0,
                       "resolved": False}
         return out
-    probe = FitContext(tau, m, np.ones_like(tau), np.full_like(tau, 2.0), n, dt, "adev", names)
-    mu = probe.X @ A
-    ctx = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", names)
-    V = ctx.relcov(A, exact_ramp=True) * np.outer(mu, mu)
-    L = np.linalg.cholesky(V)
-    full = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", tuple(t for t in PLANNED if t in ctx.laws))
-    Xall = np.linalg.solve(L, full.X)  # whitened design of every column
-    yw = np.linalg.solve(L, mu)
+    ctx, L, Xall, yw = whitened(names, A, tau, m, n, dt)
     col = {t: all_terms().index(t) for t in PLANNED}
     extras = [e for e in PLANNED if e not in names]
-    dof = int(m.size - k)
+    # the fit's threshold uses the degrees of freedom of the model it selects: at the expected curve the one of
+    # least IC (a term the length cannot yet tell from zero is left out, as the real fit leaves it out)
+    sel = _selected(Xall, yw, [col[t] for t in PLANNED if t in ctx.laws], IC_PENALTY * k)
+    dof = int(m.size - len(sel))
+    out["_fit"]["dof"] = dof
+    out["_fit"]["selected"] = "+".join(t for t in PLANNED if col[t] in sel)
     d = float(student_t.ppf(0.975, dof)) * math.sqrt(expected_inflation(dof))
     cov = _cov(Xall[:, [col[t] for t in names]])
     # the models one extra term away (always plausible at the true curve: IC rises by at most 2)
@@ -206,6 +173,20 @@ def _widths(names, A, n, dt, tau_min_s=None, share=None) -> dict:
         out[t] = {"rel_lo": lo, "rel_hi": hi, "rel_width": (hi - lo) / 2.0 if resolved else math.inf, "z": z,
                   "delta_ic": float(dq), "resolved": resolved}
     return out
+
+
+def whitened(names, A, tau, m, n, dt):
+    """The fit's view of the expected curve of the model ``names`` (Allan-law coefficients ``A``) on the taus
+    ``tau`` (averaging factors ``m``) of an ``n``-sample record: ``(ctx, L, Xall, yw)``, the fit context of the model,
+    the Cholesky factor of its covariance ``V`` (estimators' covariance and allowance, exact ramp), and the
+    whitened design of every planned column and the whitened expected curve."""
+    probe = FitContext(tau, m, np.ones_like(tau), np.full_like(tau, 2.0), n, dt, "adev", names)
+    mu = probe.X @ A
+    ctx = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", names)
+    V = ctx.relcov(A, exact_ramp=True) * np.outer(mu, mu)
+    L = np.linalg.cholesky(V)
+    full = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", tuple(t for t in PLANNED if t in ctx.laws))
+    return ctx, L, np.linalg.solve(L, full.X), np.linalg.solve(L, mu)
 
 
 def _smaller_plausible(Xall, yw, cols, ct, extras, ic_true, d, share=None):
@@ -242,6 +223,19 @@ def _smaller_plausible(Xall, yw, cols, ct, extras, ic_true, d, share=None):
                 hi = max(hi, c_t + d * sd_e)
         out.append((lo, hi))
     return out
+
+
+def _selected(Xall, yw, cols, ic_true):
+    """Columns of the model of least IC (``Q + 2 k``, :data:`IC_PENALTY`) at the expected curve among every subset
+    of ``cols`` holding at most the true model's number of terms (its IC is ``ic_true``, ``Q = 0``; a larger model
+    cannot have less); a tie keeps the larger model."""
+    best, best_ic = None, math.inf
+    for r in range(min(len(cols), int(round(ic_true / IC_PENALTY))), 0, -1):
+        for sub in itertools.combinations(cols, r):
+            ic = _q(Xall[:, list(sub)], yw) + IC_PENALTY * r
+            if ic < best_ic - 1e-9:
+                best, best_ic = list(sub), ic
+    return best
 
 
 def _cov(Xw):

@@ -6,16 +6,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from statistics import NormalDist
 
 import numpy as np
 
 from ..errors import ConfigError
 from ..noise.terms import TERM_TABLE
-from .analytic import analytic_widths, width_spread
+from .analytic import analytic_widths
 from .gmwm import gmwm_widths, simulate_gmwm_fits
 from .model import fmt_length
 from .montecarlo import MC_MAX_SAMPLES, simulate_fits, summarise
+from .spread import share_ratio
 
 __all__ = ["Plan", "make_plan", "MAX_LENGTH_S", "RECORD_SHARE", "crossing", "ESTIMATORS"]
 
@@ -29,7 +29,6 @@ _STEP = 2.0**0.5  # grid of record lengths: half an octave
 
 #: Share of records that must reach the target width at ``share_s`` (the median record reaches it at ``target_s``).
 RECORD_SHARE = 0.8
-_Z_SHARE = NormalDist().inv_cdf(RECORD_SHARE)  # the width's log spread is taken normal
 
 
 def crossing(x, y, level):
@@ -61,8 +60,9 @@ class Plan:
 
     ``terms``: term -> ``target`` (width asked), ``resolved_s`` (length from which the median record resolves it),
     ``target_s`` (length at which its expected width reaches the target; None: not within
-    :data:`MAX_LENGTH_S`), ``share_s`` (length at which :data:`RECORD_SHARE` of the records reach it: the width's
-    record-to-record log spread, :func:`~fogdrift.plan.analytic.width_spread`, taken log-normal), ``floor_width``
+    :data:`MAX_LENGTH_S`), ``share_s`` (length at which :data:`RECORD_SHARE` of the records reach it: the expected width times
+    ``share_ratio``, the ratio of the share's quantile to the median over linearised records,
+    :func:`~fogdrift.plan.spread.share_ratio`), ``floor_width``
     (width at :data:`MAX_LENGTH_S`), ``mc`` (Monte-Carlo at ``target_s``: median width, fractions, coverage, seeds,
     and ``length_s``, the length the measured width implies) and ``mc_share`` (Monte-Carlo at ``share_s``).
     ``grid``: the analytic curve (``length_s`` and each term's width). ``at_length``: what ``length_s`` supports.
@@ -180,6 +180,8 @@ def _grid_n(dt_s):
     while n <= n_max:
         out.append(int(round(n)))
         n *= _STEP
+    if out and out[-1] < n_max:  # the last point at MAX_LENGTH_S itself: "not within 30 d" means 30 d
+        out.append(n_max)
     return out
 
 
@@ -248,11 +250,25 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
             "tau_max_s": [c["_fit"]["tau_max_s"] for c in curves],
             "width": {t: [c[t]["rel_width"] for c in curves] for t in model.terms},
             "z": {t: [c[t]["z"] for c in curves] for t in model.terms}}
-    # the width RECORD_SHARE of the records stay within: the union of that share's record, times the spread
+    # the width RECORD_SHARE of the records stay within: the union of the models that share of the records may
+    # find plausible, times the spread of the fit's rules on linearised records (plan.spread), evaluated at the
+    # target length and again at the length it gives
     shared = [analytic_widths(model, n, share=RECORD_SHARE) for n in ns] if targets else curves
-    grid["width_share"] = {t: [c[t]["rel_width"] * math.exp(_Z_SHARE * width_spread(c[t]["z"], c["_fit"]["dof"]))
-                               if math.isfinite(c[t]["rel_width"]) else math.inf for c in shared]
-                           for t in model.terms}
+    grid["width_share"], spread = {}, {}
+    for t, target in targets.items():
+        w = [c[t]["rel_width"] for c in shared]
+        at = crossing(lengths, w, target)
+        ratio = math.inf
+        for _ in range(2):
+            if at is None:
+                break
+            n_at = min(ns, key=lambda n: abs(math.log(n * dt / at)))
+            ratio = share_ratio(model, n_at, t, RECORD_SHARE)
+            if not math.isfinite(ratio):
+                break
+            at = crossing(lengths, [x * ratio for x in w], target)
+        spread[t] = ratio
+        grid["width_share"][t] = [x * ratio if math.isfinite(x) else math.inf for x in w]
     terms = {}
     seeds = list(range(seed0, seed0 + int(monte_carlo)))
     notes = []
@@ -270,7 +286,8 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
         target_s = crossing(lengths, w, target)
         r = {"target": target, "unit": TERM_TABLE[t].unit, "value": model.coefficients[t],
              "resolved_s": resolved_s, "target_s": target_s, "share": RECORD_SHARE,
-             "share_s": crossing(lengths, grid["width_share"][t], target), "floor_width": w[-1]}
+             "share_s": crossing(lengths, grid["width_share"][t], target), "share_ratio": spread[t],
+             "floor_width": w[-1]}
         if target_s is not None:
             j = min(range(len(lengths)), key=lambda k: abs(math.log(lengths[k] / target_s)))
             r["tau_range_s"] = [curves[j]["_fit"]["tau_min_s"], curves[j]["_fit"]["tau_max_s"]]

@@ -1,0 +1,106 @@
+"""Record-to-record spread of a term's Allan-fit width: the fit's own rules on the linearised record.
+
+The width the median record reaches is :func:`fogdrift.plan.analytic.analytic_widths`'s.  How much wider a record
+may come out (the length for four records in five, ``share_s``) depends on what varies from record to record:
+the estimate the width is relative to, the selected model (its degrees of freedom), its ``max(1, chi2_red)``
+widening, and which models are plausible and so enter the union.  All four are taken here from the fit's rules
+applied to Gaussian records of the linearised problem: in the fit's whitened metric (``V``: the estimators'
+covariance plus the 2 % allowance, :func:`~fogdrift.plan.analytic.whitened`) a record's curve is the expected
+one plus ``e ~ N(0, S)``, ``S = L^-1 V_s L^-T`` with ``V_s`` the sampling covariance alone (a record that follows
+the model departs from it by its sampling error, not by the allowance: its ``chi2_red`` averages about 0.5).
+Per record: every subset of the planned terms is fitted by non-negative least squares, the model of least IC
+(``Q + 2 k``) is selected, the plausible models are those within the window (6), the threshold is
+``t_{0.975, dof}^2 max(1, chi2_red)`` with the selected model's ``dof``, and the term's interval is the union of
+its profile intervals (``A >= 0``) over the plausible models that hold it (any without it: not resolved).  The
+ratio of the ``p``-quantile of the widths to their median is the spread (:func:`share_ratio`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+from scipy.optimize import brentq, nnls
+from scipy.stats import t as student_t
+
+from ..allan.grid import tau_grid
+from ..noise.terms import all_terms
+from .analytic import IC_PENALTY, PLAUSIBLE_DELTA, whitened
+from .model import PLANNED_TERMS as PLANNED
+
+__all__ = ["share_ratio", "SPREAD_DRAWS"]
+
+#: Gaussian records drawn per length (fixed seed): the 80 % / median ratio to about +-2 %.
+SPREAD_DRAWS = 400
+
+
+def share_ratio(model, n_samples, term, share, draws=SPREAD_DRAWS, seed=0) -> float:
+    """``q_share / median`` of ``term``'s relative half-width (relative to each record's estimate) over ``draws``
+    Gaussian records of the linearised fit of ``n_samples`` samples (module docstring); inf when fewer than
+    ``share`` of them resolve the term, nan when the record is too short for the model."""
+    names, A, dt = model.terms, model.law_coefficients(), float(model.dt_s)
+    n = int(n_samples)
+    m = tau_grid(n, dt, "octave").astype(np.float64)
+    tau_min = getattr(model, "tau_min_s", None)
+    if tau_min is not None:
+        m = m[m * dt >= float(tau_min) * (1.0 - 1e-9)]
+    if m.size <= len(names) + 1:
+        return math.nan
+    tau = m * dt
+    ctx, L, Xall, yw0 = whitened(names, A, tau, m, n, dt)
+    mu = ctx.X @ A
+    Vs = ctx.relcov(A, exact_ramp=True, allowance=False) * np.outer(mu, mu)
+    S = np.linalg.solve(L, np.linalg.solve(L, Vs).T).T
+    Ls = np.linalg.cholesky(0.5 * (S + S.T) + 1e-12 * np.trace(S) / len(S) * np.eye(len(S)))
+    cols = [all_terms().index(u) for u in PLANNED if u in ctx.laws]
+    ct = all_terms().index(term)
+    subsets = [s for r in range(1, len(cols) + 1) for s in itertools.combinations(cols, r)]
+    rng = np.random.default_rng(seed)
+    widths = []
+    for _ in range(int(draws)):
+        yw = yw0 + Ls @ rng.standard_normal(yw0.size)
+        fits = {}
+        for s in subsets:
+            coef, r = nnls(Xall[:, list(s)], yw)
+            fits[s] = (coef, r * r, r * r + IC_PENALTY * len(s))
+        best = min(fits, key=lambda s: fits[s][2])
+        plaus = [s for s in subsets if fits[s][2] <= fits[best][2] + PLAUSIBLE_DELTA]
+        if ct not in best or any(ct not in s for s in plaus):
+            widths.append(math.inf)
+            continue
+        dof = max(1, m.size - len(best))
+        d2 = float(student_t.ppf(0.975, dof)) ** 2 * max(1.0, fits[best][1] / dof)
+        lo, hi = math.inf, 0.0
+        for s in plaus:
+            l_, h_ = _profile(Xall[:, list(s)], yw, s.index(ct), fits[s][0], fits[s][1], d2)
+            lo, hi = min(lo, l_), max(hi, h_)
+        a_hat = float(fits[best][0][best.index(ct)])
+        if not (lo > 0 and a_hat > 0):
+            widths.append(math.inf)
+            continue
+        widths.append((math.sqrt(hi) - math.sqrt(lo)) / (2.0 * math.sqrt(a_hat)))
+    w = np.asarray(widths)
+    med, q = float(np.median(w)), float(np.quantile(w, share))
+    return q / med if math.isfinite(q) and med > 0 else math.inf
+
+
+def _profile(Xw, yw, j, coef, q0, d2):
+    """Profile interval ``{a : min_{others >= 0} Q(A_j = a) <= q0 + d2}`` of column ``j`` (``coef``: the fit)."""
+    others = [i for i in range(Xw.shape[1]) if i != j]
+    a0 = float(coef[j])
+
+    def g(a):
+        r = yw - a * Xw[:, j]
+        q = float(nnls(Xw[:, others], r)[1] ** 2) if others else float(r @ r)
+        return q - q0 - d2
+
+    scale = a0 if a0 > 0 else 1.0 / max(float(np.linalg.norm(Xw[:, j])), 1e-300)
+    lo = 0.0
+    if a0 > 0 and g(0.0) > 0:
+        lo = brentq(g, 0.0, a0, xtol=1e-9 * a0)
+    x1 = max(2.0 * a0, scale)
+    while g(x1) <= 0:
+        x1 *= 2.0
+    hi = brentq(g, a0, x1, xtol=1e-9 * scale)
+    return lo, hi
