@@ -88,6 +88,19 @@ def test_a_bad_value_is_one_line_naming_the_variable(monkeypatch, name, text, si
     assert str(info.value) == f"environment variable {name}={text.strip()!r}: expected a number >= 0{unit}"
 
 
+@pytest.mark.parametrize("name, text", [(limits.ENV_MEMORY, "1e400"), (limits.ENV_MEMORY, "1e310G"),
+                                        (limits.ENV_ROWS, "1e999"), (limits.ENV_EXPANSION, "9e308e1")])
+def test_an_overflowing_value_is_one_line_not_a_traceback(monkeypatch, name, text):
+    """``FOGDRIFT_MAX_MEMORY=1e400`` parsed to infinity and failed later in ``int()`` with an OverflowError
+    traceback (issue 36); it is refused where it is read, naming the variable."""
+    monkeypatch.setenv(name, text)
+    get = {limits.ENV_ROWS: limits.max_rows, limits.ENV_EXPANSION: limits.max_expansion,
+           limits.ENV_MEMORY: limits.memory_budget}[name]
+    with pytest.raises(ConfigError, match=name) as info:
+        get()
+    assert "\n" not in str(info.value)
+
+
 def test_machine_memory_is_the_smaller_of_ram_and_rlimit_as(monkeypatch):
     import os
     import resource

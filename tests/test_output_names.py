@@ -40,3 +40,18 @@ def test_allan_refuses_axes_that_would_share_files(tmp_path):
     assert not (tmp_path / "o").exists()
     ok = CliRunner().invoke(app, ["allan", str(p), "--unit", "deg/h", "--columns", "g x", "--out", str(tmp_path / "o")])
     assert ok.exit_code == 0, ok.output
+
+
+def test_an_out_name_longer_than_the_file_system_allows_is_one_line(tmp_path):
+    """An ``--out`` of 300 bytes made ``Path.exists`` raise ENAMETOOLONG inside the folder check: a traceback
+    (issue 36).  Now one line naming the flag, the name (shortened) and its length, before any work."""
+    import numpy as np
+
+    log = tmp_path / "a.npy"
+    np.save(log, np.random.default_rng(0).standard_normal(4096))
+    out = tmp_path / ("x" * 300)
+    res = CliRunner().invoke(app, ["allan", str(log), "--rate", "100", "--unit", "deg/h", "--out", str(out)])
+    assert res.exit_code != 0 and "Traceback" not in res.output
+    err = [ln for ln in res.output.splitlines() if ln.startswith("error:")]
+    assert len(err) == 1 and "--out" in err[0] and "300 bytes" in err[0] and "too long" in err[0], res.output
+    assert not any(p.name.startswith("x") for p in tmp_path.iterdir())

@@ -35,8 +35,8 @@ refused.
 from __future__ import annotations
 
 import contextlib
-import glob as _glob
 import errno
+import glob as _glob
 import json
 import os
 import re
@@ -95,6 +95,20 @@ def check_out_dir(path, *, create_parents: bool = False) -> Path:
     fogdrift.errors.ConfigError: out= .../missing/run1: its parent folder .../missing does not exist; ...
     """
     p = Path(path).expanduser().absolute()
+    try:
+        return _check_out_dir(p, create_parents)
+    except OSError as exc:
+        if exc.errno != errno.ENAMETOOLONG:
+            raise
+        longest = max(p.parts, key=lambda part: len(os.fsencode(part)))
+        shown = longest if len(longest) <= 40 else longest[:40] + "..."
+        raise ConfigError(f"{{opt:out}}: the name {shown!r} ({len(os.fsencode(longest))} bytes; the whole path "
+                          f"{len(os.fsencode(str(p)))}) is too long for the file system; choose a shorter "
+                          "folder name") from None
+
+
+def _check_out_dir(p: Path, create_parents: bool) -> Path:
+    """:func:`check_out_dir` of the absolute path ``p``."""
     _check_links(p)
     if p.exists() and not p.is_dir():
         raise ConfigError(f"{{opt:out}} {p} exists and is not a folder; choose a folder (new or one fogdrift wrote "

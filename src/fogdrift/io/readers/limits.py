@@ -29,6 +29,7 @@ log: 5.5); set a variable to ``0`` to switch that limit off.
 from __future__ import annotations
 
 import io
+import math
 import os
 import re
 
@@ -69,6 +70,9 @@ def _env(name: str, default, *, sizes: bool = False):
         unit = " (bytes, or with K, M, G, T: 512M, 2G)" if sizes else ""
         raise ConfigError(f"environment variable {name}={text!r}: expected a number >= 0{unit}")
     value = float(m.group(1)) * _SCALE[m.group(2).lower()]
+    if not math.isfinite(value):  # 1e400: a float overflow, not a limit
+        raise ConfigError(f"environment variable {name}={text!r}: expected a finite number >= 0 (0 switches the "
+                          "limit off)")
     return None if value == 0 else value
 
 
