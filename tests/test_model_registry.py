@@ -218,3 +218,21 @@ def test_a_bad_declared_parameter_is_refused_before_any_data_with_its_flag(given
 def test_a_parameter_of_a_model_not_run_is_refused():
     with pytest.raises(ConfigError, match=r"gm11\.shift_margin is set but gm11 is not among the models run"):
         AnalysisConfig(models=("ar",), model_params={"gm11": {"shift_margin": 2.0}}).validate()
+
+
+def test_a_recurrent_network_too_large_for_the_memory_budget_is_refused_before_any_work(monkeypatch):
+    """``--hidden 100000`` under a memory budget made JAX fail allocating 40 GB with a traceback (issue 36): the
+    weights need h^2 + h n_in + 2 h + 1 float32 values x 6 copies while training (by hand below); the config
+    refuses it in one line naming --hidden and the budget, only where a recurrent model is asked for."""
+    from fogdrift.models.registry import RECURRENT_WEIGHT_COPIES, recurrent_memory_need
+    from fogdrift.pipeline import AnalysisConfig
+
+    assert RECURRENT_WEIGHT_COPIES == 6
+    assert recurrent_memory_need(100_000, 8) == 4 * 6 * (10**10 + 800_000 + 200_000 + 1)
+    monkeypatch.setenv("FOGDRIFT_MAX_MEMORY", "2G")
+    with pytest.raises(ConfigError, match=r"hidden= 100000: .* 224 GiB .* 2 GiB \(FOGDRIFT_MAX_MEMORY\)"):
+        AnalysisConfig(models=("elman",), hidden=100_000).validate()
+    AnalysisConfig(models=("ar",), hidden=100_000).validate()  # no network: nothing to refuse
+    AnalysisConfig(models=("elman",), hidden=64).validate()
+    monkeypatch.setenv("FOGDRIFT_MAX_MEMORY", "0")  # no budget
+    AnalysisConfig(models=("elman",), hidden=100_000).validate()

@@ -39,6 +39,8 @@ __all__ = [
     "describe_models",
     "class_for_file",
     "file_class_names",
+    "RECURRENT_WEIGHT_COPIES",
+    "recurrent_memory_need",
 ]
 
 
@@ -101,6 +103,22 @@ class ModelSpec:
     def load(self) -> type:
         """Import ``module`` and return the class (later calls hit the import cache)."""
         return getattr(importlib.import_module(self.module), self.cls)
+
+
+#: float32 copies of a recurrent network's weights while it trains: the weights, their gradient, Adam's two moments,
+#: the best-so-far snapshot of early stopping and one update temporary.
+RECURRENT_WEIGHT_COPIES = 6
+
+
+def recurrent_memory_need(n_hidden: int, n_inputs: int) -> int:
+    """Bytes the weights of an Elman network with ``n_hidden`` hidden units and ``n_inputs`` inputs take while
+    training: ``(h^2 + h n_in + 2 h + 1)`` float32 weights x :data:`RECURRENT_WEIGHT_COPIES` (activations aside).
+
+    >>> recurrent_memory_need(16, 8)  # 4 bytes x 6 copies x (256 + 128 + 32 + 1)
+    10008
+    """
+    h, i = int(n_hidden), int(n_inputs)
+    return 4 * RECURRENT_WEIGHT_COPIES * (h * h + h * i + 2 * h + 1)
 
 
 _RECURRENT = (("lags", "lags"), ("hidden", "hidden"), ("activation", "activation"), ("training", "training"),

@@ -11,8 +11,10 @@ import numpy as np
 from ..allan import ESTIMATORS, STATISTICS
 from ..allan.grid import MAX_TAUS
 from ..errors import ConfigError
+from ..io.readers.limits import ENV_MEMORY, format_bytes, memory_budget
 from ..lifting import MODES, get_wavelet
 from ..models import MODEL_NAMES, check_model_params, model_spec
+from ..models.registry import RECURRENT_WEIGHT_COPIES, recurrent_memory_need
 from ..noise.terms import TERM_TABLE
 from ..outliers import OUTLIER_ACTIONS
 from ..units import check_rate_hz, earth_rate_projection_dph
@@ -149,6 +151,14 @@ class AnalysisConfig:
         if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
             raise ConfigError(f"{{opt:lags}}, {{opt:hidden}} and {{opt:epochs}} must be >= 1; got {self.lags}, "
                               f"{self.hidden}, {self.epochs}")
+
+        if any(("hidden", "hidden") in model_spec(m).settings for m in self.models):
+            need, budget = recurrent_memory_need(self.hidden, self.lags), memory_budget()
+            if budget is not None and need > budget:
+                raise ConfigError(f"{{opt:hidden}} {self.hidden}: the recurrent network's weights need about "
+                                  f"{format_bytes(need)} while training ({self.hidden}^2 recurrent weights, float32, "
+                                  f"x {RECURRENT_WEIGHT_COPIES} copies); expected at most the memory budget "
+                                  f"{format_bytes(budget)} ({ENV_MEMORY}); choose a smaller {{opt:hidden}}")
 
         from ..models.grey import GM11_MIN_LENGTH  # model modules load on use (the registry's rule)
 
