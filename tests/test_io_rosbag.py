@@ -182,3 +182,31 @@ def test_corrupt_bags_are_located_errors(tmp_path, rng):
     db.write_bytes(db.read_bytes()[:4096] + b"\x00" * 4096)
     with pytest.raises(DataFormatError, match=r"ros2: unreadable or corrupt bag"):
         load(d)
+
+
+def test_a_ros1_imu_defined_with_float32_is_one_line_naming_the_definition(tmp_path):
+    """A ROS 1 bag whose sensor_msgs/Imu definition uses float32 vectors (its own md5sum in the connection
+    header): rosbags refuses the definition's hash, and the reader says so in one line that names the definition,
+    never decoding the float32 bytes as the standard float64 layout (issue 36)."""
+    import hashlib
+    import struct
+
+    ts = get_typestore(Stores.ROS1_NOETIC)
+    msgdef, _ = ts.generate_msgdef("sensor_msgs/msg/Imu")
+    msgdef32 = msgdef.replace("float64 x\nfloat64 y\nfloat64 z", "float32 x\nfloat32 y\nfloat32 z")
+    assert msgdef32 != msgdef
+    path = tmp_path / "imu32.bag"
+    with Writer1(path) as writer:
+        c = writer.add_connection("/imu/data", "sensor_msgs/msg/Imu", msgdef=msgdef32,
+                                  md5sum=hashlib.md5(msgdef32.encode()).hexdigest())
+        for i in range(200):
+            t = T0_NS + i * 10_000_000
+            head = struct.pack("<IIII", i, t // 10**9, t % 10**9, 3) + b"imu"
+            body = struct.pack("<13d", 0, 0, 0, 1, *[0.0] * 9)
+            body += struct.pack("<3f", 0.01, 0.02, 0.03) + struct.pack("<9d", *[0.5] * 9)
+            body += struct.pack("<3f", 0.0, 0.0, 9.81) + struct.pack("<9d", *[0.25] * 9)
+            writer.write(c, t, head + body)
+    with pytest.raises(DataFormatError) as info:
+        load(path, unit="rad/s")
+    text = str(info.value)
+    assert "imu32.bag" in text and "not the standard one" in text and "float32" in text and "\n" not in text

@@ -334,6 +334,11 @@ def open_table(path: Path, *, topic=None, stamp="header", temperature=None, fiel
     except DataFormatError:
         raise
     except errors as exc:
+        if "hash mismatch" in str(exc):  # rosbags compares each connection's definition with the standard type's
+            raise DataFormatError(
+                f"a message definition in the bag is not the standard one ({describe_exception(exc)}): a "
+                "sensor_msgs/Imu defined with other field types (float32 ...) cannot be decoded as the standard "
+                "layout; re-record or convert the bag with the standard sensor_msgs/Imu", path=p) from exc
         where = f" after message {n_read - 1}" if n_read else ""
         raise DataFormatError(
             f"unreadable or corrupt bag{where}; expected a ROS 1 bag file or a ROS 2 bag directory, got "
