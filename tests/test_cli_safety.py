@@ -458,3 +458,18 @@ def test_ctrl_c_while_writing_keeps_only_complete_files(bundled_path, tmp_path):
     line = _assert_clean_interrupt(rc, seconds, err, out)
     assert "report.html" in line.split("not written:")[-1] or "nothing was written" in line
     assert not (out / "report.html").exists()
+
+
+
+def test_ctrl_c_while_the_command_module_imports_prints_its_one_line(tmp_path):
+    """Ctrl-C after the guard is on but before the command's edge takes over (importing the command's module):
+    typer turns the KeyboardInterrupt into exit 130 without a word, and a loaded machine spends seconds there
+    (issue 36: start-up interrupts that ended silently).  main() now prints the line."""
+    y = tmp_path / "y.npy"
+    np.save(y, np.random.default_rng(1).standard_normal(4096))
+    out = tmp_path / "out"
+    rc, stdout, err = _sigint_at("fogdrift.cli.allan", ["allan", str(y), "--rate", "100", "--unit", "deg/h",
+                                                         "--out", str(out)])
+    assert rc == 130, err
+    assert lines(err) == ["interrupted: nothing was written"], err
+    assert stdout == "" and not out.exists()

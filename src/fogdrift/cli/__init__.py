@@ -116,6 +116,23 @@ def _outside_the_guard(signum, frame):
         interrupt.request()
 
 
+def _edge_state() -> dict:
+    """The state of the command's edge (:mod:`fogdrift.cli._app`), or {} before it is imported."""
+    return getattr(sys.modules.get(f"{__name__}._app"), "_state", None) or {}
+
+
+def _line_claimed() -> bool:
+    """Whether the command's edge (its interruption handler or the watchdog's emergency exit) printed, or is
+    printing, the interruption line: it holds the edge's lock while it does.
+
+    typer ends a KeyboardInterrupt raised outside the edge (importing the command's module, parsing its options,
+    or after the edge's block had finished) with exit 130 and no word; then no one holds the lock, and
+    :func:`main` says what happened: nothing was written, or the run had finished (the edge's ``ran``).  Taking
+    the lock here keeps the watchdog from printing a second line."""
+    lock = _edge_state().get("finish")
+    return lock is not None and not lock.acquire(blocking=False)
+
+
 def _after_the_run(code: int) -> bytes:
     return (b"interrupted: after the run had finished (its files were all written)\n" if code == 0
             else b"interrupted: after the run had ended\n")
@@ -164,6 +181,8 @@ def main():  # console-script entry point
                 _lazy_app()(prog_name="fogdrift")
             except SystemExit as exc:
                 code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+                if code == 130 and not _line_claimed():  # typer turned a Ctrl-C outside the command's edge into 130
+                    os.write(2, _after_the_run(0) if _edge_state().get("ran") else NOTHING_WRITTEN)
             except KeyboardInterrupt:  # before a command's frame took over (imports, option parsing)
                 os.write(2, NOTHING_WRITTEN)
                 code = 130

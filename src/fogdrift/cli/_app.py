@@ -435,6 +435,7 @@ def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool
     """
     _configure(json_out)
     _state["finish"] = threading.Lock()
+    _state["ran"] = False  # set once the block has finished: its files are all written
     outdir = None
     gc.freeze()
     try:
@@ -448,6 +449,7 @@ def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool
             try:
                 with outdir:
                     yield Run(outdir, bool(json_out))
+                _state["ran"] = True
             except BaseException as exc:
                 if isinstance(exc, typer.Exit) and not interrupt.requested():
                     raise
