@@ -9,7 +9,6 @@ coefficients ``A`` the fit works with (``A = (value / to_unit)^2 * law.scale(dt)
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from dataclasses import dataclass, field
