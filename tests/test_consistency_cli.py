@@ -186,3 +186,25 @@ def test_training_log_as_held_out_is_warned(logs, tmp_path):
                               "--calibration", "20", "--horizons", "20", "--out", str(tmp_path / "w")])
     assert res.exit_code == 0, res.output
     assert "is the training log itself (same SHA-256): its coverage is no held-out evidence" in res.output
+
+
+def test_a_held_out_log_declaring_another_unit_is_refused_not_read_through_unit(tmp_path):
+    """``--unit deg/s`` is the training log's; a held-out log whose header declares ``gz[rad/s]`` was read as deg/s
+    (every angle error 57x small, "no inflation needed": issue 36).  Now one line naming the file, the column and
+    both units, before any fit; a held-out log declaring the same unit passes."""
+    from fogdrift.io import load
+    from fogdrift.workflows.consistency import check_declared_units
+
+    rng = np.random.default_rng(3)
+    t = np.arange(6000) * 0.1
+    train, held, same = tmp_path / "train.csv", tmp_path / "held.csv", tmp_path / "same.csv"
+    np.savetxt(train, np.c_[t, 0.01 * rng.standard_normal(t.size)], delimiter=",", header="t_s,gz", comments="")
+    np.savetxt(held, np.c_[t, 2e-4 * rng.standard_normal(t.size)], delimiter=",", header="t_s,gz[rad/s]", comments="")
+    np.savetxt(same, np.c_[t, 0.01 * rng.standard_normal(t.size)], delimiter=",", header="t_s,gz[deg/s]", comments="")
+    res = runner.invoke(app, ["consistency", str(train), "--unit", "deg/s", "--held-out", str(held), "--out",
+                              str(tmp_path / "o")])
+    assert res.exit_code == 1 and "Traceback" not in res.output
+    err = [ln for ln in res.output.splitlines() if ln.startswith("error:")]
+    assert len(err) == 1 and "held.csv" in err[0] and "'rad/s'" in err[0] and "--unit 'deg/s'" in err[0], res.output
+    assert not (tmp_path / "o" / "consistency.json").exists()
+    check_declared_units(load(same, unit="deg/s"), "same.csv")  # the same unit: nothing to refuse

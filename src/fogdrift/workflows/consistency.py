@@ -15,8 +15,10 @@ from ..pipeline import AnalysisConfig
 from ..pipeline import run_allan as _allan_fit
 from ..report import write_json
 from ..spec import channel_kind
+from ..units import parse_unit
 
-__all__ = ["ConsistencyRun", "model_components", "run_consistency", "write_consistency", "INFLATION_DEFINITION"]
+__all__ = ["ConsistencyRun", "check_declared_units", "model_components", "run_consistency", "write_consistency",
+           "INFLATION_DEFINITION"]
 
 #: What the inflation factor means, stated in consistency.json.
 INFLATION_DEFINITION = ("lambda multiplies every component's variance parameter (N^2, K^2, sigma^2, Q^2, R^2); the "
@@ -96,6 +98,29 @@ def model_components(record, *, method="allan", components=None, source_name="",
     return full, notes, k_bounds, f"the Allan fit of {source_name}"
 
 
+def check_declared_units(rec, name: str) -> None:
+    """ConfigError if a held-out log declares, for a channel, a unit other than the one the unit option made it be
+    read in.
+
+    The option (``--unit``) is the training log's; a held-out log read through it would have its own header
+    overruled (a log that declares ``gz[rad/s]`` read as deg/s: every angle error 57x small, and "no inflation
+    needed").  Units are never guessed: the conflict is refused, naming the file, the column and both units.
+    """
+    for c in rec.signal.channels:
+        if c.declared_unit is None or c.unit_source != "option":
+            continue
+        try:
+            declared = parse_unit(c.declared_unit, c.quantity)
+            same = declared.kind == c.unit.kind and declared.factor == c.unit.factor
+        except ConfigError:
+            same = False
+        if not same:
+            raise ConfigError(f"{name}: column {c.name} declares {c.declared_unit.strip()!r}, but {{opt:unit}} "
+                              f"{c.unit.text!r} (given for the training log) would read it as {c.unit.text}; a "
+                              "held-out log is never read against its own header: give the logs in one unit, or "
+                              "fix the header")
+
+
 def run_consistency(record, held_out, *, method="allan", components=None, calibration_s=60.0,
                     horizons_s=(1.0, 10.0, 30.0, 60.0, 300.0), cover_s=60.0, origin_step_s=None, source_name="",
                     held_out_names=(), progress=None) -> ConsistencyRun:
@@ -115,10 +140,12 @@ def run_consistency(record, held_out, *, method="allan", components=None, calibr
         Their file names, for messages and the JSON.
     """
     check_records_memory("consistency", record, *held_out)
+    names = list(held_out_names) or [f"held-out log {i + 1}" for i in range(len(held_out))]
+    for rec, name in zip(held_out, names):
+        check_declared_units(rec, name)
     full, notes, k_bounds, source = model_components(record, method=method, components=components,
                                                      source_name=source_name, progress=progress)
     kinds = {c.name: channel_kind(c.quantity) for c in record.signal.channels}
-    names = list(held_out_names) or [f"held-out log {i + 1}" for i in range(len(held_out))]
     logs = []
     for rec, name in zip(held_out, names):
         miss = [a for a in record.axis_names if a not in rec.axis_names]
