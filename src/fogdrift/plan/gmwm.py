@@ -29,10 +29,7 @@ The default candidate set of the selection has no FLICKER model (:data:`fogdrift
 from __future__ import annotations
 
 import math
-import multiprocessing
 import warnings
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 from types import SimpleNamespace
 
 import numpy as np
@@ -44,6 +41,7 @@ from ..gmwm.ieee import to_ieee
 from ..gmwm.processes import PROCESSES, parse_model
 from ..gmwm.selection import select_model
 from ..simulate import simulate
+from .montecarlo import run_seeds
 
 __all__ = ["LATENT", "latent_model", "gmwm_widths", "simulate_gmwm_fits", "SELECTION_CHECKS"]
 
@@ -146,10 +144,4 @@ def simulate_gmwm_fits(model, n_samples, seeds, workers: int = 1) -> list[dict]:
     :func:`fogdrift.plan.montecarlo.summarise`.  ``workers > 1``: that many processes."""
     latent = latent_model(model)[0].name
     jobs = [(model.terms, model.dt_s, int(n_samples), int(s), model.simulate_kwargs(), latent) for s in seeds]
-    if workers > 1 and len(jobs) > 1:
-        try:
-            with ProcessPoolExecutor(max_workers=int(workers), mp_context=multiprocessing.get_context("spawn")) as ex:
-                return list(ex.map(_one, jobs))
-        except BrokenProcessPool:
-            pass
-    return [_one(j) for j in jobs]
+    return run_seeds(_one, jobs, workers)

@@ -20,7 +20,7 @@ import numpy as np
 from ..pipeline import AnalysisConfig, analyse_allan
 from ..simulate import simulate
 
-__all__ = ["simulate_fits", "summarise", "MC_MAX_SAMPLES"]
+__all__ = ["simulate_fits", "run_seeds", "summarise", "MC_MAX_SAMPLES"]
 
 #: Longest record simulated (samples): the flicker simulator shapes 4 n points by FFT (about 64 n bytes).
 MC_MAX_SAMPLES = 2**23
@@ -39,15 +39,23 @@ def simulate_fits(model, n_samples, seeds, workers: int = 1) -> list[dict]:
     if int(n_samples) > MC_MAX_SAMPLES:
         raise ValueError(f"{n_samples} samples is beyond the Monte-Carlo limit of {MC_MAX_SAMPLES}")
     jobs = [(model.terms, model.dt_s, int(n_samples), int(s), model.simulate_kwargs()) for s in seeds]
+    return run_seeds(_one, jobs, workers)
+
+
+def run_seeds(fn, jobs, workers: int = 1) -> list:
+    """``[fn(job) for job in jobs]``, in order; ``workers > 1``: in that many processes.
+
+    Fresh interpreters ("spawn"): a forked child of a process that already runs threads (numba, BLAS, a test
+    runner's worker) can die on start; a pool that breaks anyway falls back to one process.  ``fn`` must be a
+    module-level function (the pool pickles it by name).
+    """
     if workers > 1 and len(jobs) > 1:
-        # fresh interpreters ("spawn"): a forked child of a process that already runs threads (numba, BLAS, a
-        # test runner's worker) can die on start; a pool that breaks anyway falls back to one process
         try:
             with ProcessPoolExecutor(max_workers=int(workers), mp_context=multiprocessing.get_context("spawn")) as ex:
-                return list(ex.map(_one, jobs))
+                return list(ex.map(fn, jobs))
         except BrokenProcessPool:
             pass
-    return [_one(j) for j in jobs]
+    return [fn(j) for j in jobs]
 
 
 def summarise(model, fits, targets) -> dict:
