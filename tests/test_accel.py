@@ -244,3 +244,50 @@ def test_gyro_only_commands_refuse_accelerometer_channels(tmp_path):
                                           "accelerometer channels"):
         gyro_only(load(p, unit="g"), "analyze")
     gyro_only(from_array(np.zeros((4, 1)), dt_s=0.01, unit="deg/s", axis_names=["gz"]), "analyze")  # a gyro passes
+
+
+def _keys_and_texts(doc, path=""):
+    """Every key path and every string value of a JSON document."""
+    if isinstance(doc, dict):
+        for k, v in doc.items():
+            yield "key", f"{path}/{k}"
+            yield from _keys_and_texts(v, f"{path}/{k}")
+    elif isinstance(doc, list):
+        for i, v in enumerate(doc):
+            yield from _keys_and_texts(v, f"{path}[{i}]")
+    elif isinstance(doc, str):
+        yield "text", f"{path}: {doc}"
+
+
+def test_allan_json_of_an_accelerometer_names_m_s2_everywhere(tmp_path):
+    """No key or text of an accelerometer's allan.json says deg/h (dph, deg/...): the curve's keys are the CSV's
+    columns, the record names its internal unit, the shaped terms' descriptions and the outliers are in m/s^2."""
+    import json
+
+    from fogdrift.pipeline import AnalysisConfig, run_allan
+    from fogdrift.report import write_allan_outputs
+
+    rng = np.random.default_rng(5)
+    n, dt = 2**15, 0.01
+    y = 0.01 * rng.standard_normal((n, 2)) + 0.004 * np.sin(2 * np.pi * 5.0 * dt * np.arange(n))[:, None]
+    y[[100, 9000, 20000], 0] += 0.5                                   # outliers: their sigma is written too
+    acc = from_array(y, dt_s=dt, unit="m/s^2", axis_names=["ax", "ay"])
+    axes = run_allan(acc, AnalysisConfig().validate())
+    write_allan_outputs(axes, acc, tmp_path)
+    doc = json.loads((tmp_path / "allan.json").read_text())
+    found = list(_keys_and_texts(doc))
+    assert [p for kind, p in found if kind == "key" and ("dph" in p.rsplit("/", 1)[1])] == []
+    assert [p for kind, p in found if kind == "text" and "deg" in p.split(": ", 1)[1]] == []
+    assert any(p.endswith("/shaped/S/description") for kind, p in found if kind == "key")   # the tone was there
+    assert any(p.endswith("/outliers/robust_sigma_mps2") for kind, p in found if kind == "key")
+    assert doc["record"]["internal_unit"] == "m/s^2" and doc["record"]["scale_to_internal"] == 1.0
+    head = (tmp_path / "allan.csv").read_text().splitlines()[0].split(",")
+    curve = doc["axes"][0]["allan"]
+    assert set(head[1:]) <= set(curve)                                  # the JSON's keys are the CSV's columns
+    np.testing.assert_array_equal(curve["adev_mps2"], axes[0].allan.dev_dph)
+    np.testing.assert_array_equal(curve["avar_m2ps4"], axes[0].allan.var_dph2)
+    gyro = from_array(y, dt_s=dt, unit="deg/h", axis_names=["gx", "gy"])     # a gyro's keys stay deg/h
+    write_allan_outputs(run_allan(gyro, AnalysisConfig().validate()), gyro, tmp_path)
+    g = json.loads((tmp_path / "allan.json").read_text())
+    assert g["record"]["rate_unit"] == "deg/h" and "adev_dph" in g["axes"][0]["allan"]
+    assert "robust_sigma_dph" in g["axes"][0]["outliers"]

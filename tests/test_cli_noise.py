@@ -174,6 +174,25 @@ def test_candidate_tables_are_behind_details(tmp_path):
     assert a == b
 
 
+def test_noise_files_of_an_accelerometer_say_m_s2(tmp_path):
+    """An accelerometer's noise.json and wvar.csv carry m/s^2: the units block, the WV columns, the B headline and
+    the spectral lines (a 5 Hz tone) name no deg/h; a gyro's say deg/h (white noise plus a tone, 2^14 samples)."""
+    n, dt = 2**14, 0.01
+    x = np.random.default_rng(4).standard_normal(n) * 0.01 + 0.02 * np.sin(2 * np.pi * 5.0 * dt * np.arange(n))
+    for name, unit, rate, two in (("az", "m/s^2", "m/s^2", "m2ps4"), ("gz", "deg/h", "deg/h", "dph2")):
+        path = tmp_path / f"{name}.csv"
+        np.savetxt(path, np.c_[np.arange(n) * dt, x], delimiter=",", header=f"t_s,{name}", comments="")
+        _ok(runner.invoke(app, ["noise", str(path), "--unit", unit, "--out", str(tmp_path / name)]))
+        doc = json.loads((tmp_path / name / "noise.json").read_text())
+        assert doc["units"]["rate"] == rate and doc["units"]["wvar"] == f"({rate})^2"
+        ax = doc["axes"][0]
+        assert ax["spectral_lines"] and all(line.endswith(rate) for line in ax["spectral_lines"])
+        assert rate in ax["b_headline_text"] and ("deg" in ax["b_headline_text"]) == (name == "gz")
+        assert ax.get("quantity", "angular_rate") == ("specific_force" if name == "az" else "angular_rate")
+        head = (tmp_path / name / "wvar.csv").read_text().splitlines()[0]
+        assert head == f"axis,level,scale_s,wvar_{two},ci_lo95_{two},ci_hi95_{two},used,model_wvar_{two}"
+
+
 def test_gmwm_without_a_passing_candidate_prints_true_bounds_not_values():
     """No candidate passes: the table holds no model value, only the bounds the measured WV itself sets, and they
     hold the truth of a white-noise record with a slow oscillation no candidate describes."""

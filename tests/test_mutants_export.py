@@ -919,6 +919,21 @@ def test_allan_markov_term_becomes_a_gauss_markov():
     assert channels_from_result(_allan_doc(ax2), "a.json")[0].gms == []
 
 
+def test_allan_markov_term_of_an_accelerometer_reads_its_m_s2_key():
+    """An accelerometer's allan.json names the Markov sigma in its unit (``sigma_mps2``, m/s^2): export reads that
+    key (the gyro's ``sigma_dph`` is not there) and takes the number as m/s^2, not deg/h."""
+    units = {"Q": "m/s", "N": "m/s/sqrt(h)", "B": "ug", "K": "m/s^2/sqrt(h)", "R": "m/s^2/h"}
+    ax = _allan_axis("ax", {"N": (0.06, 0.05, 0.07, "resolved")}, selected=("N", "M"), units=units)
+    ax["noise"]["quantity"] = "specific_force"
+    ax["noise"]["terms"]["M"] = {"name": "M", "value": 5e-4, "unit": "m/s^2/sqrt(s)", "lo95": 3e-4, "hi95": 7e-4,
+                                 "status": "resolved"}
+    ax["noise"]["shaped"] = {"M": {"tc_s": 30.0, "tc_lo95_s": 20.0, "tc_hi95_s": 45.0, "sigma_mps2": 0.002,
+                                   "q_unit": "m/s^2/sqrt(s)"}}
+    (ch,) = channels_from_result(_allan_doc(ax), "a.json")
+    (g,) = ch.gms
+    assert ch.quantity == "accel" and g.sigma_si == approx(0.002, rel=1e-12) and g.tc_s == 30.0
+
+
 def test_allan_axis_without_a_fit_and_bad_files_are_refused(tmp_path):
     with pytest.raises(DataFormatError) as ei:
         channels_from_result({"axes": [{"name": "gx", "noise": {"statistic": "adev"}}]}, "a.json")

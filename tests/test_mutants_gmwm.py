@@ -44,6 +44,7 @@ class _Axis:
     name: str
     selection: _Sel
     allan_check: dict | None
+    quantity: str = "angular_rate"
 
 
 def _bi(value=None, lo=None, hi=None, tau=None, bound=None, reason="", label="min of the model's ADEV",
@@ -76,6 +77,7 @@ def test_accel_restatement_multiplies_value_and_interval_by_the_table_factor_and
     the table, the model and the GM's T_c pass unchanged."""
     acc = express_gmwm(_gyro_axis(), "specific_force")
     t = acc.selection.ieee.terms
+    assert acc.quantity == "specific_force" and _gyro_axis().quantity == "angular_rate"  # its texts follow it
     want = {"N_dprh": ((7200.0, 3600.0, 14400.0), "m/s/sqrt(h)"),
             "K_dphrh": ((3.0, 2.0, 5.0), "m/s^2/sqrt(h)"),
             "R_dph2": ((7.0, 6.0, 8.0), "m/s^2/h"),

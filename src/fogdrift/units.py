@@ -34,6 +34,8 @@ __all__ = [
     "ARCSEC_PER_DEG",
     "QUANTITIES",
     "INTERNAL_UNITS",
+    "KEY_SUFFIXES",
+    "name_keys",
     "STANDARD_GRAVITY_MPS2",
     "SPECIFIC_FORCE_UNITS",
     "VELOCITY_INCREMENT_UNITS",
@@ -128,6 +130,29 @@ INTERNAL_UNITS: dict[str, str] = {
     "angular_rate": "deg/h",
     "specific_force": "m/s^2",
 }
+
+#: Per quantity: the suffixes that name a value and its square in the internal unit in serialised keys and
+#: column names (``adev_dph``/``avar_dph2`` for a gyro, ``adev_mps2``/``avar_m2ps4`` for an accelerometer).
+KEY_SUFFIXES: dict[str, tuple[str, str]] = {
+    "angular_rate": ("dph", "dph2"),
+    "specific_force": ("mps2", "m2ps4"),
+}
+
+def name_keys(values: dict, quantity: str) -> dict:
+    """``values`` with each key's internal-unit suffix (``_dph``, ``_dph2``) named for ``quantity``
+    (:data:`KEY_SUFFIXES`); the same dict for an angular rate.
+
+    Examples
+    --------
+    >>> name_keys({"robust_sigma_dph": 0.1, "var_dph2": 0.01, "count": 3}, "specific_force")
+    {'robust_sigma_mps2': 0.1, 'var_m2ps4': 0.01, 'count': 3}
+    """
+    if quantity == "angular_rate":
+        return values
+    one, two = KEY_SUFFIXES[quantity]
+    return {(k[:-5] + "_" + two if k.endswith("_dph2") else k[:-4] + "_" + one if k.endswith("_dph") else k): v
+            for k, v in values.items()}
+
 
 #: The quantities :func:`parse_unit` knows (the keys of :data:`INTERNAL_UNITS`).
 QUANTITIES: tuple[str, ...] = tuple(INTERNAL_UNITS)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..units import KEY_SUFFIXES
 from .statistics import get_statistic
 
 __all__ = ["AllanResult"]
@@ -120,24 +121,43 @@ class AllanResult:
         return self._allan("dev_hi95_dph")
 
     # --- serialisation ------------------------------------------------------------------
-    def column_names(self) -> tuple:
+    def column_names(self, quantity: str = "angular_rate") -> tuple:
         """Serialised column names: ``tau_s, m, <var>_dph2, <dev>_dph, <dev>_lo68_dph, ...``.
+
+        ``quantity`` names the channel's quantity: the arrays hold its internal unit, and the unit suffixes are
+        that unit's (:data:`fogdrift.units.KEY_SUFFIXES`: ``dph``/``dph2`` for an angular rate in deg/h,
+        ``mps2``/``m2ps4`` for a specific force in m/s^2).
 
         Examples
         --------
         >>> from fogdrift.allan import allan_variance
         >>> allan_variance([1, 3, 2, 5, 4, 4, 6, 3], 1.0, statistic="mdev").column_names()[:4]
         ('tau_s', 'm', 'mvar_dph2', 'mdev_dph')
+        >>> allan_variance([1, 3, 2, 5, 4, 4, 6, 3], 1.0).column_names("specific_force")[2:5]
+        ('avar_m2ps4', 'adev_mps2', 'adev_lo68_mps2')
         """
         stat = get_statistic(self.statistic)
-        return tuple(c.replace("var_", f"{stat.var_name}_", 1) if c.startswith("var_")
-                     else c.replace("dev_", f"{stat.dev_name}_", 1) if c.startswith("dev_") else c
-                     for c in _ARRAYS)
+        try:
+            one, two = KEY_SUFFIXES[quantity]
+        except KeyError:
+            raise ValueError(f"quantity must be one of {sorted(KEY_SUFFIXES)}; got {quantity!r}") from None
 
-    def to_dict(self) -> dict:
-        """JSON-serialisable dict: arrays become lists of float/int, units are in the keys."""
+        def name(c: str) -> str:
+            if c.startswith("var_"):
+                c = c.replace("var_", f"{stat.var_name}_", 1)
+            elif c.startswith("dev_"):
+                c = c.replace("dev_", f"{stat.dev_name}_", 1)
+            else:
+                return c
+            return c[: -len("_dph2")] + f"_{two}" if c.endswith("_dph2") else c[: -len("_dph")] + f"_{one}"
+
+        return tuple(name(c) for c in _ARRAYS)
+
+    def to_dict(self, quantity: str = "angular_rate") -> dict:
+        """JSON-serialisable dict: arrays become lists of float/int, units are in the keys
+        (:meth:`column_names` of ``quantity``)."""
         out: dict = {"statistic": self.statistic}
-        for name, key in zip(_ARRAYS, self.column_names()):
+        for name, key in zip(_ARRAYS, self.column_names(quantity)):
             arr = np.asarray(getattr(self, name))
             if arr.dtype.kind in "iu":
                 out[key] = [int(v) for v in arr]

@@ -27,6 +27,7 @@ from pathlib import Path
 from .. import documents
 from ..errors import ConfigError, DataFormatError
 from ..noise.terms import TERMS
+from ..units import name_keys
 from .conversions import quantity_of_unit, single_gm_from_flicker, to_si
 
 __all__ = ["TermValue", "GaussMarkov", "ChannelModel", "MISSING_POLICIES", "Resolved", "load_result",
@@ -259,7 +260,8 @@ def _allan_channel(ax: dict, record: dict, path: str) -> ChannelModel:
         # sigma = q_c sqrt(T_c/2) is in the rate unit of q_c (IEEE-952 C.6)
         q_unit = str(m.get("q_unit", mt.get("unit", "")))
         factor = to_si(1.0, "q_c", q_unit)[0]
-        gms.append(GaussMarkov(sigma_si=_coefficient(m["sigma_dph"], "M sigma", where) * factor,
+        sigma_key, = name_keys({"sigma_dph": None}, str(noise.get("quantity", "angular_rate")))  # in its unit
+        gms.append(GaussMarkov(sigma_si=_coefficient(m[sigma_key], "M sigma", where) * factor,
                                tc_s=_coefficient(m["tc_s"], "M tc_s", where, positive=True),
                                tc_lo95_s=_f(m.get("tc_lo95_s")), tc_hi95_s=_f(m.get("tc_hi95_s")),
                                source="allan fit: M (exponentially correlated, IEEE-952 C.6)"))

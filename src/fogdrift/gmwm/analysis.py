@@ -28,6 +28,7 @@ import numpy as np
 
 from ..errors import ConfigError, DataFormatError
 from ..noise.periodic import PeriodicContent, periodic_content
+from ..noise.quantity import restate_text
 from ..noise.result import NoiseTerm
 from ..noise.terms import TERM_TABLE
 from ..noise.spectral import analyse_spectrum
@@ -72,6 +73,9 @@ class GmwmAxis:
     #: The spectral lines of the rate (:class:`fogdrift.noise.periodic.PeriodicContent`) the selection took into
     #: account; None for a curve given as a table or a rate whose spectrum shows no line.
     periodic: PeriodicContent | None = None
+    #: The channel's quantity (``"angular_rate"`` or ``"specific_force"``, :func:`fogdrift.gmwm.quantity.express_gmwm`):
+    #: the texts of :meth:`to_dict` are in its unit.
+    quantity: str = "angular_rate"
 
     def data_bounds(self) -> dict:
         """The bound the measured WV alone sets on N, Q and K (units of :data:`fogdrift.noise.TERM_UNITS`).
@@ -130,9 +134,11 @@ class GmwmAxis:
         sel = self.selection
         return {"name": self.name, "method": "gmwm", "selected": sel.selected,
                 "passed_checks": bool(sel.passed_checks), "no_result": bool(sel.no_result),
-                "b_headline_text": sel.ieee.b_headline.text(),
+                "b_headline_text": restate_text(sel.ieee.b_headline.text(), self.quantity),
                 **({} if self.allan_check is None else {"allan_check": self.allan_check}),
-                "spectral_lines": [] if self.periodic is None else list(self.periodic.descriptions),
+                "spectral_lines": [] if self.periodic is None else [restate_text(t, self.quantity)
+                                                                    for t in self.periodic.descriptions],
+                **({} if self.quantity == "angular_rate" else {"quantity": self.quantity}),
                 "j_statistic": {"q": float(sel.fit.j_stat), "df": int(sel.fit.df), "p_value": float(sel.fit.j_pvalue),
                                 "caveat": J_CAVEAT},
                 "wvar": self.wvar.to_dict(), "selection": sel.to_dict()}

@@ -66,7 +66,7 @@ def express_gmwm(axis, quantity: str):
     check = axis.allan_check
     if check is not None:
         check = {**check, "lines": [restate_text(line, quantity) for line in check.get("lines", [])]}
-    return dataclasses.replace(axis, selection=sel, allan_check=check)
+    return dataclasses.replace(axis, selection=sel, allan_check=check, quantity=quantity)
 
 
 def accel_rows(rows: list) -> list:

@@ -421,7 +421,8 @@ class GyroRecord:
         -------
         dict
             ``source, sha256, input_unit, declared_units (list), scale_to_dph, rate_unit
-            ("deg/h"), dt_s, fs_hz, native_fs_hz, block_average_factor, t0_s, n_samples,
+            ("deg/h") (for a record with accelerometer channels ``scale_to_internal`` and ``internal_unit``:
+            ``"m/s^2"``, or a dict of each channel's internal unit for a gyro and accelerometer log), dt_s, fs_hz, native_fs_hz, block_average_factor, t0_s, n_samples,
             n_axes, duration_s, axis_names (list), notes (list), temperature, signal``.  ``fs_hz`` is
             the effective rate after block averaging; ``native_fs_hz`` the rate as loaded;
             ``temperature`` is None or the range and drift of the temperature carried with the
@@ -429,13 +430,19 @@ class GyroRecord:
             ``signal`` is :meth:`fogdrift.signal.SignalDescription.to_dict` of :attr:`signal`.
         """
         temp = None if self.temperature_c is None else temperature_summary(self.temperature_c, self.dt_s).to_dict()
+        quantities = self.quantities
+        if all(q == "angular_rate" for q in quantities):
+            scale = {"scale_to_dph": self.scale_to_dph, "rate_unit": units.INTERNAL_UNITS["angular_rate"]}
+        else:  # accelerometer channels hold m/s^2: the keys say "internal", the unit is the channels'
+            each = {n: units.INTERNAL_UNITS[q] for n, q in zip(self.axis_names, quantities)}
+            one = set(each.values())
+            scale = {"scale_to_internal": self.scale_to_dph, "internal_unit": one.pop() if len(one) == 1 else each}
         return {
             "source": self.source,
             "sha256": self.sha256,
             "input_unit": self.input_unit,
             "declared_units": list(self.declared_units),
-            "scale_to_dph": self.scale_to_dph,
-            "rate_unit": "deg/h",
+            **scale,
             "dt_s": self.dt_s,
             "fs_hz": self.fs_hz,
             "native_fs_hz": self.native_fs_hz,

@@ -122,7 +122,8 @@ def express(fit: NoiseFit, quantity: str) -> NoiseFit:
         f = unit_factor(k, quantity)
         readouts[k] = Readout(r.term, None if r.value is None else r.value * f, term_table(quantity)[k].unit,
                               r.tau_s, r.slope, r.dominated, restate_text(r.note, quantity))
-    shaped = {k: dict(v) for k, v in (fit.shaped or {}).items()}
+    shaped = {k: {f: (restate_text(x, quantity) if isinstance(x, str) else x) for f, x in v.items()}
+              for k, v in (fit.shaped or {}).items()}  # descriptions ("spectral line at f Hz, a deg/h") re-stated
     if "M" in shaped:
         shaped["M"]["q_unit"] = SHAPED_UNITS[quantity][1]
         shaped["M"]["sigma_unit"] = SHAPED_UNITS[quantity][0]

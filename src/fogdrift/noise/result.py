@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..units import name_keys
 from .terms import laws_of, markov_shape, periodic_shape, power_terms, term_table
 
 __all__ = ["NoiseTerm", "NoiseFit", "TERM_STATUSES"]
@@ -229,7 +230,8 @@ class NoiseFit:
             "fit": {
                 "tau_min_s": self.tau_min_s,
                 "tau_max_s": self.tau_max_s,
-                "points": [{"tau_s": float(t), "var_dph2": float(v), "model_var_dph2": float(m), "z": float(z)}
+                "points": [name_keys({"tau_s": float(t), "var_dph2": float(v), "model_var_dph2": float(m),
+                                      "z": float(z)}, self.quantity)
                            for t, v, m, z in zip(self.fit_tau_s, self.fit_var, self.model_var, self.z)],
                 "chi2": float(self.chi2), "dof": int(self.dof), "chi2_red": float(self.chi2_red),
                 "p_value": float(self.p_value), "quality": self.quality,
@@ -239,8 +241,8 @@ class NoiseFit:
             "notes": list(self.notes),
             "b_min": self.b_min,
             "readouts": {k: v.to_dict() for k, v in self.readouts.items()},
-            "outliers": self.outliers,
-            "shaped": {k: {kk: vv for kk, vv in v.items() if not isinstance(vv, np.ndarray)}
+            "outliers": None if self.outliers is None else name_keys(self.outliers, self.quantity),
+            "shaped": {k: name_keys({kk: vv for kk, vv in v.items() if not isinstance(vv, np.ndarray)}, self.quantity)
                        for k, v in self.shaped.items()},
             "no_fit": self.no_fit,
             **({"quantity": self.quantity} if self.quantity != "angular_rate" else {}),

@@ -15,6 +15,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..units import name_keys
+
 if TYPE_CHECKING:  # result types of other stages, for the annotations only (no import at run time)
     from ..allan import AllanResult
     from ..evaluation import AxisEvaluation
@@ -45,8 +47,8 @@ class AllanAxis:
     whole_noise: NoiseFit | None = None
 
     def to_dict(self) -> dict:
-        out = {"name": self.name, "allan": self.allan.to_dict(), "noise": self.noise.to_dict(),
-               "outliers": None if self.outliers is None else self.outliers.to_dict()}
+        out = {"name": self.name, "allan": self.allan.to_dict(self.noise.quantity), "noise": self.noise.to_dict(),
+               "outliers": None if self.outliers is None else name_keys(self.outliers.to_dict(), self.noise.quantity)}
         if self.screen is not None:
             out["screen"] = self.screen
         if self.whole_noise is not None:

@@ -9,6 +9,7 @@ import numpy as np
 from .._util import strict_json
 from ..noise import TERM_TABLE
 from ..output import atomic_path
+from ..units import INTERNAL_UNITS
 from .figures import _safe, plot_allan, plot_dynamic_adev, plot_models, plot_residuals, plot_separation, plot_separation_allan
 
 __all__ = ["write_json", "allan_document", "write_allan_outputs", "write_separation_outputs", "write_model_outputs"]
@@ -67,21 +68,18 @@ def write_allan_outputs(allan_axes, record, out_dir) -> dict:
                          repr(float(r.var_dph2[i])), int(r.n_terms[i]), repr(float(r.edf[i])),
                          repr(float(r.dev_lo68_dph[i])), repr(float(r.dev_hi68_dph[i])),
                          repr(float(r.dev_lo95_dph[i])), repr(float(r.dev_hi95_dph[i]))])
-    dev = {"adev": "adev", "hdev": "hdev", "mdev": "mdev"}.get(getattr(allan_axes[0].allan, "statistic", "adev"), "dev")
-    var = {"adev": "avar", "hdev": "hvar", "mdev": "mvar"}.get(dev, "var")
     quantities = set(getattr(record, "quantities", ("angular_rate",)))
-    if quantities == {"angular_rate"}:
-        u, u2 = "dph", "dph2"
-    elif quantities == {"specific_force"}:  # accelerometer axes: the curve is in m/s^2 (the internal unit)
-        u, u2 = "mps2", "m2ps4"
+    mixed = len(quantities) != 1
+    if not mixed:  # the curve's unit in the column names (allan.json's keys: AllanResult.column_names)
+        names = allan_axes[0].allan.column_names(next(iter(quantities)))
     else:  # gyro and accelerometer axes: each row says its unit
-        u, u2 = "internal", "internal2"
-        units = {n: ("deg/h" if q == "angular_rate" else "m/s^2") for n, q in zip(record.axis_names, record.quantities)}
+        names = tuple(c.replace("_dph2", "_internal2").replace("_dph", "_internal")
+                      for c in allan_axes[0].allan.column_names())
+        units = {n: INTERNAL_UNITS[q] for n, q in zip(record.axis_names, record.quantities)}
         rows = [row + [units[row[0]]] for row in rows]
-    _write_rows_csv(out / "allan.csv",
-                    ["axis", "tau_s", "m", f"{dev}_{u}", f"{var}_{u2}", "n_terms", "edf", f"{dev}_lo68_{u}",
-                     f"{dev}_hi68_{u}", f"{dev}_lo95_{u}", f"{dev}_hi95_{u}"] + (["unit"] if u == "internal" else []),
-                    rows)
+    tau, m, var, dev, lo68, hi68, lo95, hi95 = names[:8]
+    _write_rows_csv(out / "allan.csv", ["axis", tau, m, dev, var, "n_terms", "edf", lo68, hi68, lo95, hi95]
+                    + (["unit"] if mixed else []), rows)
     plot_allan(allan_axes, out / "allan.png")
     files = {"json": out / "allan.json", "csv": out / "allan.csv", "png": out / "allan.png"}
     dyn = plot_dynamic_adev(allan_axes, out / "allan_dynamic.png")  # a disturbed axis's ADEV over time

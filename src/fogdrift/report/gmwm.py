@@ -17,6 +17,7 @@ import numpy as np
 from .._util import fmt_number
 from ..gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
 from ..output import atomic_path
+from ..units import INTERNAL_UNITS, KEY_SUFFIXES
 from .figures import _place, save_figure, literal
 from .files import write_json
 
@@ -54,7 +55,7 @@ def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
             ax.loglog(scale[ok], comp[ok], "--", lw=0.9, label=literal(label))
         ax.set_ylim(np.nanmin(wv.ci_lo95_dph2[wv.ci_lo95_dph2 > 0]) / 5, np.nanmax(wv.ci_hi95_dph2) * 3)
         ax.set_xlabel("scale [s]")
-        ax.set_ylabel("wavelet variance [(deg/h)²]")
+        ax.set_ylabel(f"wavelet variance [({INTERNAL_UNITS[a.quantity]})²]")
         ax.set_title(literal(f"{a.name}: {sel.selected}{'' if sel.passed_checks else ' (no candidate passed the checks)'}\n"
                              f"J = {fit.j_stat:.3g}, df {fit.df}, p = {fit.j_pvalue:.2g}"), fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
@@ -63,17 +64,33 @@ def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
     return save_figure(fig, path, dpi=110)
 
 
+def _quantity(axes: list[GmwmAxis]) -> str | None:
+    """The axes' one quantity, or None for gyro and accelerometer axes together."""
+    found = {a.quantity for a in axes}
+    return found.pop() if len(found) == 1 else None
+
+
+def _units(axes: list[GmwmAxis]) -> dict:
+    """``noise.json``'s units: the internal unit of the axes' quantity (per axis when they differ)."""
+    q = _quantity(axes)
+    if q is not None:
+        return {"rate": INTERNAL_UNITS[q], "wvar": f"({INTERNAL_UNITS[q]})^2", "scale": "s"}
+    return {"rate": {a.name: INTERNAL_UNITS[a.quantity] for a in axes},
+            "wvar": {a.name: f"({INTERNAL_UNITS[a.quantity]})^2" for a in axes}, "scale": "s"}
+
+
 def write_gmwm_outputs(axes: list[GmwmAxis], out_dir, *, source: str, record: dict | None = None) -> dict:
     """``noise.json`` (every axis: selection, candidates, IEEE table, J with its caveat), ``wvar.csv`` and
     ``noise.png`` in ``out_dir``; returns ``{"json", "csv", "png"}`` paths."""
     out = Path(out_dir)
     doc = {"fogdrift_result": "noise", "method": "gmwm", "source": str(source), "record": record,
-           "units": {"rate": "deg/h", "wvar": "(deg/h)^2", "scale": "s"},
+           "units": _units(axes),
            "axes": [a.to_dict() for a in axes]}
     paths = {"json": out / "noise.json", "csv": out / "wvar.csv", "png": out / "noise.png"}
     write_json(doc, paths["json"])
     with atomic_path(paths["csv"]) as tmp, open(tmp, "w", encoding="utf-8") as fh:
-        fh.write("axis,level,scale_s,wvar_dph2,ci_lo95_dph2,ci_hi95_dph2,used,model_wvar_dph2\n")
+        two = KEY_SUFFIXES[_quantity(axes)][1] if _quantity(axes) else "internal2"  # the WV's unit in the names
+        fh.write(f"axis,level,scale_s,wvar_{two},ci_lo95_{two},ci_hi95_{two},used,model_wvar_{two}\n")
         for a in axes:
             wv, fit = a.wvar, a.selection.fit
             model = fit.latent_model.wv(fit.theta, wv.tau_samples)

@@ -72,7 +72,11 @@ def settings_rows(result, *, generated: str, title: str = "") -> list:
                                                                  "matplotlib") if k in v))
     add("input", "file", result.source)
     add("input", "SHA-256", result.sha256 or "–")
-    add("input", "rate unit (as read)", f"{rec.get('input_unit')} × {_fmt(rec.get('scale_to_dph'), 6)} = deg/h")
+    if "scale_to_dph" in rec:
+        add("input", "rate unit (as read)", f"{rec.get('input_unit')} × {_fmt(rec.get('scale_to_dph'), 6)} = deg/h")
+    else:  # accelerometer channels (record metadata names the internal unit)
+        add("input", "unit (as read)", f"{rec.get('input_unit')} × {_fmt(rec.get('scale_to_internal'), 6)} = "
+                                       f"{rec.get('internal_unit')}")
     add("input", "reader notes", "; ".join(rec.get("notes", [])) or "–")
     if result.applied:
         add("input", "models", "applied unchanged from the fitted recording (not refitted)")
