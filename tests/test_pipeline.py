@@ -227,32 +227,6 @@ def test_pipeline_fits_exactly_the_configured_models():
 
 
 # ---------------------------------------------------------------------------------------------------------
-# verdict
-
-
-def _axis(**models):
-    """A model axis with constructed metrics: persistence RMSE 1.0 and MAE 0.8 deg/h."""
-    metrics = {"persistence": SimpleNamespace(rmse_dph=1.0, mae_dph=0.8, rmse_persistence_dph=1.0)}
-    for label, (rmse, mae) in models.items():
-        metrics[label] = SimpleNamespace(rmse_dph=rmse, mae_dph=mae, rmse_persistence_dph=1.0)
-    return SimpleNamespace(metrics=metrics)
-
-
-def test_verdict_sentences_on_constructed_metrics():
-    from fogdrift.report import verdict
-
-    lines = verdict(_axis(good=(0.9, 0.6), bad=(1.2, 0.9), mixed=(0.95, 0.85), mixed2=(1.1, 0.7)))
-    assert lines[0] == ("good beat persistence one step ahead: RMSE 0.9 vs 1 deg/h (-10.0 %), "
-                        "MAE 0.6 vs 0.8 deg/h (-25.0 %).")
-    assert lines[1].startswith("bad did NOT beat persistence") and "(+20.0 %)" in lines[1] and "(+12.5 %)" in lines[1]
-    assert lines[2].startswith("mixed gave a MIXED result against persistence")
-    assert lines[3].startswith("mixed2 gave a MIXED result against persistence")
-    assert lines[4] == "Lowest RMSE among learned models on the test block: good."
-    assert verdict(SimpleNamespace(metrics={"persistence": _axis().metrics["persistence"]})) == [
-        "Only the persistence baseline was run."]
-
-
-# ---------------------------------------------------------------------------------------------------------
 # found unasserted by the mutation run (docs/testing-rounds.md): the causal path, as-measured p0, block-size
 # check, rate-input models, the factory call, config validation boundaries
 

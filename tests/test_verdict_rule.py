@@ -22,7 +22,7 @@ from typer.testing import CliRunner
 from fogdrift.evaluation import headline_verdict
 from fogdrift.evaluation.heading import HeadingResult, heading_errors, heading_row
 from fogdrift.evaluation.verdicts import (adev_caveat, diverges, heading_table, heading_verdict, independent_origins,
-                                          independent_subset, judge, table2_verdict)
+                                          independent_subset, judge, one_step_lines, table2_verdict)
 
 
 def _errors(n, better_at, big=1.01, small=0.1):
@@ -323,3 +323,24 @@ def test_analysis_evaluation_carries_the_table2_flag_for_the_console():
     assert list(marks) == ["persistence: output - causal prediction (practical)"]
     flag = next(v for v in ev.verdicts if v.kind == "table2")
     assert flag.data["marks"] == marks and "FLAGGED" in flag.lines[0] and "(practical)" in flag.lines[0]
+
+
+def _one_step_axis(**models):
+    """A model axis with constructed metrics: persistence RMSE 1.0 and MAE 0.8 deg/h."""
+    metrics = {"persistence": NS(rmse_dph=1.0, mae_dph=0.8, rmse_persistence_dph=1.0)}
+    for label, (rmse, mae) in models.items():
+        metrics[label] = NS(rmse_dph=rmse, mae_dph=mae, rmse_persistence_dph=1.0)
+    return NS(metrics=metrics)
+
+
+def test_one_step_sentences_on_constructed_metrics():
+    """The paper's one-step verdict: beat only when RMSE and MAE are both lower, MIXED when they disagree."""
+    lines = one_step_lines(_one_step_axis(good=(0.9, 0.6), bad=(1.2, 0.9), mixed=(0.95, 0.85), mixed2=(1.1, 0.7)))
+    assert lines[0] == ("good beat persistence one step ahead: RMSE 0.9 vs 1 deg/h (-10.0 %), "
+                        "MAE 0.6 vs 0.8 deg/h (-25.0 %).")
+    assert lines[1].startswith("bad did NOT beat persistence") and "(+20.0 %)" in lines[1] and "(+12.5 %)" in lines[1]
+    assert lines[2].startswith("mixed gave a MIXED result against persistence")
+    assert lines[3].startswith("mixed2 gave a MIXED result against persistence")
+    assert lines[4] == "Lowest RMSE among learned models on the test block: good."
+    assert one_step_lines(NS(metrics={"persistence": _one_step_axis().metrics["persistence"]})) == [
+        "Only the persistence baseline was run."]

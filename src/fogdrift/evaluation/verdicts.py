@@ -23,6 +23,7 @@ __all__ = [
     "artefact_verdict",
     "causal_verdict",
     "paper_measure_verdict",
+    "one_step_lines",
     "compensation_verdicts",
     "heading_table",
     "artefact_table",
@@ -638,3 +639,51 @@ def headline_verdict(heading=None, artefacts=None, *, axis: str = "", reason: st
         outcome = "reduces"
     return Verdict("headline", [line], {"outcome": outcome, "model": best, "horizon_s": h,
                                         "ratio_to_bias": r.ratio_to_bias, **data}, short)
+
+
+def _cell(x, digits=4) -> str:
+    """A number as the report's tables print it (scientific below 1e-3 and from 1e4, NaN as ``NaN``)."""
+    return fmt_number(x, digits, nonfinite="NaN", sci_outside=(1e-3, 1e4))
+
+
+def one_step_lines(model_axis) -> list[str]:
+    """Plain-language sentences: which model beat persistence on the test block, judged on RMSE and MAE.
+
+    A model "beat" persistence only if both its RMSE and its MAE are lower; if one is lower and the other
+    higher the verdict says "mixed" (RMSE is dominated by a few large errors, MAE by typical ones).  These are
+    the paper's one-step measures (the report prints them under the causal and heading verdicts).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> m = {"persistence": NS(rmse_dph=1.0, mae_dph=0.8, rmse_persistence_dph=1.0),
+    ...      "Elman": NS(rmse_dph=0.9, mae_dph=0.6, rmse_persistence_dph=1.0)}
+    >>> one_step_lines(NS(metrics=m))[0]
+    'Elman beat persistence one step ahead: RMSE 0.9 vs 1 deg/h (-10.0 %), MAE 0.6 vs 0.8 deg/h (-25.0 %).'
+    """
+    learned = {k: v for k, v in model_axis.metrics.items() if k != "persistence"}
+    if not learned:
+        return ["Only the persistence baseline was run."]
+    any_m = next(iter(model_axis.metrics.values()))
+    p_rmse = any_m.rmse_persistence_dph
+    p_mae = model_axis.metrics["persistence"].mae_dph if "persistence" in model_axis.metrics else None
+    lines = []
+    for label, m in learned.items():
+        d_rmse = 100.0 * (m.rmse_dph / p_rmse - 1.0)
+        text = f"RMSE {_cell(m.rmse_dph)} vs {_cell(p_rmse)} deg/h ({d_rmse:+.1f} %)"
+        if p_mae is None:
+            better = d_rmse < 0
+            word = "beat" if better else "did NOT beat"
+        else:
+            d_mae = 100.0 * (m.mae_dph / p_mae - 1.0)
+            text += f", MAE {_cell(m.mae_dph)} vs {_cell(p_mae)} deg/h ({d_mae:+.1f} %)"
+            if d_rmse < 0 and d_mae < 0:
+                word = "beat"
+            elif d_rmse >= 0 and d_mae >= 0:
+                word = "did NOT beat"
+            else:
+                word = "gave a MIXED result against"
+        lines.append(f"{label} {word} persistence one step ahead: {text}.")
+    best = min(learned, key=lambda k: learned[k].rmse_dph)
+    lines.append(f"Lowest RMSE among learned models on the test block: {best}.")
+    return lines

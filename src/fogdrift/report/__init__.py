@@ -19,7 +19,7 @@ from .figures import (pyplot, _safe, save_figure, plot_allan, plot_models, plot_
 from .files import write_allan_outputs, write_json, write_model_outputs, write_separation_outputs
 from .html import write_report
 from .tables import (METRICS_HEADERS, NOISE_HEADERS, b_headline, b_min_cell, shaped_cell, causal_metrics_rows, fit_cell, fit_summary, metrics_rows, noise_notes,
-                     noise_row, not_estimable_notes, readout_text, term_text, verdict)
+                     noise_row, not_estimable_notes, readout_text, term_text)
 
 __all__ = [
     "NOISE_HEADERS",
@@ -36,7 +36,6 @@ __all__ = [
     "not_estimable_notes",
     "metrics_rows",
     "causal_metrics_rows",
-    "verdict",
     "write_json",
     "write_allan_outputs",
     "write_separation_outputs",

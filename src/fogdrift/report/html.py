@@ -16,7 +16,7 @@ import struct
 from datetime import datetime, timezone
 from pathlib import Path
 
-from ..evaluation.verdicts import CONSTANT_BIAS_LABEL, judge, table2_marks
+from ..evaluation.verdicts import CONSTANT_BIAS_LABEL, judge, one_step_lines, table2_marks
 from ..models.registry import MODELS
 from ..output import atomic_path
 from ..temperature import summary_line
@@ -28,7 +28,7 @@ from .settings import settings_rows
 from .summary import (OUTCOME_LABELS, SPEC_LABELS, cannot_support, noise_headline, recording_rows, spec_summary,
                       summary_dict, verdict_items)
 from .tables import (METRICS_HEADERS, NOISE_HEADERS, _fmt, causal_metrics_rows, fit_cell, metrics_rows, noise_notes, noise_row,
-                     readout_text, verdict)
+                     readout_text)
 from .pdf import write_pdf
 from .screen import screen_summary
 from .sections import sections
@@ -329,7 +329,7 @@ def _compensation_section(ax, fig_dir, pre, fig_offset, evaluated) -> str:
                  "compensation result)</h4>")
     parts.append(_table(METRICS_HEADERS, metrics_rows(ma), "metrics"))
     parts.append(_measure("Paper's measure (one step ahead; target = wavelet drift of the test block, which uses "
-                          "future samples):", verdict(ma)))
+                          "future samples):", one_step_lines(ma)))
     parts.append('<p class="note">p0 is NaN where the drift crosses zero (see <a href="#g-p0">p0</a>); the first '
                  f"{ma.score_from} test samples are not scored.</p>")
     parts.append(_img(plot_models(ma, fig_dir / f"{pre}fig{8 + fig_offset}_models_{name}.png", 8 + fig_offset)))

@@ -240,37 +240,3 @@ def causal_metrics_rows(model_axis) -> list[list[str]]:
     return rows
 
 
-def verdict(model_axis) -> list[str]:
-    """Plain-language sentences: which model beat persistence on the test block, judged on RMSE and MAE.
-
-    A model "beat" persistence only if both its RMSE and its MAE are lower; if one is lower and the other
-    higher the verdict says "mixed" (RMSE is dominated by a few large errors, MAE by typical ones).
-    """
-    learned = {k: v for k, v in model_axis.metrics.items() if k != "persistence"}
-    if not learned:
-        return ["Only the persistence baseline was run."]
-    any_m = next(iter(model_axis.metrics.values()))
-    p_rmse = any_m.rmse_persistence_dph
-    p_mae = model_axis.metrics["persistence"].mae_dph if "persistence" in model_axis.metrics else None
-    lines = []
-    for label, m in learned.items():
-        d_rmse = 100.0 * (m.rmse_dph / p_rmse - 1.0)
-        text = f"RMSE {_fmt(m.rmse_dph)} vs {_fmt(p_rmse)} deg/h ({d_rmse:+.1f} %)"
-        if p_mae is None:
-            better = d_rmse < 0
-            word = "beat" if better else "did NOT beat"
-        else:
-            d_mae = 100.0 * (m.mae_dph / p_mae - 1.0)
-            text += f", MAE {_fmt(m.mae_dph)} vs {_fmt(p_mae)} deg/h ({d_mae:+.1f} %)"
-            if d_rmse < 0 and d_mae < 0:
-                word = "beat"
-            elif d_rmse >= 0 and d_mae >= 0:
-                word = "did NOT beat"
-            else:
-                word = "gave a MIXED result against"
-        lines.append(f"{label} {word} persistence one step ahead: {text}.")
-    best = min(learned, key=lambda k: learned[k].rmse_dph)
-    lines.append(f"Lowest RMSE among learned models on the test block: {best}.")
-    return lines
-
-
