@@ -8,7 +8,7 @@
   weights and a full V, including the non-finite branches, and return fresh arrays (the optimiser keeps them).
 * ``_best_solution`` runs a start equal (once clipped into the bounds) to an earlier one only once, and returns the
   same list as running every start.
-* ``attach_allan_checks(sums=)`` hands the plausibility check's Allan sums to the Allan fit (no second octave pass)
+* ``allan_checks(sums=)`` hands the plausibility check's Allan sums to the Allan fit (no second octave pass)
   with the same comparison lines, and ``fogdrift noise`` hands them on.
 """
 
@@ -132,24 +132,24 @@ def _record(n=2**14, seed=5):
 def test_allan_check_reuses_the_plausibility_sums(monkeypatch):
     from fogdrift.allan import _kernels
     from fogdrift.gmwm.analysis import analyse_gmwm
-    from fogdrift.workflows.noise import attach_allan_checks
+    from fogdrift.workflows.noise import allan_checks
     from fogdrift.plausibility import check_record
 
     rec = _record()
     axes = [analyse_gmwm("gx", rec.axis("gx"), rec.dt_s, model="WN+RW")]
-    want = [dict(a.allan_check) for a in attach_allan_checks(rec, axes)]
+    want = allan_checks(rec, axes)
     sums = {}
     check_record(rec, sums=sums)
     assert sorted(sums) == ["gx"]
     calls = []
     real = _kernels.operator_sums
     monkeypatch.setattr(_kernels, "operator_sums", lambda p, m, *a: calls.append(m.tolist()) or real(p, m, *a))
-    got = [dict(a.allan_check) for a in attach_allan_checks(rec, axes, sums=sums)]
+    got = allan_checks(rec, axes, sums=sums)
     octave = [2**k for k in range(13)]  # m <= 2^14 / 4
     assert not any(set(c) & set(octave) for c in calls)  # no octave pass again
     assert got == want
     calls.clear()
-    attach_allan_checks(rec, axes)  # without sums the octave pass is made
+    allan_checks(rec, axes)  # without sums the octave pass is made
     assert any(set(c) >= set(octave) for c in calls)
 
 

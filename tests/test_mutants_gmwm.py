@@ -20,7 +20,7 @@ import pytest
 
 from fogdrift.evaluation import gmwm_vs_allan as cmp
 from fogdrift.evaluation.gmwm_vs_allan import compare_with_allan
-from fogdrift.workflows.noise import attach_allan_checks
+from fogdrift.workflows.noise import allan_checks
 from fogdrift.gmwm.ieee import BiasInstability, IEEEResult, IEEEValue
 from fogdrift.gmwm.quantity import GMWM_ACCEL_UNITS, UG_PER_MPS2, accel_rows, express_gmwm
 from fogdrift.noise.quantity import restate_text
@@ -352,26 +352,27 @@ def test_number_formats_of_the_sentences():
     assert cmp._b_interval(1.5, None, 2.0, None) == (1.5, 2.0)
 
 
-def test_attach_allan_checks_sets_each_named_axis_and_says_when_the_record_is_too_short():
+def test_allan_checks_compare_each_named_axis_and_say_when_the_record_is_too_short():
     from fogdrift.io import from_array
 
     x = 0.1 * np.random.default_rng(5).standard_normal((2**11, 1))
     rec = from_array(x, dt_s=0.01, unit="m/s^2", axis_names=["ax"])  # an accelerometer: compared in m/s^2
     ax = SimpleNamespace(name="ax", allan_check="untouched", **vars(_gaxis(G_N, B_G)))
     other = SimpleNamespace(name="nope", allan_check="untouched", **vars(_gaxis(G_N, B_G)))
-    out = attach_allan_checks(rec, [ax, other])
-    assert out == [ax, other] and other.allan_check == "untouched"
-    assert set(ax.allan_check) == {"agree", "n_agree", "b_agree", "term_agree", "lines"}
-    assert ax.allan_check["lines"][0].startswith("N ")
+    out = allan_checks(rec, [ax, other])
+    assert list(out) == ["ax"] and ax.allan_check == other.allan_check == "untouched"   # nothing written onto them
+    chk = out["ax"]
+    assert set(chk) == {"agree", "n_agree", "b_agree", "term_agree", "lines"}
+    assert chk["lines"][0].startswith("N ")
     # both readings in the internal unit (the GMWM's are re-stated afterwards): the Allan fit's N of white noise of
     # 0.1 m/s^2 per sample at 0.01 s is the gyro table's number 0.1 * sqrt(0.01 s) / 60, not its m/s/√h (x 3600)
-    n = float(ax.allan_check["lines"][0].split("the Allan fit ")[1].split(" ")[0])
+    n = float(chk["lines"][0].split("the Allan fit ")[1].split(" ")[0])
     assert n == pytest.approx(0.1 * math.sqrt(0.01) / 60.0, rel=0.1)
     short = from_array(x[:8], dt_s=0.01, unit="deg/h", axis_names=["gx"])
     axes = [SimpleNamespace(name="gx", allan_check=None), SimpleNamespace(name="zz", allan_check=None)]
-    assert attach_allan_checks(short, axes) is axes
-    for a in axes:
-        chk = a.allan_check
+    out = allan_checks(short, axes)
+    assert list(out) == ["gx", "zz"]
+    for chk in out.values():
         assert (chk["agree"], chk["n_agree"], chk["b_agree"]) == (None, None, None)
         (line,) = chk["lines"]
         assert line.startswith("no comparison: the Allan fit needs more data (") and line.endswith(")")

@@ -530,7 +530,7 @@ def run_analysis(record, cfg: AnalysisConfig | None = None, *, source: str | Non
 
             gmwm = analyse_gmwm(name, longest_segment(np.asarray(record.axis(name), dtype=np.float64), seg),
                                 record.dt_s)
-            gmwm.allan_check = compare_with_allan(gmwm, original.noise)  # its N and B against this axis's Allan fit
+            gmwm = dataclasses.replace(gmwm, allan_check=compare_with_allan(gmwm, original.noise))  # N, B vs Allan
         checkpoint("separation", axis=name)
         rate, bias, earth = _prepared_axis(rec_m, name, cfg)
         sep = _separation_axis(name, rate, rec_m.dt_s, cfg)

@@ -3,6 +3,8 @@ longest quiet segment of a disturbed axis), its N and B checked against the Alla
 
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -17,7 +19,7 @@ from ..segments import longest_segment
 
 from .allan import Screened, screen
 
-__all__ = ["NoiseRun", "run_noise", "write_noise", "attach_allan_checks"]
+__all__ = ["NoiseRun", "run_noise", "write_noise", "allan_checks"]
 
 
 @dataclass
@@ -70,9 +72,9 @@ def run_noise(record, *, model="auto", levels=None, robust=False, segments="auto
                                  levels=levels, robust=bool(robust)))
         if progress is not None:
             progress()
-    attach_allan_checks(record, axes, sums=sc.sums, segments=segs, screens=screens)
+    checks = allan_checks(record, axes, sums=sc.sums, segments=segs, screens=screens)
     quantities = {c.name: c.quantity for c in record.signal.channels}
-    axes = [express_gmwm(a, quantities[a.name]) for a in axes]
+    axes = [express_gmwm(dataclasses.replace(a, allan_check=checks.get(a.name)), quantities[a.name]) for a in axes]
     return NoiseRun(record, axes, sc.findings, segs, screens, quantities)
 
 
@@ -82,25 +84,21 @@ def write_noise(run: NoiseRun, out_dir) -> dict:
     return write_gmwm_outputs(run.axes, out_dir, source=str(run.record.source), record=run.record.metadata())
 
 
-def attach_allan_checks(record, axes, *, sums=None, segments=None, screens=None) -> list:
-    """Set ``allan_check`` on each GMWM axis of a record: its comparison with the Allan fit of the same axis (the
-    default fit of ``fogdrift allan``, :func:`fogdrift.pipeline.run_allan`;
-    :func:`fogdrift.evaluation.gmwm_vs_allan.compare_with_allan`); returns ``axes``.
+def allan_checks(record, axes, *, sums=None, segments=None, screens=None) -> dict:
+    """The comparison of each GMWM axis of a record with the Allan fit of the same axis (the default fit of
+    ``fogdrift allan``, :func:`fogdrift.pipeline.run_allan`; :func:`fogdrift.evaluation.gmwm_vs_allan.compare_with_allan`),
+    by axis name: the ``allan_check`` the workflow builds each :class:`~fogdrift.gmwm.analysis.GmwmAxis` with.
 
     ``sums``, ``segments``, ``screens``: what the record screen already took of each axis
     (:class:`fogdrift.workflows.allan.Screened`), handed to :func:`~fogdrift.pipeline.run_allan`, which reuses the
-    octave Allan sums instead of computing them again (the same fit, field by field)."""
+    octave Allan sums instead of computing them again (the same fit, field by field).  An axis of ``axes`` that the
+    record does not hold gets no entry."""
 
     try:
         # both readings in the units of the internal unit (the GMWM's are re-stated per quantity afterwards)
         fits = {a.name: a.noise for a in run_allan(record, AnalysisConfig().validate(), own_units=False, sums=sums,
                                                    segments=segments, screens=screens)}
     except InsufficientDataError as exc:  # too short for the Allan fit: the GMWM result stands, and says so
-        for a in axes:
-            a.allan_check = {"agree": None, "n_agree": None, "b_agree": None,
-                             "lines": [f"no comparison: the Allan fit needs more data ({exc})"]}
-        return axes
-    for a in axes:
-        if a.name in fits:
-            a.allan_check = compare_with_allan(a, fits[a.name])
-    return axes
+        return {a.name: {"agree": None, "n_agree": None, "b_agree": None,
+                         "lines": [f"no comparison: the Allan fit needs more data ({exc})"]} for a in axes}
+    return {a.name: compare_with_allan(a, fits[a.name]) for a in axes if a.name in fits}
