@@ -299,7 +299,7 @@ def test_consistency_counts_its_held_out_logs_before_the_fit(monkeypatch):
 
 
 #: Peak RSS [kB, /usr/bin/time -v] measured on one-axis float32 .npy logs (bench/RESULTS.md, "Memory of every command
-#: at 10^8 samples (issue 36)"); consistency read the log twice (training and held-out), so its samples count twice.
+#: at 10^8 samples"); consistency read the log twice (training and held-out), so its samples count twice.
 MEASURED_KB = {
     "allan": {10**6: 287_620, 10**7: 523_404, 16 * 10**6: 716_592, 10**8: 1_391_876},
     "separate": {10**6: 333_916, 10**7: 523_028, 16 * 10**6: 717_168, 10**8: 1_391_724},

@@ -98,3 +98,16 @@ def test_no_unit_factor_outside_units(path):
     """No module but ``fogdrift.units`` writes 3600 or pi/180 in its code (name S_PER_H, RAD_PER_DEG, DEG_PER_RAD)."""
     found = offences(path.read_text(encoding="utf-8"))
     assert not found, f"{path.relative_to(SRC)}: unit factor written out, name it from fogdrift.units: {found}"
+
+
+def test_code_says_what_and_why_not_which_issue():
+    """Comments and docstrings in the package tell what the code does and why, never its history: no "issue N"
+    (the issue tracker's numbers mean nothing to a reader of the code; a figure cites bench/RESULTS.md)."""
+    import re
+    from pathlib import Path
+
+    pkg = Path(__file__).resolve().parents[1] / "src" / "fogdrift"
+    found = [f"{p.relative_to(pkg)}:{i}: {line.strip()}" for p in sorted(pkg.rglob("*.py"))
+             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+             if re.search(r"\bissues? \d+\b", line, re.IGNORECASE)]
+    assert found == []

@@ -24,7 +24,7 @@ __all__ = ["app", "main"]
 
 #: Command name -> the module that declares it, in the order ``fogdrift --help`` lists them.  :func:`main` imports a
 #: command's module only when that command runs (or when the top-level help lists them all): ``fogdrift allan``
-#: no longer imports ``batch`` (and with it fleet, noise and scipy), ``compensate``, ``model`` ...
+#: does not import ``batch`` (and with it fleet, noise and scipy), ``compensate``, ``model`` ...
 COMMAND_MODULES = {
     "allan": "allan", "model": "model", "analyze": "analyze", "noise": "noise", "batch": "batch",
     "compensate": "compensate", "consistency": "consistency", "export": "export", "separate": "separate",
@@ -143,7 +143,7 @@ BLAS_THREAD_VARS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 def one_blas_thread() -> bool:
-    """Run BLAS/LAPACK on one thread in this command unless the user chose a count (issue 35, threads).
+    """Run BLAS/LAPACK on one thread in this command unless the user chose a count.
 
     The CLI's matrices are small (the record screen's null law: ``eigvalsh`` of a few hundred square; GMWM's
     covariances): on a busy machine OpenBLAS's threads spin against each other and the other jobs, measured 3-37x

@@ -429,7 +429,7 @@ def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool
 
     While the command runs, the objects that exist when it starts (the imported modules: scipy, numba, the
     analysis stack, about 10^6 objects) are frozen out of the cyclic garbage collector (:func:`gc.freeze`), and
-    given back to it at the end: every full collection during the command used to walk them all (``fogdrift
+    given back to it at the end: otherwise every full collection during the command walks them all (``fogdrift
     allan`` on ADIS imu1: 0.20 s of garbage collection, 0.07 s frozen).  What the command allocates is collected
     as before.
     """

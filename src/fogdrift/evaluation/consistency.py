@@ -1,6 +1,6 @@
 """Will these noise numbers work in my filter?  Predicted against measured angle error on a held-out log.
 
-Protocol (issue 22 item 4; the heading protocol of :mod:`fogdrift.evaluation.heading`, without a drift model):
+Protocol (the heading protocol of :mod:`fogdrift.evaluation.heading`, without a drift model):
 on a held-out static rate series ``y`` [deg/h] sampled every ``dt`` s,
 
 * origins ``t0`` every ``step_s`` s (default ``T_cal + h`` for each horizon h: calibration and horizon windows

@@ -1,6 +1,6 @@
 """Evidence in heading error: how much angle a compensator saves after a static calibration.
 
-Protocol (issue 11; method notes §5.2 free run, §6 bias), on a held-out rate series ``r`` [deg/h] at the
+Protocol (method notes §5.2 free run, §6 bias), on a held-out rate series ``r`` [deg/h] at the
 modelling interval ``dt``:
 
 * rolling origins ``t0`` every ``step_s`` (default 300 s) from ``calib_s`` on;
@@ -306,10 +306,10 @@ def heading_errors(rate_dph, dt_s, models, *, causal_window: int, wavelet="db2",
         b = float(np.mean(win))
         zc = win - b
         calib.append((b, zc, _fir(zc, g), max(H for _, H in horizons if t0 + H <= r.size)))
-    # ... so that a drift model with a batched free run forecasts all origins in one call (issue 25: the grey
-    # model's per-origin forecasts were 62 % of `compensate`); row i cut to its own h_max equals
+    # ... so that a drift model with a batched free run forecasts all origins in one call (one forecast per origin
+    # would be most of `compensate`'s time for the grey model); row i cut to its own h_max equals
     # forecast(h_max, history=c_i) (same per-row operations; a free run is causal).  On a FogdriftError the
-    # per-origin loop below runs instead and decides, as before, whether the model fails.
+    # per-origin loop below runs instead and decides whether the model fails.
     batched = _batched_forecasts(models, calib)
     for i, t0 in enumerate(origins):
         b, zc, c, h_max = calib[i]

@@ -29,7 +29,7 @@ def _gm11_next_batch(windows: np.ndarray) -> np.ndarray:
     """
     # Written for few NumPy calls per step (the free run calls it once per forecast sample): the same operations
     # as mean() (sum, then divide by the count) and _gm11_restored() (expm1(a)/a unless |a| < 1e-8), so the
-    # same values (checked bit for bit against the previous form, issue 25), about 2x faster on one row.
+    # same values (checked bit for bit against the per-origin forecast), about 2x faster on one row.
     w = windows.shape[1]
     n = w - 1
     x1 = np.cumsum(windows, axis=1)

@@ -1,4 +1,4 @@
-"""Noise fits -> state-space noise components: the one home of the mapping (issue 22 item 3).
+"""Noise fits -> state-space noise components: the one home of the mapping.
 
 A fitted noise model becomes the list of components of :mod:`fogdrift.models.statespace` (IEEE-952 units:
 N deg/sqrt(h), Q urad, K deg/h^1.5, Gauss-Markov T_c s and sigma deg/h, R deg/h^2), which the Kalman

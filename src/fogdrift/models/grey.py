@@ -702,7 +702,7 @@ class GM11(DriftModel):
 
         Row ``i`` of the result equals ``forecast(h, history=histories[i])`` (same operations on each row, so the
         same values: tested), but each forecast step is one NumPy call over every origin instead of one per
-        origin: the heading evaluation's rolling origins in one call (issue 25).
+        origin: the heading evaluation's rolling origins in one call.
 
         Parameters
         ----------

@@ -1,5 +1,5 @@
 """``fogdrift plan``: how long must a record be for the Allan fit and the GMWM to resolve each noise term and to
-reach a stated interval width (issue 34).
+reach a stated interval width.
 
 :mod:`.model` (the model, targets and lengths, parsed), :mod:`.analytic` (expected widths from the Allan fit's own
 covariance laws), :mod:`.montecarlo` (simulated records through the real fit), :mod:`.gmwm` (the same for the

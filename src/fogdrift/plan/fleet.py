@@ -1,5 +1,5 @@
 """``fogdrift plan --fleet``: how many units of a type to record to know the type's spread (and mean) of each
-noise term to a stated precision, with the fleet table of ``fogdrift batch`` as the pilot (issue 34).
+noise term to a stated precision, with the fleet table of ``fogdrift batch`` as the pilot.
 
 The pilot is the batch's ``summary.parquet`` (or a CSV with its columns): one row per file x axis, each IEEE-952
 term ``{T}_{unit}`` with its 95 % interval ``{T}_lo95_{unit}``, ``{T}_hi95_{unit}`` and ``{T}_status``.  A unit

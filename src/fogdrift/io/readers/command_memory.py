@@ -29,7 +29,7 @@ __all__ = ["FIXED_BYTES", "COMMAND_BYTES_PER_SAMPLE", "command_memory_need", "ch
 FIXED_BYTES = 600_000_000
 
 #: Peak bytes per sample and axis, per command: (peak RSS at 10^8 - at 10^6 samples) / (10^8 - 10^6), rounded up to
-#: half a byte (``bench/RESULTS.md`` "Memory of every command at 10^8 samples (issue 36)"; the float64 record is 8
+#: half a byte (``bench/RESULTS.md`` "Memory of every command at 10^8 samples"; the float64 record is 8
 #: of them).  ``export LOG`` takes the ``allan`` row (:func:`fogdrift.pipeline.run_allan`); ``consistency`` counts
 #: the samples of the training log and of every held-out log (two records in memory at once).
 COMMAND_BYTES_PER_SAMPLE: dict[str, float] = {

@@ -154,7 +154,7 @@ class TextTable(Table):
     def _read_fast(self):
         """A plain numeric delimited file through pyarrow's CSV reader, or None (then loadtxt and the scan decide).
 
-        Issue 35: ``np.loadtxt`` took 2.6-3.8 s on ADIS16405 session 1 (10^6 rows x 4), pyarrow on one thread
+        Measured: ``np.loadtxt`` took 2.6-3.8 s on ADIS16405 session 1 (10^6 rows x 4), pyarrow on one thread
         ~0.5 s.  Used only when pyarrow is installed (the ``fleet`` extra; :data:`FAST_CSV` switches it off), for a
         comma/tab/semicolon file with decimal points, and only if every cell of every row parses as a finite
         number with exactly ``n_fields`` fields per row: each cell is parsed straight to float64 (no quoting, no
