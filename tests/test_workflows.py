@@ -1,5 +1,5 @@
 """The command workflows (:mod:`fogdrift.workflows`): the CLI and ``fogdrift batch`` run the same functions, and a
-Python user gets the same result objects and files (issue 33, deliver 1)."""
+Python user gets the same result objects and files."""
 
 from __future__ import annotations
 
@@ -64,6 +64,42 @@ def test_a_python_user_runs_a_command_and_writes_its_files(tmp_path):
     files = workflow("allan").write(run, tmp_path)
     doc = json.loads(files["json"].read_text())
     assert doc["axes"][0]["name"] == "gz" and (tmp_path / "allan.png").is_file()
-    assert sorted(WORKFLOWS) == ["allan", "analyze", "noise"]
+    assert sorted(WORKFLOWS) == ["allan", "analyze", "model", "noise", "separate"]
     with pytest.raises(ConfigError, match="no workflow"):
         workflow("plot")
+
+
+def _files(folder, names):
+    return {n: (folder / n).read_bytes() for n in names}
+
+
+def test_separate_and_model_the_cli_writes_what_the_workflow_writes(tmp_path):
+    """``fogdrift separate`` and ``fogdrift model`` are their workflows plus printing: the files a Python user writes
+    with ``run_<cmd>`` + ``write_<cmd>`` are the CLI's, byte for byte (the JSON, CSV and NPZ; one axis, 1 Hz)."""
+    import fogdrift
+
+    y = simulate(2**12, 1.0, arw_dprh=0.05, bias_instability_dph=0.5, seed=4)
+    path = tmp_path / "g.npy"
+    np.save(path, y)
+    rec = load(path, unit="deg/h", rate_hz=1.0)
+    for cmd, extra, names in (
+            ("separate", [], ["separation.json", "separation.csv", "separation_table.csv"]),
+            ("model", ["--models", "persistence,ar"], ["metrics.json", "bundle/manifest.json"])):
+        res = runner.invoke(app, [cmd, str(path), "--unit", "deg/h", "--rate", "1", *extra, "--out",
+                                  str(tmp_path / f"cli_{cmd}")])
+        assert res.exit_code == 0, res.output + repr(res.exception)
+        cfg = fogdrift.pipeline.AnalysisConfig(**({"models": ("persistence", "ar")} if cmd == "model" else {}))
+        run = getattr(fogdrift, f"run_{cmd}")(rec, cfg)
+        assert run.factor == 1 and [a.name for a in run.axes] == ["col0"] and run.findings == []
+        getattr(fogdrift, f"write_{cmd}")(run, tmp_path / f"py_{cmd}")
+        cli, py = _files(tmp_path / f"cli_{cmd}", names), _files(tmp_path / f"py_{cmd}", names)
+        for n in names:
+            if n.endswith(".json"):   # the run's own times and paths aside
+                a, b = (json.loads(x) for x in (cli[n], py[n]))
+                for d in (a, b):
+                    d.pop("created_utc", None), d.pop("seal_sha256", None), d.pop("source", None)
+                    for ax in d.get("axes", []):
+                        ax.pop("fit_seconds", None)
+                assert a == b, n
+            else:
+                assert cli[n] == py[n], n

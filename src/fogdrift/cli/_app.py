@@ -520,22 +520,22 @@ def gyro_only(record, command: str) -> None:
                           "leave them out with {opt:columns}")
 
 
-def check_plausible(record, *, sums: dict | None = None) -> None:
-    """Warn (one line each) when the record is implausible for any gyro: a wrong --unit or --time-unit.
+def check_plausible(record, *, sums: dict | None = None) -> list:
+    """Warn (one line each) when the record is implausible for any gyro (a wrong --unit or --time-unit); return them.
 
     ``sums``: a dict that receives the octave Allan sums of the noise floors
     (:func:`fogdrift.plausibility.check_record`), for a command that reuses them.
     """
-    for finding in check_record(record, sums=sums):
+    found = list(check_record(record, sums=sums))
+    for finding in found:
         warn(f"{Path(str(record.source)).name}: {finding.render(FLAGS)}")
+    return found
 
 
 def check_model_rate(record, cfg) -> int:
-    """The block-average factor to the modelling rate, decided once (:func:`fogdrift.pipeline.model_factor`).
-
-    A modelling rate that does not divide the native rate by an integer is refused here, before any work;
-    the factor returned is handed to the pipeline (``factor=``), which does not decide it again.
-    """
+    """The block-average factor to the modelling rate (:func:`fogdrift.pipeline.model_factor`, the rule the
+    workflows apply): a modelling rate that does not divide the native rate by an integer is refused here, before
+    anything is printed or computed."""
     from ..pipeline import model_factor
 
     return model_factor(record, cfg)

@@ -64,8 +64,9 @@ def model(
 ):
     """Fit drift models on the training block and compare them on the test block."""
     from ..evaluation import causal_verdict, paper_measure_verdict
-    from ..pipeline import AnalysisConfig, run_models
-    from ..report import causal_metrics_rows, metrics_rows, write_model_outputs
+    from ..pipeline import AnalysisConfig
+    from ..report import causal_metrics_rows, metrics_rows
+    from ..workflows.model import run_model, write_model
 
     with run("model", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
              expect=("metrics.json",)) as r:
@@ -74,11 +75,12 @@ def model(
                              model_rate_hz=model_rate or None, model_params=parse_model_params(param)).validate()
         record = load.load()
         gyro_only(record, "model")
-        factor = check_model_rate(record, cfg)
+        check_model_rate(record, cfg)  # a modelling rate that does not divide the record's: refused before any print
         echo_record(load, record)
-        check_plausible(record)
+        findings = check_plausible(record)
         with progress("model", record.axis_names) as (_, epoch_cb):
-            results = run_models(record, cfg, progress=epoch_cb, factor=factor)
+            done = run_model(record, cfg, progress=epoch_cb, findings=findings)
+        results = done.axes
         say(model_axes_text(results, record))
         for ma in results:
             console.print(metrics_table(f"axis {ma.name}: one-step metrics on the test block, paper's measure "
@@ -88,10 +90,7 @@ def model(
             for v in (causal_verdict(ma), paper_measure_verdict(ma)):
                 for line in v.lines:
                     say("  " + line)
-        write_model_outputs(results, r.out.path)
-        # the self-describing bundle 'fogdrift compensate' applies to other logs
-        from ..bundle import write_bundle
-
-        say(f"bundle: {write_bundle(r.out.path / 'bundle', results, cfg, record).path}")
+        files = write_model(done, r.out.path)  # the self-describing bundle 'fogdrift compensate' applies to other logs
+        say(f"bundle: {files['bundle'].path}")
         r.wrote()
-        r.print_json(r.out.path / "metrics.json")
+        r.print_json(files["metrics"])

@@ -37,8 +37,9 @@ def separate(
     json_out: JsonOpt = False,
 ):
     """Lifting-wavelet separation into drift (approximation) and white noise (details)."""
-    from ..pipeline import AnalysisConfig, run_separation
-    from ..report import noise_row, write_separation_outputs
+    from ..pipeline import AnalysisConfig
+    from ..report import noise_row
+    from ..workflows.separate import run_separate, write_separate
 
     with run("separate", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
              expect=("separation.npz", "separation.csv", "separation_table.csv", "separation.json")) as r:
@@ -46,14 +47,15 @@ def separate(
                              model_rate_hz=model_rate or None, taus=parse_taus(taus)).validate()
         record = load.load()
         gyro_only(record, "separate")
-        factor = check_model_rate(record, cfg)
+        check_model_rate(record, cfg)  # a modelling rate that does not divide the record's: refused before any print
         echo_record(load, record)
-        check_plausible(record)
+        findings = check_plausible(record)
         with progress("separate", record.axis_names):
-            seps = run_separation(record, cfg, factor=factor)
+            done = run_separate(record, cfg, findings=findings)
+        seps = done.axes
         removed = ", ".join(f"{s.name} {s.mean_removed_dph:.6g} deg/h" for s in seps)
-        say(f"modelling rate {modelling_rate_text(record, seps[0].dt_s, factor)}; the mean of each axis was removed before "
-            f"separating (a constant would go wholly into the drift): {removed}")
+        say(f"modelling rate {modelling_rate_text(record, seps[0].dt_s, done.factor)}; the mean of each axis was removed "
+            f"before separating (a constant would go wholly into the drift): {removed}")
         for s in seps:
             console.print(noise_table(
                 f"axis {s.name}: {wavelet} level {s.level}, {mode}, dt {s.dt_s:g} s "
@@ -62,6 +64,6 @@ def separate(
             if s.level_scan:
                 say("  level scan: " + "; ".join(
                     f"L{d.level}: noise slope {d.noise_adev_slope:+.2f}" for d in s.level_scan))
-        write_separation_outputs(seps, r.out.path)
+        write_separate(done, r.out.path)
         r.wrote()
         r.print_json(r.out.path / "separation.json")

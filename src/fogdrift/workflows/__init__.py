@@ -6,7 +6,7 @@ and a Python user call the same functions, so a batch folder holds what the sing
 
     >>> from fogdrift.workflows import WORKFLOWS
     >>> sorted(WORKFLOWS)
-    ['allan', 'analyze', 'noise']
+    ['allan', 'analyze', 'model', 'noise', 'separate']
 
 Each run object keeps its inputs (the record, the configuration, the segment plan and the record screen) beside its
 results, so that ``write_<command>`` and the printers need nothing else.
@@ -48,6 +48,9 @@ class Workflow:
 WORKFLOWS: dict[str, Workflow] = {
     "allan": Workflow("allan", "allan", "Allan variance and IEEE-952 coefficients of every axis"),
     "noise": Workflow("noise", "noise", "GMWM noise model of every axis"),
+    "separate": Workflow("separate", "separate", "lifting-wavelet separation of every axis into drift and white noise"),
+    "model": Workflow("model", "model", "drift models fitted on the training block, compared on the test block, and "
+                                         "the model bundle"),
     "analyze": Workflow("analyze", "analyze", "the whole method (separation, drift models, compensation) with an "
                                                "HTML report"),
 }
