@@ -64,7 +64,7 @@ def test_a_python_user_runs_a_command_and_writes_its_files(tmp_path):
     files = workflow("allan").write(run, tmp_path)
     doc = json.loads(files["json"].read_text())
     assert doc["axes"][0]["name"] == "gz" and (tmp_path / "allan.png").is_file()
-    assert sorted(WORKFLOWS) == ["allan", "analyze", "model", "noise", "separate"]
+    assert sorted(WORKFLOWS) == ["allan", "analyze", "export", "model", "noise", "separate"]
     with pytest.raises(ConfigError, match="no workflow"):
         workflow("plot")
 
@@ -103,3 +103,21 @@ def test_separate_and_model_the_cli_writes_what_the_workflow_writes(tmp_path):
                 assert a == b, n
             else:
                 assert cli[n] == py[n], n
+
+
+def test_export_the_cli_writes_what_the_workflow_writes(tmp_path):
+    """``fogdrift export LOG`` is ``run_export`` + ``write_export``: the same target files and allan.json."""
+    import fogdrift
+
+    path = _log(tmp_path)
+    res = runner.invoke(app, ["export", str(path), "--unit", "deg/h", "--rate", "100", "--target", "kalibr,json",
+                              "--out", str(tmp_path / "cli")])
+    assert res.exit_code == 0, res.output + repr(res.exception)
+    run = fogdrift.run_export(load(path, unit="deg/h", rate_hz=100.0), targets="kalibr,json")
+    assert run.targets == ["kalibr", "json"] and run.fit is not None and run.context.rate_hz == 100.0
+    files = fogdrift.write_export(run, tmp_path / "py")
+    assert sorted(files) == ["allan", "json", "kalibr"]
+    for name in ("imu.yaml", "allan.csv"):
+        assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "py" / name).read_bytes(), name
+    a, b = (json.loads((tmp_path / d / "allan.json").read_text()) for d in ("cli", "py"))
+    assert a == b

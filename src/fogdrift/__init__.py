@@ -8,9 +8,9 @@ the CLI's entry point owns SIGINT before anything is imported):
 
 * ``fogdrift.read(path, unit=..., rate_hz=...)`` -> ``GyroRecord`` (:func:`fogdrift.io.load`), and
   ``fogdrift.from_array(rates, dt_s=..., unit=...)``;
-* ``fogdrift.run_allan(record)``, ``run_noise``, ``run_separate``, ``run_model``, ``run_analyze``: the commands'
-  workflows (:mod:`fogdrift.workflows`), returning their run objects, with ``write_allan``, ``write_noise``,
-  ``write_separate``, ``write_model``, ``write_analyze`` for their files;
+* ``fogdrift.run_allan(record)``, ``run_noise``, ``run_separate``, ``run_model``, ``run_analyze``, ``run_export``:
+  the commands' workflows (:mod:`fogdrift.workflows`), returning their run objects, with ``write_allan``,
+  ``write_noise``, ``write_separate``, ``write_model``, ``write_analyze``, ``write_export`` for their files;
 * ``fogdrift.fit_noise(allan_result)`` (the Allan fit) and ``fogdrift.simulate_rate(n, dt_s, ...)``
   (:func:`fogdrift.simulate.simulate`).
 
@@ -35,6 +35,8 @@ _FRONT_DOOR = {
     "write_separate": ("fogdrift.workflows.separate", "write_separate"),
     "run_model": ("fogdrift.workflows.model", "run_model"),
     "write_model": ("fogdrift.workflows.model", "write_model"),
+    "run_export": ("fogdrift.workflows.export", "run_export"),
+    "write_export": ("fogdrift.workflows.export", "write_export"),
     "run_analyze": ("fogdrift.workflows.analyze", "run_analyze"),
     "write_analyze": ("fogdrift.workflows.analyze", "write_analyze"),
     "fit_noise": ("fogdrift.noise", "fit_noise"),

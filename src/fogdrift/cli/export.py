@@ -54,40 +54,35 @@ def export(
 ):
     """Export the noise model to the estimators' own files, every number with its source, interval, continuous and
     discrete value and conversion in a comment."""
-    from ..export import build_context, parse_targets, render
-    from ..export.model import channels_from_result
+    from ..export import parse_targets
     from ..export.targets import TARGETS
+    from ..workflows.export import run_export, write_export
 
     gyro, accel, result = list(gyro or []), list(accel or []), list(result or [])
     names = [t.name for t in TARGETS.values()]
     with run("export", out, default_out=DEFAULT_OUT, inputs=[p for p in [log, *gyro, *accel, *result] if p is not None],
              expect=[TARGETS[n].filename for n in names]) as r:
-        chosen = parse_targets(target)
+        parse_targets(target)  # an unknown target: one line before the log is read
         if log is None and not gyro and not accel and not result:
             raise ConfigError("nothing to export: give a log, or saved results with --gyro / --accel / --result")
-        channels = []
+        record = None
         if log is not None:
-            from ..pipeline import AnalysisConfig, run_allan
-            from ..workflows.allan import AllanRun, write_allan
-
             opts = dataclasses.replace(load, file=log)
             record = opts.load()
             echo_record(opts, record)
             check_plausible(record)
-            cfg = AnalysisConfig()
+        options = dict(gyro=gyro, accel=accel, results=result, targets=target, rate_hz=update_rate, missing=missing,
+                       topic=rostopic)
+        if record is None:
+            done = run_export(None, **options)
+        else:
             with progress("export", record.axis_names) as (allan_cb, _):  # the whole record: no screen, no segments
-                fit = AllanRun(record, cfg, run_allan(record, cfg, progress=allan_cb))
-            channels = channels_from_result(fit, str(log))
-            write_allan(fit, r.out.path)
-        ctx = build_context(gyro, accel, results=result, channels=channels, rate_hz=update_rate, missing=missing,
-                            topic=rostopic)
-        texts = {n: render(n, ctx) for n in chosen}  # everything is rendered before any file is written
-        for n, text in texts.items():
-            with r.out.file(TARGETS[n].filename) as tmp:
-                Path(tmp).write_text(text, encoding="utf-8")
+                done = run_export(record, progress=allan_cb, **options)
+        write_export(done, r.out.path)  # everything was rendered before any file is written
+        ctx = done.context
         chans = ", ".join(f"{c.label} ({c.method})" for c in ctx.gyro + ctx.accel)
         say(f"exported {chans} at {ctx.rate_hz:g} Hz, --missing {ctx.missing}")
-        for n in chosen:  # per target: the time convention written, and what the user must still fill in
+        for n in done.targets:  # per target: the time convention written, and what the user must still fill in
             conv, items = ctx.todo.get(n, ("", []))
             say(f"{n} ({TARGETS[n].filename}): time convention: {conv}; fill in: {'; '.join(items) or 'nothing'}")
         for line in ctx.notes:

@@ -6,7 +6,7 @@ and a Python user call the same functions, so a batch folder holds what the sing
 
     >>> from fogdrift.workflows import WORKFLOWS
     >>> sorted(WORKFLOWS)
-    ['allan', 'analyze', 'model', 'noise', 'separate']
+    ['allan', 'analyze', 'export', 'model', 'noise', 'separate']
 
 Each run object keeps its inputs (the record, the configuration, the segment plan and the record screen) beside its
 results, so that ``write_<command>`` and the printers need nothing else.
@@ -51,6 +51,8 @@ WORKFLOWS: dict[str, Workflow] = {
     "separate": Workflow("separate", "separate", "lifting-wavelet separation of every axis into drift and white noise"),
     "model": Workflow("model", "model", "drift models fitted on the training block, compared on the test block, and "
                                          "the model bundle"),
+    "export": Workflow("export", "export", "the noise model in the estimators' own files (Kalibr, OpenVINS, VINS, "
+                                            "ORB-SLAM3, KF-GINS, imuSensor, gnss-ins-sim, JSON)"),
     "analyze": Workflow("analyze", "analyze", "the whole method (separation, drift models, compensation) with an "
                                                "HTML report"),
 }
