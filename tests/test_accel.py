@@ -49,7 +49,11 @@ def test_unit_g_reads_an_accelerometer_in_m_s2(tmp_path):
     assert rec.quantities == ("specific_force",) * 3
     assert rec.signal.channels[2].internal_unit == "m/s^2"
     np.testing.assert_allclose(rec.data_internal, x * G0, rtol=1e-14)   # 1 g = 9.80665 m/s^2, by hand
-    assert rec.data_internal is rec.rate_dph
+    with pytest.raises(AttributeError, match=r"ax, ay, az of .*a\.csv hold a specific force in m/s\^2, not an "
+                                             r"angular rate in deg/h: read \.data_internal"):
+        rec.rate_dph                                                   # no deg/h name on m/s^2 numbers
+    gyro = load(_csv(tmp_path, "g.csv", "t_s,gx", [[0.0, 1.0], [0.01, 2.0]]), unit="deg/s")
+    assert gyro.rate_dph is gyro.data_internal and gyro.rate_dph[1, 0] == 7200.0
 
 
 def test_unit_mg_factor(tmp_path):

@@ -65,16 +65,16 @@ def test_six_channels_read_back_with_their_quantities(tmp_path, ros, storage, va
     assert rec.axis_names == SIX
     assert rec.quantities == ("angular_rate",) * 3 + ("specific_force",) * 3
     assert rec.declared_units == ("rad/s",) * 3 + ("m/s^2",) * 3
-    assert_array_equal(rec.rate_dph[:, 3:], a)                   # m/s^2 is the internal unit: exactly the values
-    assert_allclose(rec.rate_dph[:, :3], w * RAD, rtol=1e-15)
+    assert_array_equal(rec.data_internal[:, 3:], a)                   # m/s^2 is the internal unit: exactly the values
+    assert_allclose(rec.data_internal[:, :3], w * RAD, rtol=1e-15)
     assert rec.dt_s == 0.005
     # the default selection is the gyro, as before linear acceleration was read
     gyro = load(path)
     assert gyro.axis_names == SIX[:3] and gyro.quantities == ("angular_rate",) * 3
-    assert_array_equal(gyro.rate_dph, rec.rate_dph[:, :3])
+    assert_array_equal(gyro.rate_dph, rec.data_internal[:, :3])
     acc = load(path, columns="az,ax")
     assert acc.axis_names == ("az", "ax") and acc.quantities == ("specific_force",) * 2
-    assert_array_equal(acc.rate_dph, a[:, [2, 0]])
+    assert_array_equal(acc.data_internal, a[:, [2, 0]])
 
 
 @pytest.mark.parametrize("fields, names", [("gyro", SIX[:3]), ("accel", SIX[3:]), ("both", SIX), (" Both ", SIX)])
@@ -82,7 +82,7 @@ def test_fields_option_decides_the_default_selection(tmp_path, fields, names):
     path, w, a = _bag(tmp_path, 2)
     rec = load(path, reader_options={"fields": fields})
     assert rec.axis_names == names
-    got = dict(zip(rec.axis_names, rec.rate_dph.T))
+    got = dict(zip(rec.axis_names, rec.data_internal.T))
     for k, name in enumerate(SIX):
         if name in got:
             assert_array_equal(got[name], a[:, k - 3] if k >= 3 else w[:, k] * RAD)

@@ -532,15 +532,6 @@ def check_plausible(record, *, sums: dict | None = None) -> list:
     return found
 
 
-def check_model_rate(record, cfg) -> int:
-    """The block-average factor to the modelling rate (:func:`fogdrift.pipeline.model_factor`, the rule the
-    workflows apply): a modelling rate that does not divide the native rate by an integer is refused here, before
-    anything is printed or computed."""
-    from ..pipeline import model_factor
-
-    return model_factor(record, cfg)
-
-
 def precheck(*, wavelet=None, mode=None, training=None, estimator=None, terms=None) -> None:
     """Refuse bad option values before the file is read, for commands without a full analysis configuration.
 

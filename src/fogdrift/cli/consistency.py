@@ -160,7 +160,7 @@ def consistency(
     variance inflation that gives nominal coverage; writes consistency.json."""
     with run("consistency", out, default_out=DEFAULT_OUT, inputs=[load.file, *(held_out or []), components],
              json_out=json_out, expect=("consistency.json",)) as r:
-        from ..evaluation.consistency import summary_cell, verdict_line
+        from ..evaluation.consistency import summary_cell
         from ..workflows.consistency import run_consistency, write_consistency
 
         if not held_out:

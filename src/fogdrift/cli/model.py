@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app, check_model_rate,
+from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app,
                    check_plausible, console, csv_list, echo_record, parse_level, progress, run, say,
                    with_load_options)
 from ._tables import metrics_table
@@ -75,7 +75,6 @@ def model(
                              model_rate_hz=model_rate or None, model_params=parse_model_params(param)).validate()
         record = load.load()
         gyro_only(record, "model")
-        check_model_rate(record, cfg)  # a modelling rate that does not divide the record's: refused before any print
         echo_record(load, record)
         findings = check_plausible(record)
         with progress("model", record.axis_names) as (_, epoch_cb):

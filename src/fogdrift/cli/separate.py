@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app, check_model_rate,
+from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app,
                    check_plausible, console, echo_record, parse_level, parse_taus, progress, run, say,
                    with_load_options)
 from ._tables import noise_table
@@ -47,7 +47,6 @@ def separate(
                              model_rate_hz=model_rate or None, taus=parse_taus(taus)).validate()
         record = load.load()
         gyro_only(record, "separate")
-        check_model_rate(record, cfg)  # a modelling rate that does not divide the record's: refused before any print
         echo_record(load, record)
         findings = check_plausible(record)
         with progress("separate", record.axis_names):

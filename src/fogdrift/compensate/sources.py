@@ -148,7 +148,7 @@ def _loaded(path, load_kwargs) -> LogSource:
     def chunks(chunk):
         for lo in range(0, rec.n_samples, chunk):
             hi = min(rec.n_samples, lo + chunk)
-            yield rec.t0_s + np.arange(lo, hi) * rec.dt_s, rec.rate_dph[lo:hi]
+            yield rec.t0_s + np.arange(lo, hi) * rec.dt_s, rec.data_internal[lo:hi]
 
     return LogSource(path=Path(rec.source), signal=rec.signal, t0_s=rec.t0_s, n_samples=rec.n_samples,
                      sha256=rec.sha256, notes=list(rec.notes), _chunks=chunks)

@@ -26,8 +26,8 @@ option (``--unit``).  The option has two forms:
 **Never silently a gyro:** a channel whose name says accelerometer read in an angular-rate unit (or a
 gyro-named channel read in a specific-force unit) is refused in one line naming the channel, the unit and
 where it came from.  The internal unit of specific force is m/s^2 (:data:`fogdrift.units.INTERNAL_UNITS`):
-an accelerometer channel's numbers in :attr:`fogdrift.io.GyroRecord.rate_dph` are in m/s^2 (the attribute
-keeps its historical name; :attr:`fogdrift.io.GyroRecord.data_internal` is the same array).
+an accelerometer channel's numbers in :attr:`fogdrift.io.GyroRecord.data_internal` are in m/s^2 (a record with
+accelerometer channels has no ``rate_dph``: that name is the gyro channels' deg/h).
 """
 
 from __future__ import annotations

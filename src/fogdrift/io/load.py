@@ -118,7 +118,7 @@ def load(
     Returns
     -------
     GyroRecord
-        ``rate_dph`` is a read-only view; for a float64 ``.npy`` in deg/h it is a view of the
+        ``data_internal`` is a read-only view; for a float64 ``.npy`` in deg/h it is a view of the
         memory map (no copy).  ``sha256`` is the hash of the file's bytes, computed while
         they were read.
 
@@ -447,7 +447,7 @@ def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes
             temp_c = np.asarray(data[a:b, temp[0]], dtype=np.float64)
             temp_c = temp_c + temp[1] if temp[1] else temp_c.copy()
         records.append(GyroRecord(
-            rate_dph=rate, dt_s=dt, axis_names=names, source=str(p), input_unit=unit,
+            data_internal=rate, dt_s=dt, axis_names=names, source=str(p), input_unit=unit,
             scale_to_dph=float(scale) if np.ndim(scale) == 0 else 1.0,
             t0_s=float(t[a]) if t is not None else 0.0, notes=tuple(seg_notes), sha256=sha256,
             declared_units=declared, temperature_c=temp_c, signal=signal,

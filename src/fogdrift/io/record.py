@@ -31,18 +31,18 @@ RATE_RTOL = 1e-9
 
 @dataclass(frozen=True, eq=False)
 class GyroRecord:
-    """A uniformly sampled multi-axis gyro record in deg/h.
+    """A uniformly sampled multi-axis record of gyro and/or accelerometer channels, each in its internal unit.
 
     Parameters
     ----------
-    rate_dph : ndarray, shape (n_samples, n_axes), float64
-        Angular rate in deg/h; an accelerometer channel (quantity ``"specific_force"`` in :attr:`signal`) holds
-        its specific force in m/s^2 here (the name is historical; :attr:`data_internal` is the same array).  Stored as a read-only view (possibly of a memory map): copy
-        it before modifying.
+    data_internal : ndarray, shape (n_samples, n_axes), float64
+        Each channel in its quantity's internal unit (:attr:`quantities`, :data:`fogdrift.units.INTERNAL_UNITS`):
+        an angular rate in deg/h, a specific force in m/s^2.  Stored as a read-only view (possibly of a memory
+        map): copy it before modifying.  :attr:`rate_dph` reads the same array for a record of gyro channels only.
     dt_s : float
         Sample interval in s (> 0).
     axis_names : tuple of str
-        One unique name per column of ``rate_dph``.
+        One unique name per column of ``data_internal``.
     source : str
         File path, or ``"<array>"``.
     input_unit : str
@@ -77,7 +77,7 @@ class GyroRecord:
     ``n_samples * dt_s``.  Records compare by identity (they hold arrays).
     """
 
-    rate_dph: np.ndarray
+    data_internal: np.ndarray
     dt_s: float
     axis_names: tuple[str, ...]
     source: str
@@ -92,19 +92,19 @@ class GyroRecord:
     signal: SignalDescription | None = None
 
     def __post_init__(self):
-        r = self.rate_dph
+        r = self.data_internal
         if not isinstance(r, np.ndarray) or r.ndim != 2 or r.dtype != np.float64:
             raise ConfigError(
-                "rate_dph must be a float64 array of shape (n_samples, n_axes); got "
+                "data_internal must be a float64 array of shape (n_samples, n_axes); got "
                 f"{type(r).__name__} {getattr(r, 'dtype', '')} {getattr(r, 'shape', '')}".rstrip()
             )
         if r.flags.writeable:
             r = r.view()
             r.flags.writeable = False
-            object.__setattr__(self, "rate_dph", r)
+            object.__setattr__(self, "data_internal", r)
         names = tuple(str(a) for a in self.axis_names)
         if len(names) != r.shape[1]:
-            raise ConfigError(f"axis_names must name the {r.shape[1]} columns of rate_dph; got {names!r}")
+            raise ConfigError(f"axis_names must name the {r.shape[1]} columns of data_internal; got {names!r}")
         if len(set(names)) != len(names):
             raise ConfigError(f"axis_names must be unique; got {names!r}")
         check_distinct_names(names, "axis names", "rename a column (the file's header) or select one with "
@@ -141,10 +141,19 @@ class GyroRecord:
             self._check_signal()
 
     @property
-    def data_internal(self) -> np.ndarray:
-        """:attr:`rate_dph` under the name that says what it holds: each channel in its quantity's internal unit
-        (deg/h for a gyro channel, m/s^2 for an accelerometer channel, :attr:`quantities`)."""
-        return self.rate_dph
+    def rate_dph(self) -> np.ndarray:
+        """The angular rates in deg/h: :attr:`data_internal` of a record whose channels are all gyros.
+
+        Raises
+        ------
+        AttributeError
+            The record has accelerometer channels: their numbers are m/s^2, not deg/h (read :attr:`data_internal`).
+        """
+        accel = [n for n, q in zip(self.axis_names, self.quantities) if q != "angular_rate"]
+        if accel:
+            raise AttributeError(f"{', '.join(accel)} of {self.source} hold a specific force in m/s^2, not an angular "
+                                 "rate in deg/h: read .data_internal (each channel in its internal unit)")
+        return self.data_internal
 
     @property
     def quantities(self) -> tuple[str, ...]:
@@ -194,12 +203,12 @@ class GyroRecord:
     @property
     def n_samples(self) -> int:
         """Number of samples."""
-        return int(self.rate_dph.shape[0])
+        return int(self.data_internal.shape[0])
 
     @property
     def n_axes(self) -> int:
         """Number of axes (columns)."""
-        return int(self.rate_dph.shape[1])
+        return int(self.data_internal.shape[1])
 
     @property
     def fs_hz(self) -> float:
@@ -248,7 +257,7 @@ class GyroRecord:
         ConfigError
             If ``key`` names no axis.
         """
-        return self.rate_dph[:, self._axis_index(key)]
+        return self.data_internal[:, self._axis_index(key)]
 
     def select(self, keys) -> "GyroRecord":
         """Record with a subset of the axes, in the order given.
@@ -273,7 +282,7 @@ class GyroRecord:
         else:
             unit, scale = ",".join(f"{c.name}={c.unit_as_read}" for c in chans), 1.0
         return dataclasses.replace(
-            self, rate_dph=take_columns(self.rate_dph, idx), axis_names=tuple(self.axis_names[i] for i in idx),
+            self, data_internal=take_columns(self.data_internal, idx), axis_names=tuple(self.axis_names[i] for i in idx),
             declared_units=tuple(self.declared_units[i] for i in idx), signal=signal, input_unit=unit,
             scale_to_dph=scale,
         )
@@ -299,7 +308,7 @@ class GyroRecord:
         note = f"slice: samples {lo}-{hi - 1} of {n}"
         temp = None if self.temperature_c is None else self.temperature_c[lo:hi]
         return dataclasses.replace(
-            self, rate_dph=self.rate_dph[lo:hi], t0_s=self.t0_s + lo * self.dt_s, notes=self.notes + (note,),
+            self, data_internal=self.data_internal[lo:hi], t0_s=self.t0_s + lo * self.dt_s, notes=self.notes + (note,),
             temperature_c=temp,
         )
 
@@ -405,12 +414,12 @@ class GyroRecord:
                 f"block average to {m * self.dt_s:.10g} s needs {m} samples for one block; got {n}",
                 needed=m, got=n, path=self.source,
             )
-        avg = block_average(self.rate_dph, m)
+        avg = block_average(self.data_internal, m)
         dropped = n - avg.shape[0] * m
         note = f"block-averaged x{m} ({self.dt_s:.10g} s -> {m * self.dt_s:.10g} s), dropped {dropped} trailing samples"
         temp = None if self.temperature_c is None else block_average(self.temperature_c, m)
         signal = self.signal.averaged(m)
-        return dataclasses.replace(self, rate_dph=avg, dt_s=signal.sampling.dt_s, notes=self.notes + (note,),
+        return dataclasses.replace(self, data_internal=avg, dt_s=signal.sampling.dt_s, notes=self.notes + (note,),
                                    block_average_factor=signal.sampling.block_average_factor, temperature_c=temp,
                                    signal=signal)
 
@@ -665,18 +674,19 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
             path=source, column=names[j],
         )
     scale = spec.scale_to_internal(dt)
-    rate_dph = to_dph(arr, scale)
+    data = to_dph(arr, scale)
     if scale != 1.0:
-        bad = first_nonfinite(rate_dph)
+        bad = first_nonfinite(data)
         if bad is not None:
             i, j = bad
             raise DataFormatError(
-                f"value at sample {i} overflows in deg/h; expected |value| * {scale:.6g} below "
+                f"value at sample {i} overflows in {units.INTERNAL_UNITS[spec.quantity]}; expected |value| * "
+                f"{scale:.6g} below "
                 f"{np.finfo(np.float64).max:.3g}, got {float(arr[i, j])!r} {unit}", path=source, column=names[j],
             )
     signal = SignalDescription(sampling, tuple(
         Channel(name=n, unit=spec, unit_source="argument", declared_unit=None, scale_to_internal=scale) for n in names))
     return GyroRecord(
-        rate_dph=rate_dph, dt_s=dt, axis_names=tuple(names), source=str(source),
+        data_internal=data, dt_s=dt, axis_names=tuple(names), source=str(source),
         input_unit=unit, scale_to_dph=scale, signal=signal,
     )

@@ -212,16 +212,16 @@ def _treated_record(record, cfg: AnalysisConfig):
     The float64 copy of the table is made only when an axis was treated (8 bytes per sample and axis)."""
     reports, treated = {}, {}
     for k, name in enumerate(record.axis_names):
-        y, reports[name] = treat_outliers(record.rate_dph[:, k], cfg.outliers)
+        y, reports[name] = treat_outliers(record.data_internal[:, k], cfg.outliers)
         if cfg.outliers != "warn" and reports[name].count:
             treated[k] = y
     if not treated:
         return record, reports
-    data = np.array(record.rate_dph, dtype=np.float64)
+    data = np.array(record.data_internal, dtype=np.float64)
     for k, y in treated.items():
         data[:, k] = y
     note = f"outliers {cfg.outliers}: " + ", ".join(f"{n} {r.count}" for n, r in reports.items())
-    return dataclasses.replace(record, rate_dph=data, notes=tuple(record.notes) + (note,)), reports
+    return dataclasses.replace(record, data_internal=data, notes=tuple(record.notes) + (note,)), reports
 
 
 def model_factor(record, cfg: AnalysisConfig) -> int:

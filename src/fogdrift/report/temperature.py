@@ -68,7 +68,7 @@ def plot_rate_and_temperature(record, path, *, summary=None) -> Path:
     n = record.n_samples
     k = max(1, n // MAX_POINTS)
     t = record.t0_s + (np.arange(n // k) * k + (k - 1) / 2.0) * record.dt_s
-    rate = _decimated(np.asarray(record.rate_dph), n // k)
+    rate = _decimated(np.asarray(record.data_internal), n // k)
     temp_d = _decimated(np.asarray(temp), n // k)
     fig, axs = plt.subplots(record.n_axes + 1, 1, figsize=(9, 2.0 * (record.n_axes + 1)), sharex=True,
                             squeeze=False)
