@@ -70,7 +70,10 @@ def test_header_declares_the_quantity_per_column(tmp_path):
     np.testing.assert_allclose(rec.data_internal[0], [3600.0, 7200.0, 0.5 * G0, -G0], rtol=1e-14)
     assert rec.input_unit == "gx=deg/s,gy=deg/s,ax=g,ay=g"
     sub = rec.select("ax,ay")   # one unit again: the legacy fields are that unit's
-    assert sub.input_unit == "g" and sub.scale_to_dph == G0
+    assert sub.input_unit == "g" and sub.scale_to_internal == G0
+    with pytest.raises(AttributeError, match=r"ax, ay of .* read \.scale_to_internal"):
+        sub.scale_to_dph                                    # the factor to m/s^2 is no factor to deg/h
+    assert rec.select("gx").scale_to_dph == 3600.0 and rec.scale_to_internal == 1.0   # several units: no one factor
 
 
 def test_per_quantity_unit_option(tmp_path):

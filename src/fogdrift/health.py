@@ -111,7 +111,7 @@ def _unit(record, k) -> str:
 
 def _scale(record, k) -> float:
     chans = getattr(getattr(record, "signal", None), "channels", None)
-    return float(chans[k].scale_to_internal) if chans and k < len(chans) else float(record.scale_to_dph)
+    return float(chans[k].scale_to_internal) if chans and k < len(chans) else float(record.scale_to_internal)
 
 
 def _noise(x: np.ndarray) -> float:

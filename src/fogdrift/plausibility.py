@@ -220,7 +220,7 @@ def gyro_class(n_dprh: float) -> str:
 def _factor(unit: str, record) -> float:
     """Multiply the record's deg/h values by this to get what they would be were the file in ``unit``
     (parsed by :func:`fogdrift.units.parse_unit`, the one unit parser)."""
-    return parse_unit(unit).scale_to_internal(record.dt_s) / float(record.scale_to_dph)
+    return parse_unit(unit).scale_to_internal(record.dt_s) / float(record.scale_to_internal)
 
 
 def _read_as_increments(unit) -> bool:

@@ -448,7 +448,7 @@ def _records(table, data, t, r_idx, dt, seg_bounds, gap_info, unit, scale, notes
             temp_c = temp_c + temp[1] if temp[1] else temp_c.copy()
         records.append(GyroRecord(
             data_internal=rate, dt_s=dt, axis_names=names, source=str(p), input_unit=unit,
-            scale_to_dph=float(scale) if np.ndim(scale) == 0 else 1.0,
+            scale_to_internal=float(scale) if np.ndim(scale) == 0 else 1.0,
             t0_s=float(t[a]) if t is not None else 0.0, notes=tuple(seg_notes), sha256=sha256,
             declared_units=declared, temperature_c=temp_c, signal=signal,
         ))

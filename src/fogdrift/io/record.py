@@ -47,8 +47,9 @@ class GyroRecord:
         File path, or ``"<array>"``.
     input_unit : str
         Unit of the input numbers as given (``"deg/s"``, ``"inc:arcsec"`` ...).
-    scale_to_dph : float
-        Factor that was applied to the input numbers to get deg/h.
+    scale_to_internal : float
+        Factor that was applied to the input numbers to get the internal unit (1 for channels read in several units;
+        each channel's own is in :attr:`signal`).  :attr:`scale_to_dph` reads it for a record of gyro channels.
     t0_s : float, optional
         Time of the first sample in s.
     notes : tuple of str, optional
@@ -68,7 +69,7 @@ class GyroRecord:
     signal : fogdrift.signal.SignalDescription, optional
         The sampling and channels as :func:`fogdrift.io.load` described them while reading (where
         the interval and each unit came from); kept through :meth:`select` and block averaging.
-        Default: made here from ``dt_s``, ``input_unit``, ``scale_to_dph``, ``declared_units`` and
+        Default: made here from ``dt_s``, ``input_unit``, ``scale_to_internal``, ``declared_units`` and
         ``block_average_factor`` with the sources ``"argument"``.  Must agree with those fields.
 
     Notes
@@ -82,7 +83,7 @@ class GyroRecord:
     axis_names: tuple[str, ...]
     source: str
     input_unit: str
-    scale_to_dph: float
+    scale_to_internal: float
     t0_s: float = 0.0
     notes: tuple[str, ...] = ()
     sha256: str | None = None
@@ -116,7 +117,7 @@ class GyroRecord:
         object.__setattr__(self, "declared_units", declared)
         object.__setattr__(self, "dt_s", units.check_dt_s(self.dt_s, "dt_s"))
         object.__setattr__(self, "t0_s", float(self.t0_s))
-        object.__setattr__(self, "scale_to_dph", float(self.scale_to_dph))
+        object.__setattr__(self, "scale_to_internal", float(self.scale_to_internal))
         object.__setattr__(self, "source", str(self.source))
         object.__setattr__(self, "notes", tuple(str(n) for n in self.notes))
         object.__setattr__(self, "sha256", None if self.sha256 is None else str(self.sha256))
@@ -149,11 +150,27 @@ class GyroRecord:
         AttributeError
             The record has accelerometer channels: their numbers are m/s^2, not deg/h (read :attr:`data_internal`).
         """
+        self._only_gyros("read .data_internal (each channel in its internal unit)")
+        return self.data_internal
+
+    def _only_gyros(self, instead: str) -> None:
+        """Refuse a deg/h name on a record with accelerometer channels (AttributeError naming them and ``instead``)."""
         accel = [n for n, q in zip(self.axis_names, self.quantities) if q != "angular_rate"]
         if accel:
             raise AttributeError(f"{', '.join(accel)} of {self.source} hold a specific force in m/s^2, not an angular "
-                                 "rate in deg/h: read .data_internal (each channel in its internal unit)")
-        return self.data_internal
+                                 f"rate in deg/h: {instead}")
+
+    @property
+    def scale_to_dph(self) -> float:
+        """The factor from the input numbers to deg/h: :attr:`scale_to_internal` of a record of gyro channels.
+
+        Raises
+        ------
+        AttributeError
+            The record has accelerometer channels (their factor is to m/s^2: read :attr:`scale_to_internal`).
+        """
+        self._only_gyros("read .scale_to_internal (the factor to each channel's internal unit)")
+        return self.scale_to_internal
 
     @property
     def quantities(self) -> tuple[str, ...]:
@@ -165,7 +182,7 @@ class GyroRecord:
         spec = units.parse_unit(self.input_unit, None)
         sampling = Sampling(dt_s=self.dt_s, dt_source="argument", block_average_factor=self.block_average_factor)
         return SignalDescription(sampling, tuple(
-            Channel(name=n, unit=spec, unit_source="argument", declared_unit=d, scale_to_internal=self.scale_to_dph)
+            Channel(name=n, unit=spec, unit_source="argument", declared_unit=d, scale_to_internal=self.scale_to_internal)
             for n, d in zip(self.axis_names, self.declared_units)))
 
     def _check_signal(self) -> None:
@@ -183,13 +200,13 @@ class GyroRecord:
         mixed = len({(c.unit_as_read, c.scale_to_internal) for c in sig.channels}) > 1
         for c, d in zip(sig.channels, self.declared_units):
             # one unit for all channels: the legacy fields are that unit and its factor; channels of different
-            # units (a gyro+accelerometer log): input_unit lists name=unit and scale_to_dph is 1 (no one factor)
+            # units (a gyro+accelerometer log): input_unit lists name=unit and scale_to_internal is 1 (no one factor)
             unit_ok = (f"{c.name}={c.unit_as_read}" in self.input_unit.split(",")) if mixed \
                 else c.unit_as_read == self.input_unit.strip()
-            scale_ok = self.scale_to_dph == 1.0 if mixed else c.scale_to_internal == self.scale_to_dph
+            scale_ok = self.scale_to_internal == 1.0 if mixed else c.scale_to_internal == self.scale_to_internal
             if not unit_ok or not scale_ok or c.declared_unit != d:
                 bad.append(f"channel {c.name!r} ({c.quantity}, {c.unit_as_read}, x{c.scale_to_internal:.10g}) vs "
-                           f"the record ({self.input_unit}, x{self.scale_to_dph:.10g})")
+                           f"the record ({self.input_unit}, x{self.scale_to_internal:.10g})")
                 break
         if bad:
             raise ConfigError("signal does not describe this record: " + "; ".join(bad))
@@ -284,7 +301,7 @@ class GyroRecord:
         return dataclasses.replace(
             self, data_internal=take_columns(self.data_internal, idx), axis_names=tuple(self.axis_names[i] for i in idx),
             declared_units=tuple(self.declared_units[i] for i in idx), signal=signal, input_unit=unit,
-            scale_to_dph=scale,
+            scale_to_internal=scale,
         )
 
     def slice(self, start: int, stop: int) -> "GyroRecord":
@@ -441,11 +458,11 @@ class GyroRecord:
         temp = None if self.temperature_c is None else temperature_summary(self.temperature_c, self.dt_s).to_dict()
         quantities = self.quantities
         if all(q == "angular_rate" for q in quantities):
-            scale = {"scale_to_dph": self.scale_to_dph, "rate_unit": units.INTERNAL_UNITS["angular_rate"]}
+            scale = {"scale_to_dph": self.scale_to_internal, "rate_unit": units.INTERNAL_UNITS["angular_rate"]}
         else:  # accelerometer channels hold m/s^2: the keys say "internal", the unit is the channels'
             each = {n: units.INTERNAL_UNITS[q] for n, q in zip(self.axis_names, quantities)}
             one = set(each.values())
-            scale = {"scale_to_internal": self.scale_to_dph, "internal_unit": one.pop() if len(one) == 1 else each}
+            scale = {"scale_to_internal": self.scale_to_internal, "internal_unit": one.pop() if len(one) == 1 else each}
         return {
             "source": self.source,
             "sha256": self.sha256,
@@ -688,5 +705,5 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
         Channel(name=n, unit=spec, unit_source="argument", declared_unit=None, scale_to_internal=scale) for n in names))
     return GyroRecord(
         data_internal=data, dt_s=dt, axis_names=tuple(names), source=str(source),
-        input_unit=unit, scale_to_dph=scale, signal=signal,
+        input_unit=unit, scale_to_internal=scale, signal=signal,
     )
