@@ -236,3 +236,14 @@ def test_a_recurrent_network_too_large_for_the_memory_budget_is_refused_before_a
     AnalysisConfig(models=("elman",), hidden=64).validate()
     monkeypatch.setenv("FOGDRIFT_MAX_MEMORY", "0")  # no budget
     AnalysisConfig(models=("elman",), hidden=100_000).validate()
+
+
+def test_declared_inputs_reach_only_the_models_that_declare_them():
+    """The Kalman row declares ``dt_s`` (it works in seconds) and reads ``noise_method`` from the settings; a model
+    whose row declares no input is built without them (an undeclared keyword would be a TypeError)."""
+    from fogdrift.models.registry import build_model, model_spec
+
+    assert model_spec("kalman").inputs == ("dt_s",) and model_spec("ar").inputs == ()
+    k = build_model("kalman", {"noise_method": "gmwm"}, inputs={"dt_s": 0.5, "unused": 1})
+    assert k.get_params()["dt_s"] == 0.5 and k.get_params()["noise_method"] == "gmwm"
+    assert build_model("ar", {"lags": 3}, inputs={"dt_s": 0.5}).get_params()["order"] == 3

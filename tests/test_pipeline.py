@@ -74,7 +74,7 @@ def _cfg(**kw):
 @pytest.fixture
 def spy(monkeypatch):
     model = Spy()
-    monkeypatch.setattr(pipeline, "make_model", lambda name, cfg, progress=None: model)
+    monkeypatch.setattr(pipeline, "make_model", lambda name, cfg, progress=None, inputs=None: model)
     return model
 
 
@@ -120,7 +120,7 @@ def test_blocks_fitted_and_scored_are_the_split_blocks(spy):
 def test_scoring_starts_lags_into_the_test_block(monkeypatch):
     lags = 3
     model = Spy(bad=lags, error=100.0)  # perfect except huge errors on the first `lags` test samples
-    monkeypatch.setattr(pipeline, "make_model", lambda name, cfg, progress=None: model)
+    monkeypatch.setattr(pipeline, "make_model", lambda name, cfg, progress=None, inputs=None: model)
     rec, _ = _record()
     (ma,) = run_models(rec, _cfg(lags=lags))
     assert ma.score_from == lags
@@ -135,7 +135,7 @@ def test_scoring_starts_lags_into_the_test_block(monkeypatch):
 def test_one_bad_prediction_inside_the_window_is_scored(monkeypatch):
     # control for the test above: the same spy with lags=0 errors scored -> RMSE = 100 sqrt(k/n) by hand
     model = Spy(bad=4, error=100.0)
-    monkeypatch.setattr(pipeline, "make_model", lambda name, cfg, progress=None: model)
+    monkeypatch.setattr(pipeline, "make_model", lambda name, cfg, progress=None, inputs=None: model)
     rec, _ = _record()
     (ma,) = run_models(rec, _cfg(lags=2))
     n_scored = 80 - 2
@@ -290,7 +290,7 @@ def test_block_size_check_at_the_boundary(spy, n, block, ok):
 def test_rate_input_models_see_the_rate_blocks(monkeypatch):
     model = Spy()
     model.input_kind = "rate"
-    monkeypatch.setattr(pipeline, "make_model", lambda name, cfg, progress=None: model)
+    monkeypatch.setattr(pipeline, "make_model", lambda name, cfg, progress=None, inputs=None: model)
     rec, x = _record()
     (ma,) = run_models(rec, _cfg())
     rate = x - x[:240].mean()
@@ -307,8 +307,8 @@ def test_rate_input_models_see_the_rate_blocks(monkeypatch):
 def test_factory_receives_name_settings_and_progress_and_records_fit_time(monkeypatch):
     seen = []
 
-    def factory(name, cfg, progress=None):
-        seen.append((name, cfg.level, cfg.lags, progress))
+    def factory(name, cfg, progress=None, inputs=None):
+        seen.append((name, cfg.level, cfg.lags, progress, inputs))
         return Spy()
 
     def progress(*args):
@@ -321,7 +321,7 @@ def test_factory_receives_name_settings_and_progress_and_records_fit_time(monkey
 
     rate = np.asarray(ma.rate_dph)
     level = int(choose_level(level_scan(rate, 1.0, wavelet="db2", mode="symmetric")))
-    assert seen == [("ar", level, 3, progress)]
+    assert seen == [("ar", level, 3, progress, {"dt_s": 1.0})]   # the data's inputs, for the rows that declare them
     assert ma.name == "gz" and list(ma.fit_seconds) == ["spy"] and 0.0 <= ma.fit_seconds["spy"] < 60.0
     assert any(note.startswith("p0 is unstable near zero") for note in ma.notes)  # the drift crosses zero
 

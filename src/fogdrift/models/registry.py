@@ -89,6 +89,10 @@ class ModelSpec:
         Constructor keywords with a fixed value.
     params : tuple of ModelParam
         Hyper-parameters users may set by name (:func:`parse_model_params`, ``AnalysisConfig.model_params``).
+    inputs : tuple of str
+        Constructor keywords the caller supplies from the data, not from the settings (``"dt_s"``: the sample
+        interval at the modelling rate, for a model that works in seconds); :func:`build_model` takes them as
+        ``inputs=``.
     """
 
     name: str
@@ -99,6 +103,7 @@ class ModelSpec:
     settings: tuple = ()
     fixed: tuple = ()
     params: tuple = ()
+    inputs: tuple = ()
 
     def load(self) -> type:
         """Import ``module`` and return the class (later calls hit the import cache)."""
@@ -145,7 +150,8 @@ MODELS: tuple[ModelSpec, ...] = (
     ModelSpec("ar", "fogdrift.models.ar", "AR", "AR(p)",
               "least-squares AR(p) with intercept, p = `lags`", (("order", "lags"),)),
     ModelSpec("kalman", "fogdrift.models.kalman", "Kalman", "Kalman",
-              "Kalman filter on the rate from the training block's noise model (bias, random walk, Gauss-Markov)"),
+              "Kalman filter on the rate from the training block's noise model (bias, random walk, Gauss-Markov)",
+              settings=(("noise_method", "noise_method"),), inputs=("dt_s",)),
     ModelSpec("persistence", "fogdrift.models.persistence", "Persistence", "persistence",
               "repeat the last value (the baseline every table shows)"),
 )
@@ -281,7 +287,7 @@ def check_model_params(model_params, models=None) -> dict:
     return out
 
 
-def build_model(name: str, settings=None, progress=None):
+def build_model(name: str, settings=None, progress=None, *, inputs=None):
     """An unfitted drift model from its name and the analysis settings.
 
     Parameters
@@ -295,6 +301,9 @@ def build_model(name: str, settings=None, progress=None):
     progress : callable, optional
         ``progress(epoch, n_epochs, train_loss, val_loss)``, passed to models that take one
         (the recurrent ones); ignored by the others.
+    inputs : mapping, optional
+        Values from the data (``{"dt_s": 1.0}``); a model receives those its row declares (``ModelSpec.inputs``),
+        the others are not passed.
 
     Returns
     -------
@@ -312,6 +321,8 @@ def build_model(name: str, settings=None, progress=None):
     GM11(mode='rolling', window=12, shift='auto', shift_margin=1.0)
     >>> build_model("AR", {"lags": 3})
     AR(order=3, max_order=12)
+    >>> build_model("kalman", {"noise_method": "gmwm"}, inputs={"dt_s": 0.5}).get_params()["dt_s"]
+    0.5
     """
     spec = model_spec(name)
     cls = spec.load()
@@ -328,6 +339,7 @@ def build_model(name: str, settings=None, progress=None):
         kwargs.update((mp or {}).get(spec.name, {}))
     if progress is not None and "progress" in cls._param_names():
         kwargs["progress"] = progress
+    kwargs.update({k: v for k, v in (inputs or {}).items() if k in spec.inputs})
     return cls(**kwargs)
 
 

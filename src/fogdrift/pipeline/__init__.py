@@ -386,11 +386,7 @@ def _fit_axis_models(name, rate, dt_s, cfg: AnalysisConfig, bias, earth, progres
     if fitted is None:
         for model_name in cfg.models:
             checkpoint("fitting", axis=name, model=model_name)
-            model = make_model(model_name, cfg, progress)
-            if "dt_s" in model.get_params():  # state-space models (Kalman) work in seconds
-                model.set_params(dt_s=dt_s)
-            if "noise_method" in model.get_params():  # the Kalman identifies its noise model as the analysis does
-                model.set_params(noise_method=cfg.noise_method)
+            model = make_model(model_name, cfg, progress, inputs={"dt_s": dt_s})  # the rows declare what they take
             t0 = time.perf_counter()
             fit_on = blocks if model.input_kind == "rate" else drift  # a Kalman filter sees the rate itself
             model.fit(fit_on["train"], fit_on["val"])
