@@ -126,6 +126,7 @@ class ScoreProblem:
         self.c = 1.0 - 2.0 / (9.0 * nu_sampling)
         self.s = np.sqrt(2.0 / (9.0 * self.nu))
         self.y3 = np.cbrt(self.y)
+        self._memo = {}
         self.upper = np.asarray(upper, dtype=np.float64)
         # coefficient scale at which a column alone reaches the data somewhere (conditioning of the solver)
         with np.errstate(divide="ignore"):
@@ -147,8 +148,21 @@ class ScoreProblem:
         """Minimise ``Q`` over the coefficients in ``cols`` (others 0); ``fixed=(col, value)`` pins one of them.
 
         Returns ``(a, Q)`` with ``a`` the coefficients of the free columns (in ``cols`` order, minus the fixed one).
+
+        The same problem asked again (``cols``, ``a0``, ``fixed`` and the design ``X``, which a
+        :class:`~fogdrift.noise.context.FitContext` may change between calls, all equal) returns the remembered
+        answer: the fit is deterministic, and a profile interval or a model selection asks about a fifth of its
+        fits twice (issue 35).
         """
         cols = list(cols)
+        key = (tuple(cols), None if a0 is None else np.asarray(a0, dtype=np.float64).tobytes(),
+               None if fixed is None else (fixed[0], float(fixed[1]).hex()), self.X.tobytes())
+        hit = self._memo.get(key)
+        if hit is None:
+            hit = self._memo[key] = self._fit(cols, a0, fixed)
+        return hit[0].copy(), hit[1]
+
+    def _fit(self, cols, a0, fixed):
         free = [c for c in cols if fixed is None or c != fixed[0]]
         add = np.zeros(self.y.size) if fixed is None else self.X[:, fixed[0]] * fixed[1]
         if not free:
