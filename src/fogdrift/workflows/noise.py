@@ -68,8 +68,8 @@ def run_noise(record, *, model="auto", levels=None, robust=False, segments="auto
     sc = screened if screened is not None else screen(record, segments, command="noise")
     segs, screens = sc.segments, sc.screens
     axes, spectra = [], {}
+    candidates_for(model)  # a bad model string is refused before any spectrum is computed (as analyse_gmwm does)
     for name in record.axis_names:
-        candidates_for(model)  # a bad model string is refused before any spectrum is computed
         rate = np.asarray(longest_segment(record.axis(name), segs[name]), dtype=np.float64)
         spectra[name] = (rate, record.dt_s, analyse_spectrum(rate, record.dt_s))  # the Allan check reuses it
         axes.append(analyse_gmwm(name, rate, record.dt_s, model=model, levels=levels, robust=bool(robust),
