@@ -271,12 +271,18 @@ def _windows(y: np.ndarray, L: int):
     edges = (np.arange(M + 1) * y.size) // M
     s = np.empty(M)
     mu = np.empty(M)
+    lines = {}  # window length -> (centred sample index t, t . t): the windows have one or two lengths
+    bounds = edges.tolist()
     for j in range(M):
-        w = y[edges[j]:edges[j + 1]]
-        t = np.arange(w.size) - (w.size - 1) / 2.0
-        mu[j] = w.mean()
-        c = w - mu[j]
-        slope = np.dot(t, c) / np.dot(t, t)
+        w = y[bounds[j]:bounds[j + 1]]
+        line = lines.get(w.size)
+        if line is None:
+            t = np.arange(w.size) - (w.size - 1) / 2.0
+            line = lines[w.size] = (t, np.dot(t, t))
+        t, tt = line
+        mu[j] = m = w.mean()
+        c = w - m
+        slope = np.dot(t, c) / tt
         r = c - slope * t
         s[j] = np.dot(r, r) / (w.size - 2)
     return edges, s, mu
@@ -339,9 +345,10 @@ def _sf(law, x: float) -> float:
     from scipy.special import ndtr
 
     lam, dof = law
+    dof_lam, two_lam = dof * lam, 2.0 * lam  # the products k1 forms first, formed once
 
     def k1(t):
-        return float(np.sum(dof * lam / (1.0 - 2.0 * lam * t)))
+        return float(np.sum(dof_lam / (1.0 - two_lam * t)))
 
     t_hi = 0.5 / float(lam.max()) * (1.0 - 1e-12)
     t_lo = -1.0

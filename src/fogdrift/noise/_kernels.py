@@ -58,21 +58,16 @@ def pgn(Xs, add, W, y3, c, s, u0, ub, max_iter, tol):  # pragma: no cover - comp
     q = r @ r
     for _ in range(max_iter):
         d = np.empty(n)
-        for i in range(n):
-            mu = add[i]
-            for k in range(p):
-                mu += Xs[i, k] * x[k]
-            if mu < 1e-300:
-                mu = 1e-300
-            d[i] = -(y3[i] / np.cbrt(mu)) / (3.0 * mu * s[i])
         zz = np.empty(n)
-        for i in range(n):
+        for i in range(n):  # the model value and its cube root once for both (the same numbers as two passes)
             mu = add[i]
             for k in range(p):
                 mu += Xs[i, k] * x[k]
             if mu < 1e-300:
                 mu = 1e-300
-            zz[i] = (y3[i] / np.cbrt(mu) - c[i]) / s[i]
+            ratio = y3[i] / np.cbrt(mu)
+            d[i] = -ratio / (3.0 * mu * s[i])
+            zz[i] = (ratio - c[i]) / s[i]
         J = (W @ (Xs * d.reshape(-1, 1))) * dhuber(W @ zz).reshape(-1, 1)
         g = J.T @ r
         free = np.ones(p, dtype=np.bool_)

@@ -108,12 +108,16 @@ def _kernel():
             nc = a.size
             nk = coef.size
             pw = 2 * (nk - 1)
+            # sin(w b[c]) of the previous cell, per (p, q, sign): the cells tile the band (b[c - 1] == a[c]), so it
+            # is this cell's sin(w a[c]), the same number (half the sines)
+            upper = np.empty(2 * nk * nk)
             for i in range(nm):
                 for j in range(i, nm):
                     mi = m[i]
                     mj = m[j]
                     mx = max(mi, mj)
                     acc = 0.0
+                    known = False
                     for c in range(nc):
                         d = b[c] - a[c]
                         fm = 0.5 * (a[c] + b[c])
@@ -121,18 +125,26 @@ def _kernel():
                             si = abs(math.sin(math.pi * fm * mi))
                             sj = abs(math.sin(math.pi * fm * mj))
                             v = si**pw * sj**pw
+                            known = False
                         else:
+                            reuse = known and b[c - 1] == a[c]
                             v = 0.0
+                            k = 0
                             for p in range(nk):
                                 for q in range(nk):
                                     cc = 0.5 * coef[p] * coef[q]
                                     for sgn in (-1.0, 1.0):
                                         w = 2.0 * math.pi * (p * mi + sgn * q * mj)
                                         x = w * d
+                                        sb = math.sin(w * b[c])
+                                        sa = upper[k] if reuse else math.sin(w * a[c])
+                                        upper[k] = sb
+                                        k += 1
                                         if abs(x) < 1e-6:
                                             v += cc * math.cos(w * fm)
                                         else:
-                                            v += cc * (math.sin(w * b[c]) - math.sin(w * a[c])) / x
+                                            v += cc * (sb - sa) / x
+                            known = True
                         acc += v * P[c]
                     out[i, j] = acc
                     out[j, i] = acc

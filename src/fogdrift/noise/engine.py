@@ -126,6 +126,7 @@ class ScoreProblem:
         self.c = 1.0 - 2.0 / (9.0 * nu_sampling)
         self.s = np.sqrt(2.0 / (9.0 * self.nu))
         self.y3 = np.cbrt(self.y)
+        self._memo, self._parts = {}, {}
         self.upper = np.asarray(upper, dtype=np.float64)
         # coefficient scale at which a column alone reaches the data somewhere (conditioning of the solver)
         with np.errstate(divide="ignore"):
@@ -147,8 +148,35 @@ class ScoreProblem:
         """Minimise ``Q`` over the coefficients in ``cols`` (others 0); ``fixed=(col, value)`` pins one of them.
 
         Returns ``(a, Q)`` with ``a`` the coefficients of the free columns (in ``cols`` order, minus the fixed one).
+
+        The same problem asked again (``cols``, ``a0``, ``fixed`` and the design ``X``, which a
+        :class:`~fogdrift.noise.context.FitContext` may change between calls, all equal) returns the remembered
+        answer: the fit is deterministic, and a profile interval or a model selection asks about a fifth of its
+        fits twice.
         """
         cols = list(cols)
+        design = self.X.tobytes()
+        key = (tuple(cols), None if a0 is None else np.asarray(a0, dtype=np.float64).tobytes(),
+               None if fixed is None else (fixed[0], float(fixed[1]).hex()), design)
+        hit = self._memo.get(key)
+        if hit is None:
+            hit = self._memo[key] = self._fit(cols, a0, fixed, design)
+        return hit[0].copy(), hit[1]
+
+    def _columns(self, free, design):
+        """What a fit on the free columns ``free`` needs of the design, formed once per design:
+        ``(scale, Xs, ub, ub (1 - 1e-9), Xs / y, 1 / y)``."""
+        key = (tuple(free), design)
+        part = self._parts.get(key)
+        if part is None:
+            scale = self.scale[free]
+            Xs = np.ascontiguousarray(self.X[:, free] * scale)
+            ub = np.ascontiguousarray(self.upper[free] / scale, dtype=np.float64)
+            wt = 1.0 / self.y
+            part = self._parts[key] = (scale, Xs, ub, ub * (1 - 1e-9), Xs * wt[:, None], wt)
+        return part
+
+    def _fit(self, cols, a0, fixed, design):
         free = [c for c in cols if fixed is None or c != fixed[0]]
         add = np.zeros(self.y.size) if fixed is None else self.X[:, fixed[0]] * fixed[1]
         if not free:
@@ -156,17 +184,13 @@ class ScoreProblem:
                 return np.array([]), math.inf
             w = _huber_py(self.W @ self.scores(add))
             return np.array([]), float(w @ w)
-        scale = self.scale[free]
-        Xs = self.X[:, free] * scale
-        ub = self.upper[free] / scale
+        scale, Xs, ub, ub_in, Xw, wt = self._columns(free, design)
         if a0 is None:
-            wt = 1.0 / self.y
-            u0, _ = nnls(Xs * wt[:, None], np.maximum(self.y - add, 0.0) * wt)
+            u0, _ = nnls(Xw, np.maximum(self.y - add, 0.0) * wt)
         else:
             u0 = np.asarray(a0, dtype=np.float64) / scale
-        u0 = np.clip(u0, 1e-6, ub * (1 - 1e-9))
-        u, q = _wh_kernel()(np.ascontiguousarray(Xs), add, self.W, self.y3, self.c, self.s, u0,
-                            np.ascontiguousarray(ub, dtype=np.float64), 100, 1e-10)
+        u0 = np.clip(u0, 1e-6, ub_in)
+        u, q = _wh_kernel()(Xs, add, self.W, self.y3, self.c, self.s, u0, ub, 100, 1e-10)
         return u * scale, float(q)
 
 

@@ -96,9 +96,22 @@ def library_versions() -> dict:
     return out
 
 
+def _spectrum_of(x, dt_s, known=None):
+    """:func:`~fogdrift.noise.spectral.analyse_spectrum` of ``x``, or ``known``'s summary when ``known`` =
+    ``(samples, dt_s, summary)`` was taken of these very samples (same dtype and interval, equal bit for bit):
+    ``fogdrift noise`` hands its GMWM's spectra to the Allan check of the same axes."""
+    if known is not None:
+        seen, seen_dt, summary = known
+        a = np.asarray(x)
+        if (seen_dt == dt_s and a.dtype == seen.dtype and a.shape == seen.shape
+                and np.array_equal(np.ascontiguousarray(a).view(np.uint8), np.ascontiguousarray(seen).view(np.uint8))):
+            return summary
+    return analyse_spectrum(x, dt_s)
+
+
 def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False,
                   spectrum="auto", outliers=None, quantity="angular_rate", sums=None, segments=None,
-                  screen=None) -> AllanAxis:
+                  screen=None, known_spectrum=None) -> AllanAxis:
     """Allan-family variance and noise identification of one 1-D rate series.
 
     The curve is computed on the configured grid (``cfg.taus``) for display; the noise fit always uses an octave
@@ -122,14 +135,17 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     plausibility check's octave ADEV, :func:`fogdrift.plausibility.check_record`); its sums are reused and only the
     missing cluster sizes are computed.  Ignored unless it holds the same array (after outlier treatment), interval,
     statistic and estimator.
+
+    ``known_spectrum``: ``(samples, dt_s, summary)``, a spectrum another stage took, used for ``spectrum="auto"``
+    when it was taken of the very samples analysed here (:func:`_spectrum_of`).
     """
     if check_outliers:
         rate_dph, outliers = treat_outliers(rate_dph, cfg.outliers)
     if segments is not None:
         return _analyse_segments(name, rate_dph, dt_s, cfg, segments, spectrum=spectrum, outliers=outliers,
-                                 quantity=quantity, screen=screen, progress=progress)
+                                 quantity=quantity, screen=screen, progress=progress, known_spectrum=known_spectrum)
     if isinstance(spectrum, str) and spectrum == "auto":
-        spectrum = analyse_spectrum(rate_dph, dt_s)
+        spectrum = _spectrum_of(rate_dph, dt_s, known_spectrum)
     content = periodic_content(spectrum)
     # Every grid this analysis may need (display, octave, octave + the null taus of the periodic content) is known
     # before the data are touched: one pass of operator sums serves them all, and each result is rebuilt from the
@@ -170,7 +186,7 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
 
 
 def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, spectrum, outliers, quantity,
-                      screen, progress=None) -> AllanAxis:
+                      screen, progress=None, known_spectrum=None) -> AllanAxis:
     """The Allan analysis of the quiet ``segments`` of a disturbed record (``(start, stop)`` samples): the overlapping
     Allan variance pooled over the segments without bridging a gap (:func:`fogdrift.allan.allan_variance_segments`;
     other statistics and estimators: the longest segment alone), the spectrum of the longest segment, the noise
@@ -178,7 +194,7 @@ def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, sp
     segs = sorted((int(a), int(b)) for a, b in segments)
     longest = max(segs, key=lambda s: s[1] - s[0])
     if isinstance(spectrum, str) and spectrum == "auto":
-        spectrum = analyse_spectrum(rate_dph[longest[0]:longest[1]], dt_s)
+        spectrum = _spectrum_of(rate_dph[longest[0]:longest[1]], dt_s, known_spectrum)
     content = periodic_content(spectrum)
     if cfg.statistic == "adev" and cfg.estimator == "overlapping":
         res = allan_variance_segments(rate_dph, dt_s, segs, taus=cfg.taus)
@@ -291,7 +307,7 @@ def _check_earth_axes(record, cfg: AnalysisConfig) -> None:
 
 def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | None = None, *,
               own_units: bool = True, sums: dict | None = None, segments: dict | None = None,
-              screens: dict | None = None) -> list[AllanAxis]:
+              screens: dict | None = None, spectra: dict | None = None) -> list[AllanAxis]:
     """Allan variance and noise identification of every axis of a record at its native rate.
 
     ``own_units`` (default True): each axis's fit in its quantity's term table (an accelerometer's velocity random
@@ -303,6 +319,8 @@ def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | No
 
     ``segments``: axis name -> ``[(start, stop), ...]`` quiet segments to fit instead of the whole record (None or a
     missing name: the whole record); ``screens``: axis name -> the record screen's dict, kept on the result.
+    ``spectra``: axis name -> ``(samples, dt_s, SpectrumSummary)`` another stage took (``analyse_allan``'s
+    ``known_spectrum``), reused where they are the samples analysed.
     The memory need is held to the budget first (:func:`fogdrift.io.readers.command_memory.check_records_memory`).
     """
     check_records_memory("allan", record)
@@ -313,7 +331,7 @@ def run_allan(record, cfg: AnalysisConfig | None = None, progress: Callable | No
         out.append(analyse_allan(name, record.axis(name), record.dt_s, cfg, progress, check_outliers=True,
                                  quantity=record.signal.channel(name).quantity if own_units else "angular_rate",
                                  sums=(sums or {}).get(name), segments=(segments or {}).get(name),
-                                 screen=(screens or {}).get(name)))
+                                 screen=(screens or {}).get(name), known_spectrum=(spectra or {}).get(name)))
     return out
 
 

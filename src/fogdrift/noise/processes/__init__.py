@@ -62,6 +62,7 @@ PROCESSES = MappingProxyType(_TABLE)
 
 
 _ORDERED: list = []  # the ordered rows, rebuilt after each change of the table
+_NAMES: dict = {}  # "power" / "shaped" -> their letters, rebuilt after each change of the table (a fit asks ~10^4 times)
 
 
 def version() -> int:
@@ -86,17 +87,24 @@ def processes() -> tuple:
 
 def _changed() -> None:
     _ORDERED.clear()
+    _NAMES.clear()
     _VERSION[0] += 1
 
 
 def power_law_names() -> tuple:
     """Letters of the power-law terms (the linear columns of the Allan fit), in order of their power of tau."""
-    return tuple(p.name for p in processes() if p.power_law)
+    names = _NAMES.get("power")
+    if names is None:
+        names = _NAMES["power"] = tuple(p.name for p in processes() if p.power_law)
+    return names
 
 
 def shaped_names() -> tuple:
     """Letters of the shaped Annex C terms (S, M, ...)."""
-    return tuple(p.name for p in processes() if not p.power_law)
+    names = _NAMES.get("shaped")
+    if names is None:
+        names = _NAMES["shaped"] = tuple(p.name for p in processes() if not p.power_law)
+    return names
 
 
 def _spellings(p: NoiseProcess) -> tuple:
