@@ -1,5 +1,5 @@
-"""Tests added for the surviving mutants of ``fogdrift.noise.quantity`` (issue 24 item 2, docs/testing-rounds.md "Round 2:
-new modules (issues 21-23)"): :func:`express` re-states every number of a fit (value, interval, B_min and its SI
+"""Tests of ``fogdrift.noise.quantity`` (first written against the surviving mutants of a mutation round,
+docs/testing-rounds.md): :func:`express` re-states every number of a fit (value, interval, B_min and its SI
 copy, read-outs) by the factor of its own term, relabels the units, and leaves a gyro fit alone.
 
 The factors themselves are pinned by hand in ``tests/test_accel.py::test_unit_factor_gyro_to_accel``

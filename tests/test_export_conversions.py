@@ -1,5 +1,5 @@
-"""Tests added for the surviving mutants of ``fogdrift.export.conversions`` (issue 24 item 2, docs/testing-rounds.md
-"Round 2: new modules (issues 21-23)").
+"""Tests of ``fogdrift.export.conversions`` (first written against the surviving mutants of a mutation round,
+docs/testing-rounds.md).
 
 Each test pins a rule a one-line change would break: the inverse conversions by hand, the edges of the rate and
 correlation-time validators (0, a value between 0 and 1, a negative, a non-finite or non-numeric value), the

@@ -1,5 +1,5 @@
-"""Tests added for the surviving mutants of ``fogdrift.io.channel_quantity`` (the accelerometer channel / unit rule)
-in mutation round 3 (issue 24 item 2, docs/testing-rounds.md).
+"""Tests of ``fogdrift.io.channel_quantity`` (the accelerometer channel / unit rule), first written against the
+surviving mutants of mutation round 3 (docs/testing-rounds.md).
 
 Each test pins a rule a one-line change would break: the ``unit`` option given as a parsed UnitSpec, refused when
 it is not a string, entries that are not KEY=UNIT (an empty key, a second '='), a column given twice, and the

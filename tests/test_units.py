@@ -1,6 +1,5 @@
-"""Tests added for the mutants of ``fogdrift.units`` that the mutation selection (test_signal_units, test_io_units,
-test_accel*) never reached (issue 24 item 2, docs/testing-rounds.md "Round 2: new modules (issues 21-23)"): the Earth-rate
-projection, the rate and increment scales to deg/h and the temperature offsets, each by hand."""
+"""Tests of ``fogdrift.units`` beside those of the readers (test_signal_units, test_io_units, test_accel*), first
+written against the mutants those never reached (docs/testing-rounds.md): the Earth-rate projection, the rate and increment scales to deg/h and the temperature offsets, each by hand."""
 
 from __future__ import annotations
 
