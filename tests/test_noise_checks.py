@@ -25,7 +25,6 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from scipy.stats import chi2
 
 from fogdrift.noise import checks, context
 from fogdrift.noise._spectral_null import _MedianNull, _null_and_critical

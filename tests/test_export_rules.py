@@ -1,5 +1,5 @@
-"""Tests added for the surviving mutants of ``fogdrift.export`` (writers, model, discretize, targets) in mutation
-round 3 (issue 24 item 2, docs/testing-rounds.md).
+"""Rules of ``fogdrift.export`` (writers, model, discretize, targets), pinned one by one: first written against the
+surviving mutants of mutation round 3 (docs/testing-rounds.md).
 
 Each test pins a rule a one-line change would break, against values worked out by hand: every field of a GMWM
 (``noise.json``) and an Allan (``allan.json``) result read into a :class:`ChannelModel` (units, defaults, statuses,
