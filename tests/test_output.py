@@ -213,3 +213,43 @@ def test_dead_processes_temporaries_are_removed(tmp_path):
     (folder / f"{TMP_PREFIX}{os.getppid()}-other.png").write_text("a running process is writing it")
     _run(folder, ["a.json"])
     assert listing(folder) == sorted([MANIFEST, "a.json", f"{TMP_PREFIX}{os.getppid()}-other.png"])
+
+
+def test_the_manifest_lists_a_file_before_it_appears(tmp_path, monkeypatch):
+    """Each rename of a finished temporary file into place happens after the manifest on disk lists it (a run killed
+    between the two leaves a listed file absent, which a later run skips, never a file no manifest records); a
+    rename that fails takes the entry back.  Also on a re-run whose previous file is moved aside first."""
+    import fogdrift.output as output
+
+    folder = tmp_path / "out"
+    seen = []
+    real = os.replace
+
+    def replace(src, dst):
+        if Path(src).name.startswith(TMP_PREFIX) and Path(dst).name != MANIFEST:
+            listed = json.loads((folder / MANIFEST).read_text())["files"]
+            seen.append((Path(dst).name, Path(dst).name in listed, Path(dst).exists()))
+        return real(src, dst)
+
+    monkeypatch.setattr(output.os, "replace", replace)
+    for run in range(2):                                   # the second run moves the first run's a.txt aside
+        with OutputDir(folder, command="test") as out:
+            for name in ("a.txt", "b.txt"):
+                with out.file(name) as tmp:
+                    tmp.write_text(f"{name} {run}")
+            out.complete = True
+    assert seen == [("a.txt", True, False), ("b.txt", True, False)] * 2
+    assert (folder / "a.txt").read_text() == "a.txt 1"
+
+    def failing(src, dst):
+        if Path(src).name.startswith(TMP_PREFIX) and Path(dst).name != MANIFEST:
+            raise OSError(28, "No space left on device")
+        return real(src, dst)
+
+    monkeypatch.setattr(output.os, "replace", failing)
+    with pytest.raises(Exception):
+        with OutputDir(tmp_path / "full", command="test") as out:
+            with out.file("c.txt") as tmp:
+                tmp.write_text("c")
+    doc = json.loads((tmp_path / "full" / MANIFEST).read_text()) if (tmp_path / "full" / MANIFEST).exists() else {}
+    assert "c.txt" not in doc.get("files", [])

@@ -642,11 +642,19 @@ class OutputDir:
                     aside = self.path / self._backup / rel  # the previous run's file, until this run is complete
                     aside.parent.mkdir(parents=True, exist_ok=True)
                     os.replace(final, aside)
-                os.replace(tmp, final)
-                self._pending.discard(tmp)
-                if rel not in self.written:
+                new = rel not in self.written
+                if new:  # listed before it appears: a kill in between leaves a listed file absent, never a file unlisted
                     self.written.append(rel)
-                self._write_manifest()
+                    self._write_manifest()
+                try:
+                    os.replace(tmp, final)
+                except BaseException:
+                    if new:
+                        self.written.remove(rel)
+                        with contextlib.suppress(OSError):
+                            self._write_manifest()
+                    raise
+                self._pending.discard(tmp)
         except BaseException as exc:
             with self._lock:
                 self._pending.discard(tmp)
