@@ -20,6 +20,7 @@ import time
 import numpy as np
 
 from fogdrift.plan import make_plan, parse_model
+from fogdrift.plan.core import _mc_length
 from fogdrift.plan.montecarlo import simulate_fits, summarise
 from fogdrift.plan.spread import fit_rule_widths
 
@@ -70,6 +71,10 @@ def main(argv=None):
     print(f"  real fits: {met} / {len(seeds)} reach ±{100 * target:g} % ({100 * met / len(seeds):.1f} %), coverage "
           f"{round(s['coverage'] * len(seeds))} / {len(seeds)}, median ±{100 * np.median(w):.2f} %, q80 "
           f"±{100 * np.quantile(w, 0.8):.2f} % ({time.time() - t1:.0f} s)", flush=True)
+    if a.at == "target":  # the length the seeds' median width implies, on the analytic curve's local slope
+        implied = _mc_length(length, s["median_width"], target, plan.grid["length_s"], plan.grid["width"][a.term])
+        if implied:
+            print(f"  the seeds' median implies {implied:.6g} s ({100 * (implied / length - 1):+.1f} % of target_s)")
     out = {"sensor": a.sensor, "term": a.term, "target": target, "at": a.at, "n_samples": n,
            "target_s": r["target_s"], "share_s": r["share_s"], "share_ratio": r["share_ratio"], "seeds": seeds,
            "met": met, "summary": s, "fits": fits}
