@@ -211,8 +211,9 @@ def _share_length(model, term, target, lengths, w_share):
     x1 = g0
     for _ in range(_SHARE_ITER):
         g1, r = step(x1, SPREAD_DRAWS // 4)
-        if g1 is None:
-            return None, r
+        if g1 is None:  # too few records resolve the term there: back to the last length that gave one
+            x1 = g0
+            break
         h0, h1 = g0 - x0, g1 - x1
         x2 = x1 - h1 * (x1 - x0) / (h1 - h0) if h1 != h0 else g1
         x2 = min(max(x2, math.log(lengths[0])), math.log(lengths[-1]))
