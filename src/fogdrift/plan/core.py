@@ -15,7 +15,7 @@ from .analytic import analytic_widths
 from .gmwm import gmwm_widths, simulate_gmwm_fits
 from .model import fmt_length
 from .montecarlo import MC_MAX_SAMPLES, simulate_fits, summarise
-from .spread import share_ratio
+from .spread import SPREAD_DRAWS, share_ratio
 
 __all__ = ["Plan", "make_plan", "MAX_LENGTH_S", "RECORD_SHARE", "crossing", "ESTIMATORS"]
 
@@ -29,6 +29,8 @@ _STEP = 2.0**0.5  # grid of record lengths: half an octave
 
 #: Share of records that must reach the target width at ``share_s`` (the median record reaches it at ``target_s``).
 RECORD_SHARE = 0.8
+_SHARE_ITER = 6  # secant steps at most for share_s, to a relative change of the length below _SHARE_TOL
+_SHARE_TOL = 0.005
 
 
 def crossing(x, y, level):
@@ -185,6 +187,43 @@ def _grid_n(dt_s):
     return out
 
 
+def _share_length(model, term, target, lengths, w_share):
+    """``(length, ratio)``: the fixed point ``L = crossing(w_share * share_ratio(L))`` (the length at which the 80 %
+    width, the share union's width times the spread at that length, reaches ``target``; None if it never does).
+
+    The ratio falls with length, so plain substitution oscillates about the fixed point (MEMS B: 57 906 ->
+    106 415 -> 85 541 -> 92 502 -> ... samples); a secant step on ``log L`` finds it in 3-4 evaluations of
+    ``SPREAD_DRAWS // 4`` records, then the ratio is taken there with ``SPREAD_DRAWS`` and the length read again.
+    """
+    dt = model.dt_s
+
+    def step(x, draws):
+        r = share_ratio(model, max(int(round(math.exp(x) / dt)), _MIN_SAMPLES), term, RECORD_SHARE, draws=draws)
+        if not math.isfinite(r):
+            return None, r
+        at = crossing(lengths, [v * r for v in w_share], target)
+        return (None if at is None else math.log(at)), r
+
+    x0 = math.log(crossing(lengths, w_share, target))
+    g0, r = step(x0, SPREAD_DRAWS // 4)
+    if g0 is None:
+        return None, r
+    x1 = g0
+    for _ in range(_SHARE_ITER):
+        g1, r = step(x1, SPREAD_DRAWS // 4)
+        if g1 is None:  # too few records resolve the term there: back to the last length that gave one
+            x1 = g0
+            break
+        h0, h1 = g0 - x0, g1 - x1
+        x2 = x1 - h1 * (x1 - x0) / (h1 - h0) if h1 != h0 else g1
+        x2 = min(max(x2, math.log(lengths[0])), math.log(lengths[-1]))
+        x0, g0, x1 = x1, g1, x2
+        if abs(x1 - x0) < _SHARE_TOL:
+            break
+    g, r = step(x1, SPREAD_DRAWS)
+    return (None if g is None else math.exp(g)), r
+
+
 def _mc_length(L, w_mc, target, grid_len, grid_w):
     """Length the measured median width implies, with the analytic curve's local log-log slope at ``L``."""
     gl, gw = np.asarray(grid_len), np.asarray(grid_w)
@@ -252,21 +291,12 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
             "z": {t: [c[t]["z"] for c in curves] for t in model.terms}}
     # the width RECORD_SHARE of the records stay within: the union of the models that share of the records may
     # find plausible, times the spread of the fit's rules on linearised records (plan.spread), evaluated at the
-    # target length and again at the length it gives
+    # length it gives (a fixed point, _share_length)
     shared = [analytic_widths(model, n, share=RECORD_SHARE) for n in ns] if targets else curves
     grid["width_share"], spread = {}, {}
     for t, target in targets.items():
         w = [c[t]["rel_width"] for c in shared]
-        at = crossing(lengths, w, target)
-        ratio = math.inf
-        for _ in range(2):
-            if at is None:
-                break
-            n_at = min(ns, key=lambda n: abs(math.log(n * dt / at)))
-            ratio = share_ratio(model, n_at, t, RECORD_SHARE)
-            if not math.isfinite(ratio):
-                break
-            at = crossing(lengths, [x * ratio for x in w], target)
+        ratio = _share_length(model, t, target, lengths, w)[1] if crossing(lengths, w, target) else math.inf
         spread[t] = ratio
         grid["width_share"][t] = [x * ratio if math.isfinite(x) else math.inf for x in w]
     terms = {}

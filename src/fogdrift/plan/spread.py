@@ -13,6 +13,11 @@ Per record: every subset of the planned terms is fitted by non-negative least sq
 ``t_{0.975, dof}^2 max(1, chi2_red)`` with the selected model's ``dof``, and the term's interval is the union of
 its profile intervals (``A >= 0``) over the plausible models that hold it (any without it: not resolved).  The
 ratio of the ``p``-quantile of the widths to their median is the spread (:func:`share_ratio`).
+
+:func:`fit_rule_widths` checks the linearisation: the fit itself (:func:`fogdrift.noise.identify.identify`, every
+rule of ``fogdrift allan`` but the automatic fit range and the Markov candidates) on Allan curves drawn from the
+same sampling covariance (Wilson-Hilferty: ``cbrt(y / mu)`` Gaussian with the estimators' EDF and correlation).
+It costs about 0.1 s per record, so the plan does not use it (docs/plan.md, "80 % of records").
 """
 
 from __future__ import annotations
@@ -22,17 +27,21 @@ import math
 
 import numpy as np
 from scipy.optimize import brentq, nnls
+from scipy.stats import chi2
 from scipy.stats import t as student_t
 
 from ..allan.grid import tau_grid
+from ..noise.context import FitContext
+from ..noise.identify import identify
 from ..noise.terms import all_terms
 from .analytic import IC_PENALTY, PLAUSIBLE_DELTA, whitened
 from .model import PLANNED_TERMS as PLANNED
 
-__all__ = ["share_ratio", "SPREAD_DRAWS"]
+__all__ = ["share_ratio", "fit_rule_widths", "model_curves", "SPREAD_DRAWS"]
 
-#: Gaussian records drawn per length (fixed seed): the 80 % / median ratio to about +-2 %.
-SPREAD_DRAWS = 400
+#: Gaussian records drawn per length (fixed seed): the 80 % / median ratio to about +-1 % (400 draws: +-2 %, i.e.
+#: +-7 % in the 80 % length of a B, whose width falls as about n^-0.3; docs/plan.md "80 % of records").
+SPREAD_DRAWS = 1600
 
 
 def share_ratio(model, n_samples, term, share, draws=SPREAD_DRAWS, seed=0) -> float:
@@ -83,6 +92,54 @@ def share_ratio(model, n_samples, term, share, draws=SPREAD_DRAWS, seed=0) -> fl
     w = np.asarray(widths)
     med, q = float(np.median(w)), float(np.quantile(w, share))
     return q / med if math.isfinite(q) and med > 0 else math.inf
+
+
+def fit_rule_widths(model, n_samples, term, draws=100, seed=0) -> np.ndarray:
+    """``term``'s relative half-width (relative to each record's estimate; inf where not resolved) from the Allan
+    fit's own :func:`~fogdrift.noise.identify.identify` on ``draws`` Allan curves of ``n_samples`` samples drawn
+    from the model: on the fit's octave taus (from ``model.tau_min_s``), ``cbrt(y_i / mu_i) = c_i + s_i z_i`` with
+    ``c = 1 - 2 / (9 nu)``, ``s = sqrt(2 / (9 nu))``, ``nu_i`` the sampling EDF and ``z`` Gaussian with the
+    sampling correlation of the estimators (``FitContext.relcov(A, exact_ramp=True, allowance=False)``).  The fit
+    range is fixed to those taus and the Markov candidates are off (neither changed a width on simulated records of
+    the three classes of docs/plan.md)."""
+    n, dt = int(n_samples), float(model.dt_s)
+    m, mu, nu, curves = model_curves(model, n, draws, seed)
+    if m.size <= len(model.terms) + 1:
+        return np.full(int(draws), math.inf)
+    tau = m * dt
+    out = []
+    for y in curves:
+        fit = identify(tau, y, n, dt, var_hi95=y * nu / chi2.ppf(0.025, nu), m=m,
+                       tau_range_s=(float(tau[0]), math.inf), markov=False)
+        r = fit.terms[term]
+        ok = r.status == "resolved" and r.value and r.lo95 is not None and r.hi95 is not None
+        out.append((r.hi95 - r.lo95) / (2.0 * r.value) if ok else math.inf)
+    return np.asarray(out)
+
+
+def model_curves(model, n_samples, draws, seed=0):
+    """``(m, mu, nu, curves)``: the fit's octave averaging factors (from ``model.tau_min_s``), the model's expected
+    Allan variance and the estimators' sampling EDF there, and ``draws`` Allan curves drawn from it (rows):
+    ``cbrt(y / mu) = 1 - 2 / (9 nu) + sqrt(2 / (9 nu)) z``, ``z`` Gaussian with the estimators' sampling correlation
+    (Wilson-Hilferty: each ``y / mu`` about ``chi2_nu / nu``, mean 1)."""
+    names, A, dt = model.terms, model.law_coefficients(), float(model.dt_s)
+    n = int(n_samples)
+    m = tau_grid(n, dt, "octave").astype(np.float64)
+    tau_min = getattr(model, "tau_min_s", None)
+    if tau_min is not None:
+        m = m[m * dt >= float(tau_min) * (1.0 - 1e-9)]
+    if m.size <= len(names) + 1:
+        return m, None, None, None
+    tau = m * dt
+    probe = FitContext(tau, m, np.ones_like(tau), np.full_like(tau, 2.0), n, dt, "adev", names)
+    mu = probe.X @ A
+    C = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", names).relcov(A, exact_ramp=True, allowance=False)
+    nu = 2.0 / np.diag(C)
+    sd = np.sqrt(np.diag(C))
+    Lc = np.linalg.cholesky(C / np.outer(sd, sd) + 1e-10 * np.eye(tau.size))
+    c, s = 1.0 - 2.0 / (9.0 * nu), np.sqrt(2.0 / (9.0 * nu))
+    z = np.random.default_rng(seed).standard_normal((int(draws), tau.size)) @ Lc.T
+    return m, mu, nu, mu * np.maximum(c + s * z, 1e-3) ** 3
 
 
 def _profile(Xw, yw, j, coef, q0, d2):
