@@ -164,6 +164,37 @@ def edf_simple_safe(n_phase, m, alpha) -> float:
     return edf_formula(float(n_phase), float(m), int(alpha))
 
 
+def edf_simple_safe_array(n_phase, m, alpha) -> np.ndarray:
+    """:func:`edf_simple_safe` element by element over arrays (broadcast): the same formulas, evaluated per alpha
+    on the elements that have it, and 1 where the record is too short for the tau.
+
+    Examples
+    --------
+    >>> edf_simple_safe_array(1025, np.array([1, 16, 600]), np.array([-1, 0, 0])).round(4).tolist()
+    [889.6787, 93.5471, 1.0]
+    """
+    N, mm, a = np.broadcast_arrays(np.asarray(n_phase, dtype=np.float64), np.asarray(m, dtype=np.float64),
+                                   np.asarray(alpha, dtype=np.int64))
+    out = np.ones(N.shape, dtype=np.float64)
+    ok = ~((N < 3) | (2 * mm > N - 1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for value in np.unique(a[ok]):
+            k = ok & (a == value)
+            n, q = N[k], mm[k]
+            if value == 2:
+                e = (n + 1) * (n - 2 * q) / (2 * (n - q))
+            elif value == 1:
+                e = np.exp(np.sqrt(np.log((n - 1) / (2 * q)) * np.log((2 * q + 1) * (n - 1) / 4)))
+            elif value == 0:
+                e = (3 * (n - 1) / (2 * q) - 2 * (n - 2) / n) * 4 * q**2 / (4 * q**2 + 5)
+            elif value == -1:
+                e = np.where(q <= 1, 2 * (n - 2) ** 2 / (2.3 * n - 4.9), 5 * n**2 / (4 * q * (n + 3 * q)))
+            else:
+                e = ((n - 2) / q) * ((n - 1) ** 2 - 3 * q * (n - 1) + 4 * q**2) / (n - 3) ** 2
+            out[k] = e
+    return out
+
+
 # ----------------------------------------------------------------------------------------
 # Greenhall & Riley (2003)
 # ----------------------------------------------------------------------------------------

@@ -44,7 +44,7 @@ from .._util import check_series
 from ..errors import ConfigError, InsufficientDataError
 from ..units import check_dt_s
 from . import _kernels
-from .ci import P68, chi2_bounds, edf_greenhall, edf_simple_safe, resolve_alpha
+from .ci import P68, chi2_bounds, edf_greenhall, edf_simple_safe, edf_simple_safe_array, resolve_alpha
 from .grid import tau_grid
 from .result import AllanResult
 from .statistics import get_statistic
@@ -216,28 +216,40 @@ def allan_variance(
                             noise_alpha=noise_alpha)
 
 
-def choose_alphas(noise_alpha, tau_s, var, stat, edf_of, few_intervals):
+def choose_alphas(noise_alpha, tau_s, var, stat, edf_of, few_intervals, *, edf_many=None):
     """The noise type (power-law alpha) and EDF of each tau: ``noise_alpha`` resolved (:func:`resolve_alpha`),
     ``"conservative"`` the smallest EDF among the IEEE-952 alphas; with ``"auto"``, where ``few_intervals`` (fewer
     than :data:`AUTO_MIN_INTERVALS` averaging intervals fit in the record) and the slope says phase noise, the
-    smallest EDF too (a bounded disturbance at long tau looks the same).  ``edf_of(i, alpha)`` is the EDF rule.
-    Returns ``(alphas, edf, rule)``."""
+    smallest EDF too (a bounded disturbance at long tau looks the same).  ``edf_of(i, alpha)`` is the EDF rule;
+    ``edf_many(idx, alphas)``, when given, the same rule over arrays of tau numbers and alphas (one call instead of
+    one per tau: thousands of taus with ``--taus all``).  Returns ``(alphas, edf, rule)``."""
     m_size = len(tau_s)
+
+    def many(idx, a):
+        if edf_many is not None:
+            return np.asarray(edf_many(idx, a), dtype=np.float64)
+        return np.array([edf_of(i, b) for i, b in zip(idx.tolist(), a.tolist())], dtype=np.float64)
+
+    def candidates(idx):  # (len(idx), n_alphas): every IEEE-952 alpha's EDF at each tau
+        return np.column_stack([many(idx, np.full(idx.size, a, dtype=np.int64)) for a in IEEE952_ALPHAS]) \
+            if idx.size else np.empty((0, len(IEEE952_ALPHAS)))
+
     alphas, rule = resolve_alpha(noise_alpha, tau_s, var, slopes=stat.dev_slopes, candidates=IEEE952_ALPHAS)
     if isinstance(alphas, str):  # conservative
-        cands = np.array([[edf_of(i, a) for a in IEEE952_ALPHAS] for i in range(m_size)]).reshape(m_size, -1)
+        cands = candidates(np.arange(m_size))
         pick = np.argmin(cands, axis=1)
         return np.asarray(IEEE952_ALPHAS, dtype=np.int64)[pick], cands[np.arange(m_size), pick], rule
     alphas = np.array(alphas, dtype=np.int64)
-    edf = np.array([edf_of(i, a) for i, a in enumerate(alphas)], dtype=np.float64)
+    edf = many(np.arange(m_size), alphas)
     if isinstance(noise_alpha, str):  # auto: a phase-noise slope at long tau is not evidence of phase noise
         few = np.flatnonzero((alphas > 0) & np.asarray(few_intervals, dtype=bool))
-        for i in few:
-            cand = [edf_of(i, a) for a in IEEE952_ALPHAS]
-            k = int(np.nanargmin(cand))
-            if cand[k] < edf[i]:
-                alphas[i], edf[i] = IEEE952_ALPHAS[k], cand[k]
         if few.size:
+            cand = candidates(few)
+            k = np.nanargmin(cand, axis=1)
+            best = cand[np.arange(few.size), k]
+            take = best < edf[few]
+            alphas[few[take]] = np.asarray(IEEE952_ALPHAS, dtype=np.int64)[k[take]]
+            edf[few[take]] = best[take]
             rule += (f"; where fewer than {AUTO_MIN_INTERVALS} averaging intervals fit in the record and the "
                      "slope says phase noise (alpha > 0: a bounded disturbance at long tau looks the same), "
                      "the smallest EDF among the IEEE-952 alphas")
@@ -281,10 +293,11 @@ def result_from_sums(sums, n, m, strides, dt_s, *, statistic, estimator, noise_a
     var = stat.variance(sums, m, n_terms)
     tau_s = m * dt
 
-    edf_of, cap_of, base = _edf_rule(stat, estimator, n, m, strides)
-    alphas, edf, rule = choose_alphas(noise_alpha, tau_s, var, stat, edf_of, n < AUTO_MIN_INTERVALS * m)
-    if cap_of is not None:  # a strided (fast) sum cannot have more EDF than the full overlapping one
-        edf = np.minimum(edf, [cap_of(i, a) for i, a in enumerate(alphas)])
+    edf_of, edf_many, cap_many, base = _edf_rule(stat, estimator, n, m, strides)
+    alphas, edf, rule = choose_alphas(noise_alpha, tau_s, var, stat, edf_of, n < AUTO_MIN_INTERVALS * m,
+                                      edf_many=edf_many)
+    if cap_many is not None:  # a strided (fast) sum cannot have more EDF than the full overlapping one
+        edf = np.minimum(edf, cap_many(np.arange(m.size), alphas))
     edf = np.clip(np.nan_to_num(edf, nan=1.0, posinf=float(n_terms.max())), 1.0, np.maximum(n_terms, 1))
 
     lo68, hi68 = chi2_bounds(var, edf, P68)
@@ -310,10 +323,12 @@ def result_from_sums(sums, n, m, strides, dt_s, *, statistic, estimator, noise_a
 
 
 def _edf_rule(stat, estimator, n, m, strides):
-    """``(edf_of(i, alpha), cap_of(i, alpha) or None, description)`` for a statistic and sampling.
+    """``(edf_of(i, alpha), edf_many(idx, alphas) or None, cap_many(idx, alphas) or None, description)`` for a
+    statistic and sampling.
 
-    ``edf_of`` is the unclipped EDF of tau number i; ``cap_of`` an upper bound applied after alpha
-    is chosen (the fast estimator's EDF never exceeds the overlapping one).
+    ``edf_of`` is the unclipped EDF of tau number i (``edf_many`` the same over arrays, for the closed-form rules);
+    ``cap_many`` an upper bound applied after alpha is chosen (the fast estimator's EDF never exceeds the
+    overlapping one).
     """
     n_phase = n + 1
     if stat.edf_method == "greenhall":
@@ -325,7 +340,7 @@ def _edf_rule(stat, estimator, n, m, strides):
 
         text = (f"Greenhall-Riley EDF (d={stat.order}{', modified' if stat.windowed else ''}, "
                 f"{'stride factor m' if overlapping else 'stride factor 1'}) with N+1 phase points")
-        return edf_of, None, text
+        return edf_of, None, None, text
 
     # Allan deviation: phase points and averaging factor of the series whose overlapping
     # Table-5 EDF applies
@@ -342,7 +357,10 @@ def _edf_rule(stat, estimator, n, m, strides):
     def edf_of(i, a):
         return edf_simple_safe(edf_n[i], edf_m[i], a)
 
-    def cap_of(i, a):
-        return edf_simple_safe(n_phase, m[i], a)
+    def edf_many(idx, a):
+        return edf_simple_safe_array(edf_n[idx], edf_m[idx], a)
 
-    return edf_of, (cap_of if estimator == "fast" else None), text
+    def cap_many(idx, a):
+        return edf_simple_safe_array(n_phase, m[idx], a)
+
+    return edf_of, edf_many, (cap_many if estimator == "fast" else None), text
