@@ -281,3 +281,24 @@ def test_local_slopes_are_each_windows_least_squares_slope():
     tau = np.arange(1.0, 2001.0)
     for power, alpha in ((-1.0, 0), (1.0, -2), (-2.0, 2)):
         assert set(alpha_from_slope(tau, tau**power, {2: -1.0, 0: -0.5, -1: 0.0, -2: 0.5}, (2, 0, -1, -2)).tolist()) == {alpha}
+
+
+def test_edf_over_arrays_is_the_scalar_rule_element_by_element():
+    """Every alpha, m = 1 (the flicker-FM special case), fractional m (the fast estimator), and taus too long for the
+    record (EDF 1) give the scalar rule's number exactly."""
+    import itertools
+
+    import numpy as np
+
+    from fogdrift.allan.ci import edf_simple_safe, edf_simple_safe_array
+
+    n_phase = np.array([2, 3, 5, 64, 1025, 1025, 100001, 7.5])
+    m = np.array([1, 1, 2, 1, 16, 511, 1234, 2.25])
+    for a in (2, 1, 0, -1, -2):
+        got = edf_simple_safe_array(n_phase, m, np.full(m.size, a))
+        want = [edf_simple_safe(n, mm, a) for n, mm in zip(n_phase, m)]
+        np.testing.assert_array_equal(got, want)
+    pairs = list(itertools.product([2, 0, -1, -2], range(m.size)))
+    mixed = edf_simple_safe_array(n_phase[[i for _, i in pairs]], m[[i for _, i in pairs]], [a for a, _ in pairs])
+    np.testing.assert_array_equal(mixed, [edf_simple_safe(n_phase[i], m[i], a) for a, i in pairs])
+    assert edf_simple_safe_array(5, 3, 0) == 1.0          # 2 m > N - 1: the record is too short for the tau
