@@ -140,3 +140,23 @@ def test_cli_estimator_option(tmp_path):
     res = CliRunner().invoke(_commands(), ["plan", "--model", MEMS, "--rate", "10", "--estimator", "kalman",
                                            "--out", str(out)])
     assert res.exit_code == 1 and "--estimator must be both, allan or gmwm" in res.output.strip()
+
+
+def test_a_stated_length_is_read_for_the_gmwm_too():
+    """``--length``: what the record supports by each estimator planned for, the GMWM's from its own covariance law
+    (the widths of :func:`gmwm_widths` at that length), said as such on the line."""
+    from fogdrift.plan.core import make_plan
+    from fogdrift.plan.gmwm import gmwm_widths
+    from fogdrift.plan.model import parse_model
+
+    m = parse_model("N=0.3 deg/sqrt(h), B=5 deg/h, K=20 deg/h^1.5", 0.1)
+    both = make_plan(m, {}, length_s=7200.0)
+    g = gmwm_widths(m, 72000)
+    assert both.at_length["gmwm"]["terms"] == {t: {"resolved": g[t]["resolved"], "rel_width": g[t]["rel_width"]}
+                                               for t in m.terms}
+    line = both.lines()[-1]
+    allan_part, gmwm_part = line.split("; ")
+    assert allan_part.startswith("a 2 h record resolves N to ±") and allan_part.endswith("(Allan fit)")
+    assert gmwm_part.endswith("(GMWM)") and f"N to ±{100 * g['N']['rel_width']:.2g} %" in gmwm_part
+    assert "gmwm" not in make_plan(m, {}, length_s=7200.0, estimators=("allan",)).at_length
+    assert make_plan(m, {}, length_s=7200.0, estimators=("gmwm",)).lines()[-1].count("(") == 1

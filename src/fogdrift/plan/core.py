@@ -145,12 +145,14 @@ class Plan:
             out.append(s)
         if self.at_length:
             L = self.at_length
-            good = [f"{t} to ±{100 * v['rel_width']:.2g} %" for t, v in L["terms"].items() if v["resolved"]]
-            bound = [t for t, v in L["terms"].items() if not v["resolved"]]
-            s = f"a {fmt_length(L['length_s'])} record " + (f"resolves {', '.join(good)}" if good else "resolves no term")
-            if bound:
-                s += f" and gives {', '.join(bound)} only as a bound"
-            out.append(s)
+            parts = []
+            for name, terms in ((("Allan fit", L["terms"]),) if "allan" in self.estimators else ()) + \
+                    ((("GMWM", L["gmwm"]["terms"]),) if "gmwm" in L else ()):
+                good = [f"{t} to ±{100 * v['rel_width']:.2g} %" for t, v in terms.items() if v["resolved"]]
+                bound = [t for t, v in terms.items() if not v["resolved"]]
+                s = f"resolves {', '.join(good)}" if good else "resolves no term"
+                parts.append(s + (f" and gives {', '.join(bound)} only as a bound" if bound else "") + f" ({name})")
+            out.append(f"a {fmt_length(L['length_s'])} record " + "; ".join(parts))
         return out
 
     def to_dict(self) -> dict:
@@ -354,4 +356,9 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
         if seeds and n <= MC_MAX_SAMPLES and "allan" in estimators:
             fits = simulate_fits(model, n, seeds, workers=workers)
             at["mc"] = summarise(model, fits, {})
+        if "gmwm" in estimators:  # the same question for the GMWM, from its own covariance law
+            g = gmwm_widths(model, n)
+            at["gmwm"] = {"tau_max_s": g["_fit"]["tau_max_s"],
+                          "terms": {t: {"resolved": g[t]["resolved"], "rel_width": g[t]["rel_width"]}
+                                    for t in model.terms}}
     return Plan(model, dict(targets), terms, grid, at, seeds, notes + list(model.notes), estimators)
