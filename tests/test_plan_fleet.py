@@ -221,7 +221,8 @@ def test_cli_plan_fleet(tmp_path):
     (["--fleet", str(FIXTURE), "--target", "K:25%"], "--fleet K: 2 unit(s) of 15"),
     (["--fleet", str(FIXTURE), "--units", "1"], "--units must be between 2"),
     (["--fleet", str(FIXTURE), "--model", "N=1 deg/sqrt(h)"], "drop the pilot FILE, --model, --length"),
-    (["--units", "5"], "give --fleet")])
+    (["--units", "5"], "give --fleet"),
+    (["--fleet", str(FIXTURE), "--estimator", "gmwm"], "does not say which estimator made its rows")])
 def test_cli_plan_fleet_refusals_are_one_line(tmp_path, args, words):
     from typer.testing import CliRunner
 
@@ -231,3 +232,24 @@ def test_cli_plan_fleet_refusals_are_one_line(tmp_path, args, words):
     assert res.exit_code == 1
     text = res.output.strip()
     assert words in text and len(text.splitlines()) == 1, text
+
+
+def test_one_estimators_rows_are_planned_never_two_pooled():
+    """A unit measured by both estimators would count twice: rows of batch allan/analyze are the Allan fit's, of
+    batch noise the GMWM's; both asked for takes whichever the table holds, and refuses a table of both."""
+    from fogdrift.errors import ConfigError
+    from fogdrift.plan.fleet import rows_of_estimator
+
+    allan = [{"command": "allan", "axis": "gx"}, {"command": "analyze", "axis": "gy"}]
+    gmwm = [{"command": "noise", "axis": "gx"}]
+    assert rows_of_estimator(allan) == (allan, "allan") and rows_of_estimator(gmwm, ("gmwm",)) == (gmwm, "gmwm")
+    assert rows_of_estimator(allan + gmwm, ("gmwm",)) == (gmwm, "gmwm")
+    assert rows_of_estimator(allan + gmwm, ("allan",)) == (allan, "allan")
+    with pytest.raises(ConfigError, match="holds rows of the Allan fit .* and of the GMWM"):
+        rows_of_estimator(allan + gmwm)
+    with pytest.raises(ConfigError, match="holds Allan fit rows only; .*gmwm finds none"):
+        rows_of_estimator(allan, ("gmwm",))
+    bare = [{"axis": "gx"}]                                   # a CSV without the batch's command column
+    assert rows_of_estimator(bare) == (bare, None)
+    with pytest.raises(ConfigError, match="does not say which estimator"):
+        rows_of_estimator(bare, ("allan",))

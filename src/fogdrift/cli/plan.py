@@ -42,7 +42,8 @@ def plan(
     workers: Annotated[int, typer.Option("--workers", help="Processes for the Monte-Carlo.")] = 1,
     estimator: Annotated[str, typer.Option("--estimator", help="Estimator(s) to plan for: both (default), allan "
                          "(the Allan fit, as fogdrift allan) or gmwm (the GMWM of the model's latent processes, "
-                         "as fogdrift noise --method gmwm --model WN+RW+FLICKER ...).")] = "both",
+                         "as fogdrift noise --method gmwm --model WN+RW+FLICKER ...); with --fleet, the rows of "
+                         "that estimator (batch allan/analyze: allan, batch noise: gmwm).")] = "both",
     axis: Annotated[Optional[str], typer.Option("--axis", help="Pilot axis (default: the first gyro axis); with "
                     "--fleet, plan this axis's units alone (default: the gyro axes pooled).")] = None,
     fleet: Annotated[Optional[Path], typer.Option("--fleet", help="Plan a fleet instead: a fogdrift batch output "
@@ -60,8 +61,12 @@ def plan(
     (Allan fit and GMWM; analytic, checked by Monte-Carlo); writes plan.json and plan.png."""
     with run("plan", out, default_out=DEFAULT_OUT, inputs=[load.file, fleet, model if model and model.strip().lower().endswith(".json") else None], json_out=json_out,
              expect=("plan.json",) if fleet is not None else ("plan.json", "plan.png")) as r:
+        est = {"both": ("allan", "gmwm"), "allan": ("allan",), "gmwm": ("gmwm",)}.get(str(estimator).strip().lower())
+        if est is None:
+            raise ConfigError(f"{{opt:estimator}} must be both, allan or gmwm; got {estimator!r}")
         if fleet is not None or units is not None or mean_target is not None:
-            return _fleet_plan(r, fleet, load.file, model, target, mean_target, units, axis, length, monte_carlo)
+            return _fleet_plan(r, fleet, load.file, model, target, mean_target, units, axis, length, monte_carlo,
+                               est)
         from ..plan import make_plan, parse_length, parse_model, parse_targets, read_model_file
         from ..report import write_json
         from ..report.plan_figure import plot_plan
@@ -74,9 +79,6 @@ def plan(
         if workers < 1 or workers > 64:
             raise ConfigError(f"{{opt:workers}} must be between 1 and 64; got {workers}")
         length_s = None if length is None else parse_length(length)
-        est = {"both": ("allan", "gmwm"), "allan": ("allan",), "gmwm": ("gmwm",)}.get(str(estimator).strip().lower())
-        if est is None:
-            raise ConfigError(f"{{opt:estimator}} must be both, allan or gmwm; got {estimator!r}")
         if model is not None:
             if model.strip().lower().endswith(".json"):
                 m = read_model_file(model, None if rate is None else 1.0 / rate, axis)
@@ -129,10 +131,11 @@ def _pilot_model(load, axis):
 
 
 
-def _fleet_plan(r, fleet, file, model, target, mean_target, units, axis, length, monte_carlo):
-    """``--fleet``: units of the type to record (:mod:`fogdrift.plan.fleet`); writes plan.json with a ``fleet``
-    section."""
-    from ..plan.fleet import fleet_pilot, make_fleet_plan, parse_fleet_targets, read_fleet_table
+def _fleet_plan(r, fleet, file, model, target, mean_target, units, axis, length, monte_carlo, est):
+    """``--fleet``: units of the type to record (:mod:`fogdrift.plan.fleet`), from the rows of one estimator
+    (``est``); writes plan.json with a ``fleet`` section."""
+    from ..plan.fleet import ESTIMATOR_NAMES, fleet_pilot, make_fleet_plan, parse_fleet_targets, read_fleet_table
+    from ..plan.fleet import rows_of_estimator
     from ..report import write_json
 
     if fleet is None:
@@ -142,17 +145,20 @@ def _fleet_plan(r, fleet, file, model, target, mean_target, units, axis, length,
         raise ConfigError("{opt:fleet} plans from the fleet table alone; drop the pilot FILE, {opt:model}, "
                           "{opt:length} and {opt:monte_carlo}")
     rows, path = read_fleet_table(fleet)
+    rows, which = rows_of_estimator(rows, est, str(path))
     pilot = fleet_pilot(rows, source=str(path), axis=axis)
     spread, mean = parse_fleet_targets(target, mean_target, tuple(pilot.terms))
     p = make_fleet_plan(pilot, spread, mean, units, explicit=bool(target or mean_target))
-    say(f"pilot fleet: {path} ({pilot.n_rows} units{', axes ' + ', '.join(pilot.axes) if pilot.axes else ''})")
+    say(f"pilot fleet: {path} ({pilot.n_rows} units{', axes ' + ', '.join(pilot.axes) if pilot.axes else ''}"
+        f"{'' if which is None else ', ' + ESTIMATOR_NAMES[which] + ' rows'})")
     for line in p.lines():
         say(line)
     for note in p.notes:
         say(f"  {note}", style="yellow")
     say("  widths are 95 % half-widths relative to the value; spread: the between-unit SD with the units' own "
         "errors taken out; units recorded as the pilot's were", style="dim")
-    out = write_json({"fogdrift_result": "plan", "estimator": "fleet (fogdrift batch table)",
+    out = write_json({"fogdrift_result": "plan", "estimator": "fleet (fogdrift batch table"
+                                                              f"{'' if which is None else ', ' + ESTIMATOR_NAMES[which]})",
                       "fleet": p.to_dict()}, r.out.path / "plan.json")
     r.wrote()
     r.print_json(out)

@@ -36,7 +36,7 @@ from ..io.readers.base import require
 from ..noise.terms import ACCEL_TERM_TABLE, TERM_TABLE
 from .model import PLANNED_TERMS, parse_targets
 
-__all__ = ["FleetPilot", "FleetPlan", "read_fleet_table", "fleet_pilot", "term_spread", "sd_interval",
+__all__ = ["FleetPilot", "FleetPlan", "read_fleet_table", "rows_of_estimator", "ESTIMATOR_OF_COMMAND", "fleet_pilot", "term_spread", "sd_interval",
            "spread_width", "mean_width", "units_needed", "make_fleet_plan", "parse_fleet_targets",
            "DEFAULT_SPREAD_TARGET", "DEFAULT_MEAN_TARGET", "MAX_UNITS", "MIN_UNITS", "SUMMARY_NAME", "Z95"]
 
@@ -54,7 +54,48 @@ DEFAULT_MEAN_TARGET = 0.10
 Z95 = 1.959963984540054
 
 
+#: The estimator behind a fleet-table row, by the ``fogdrift batch`` command that made it.
+ESTIMATOR_OF_COMMAND = {"allan": "allan", "analyze": "allan", "noise": "gmwm"}
+#: The estimators' names on the first screen.
+ESTIMATOR_NAMES = {"allan": "Allan fit", "gmwm": "GMWM"}
+
+
 # -- the fleet table ----------------------------------------------------------------------------------------
+def rows_of_estimator(rows, estimators=("allan", "gmwm"), source="fleet table") -> tuple[list[dict], str | None]:
+    """The rows of one estimator (:data:`ESTIMATOR_OF_COMMAND` of each row's ``command``) and its name; the units
+    of a type are planned from one estimator's intervals, never two pooled (a unit would count twice).
+
+    ``estimators``: the ones asked for (``{opt:estimator}``; both: whichever the table holds, if it holds one).  A
+    table without a ``command`` column is taken as it is when both are asked for (the name is then None).
+
+    Raises
+    ------
+    ConfigError
+        Rows of both estimators with both asked for, or no row of the estimator asked for.
+
+    Examples
+    --------
+    >>> rows_of_estimator([{"command": "noise", "axis": "gx"}], ("gmwm",))
+    ([{'command': 'noise', 'axis': 'gx'}], 'gmwm')
+    """
+    kinds = {ESTIMATOR_OF_COMMAND.get(str(r.get("command", ""))) for r in rows}
+    if None in kinds:
+        if set(estimators) >= {"allan", "gmwm"}:
+            return list(rows), None
+        raise ConfigError(f"{{opt:fleet}} {source}: the table does not say which estimator made its rows (no batch "
+                          f"'command' column for some); drop {{opt:estimator}} to plan from the table as it is")
+    found = kinds & set(estimators)
+    held = " and ".join(ESTIMATOR_NAMES[k] for k in sorted(kinds))
+    if not found:
+        raise ConfigError(f"{{opt:fleet}} {source} holds {held} rows only; {{opt:estimator}} "
+                          f"{' or '.join(estimators)} finds none")
+    if len(found) > 1:
+        raise ConfigError(f"{{opt:fleet}} {source} holds rows of the Allan fit (batch allan/analyze) and of the GMWM "
+                          "(batch noise): plan from one, with {opt:estimator} allan or gmwm")
+    name = found.pop()
+    return [r for r in rows if ESTIMATOR_OF_COMMAND[str(r.get("command"))] == name], name
+
+
 def read_fleet_table(path) -> tuple[list[dict], Path]:
     """Rows of a fleet table: a ``fogdrift batch`` output folder (its :data:`SUMMARY_NAME`), the Parquet file, or a
     CSV with the same column names (e.g. ``duckdb -c "COPY (SELECT * FROM 'summary.parquet') TO 'fleet.csv'"``).
