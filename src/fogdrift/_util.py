@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import secrets
 
 import numpy as np
 
@@ -174,13 +175,42 @@ def strict_json(obj, *, indent: int | None = 2, sort_keys: bool = False) -> str:
     The one strict-JSON serialiser: :func:`fogdrift.report.files.write_json` writes its text atomically (every
     result file), :mod:`fogdrift.output` its manifest.
 
+    With ``indent``, objects and lists of objects are indented and a list of numbers (a curve, a table column)
+    is written on one line: the same JSON value, a file a person can read (a 25 000-tau curve is not 25 000 lines),
+    written by the C encoder instead of Python's indenting one.
+
     >>> import numpy as np
     >>> strict_json({"tau_s": np.float64(2.0), "edf": float("nan"), "m": np.arange(2)}, indent=None)
     '{"tau_s": 2.0, "edf": null, "m": [0, 1]}'
+    >>> print(strict_json({"m": [1, 2, None], "axes": [{"name": "gx"}]}, indent=1))
+    {
+     "m": [1, 2, null],
+     "axes": [
+      {
+       "name": "gx"
+      }
+     ]
+    }
     """
     # NaN and +-Infinity become null as the text is parsed back (what finite_or_null does, without a second walk)
     data = json.loads(json.dumps(obj, default=json_default), parse_constant=lambda _: None)
-    return json.dumps(data, indent=indent, sort_keys=sort_keys, allow_nan=False)
+    if indent is None:
+        return json.dumps(data, sort_keys=sort_keys, allow_nan=False)
+    rows: list[str] = []
+    mark = f"@{secrets.token_hex(8)}:"  # a placeholder no value of the document can hold by chance
+
+    def pack(x):
+        if isinstance(x, dict):
+            return {k: pack(v) for k, v in x.items()}
+        if isinstance(x, list):
+            if x and all(v is None or type(v) in (int, float) for v in x):
+                rows.append(json.dumps(x, allow_nan=False))
+                return f"{mark}{len(rows) - 1}"
+            return [pack(v) for v in x]
+        return x
+
+    text = json.dumps(pack(data), indent=indent, sort_keys=sort_keys, allow_nan=False)
+    return re.sub(f'"{re.escape(mark)}(\\d+)"', lambda m: rows[int(m.group(1))], text)
 
 
 def safe_name(name) -> str:
