@@ -214,6 +214,15 @@ def test_cli_plan_fleet(tmp_path):
     d = json.loads((out / "plan.json").read_text())
     assert d["fleet"]["terms"]["N"]["spread_target"] == 0.3 and d["fleet"]["terms"]["B"]["mean_target"] == 0.1
     assert d["fleet"]["terms"]["B"]["spread_target"] is None
+    # the figure and the curve it draws: the expected widths against fleet size, the same rule as the plan's
+    from fogdrift.plan.fleet import CURVE_UNITS, spread_width
+
+    n = d["fleet"]["terms"]["N"]
+    assert (out / "plan.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert n["curve"]["units"] == CURVE_UNITS.tolist() and n["curve"]["units"][0] == 2
+    assert n["curve"]["units"][-1] == 10_000
+    np.testing.assert_allclose(n["curve"]["spread_width"], spread_width(CURVE_UNITS, n["within_share"]), rtol=1e-12)
+    assert np.all(np.diff(n["curve"]["mean_width"]) < 0)      # more units, a narrower mean
 
 
 @pytest.mark.parametrize("args, words", [

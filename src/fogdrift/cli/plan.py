@@ -60,7 +60,7 @@ def plan(
     """How long must I record?  The length at which each term is resolved and reaches its target 95 % width
     (Allan fit and GMWM; analytic, checked by Monte-Carlo); writes plan.json and plan.png."""
     with run("plan", out, default_out=DEFAULT_OUT, inputs=[load.file, fleet, model if model and model.strip().lower().endswith(".json") else None], json_out=json_out,
-             expect=("plan.json",) if fleet is not None else ("plan.json", "plan.png")) as r:
+             expect=("plan.json", "plan.png")) as r:
         est = {"both": ("allan", "gmwm"), "allan": ("allan",), "gmwm": ("gmwm",)}.get(str(estimator).strip().lower())
         if est is None:
             raise ConfigError(f"{{opt:estimator}} must be both, allan or gmwm; got {estimator!r}")
@@ -136,6 +136,7 @@ def _fleet_plan(r, fleet, file, model, target, mean_target, units, axis, length,
     (``est``); writes plan.json with a ``fleet`` section."""
     from ..plan.fleet import ESTIMATOR_NAMES, fleet_pilot, make_fleet_plan, parse_fleet_targets, read_fleet_table
     from ..plan.fleet import rows_of_estimator
+    from ..report.plan_figure import plot_fleet_plan
     from ..report import write_json
 
     if fleet is None:
@@ -160,5 +161,6 @@ def _fleet_plan(r, fleet, file, model, target, mean_target, units, axis, length,
     out = write_json({"fogdrift_result": "plan", "estimator": "fleet (fogdrift batch table"
                                                               f"{'' if which is None else ', ' + ESTIMATOR_NAMES[which]})",
                       "fleet": p.to_dict()}, r.out.path / "plan.json")
+    plot_fleet_plan(p, r.out.path / "plan.png")
     r.wrote()
     r.print_json(out)

@@ -52,6 +52,8 @@ DEFAULT_SPREAD_TARGET = 0.25
 DEFAULT_MEAN_TARGET = 0.10
 #: Normal 97.5 % quantile: a 95 % interval is +-Z95 sd.
 Z95 = 1.959963984540054
+#: Fleet sizes at which a plan keeps each term's width curve (about 16 per decade from 2 to :data:`MAX_UNITS`).
+CURVE_UNITS = np.unique(np.round(np.logspace(math.log10(2), math.log10(MAX_UNITS), 60)).astype(np.int64))
 
 
 #: The estimator behind a fleet-table row, by the ``fogdrift batch`` command that made it.
@@ -349,7 +351,8 @@ class FleetPlan:
     """Result of :func:`make_fleet_plan`.  ``terms``: term -> the pilot's :func:`term_spread` plus ``unit``,
     ``labels``, ``spread_target`` / ``mean_target`` (widths asked; None: not asked), ``spread_units`` /
     ``mean_units`` (units needed; None: more than :data:`MAX_UNITS` or the spread is not resolved),
-    ``spread_resolved_units`` (units from which the expected interval of the spread excludes 0) and, with
+    ``spread_resolved_units`` (units from which the expected interval of the spread excludes 0), ``curve`` (the
+    expected widths at the fleet sizes :data:`CURVE_UNITS`: ``units``, ``spread_width``, ``mean_width``) and, with
     ``units``, ``at_units`` (the widths ``units`` units give)."""
 
     pilot: FleetPilot
@@ -502,6 +505,8 @@ def make_fleet_plan(pilot: FleetPilot, spread_targets: dict, mean_targets: dict,
         r["spread_resolved_units"] = units_needed(-lo, -1e-12) if r["resolved"] else None
         if units is not None:
             r["at_units"] = {"spread_width": float(sw[units - 2]), "mean_width": float(mw[units - 2])}
+        k = CURVE_UNITS - 2  # the widths against fleet size, for the figure and plan.json
+        r["curve"] = {"units": CURVE_UNITS.tolist(), "spread_width": sw[k].tolist(), "mean_width": mw[k].tolist()}
         out[t] = r
     if not out:
         raise ConfigError(f"{{opt:fleet}} {pilot.source}: no term is resolved in {MIN_UNITS} or more of its "

@@ -1,6 +1,7 @@
-"""Figure of ``fogdrift plan``: expected relative 95 % half-width of each term against record length (log-log),
+"""Figures of ``fogdrift plan``: expected relative 95 % half-width of each term against record length (log-log),
 each target marked, the Monte-Carlo medians as points; the GMWM's curves (when planned) dash-dotted in the term's
-colour, its Monte-Carlo medians as plus signs."""
+colour, its Monte-Carlo medians as plus signs.  With ``--fleet``: each term's spread and type-mean widths against the
+number of units."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import numpy as np
 from ..units import S_PER_H
 from .figures import pyplot, save_figure
 
-__all__ = ["plot_plan"]
+__all__ = ["plot_plan", "plot_fleet_plan"]
 
 
 def plot_plan(plan, path) -> Path:
@@ -72,3 +73,33 @@ def _gmwm_curve(ax, plan, t, L, color) -> None:
     if mc and mc.get("median_width") is not None and math.isfinite(mc["median_width"]):
         ax.plot([mc["n_samples"] * plan.model.dt_s / S_PER_H], [100.0 * mc["median_width"]], "+", color=color,
                 ms=9, label=f"{t} GMWM Monte-Carlo median ({mc['n_seeds']} seeds)")
+
+
+def plot_fleet_plan(plan, path) -> Path:
+    """Write the fleet figure (PNG) of :class:`fogdrift.plan.fleet.FleetPlan` to ``path``: per term the expected
+    95 % half-width of the between-unit SD (solid) and of the type's mean (dashed) against the number of units
+    (log-log), each target dotted, the units needed as circles, ``--units`` as a vertical line."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(7.0, 4.6))
+    for i, (t, r) in enumerate(plan.terms.items()):
+        color, c = f"C{i}", r["curve"]
+        m = np.asarray(c["units"], dtype=float)
+        sw = 100.0 * np.asarray(c["spread_width"], dtype=float)
+        if np.any(np.isfinite(sw)):
+            ax.loglog(m, np.where(np.isfinite(sw), sw, np.nan), color=color, label=f"{t} spread (between-unit SD)")
+        ax.loglog(m, 100.0 * np.asarray(c["mean_width"], dtype=float), color=color, ls="--", lw=0.9,
+                  label=f"{t} type mean")
+        for target, needed in ((r["spread_target"], r["spread_units"]), (r["mean_target"], r["mean_units"])):
+            if target is None:
+                continue
+            ax.axhline(100.0 * target, color=color, ls=":", lw=0.9)
+            if needed is not None:
+                ax.plot([needed], [100.0 * target], "o", color=color, mfc="none")
+    if plan.units is not None:
+        ax.axvline(plan.units, color="0.5", ls="--", lw=0.9, label="--units")
+    ax.set_xlabel("units recorded")
+    ax.set_ylabel("95 % half-width [% of value]")
+    ax.set_title(f"fogdrift plan --fleet: {plan.pilot.n_rows} pilot units ({plan.pilot.source})", fontsize=8)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    return save_figure(fig, path)
