@@ -87,7 +87,12 @@ def compare(a: Path, b: Path) -> int:
     return 1 if bad else 0
 
 
+USAGE = "usage: output_digest.py OUT_FOLDER | output_digest.py --compare A/digest.json B/digest.json"
+
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["--compare"]:
-        sys.exit(compare(Path(sys.argv[2]), Path(sys.argv[3])))
-    run(Path(sys.argv[1]))
+    args = sys.argv[1:]
+    if args[:1] == ["--compare"] and len(args) == 3:
+        sys.exit(compare(Path(args[1]), Path(args[2])))
+    if len(args) != 1 or args[0].startswith("-"):  # never an output folder named like an option
+        sys.exit(USAGE)
+    run(Path(args[0]))
