@@ -139,22 +139,22 @@ def edf_simple(n_phase, m, alpha) -> float:
 
 def edf_formula(N: float, mm: float, a: int) -> float:
     """SP 1065 Table 5 formulas (see :func:`edf_simple`); unchecked, float arguments."""
+    return float(_table5(np.array([N], dtype=np.float64), np.array([mm], dtype=np.float64), int(a))[0])
+
+
+def _table5(n: np.ndarray, q: np.ndarray, a: int) -> np.ndarray:
+    """The Table-5 EDF of power-law alpha ``a`` at ``n`` phase points and averaging factor ``q`` (float arrays,
+    unchecked): the one home of the formulas (:func:`edf_formula`, :func:`edf_simple_safe_array`)."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        N = np.float64(N)
         if a == 2:
-            edf = (N + 1) * (N - 2 * mm) / (2 * (N - mm))
-        elif a == 1:
-            edf = np.exp(np.sqrt(np.log((N - 1) / (2 * mm)) * np.log((2 * mm + 1) * (N - 1) / 4)))
-        elif a == 0:
-            edf = (3 * (N - 1) / (2 * mm) - 2 * (N - 2) / N) * 4 * mm**2 / (4 * mm**2 + 5)
-        elif a == -1:
-            if mm <= 1:
-                edf = 2 * (N - 2) ** 2 / (2.3 * N - 4.9)
-            else:
-                edf = 5 * N**2 / (4 * mm * (N + 3 * mm))
-        else:
-            edf = ((N - 2) / mm) * ((N - 1) ** 2 - 3 * mm * (N - 1) + 4 * mm**2) / (N - 3) ** 2
-    return float(edf)
+            return (n + 1) * (n - 2 * q) / (2 * (n - q))
+        if a == 1:
+            return np.exp(np.sqrt(np.log((n - 1) / (2 * q)) * np.log((2 * q + 1) * (n - 1) / 4)))
+        if a == 0:
+            return (3 * (n - 1) / (2 * q) - 2 * (n - 2) / n) * 4 * q**2 / (4 * q**2 + 5)
+        if a == -1:
+            return np.where(q <= 1, 2 * (n - 2) ** 2 / (2.3 * n - 4.9), 5 * n**2 / (4 * q * (n + 3 * q)))
+        return ((n - 2) / q) * ((n - 1) ** 2 - 3 * q * (n - 1) + 4 * q**2) / (n - 3) ** 2
 
 
 def edf_simple_safe(n_phase, m, alpha) -> float:
@@ -177,21 +177,9 @@ def edf_simple_safe_array(n_phase, m, alpha) -> np.ndarray:
                                    np.asarray(alpha, dtype=np.int64))
     out = np.ones(N.shape, dtype=np.float64)
     ok = ~((N < 3) | (2 * mm > N - 1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for value in np.unique(a[ok]):
-            k = ok & (a == value)
-            n, q = N[k], mm[k]
-            if value == 2:
-                e = (n + 1) * (n - 2 * q) / (2 * (n - q))
-            elif value == 1:
-                e = np.exp(np.sqrt(np.log((n - 1) / (2 * q)) * np.log((2 * q + 1) * (n - 1) / 4)))
-            elif value == 0:
-                e = (3 * (n - 1) / (2 * q) - 2 * (n - 2) / n) * 4 * q**2 / (4 * q**2 + 5)
-            elif value == -1:
-                e = np.where(q <= 1, 2 * (n - 2) ** 2 / (2.3 * n - 4.9), 5 * n**2 / (4 * q * (n + 3 * q)))
-            else:
-                e = ((n - 2) / q) * ((n - 1) ** 2 - 3 * q * (n - 1) + 4 * q**2) / (n - 3) ** 2
-            out[k] = e
+    for value in np.unique(a[ok]):
+        k = ok & (a == value)
+        out[k] = _table5(N[k], mm[k], int(value))
     return out
 
 

@@ -44,16 +44,24 @@ __all__ = ["share_ratio", "fit_rule_widths", "model_curves", "SPREAD_DRAWS"]
 SPREAD_DRAWS = 1600
 
 
+def _fit_m(model, n: int) -> np.ndarray:
+    """The averaging factors the fit uses on ``n`` samples: the octave grid from the model's ``tau_min_s`` (a pilot's
+    fitted range) on, as float."""
+    dt = float(model.dt_s)
+    m = tau_grid(n, dt, "octave").astype(np.float64)
+    tau_min = getattr(model, "tau_min_s", None)
+    if tau_min is not None:
+        m = m[m * dt >= float(tau_min) * (1.0 - 1e-9)]
+    return m
+
+
 def share_ratio(model, n_samples, term, share, draws=SPREAD_DRAWS, seed=0) -> float:
     """``q_share / median`` of ``term``'s relative half-width (relative to each record's estimate) over ``draws``
     Gaussian records of the linearised fit of ``n_samples`` samples (module docstring); inf when fewer than
     ``share`` of them resolve the term, nan when the record is too short for the model."""
     names, A, dt = model.terms, model.law_coefficients(), float(model.dt_s)
     n = int(n_samples)
-    m = tau_grid(n, dt, "octave").astype(np.float64)
-    tau_min = getattr(model, "tau_min_s", None)
-    if tau_min is not None:
-        m = m[m * dt >= float(tau_min) * (1.0 - 1e-9)]
+    m = _fit_m(model, n)
     if m.size <= len(names) + 1:
         return math.nan
     tau = m * dt
@@ -124,10 +132,7 @@ def model_curves(model, n_samples, draws, seed=0):
     (Wilson-Hilferty: each ``y / mu`` about ``chi2_nu / nu``, mean 1)."""
     names, A, dt = model.terms, model.law_coefficients(), float(model.dt_s)
     n = int(n_samples)
-    m = tau_grid(n, dt, "octave").astype(np.float64)
-    tau_min = getattr(model, "tau_min_s", None)
-    if tau_min is not None:
-        m = m[m * dt >= float(tau_min) * (1.0 - 1e-9)]
+    m = _fit_m(model, n)
     if m.size <= len(names) + 1:
         return m, None, None, None
     tau = m * dt
