@@ -386,7 +386,7 @@ def emergency_exit() -> None:
     """The SIGINT watchdog's action when the main thread did not stop in time (fogdrift.cli.main): remove
     unfinished temporary files, print the one line, end the process with 130.  Runs in another thread."""
     if _state["finish"].acquire(timeout=0.3):
-        out = active()
+        out = active() or _state.get("out")
         for od in reversed(list(_output._active)):  # every folder of the run (a batch's and a file's)
             od.abort(timeout=0.2)
         summary = out.summary() if out is not None else "nothing was written"
@@ -436,12 +436,13 @@ def run(command: str, out: Path, *, default_out: Path, inputs=(), json_out: bool
     _configure(json_out)
     _state["finish"] = threading.Lock()
     _state["ran"] = False  # set once the block has finished: its files are all written
-    outdir = None
+    outdir = _state["out"] = None
     gc.freeze()
     try:
         with errors(), _warning_lines():
             missing = [q for q in Path(out).expanduser().absolute().parents if not q.exists()]
             outdir = out_class(out, command=command, create_parents=True, protect=[p for p in inputs if p is not None])
+            _state["out"] = outdir  # the watchdog's line names it even once the folder has left the active list
             if missing:  # as mkdir -p, and said (once the folder is known to be usable): a typo shows in this line
                 say(f"--out {out}: creating its parent folder {missing[0]}", style="dim")
             outdir.expect(*expect)
