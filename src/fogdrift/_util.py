@@ -192,25 +192,52 @@ def strict_json(obj, *, indent: int | None = 2, sort_keys: bool = False) -> str:
      ]
     }
     """
-    # NaN and +-Infinity become null as the text is parsed back (what finite_or_null does, without a second walk)
-    data = json.loads(json.dumps(obj, default=json_default), parse_constant=lambda _: None)
-    if indent is None:
-        return json.dumps(data, sort_keys=sort_keys, allow_nan=False)
-    rows: list[str] = []
+    rows: list[str] | None = None if indent is None else []
     mark = f"@{secrets.token_hex(8)}:"  # a placeholder no value of the document can hold by chance
-
-    def pack(x):
-        if isinstance(x, dict):
-            return {k: pack(v) for k, v in x.items()}
-        if isinstance(x, list):
-            if x and all(v is None or type(v) in (int, float) for v in x):
-                rows.append(json.dumps(x, allow_nan=False))
-                return f"{mark}{len(rows) - 1}"
-            return [pack(v) for v in x]
-        return x
-
-    text = json.dumps(pack(data), indent=indent, sort_keys=sort_keys, allow_nan=False)
+    text = json.dumps(_plain(obj, rows, mark), indent=indent, sort_keys=sort_keys, allow_nan=False)
+    if not rows:
+        return text
     return re.sub(f'"{re.escape(mark)}(\\d+)"', lambda m: rows[int(m.group(1))], text)
+
+
+def _plain(x, rows, mark):
+    """``x`` as plain JSON values (dict with str keys, list, str, int, float, bool, None), NaN and infinity as
+    None, in one walk: what ``json.loads(json.dumps(x, default=json_default))`` gives with non-finite numbers
+    read as null.  With ``rows`` (a list), a non-empty list of numbers and nulls is encoded into ``rows`` and
+    replaced by ``mark`` + its index (written on one line by :func:`strict_json`)."""
+    if isinstance(x, np.ndarray) and x.dtype.kind in "fiub" and x.ndim == 1:
+        vals = x.tolist()
+        if x.dtype.kind == "f" and not np.isfinite(x).all():
+            for i in np.flatnonzero(~np.isfinite(x)).tolist():
+                vals[i] = None
+        if rows is None or not vals or x.dtype.kind == "b":
+            return vals
+        rows.append(json.dumps(vals, allow_nan=False))
+        return f"{mark}{len(rows) - 1}"
+    if isinstance(x, dict):
+        return {k if isinstance(k, str) else _key(k): _plain(v, rows, mark) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        vals = [_plain(v, rows, mark) for v in x]
+        if rows is not None and vals and all(v is None or type(v) in (int, float) for v in vals):
+            rows.append(json.dumps(vals, allow_nan=False))
+            return f"{mark}{len(rows) - 1}"
+        return vals
+    if isinstance(x, np.generic):
+        x = x.item()
+    if isinstance(x, float):
+        return float(x) if math.isfinite(x) else None
+    if x is None or isinstance(x, (str, int)):
+        return int(x) if type(x) not in (int, bool) and isinstance(x, int) else x
+    if isinstance(x, np.ndarray):
+        return _plain(x.tolist(), rows, mark)
+    return _plain(json_default(x), rows, mark)
+
+
+def _key(k) -> str:
+    """A non-str dict key as JSON writes it (``1`` -> ``"1"``, ``True`` -> ``"true"``, ``None`` -> ``"null"``)."""
+    if not (k is None or isinstance(k, (int, float))):
+        raise TypeError(f"keys must be str, int, float, bool or None, not {type(k).__name__}")
+    return json.dumps(k)
 
 
 def safe_name(name) -> str:
