@@ -1,6 +1,6 @@
 """Write docs/reference/cli.md: every command and flag, generated from the commands themselves (their --help).
 
-Run by ``make docs`` before the site is built; ``tests/test_docs_site.py`` checks the page is current.
+Run by ``make docs`` before the site is built; ``tests/project/test_docs_site.py`` checks the page is current.
 """
 
 from __future__ import annotations

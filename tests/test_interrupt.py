@@ -1,7 +1,7 @@
 """Cooperative interruption: the flag, checkpoints, stage listeners, the SIGINT guard and its watchdog.
 
 Real signals to this process (os.kill); the CLI-level tests with a real Ctrl-C in a subprocess are in
-tests/test_cli_safety.py.
+tests/cli/test_cli_safety.py.
 """
 
 from __future__ import annotations

@@ -82,7 +82,7 @@ def test_quiet_triad_with_a_short_mean_vector_is_flagged_whatever_the_signs(mean
 
 def test_gmwm_batch_row_counts_only_the_scales_the_fit_used(tmp_path):
     """WN+RW through a 2-tap moving average (an output filter), 2^16 - 1 samples: 14 scales, the selection
-    excludes levels 1-3 (as in tests/test_gmwm_selection.py), so the fit uses 11 scales: fit_n_points = 11 =
+    excludes levels 1-3 (as in tests/gmwm/test_gmwm_selection.py), so the fit uses 11 scales: fit_n_points = 11 =
     dof 9 + 2 parameters, noise.json's levels 4-14.  Catches: fit_n_points as every scale of the WV (14), or as
     the dof."""
     from fogdrift.fleet.commands import run_noise_command

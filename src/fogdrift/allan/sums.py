@@ -6,7 +6,7 @@ content, each with its EDF alphas) need the same sums of squared difference oper
 sizes m.  :class:`AllanSums` computes each m once; every :class:`~fogdrift.allan.AllanResult` is then rebuilt by
 :func:`fogdrift.allan.core.result_from_sums`, the function :func:`fogdrift.allan.allan_variance` itself ends in, so
 a result is identical field by field to that of ``allan_variance`` with the same options (the compiled kernel sums
-each m on its own: the sums do not depend on which m share a pass; tested in ``tests/test_pipeline_allan_sums.py``).
+each m on its own: the sums do not depend on which m share a pass; tested in ``tests/workflows/test_pipeline_allan_sums.py``).
 """
 
 from __future__ import annotations

@@ -479,7 +479,7 @@ def bias_gm(ch: ChannelModel, policy: str) -> tuple[GaussMarkov, str]:
     that GM is made from the B reading (the ADEV minimum), B resolved under ``policy``.  A flicker term whose 95 %
     interval reaches 0 (status ``unresolved``: the model without it describes the curve about as well) does not
     displace a fitted Gauss-Markov term: a small flicker beside a Markov hump would otherwise become the filter's
-    bias, with the hump's variance lost (seen in the gnss-ins-sim round trip, tests/test_export_roundtrip.py).
+    bias, with the hump's variance lost (seen in the gnss-ins-sim round trip, tests/export/test_export_roundtrip.py).
     """
     cands = [(g, f"the model's slowest Gauss-Markov term ({g.source}): sigma and T_c as fitted") for g in ch.gms]
     b = ch.terms["B"]

@@ -37,7 +37,7 @@ __all__ = ["FileTask", "run_file", "load_record", "split_by_quantity", "MANIFEST
 MANIFEST = "batch.json"
 #: Test hook, inert unless set: ``FILE:PID`` makes the task of the batch file ``FILE`` (its display name) send
 #: SIGKILL to process ``PID`` (``self``: the worker process running it) once it holds its folder's lock, so that
-#: tests kill a worker or a scheduler mid-batch at an event, not a time (tests/test_fleet_dying.py).
+#: tests kill a worker or a scheduler mid-batch at an event, not a time (tests/fleet/test_fleet_dying.py).
 TEST_KILL_ENV = "FOGDRIFT_TEST_KILL"
 
 

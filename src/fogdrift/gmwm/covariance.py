@@ -12,7 +12,7 @@ the other's, so the number of coefficient pairs at each lag is the smaller ``M``
 ``max`` in the denominator, not the geometric mean; checked by Monte Carlo in the tests.)
 The covariance of Allan-family estimates (AVAR/HVAR/MVAR at any averaging factor) has its
 one home in :mod:`fogdrift.noise.covariance` (cell-averaged quadrature); against the Monte
-Carlo of ``tests/test_gmwm_covariance.py`` (WN+RW+GM, N = 2^16, 200 records, m = 1..3000) it
+Carlo of ``tests/gmwm/test_gmwm_covariance.py`` (WN+RW+GM, N = 2^16, 200 records, m = 1..3000) it
 agreed with the Filon version removed from here to 1e-4 in the standard deviations.
 
 Quadrature.  ``I_ab = int_0^{1/2} G_a G_b S^2 df`` is evaluated on geometric panels

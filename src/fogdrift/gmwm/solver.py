@@ -26,7 +26,7 @@ Compilation: numba compiles the solver on its first use (about half a minute on 
 it beside this file; later processes load it in a fraction of a second.  The cache holds the WV kernel as it was
 when the solver was compiled (numba does not follow a callee into another module): after editing the kernel in
 :mod:`fogdrift.gmwm.processes`, touch this file so that the solver is compiled again
-(``tests/test_gmwm_solver.py``, which compares with ``least_squares`` on the live kernel, fails on a stale copy).
+(``tests/gmwm/test_gmwm_solver.py``, which compares with ``least_squares`` on the live kernel, fails on a stale copy).
 """
 
 from __future__ import annotations

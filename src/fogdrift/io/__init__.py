@@ -81,7 +81,7 @@ How to add a reader
    extensions, accepted reader options (``load(..., reader_options={...})``), each a
    :class:`~fogdrift.io.registry.ReaderOption` (name, type, help, flag): every command of the
    CLI then has its flag, with no edit in :mod:`fogdrift.cli`.
-3. Test it like ``tests/test_io_formats.py``: values against the writer's, located errors,
+3. Test it like ``tests/io/test_io_formats.py``: values against the writer's, located errors,
    the SHA-256 against :func:`hashlib.sha256` of the file.
 
 Everything else (column choice, time checks, gaps, unit conversion, the record) is shared.

@@ -159,7 +159,7 @@ def choose_level(diagnostics, *, tol: float = 0.1) -> int:
     the drift (db2, J = 4, periodization: a sinusoid with a period of 4 * 2**J = 64 samples
     keeps 0.938 of its power in the drift whatever its phase; one of 2 * 2**J = 32 samples
     keeps 0.007 to 0.93 depending on its phase, 0.387 for a sine; measured in
-    ``tests/test_lifting_levels.py``).
+    ``tests/lifting/test_lifting_levels.py``).
 
     Parameters
     ----------

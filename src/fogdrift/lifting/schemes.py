@@ -29,7 +29,7 @@ as a product of triangular steps (Daubechies & Sweldens 1998): with
   at the level of db2's.  The last predict step is the highpass completion
   ``G_e / G_o`` of the reduced matrix.  Verified numerically: all bands equal
   ``pywt.wavedec(x, "db4", mode="periodization")`` to 4e-15 * max|x| for odd and even n
-  (``tests/test_lifting_pywt.py``); ``tests/test_lifting_schemes.py`` re-derives the table
+  (``tests/lifting/test_lifting_pywt.py``); ``tests/lifting/test_lifting_schemes.py`` re-derives the table
   entry from PyWavelets' filters.
 
 References

@@ -18,7 +18,7 @@ Boundary modes
     Each step is inverted exactly with the same reflection, so reconstruction is perfect
     for any length (Daubechies & Sweldens 1998), but the transform is not orthogonal.
 
-    Caveat (measured, ``tests/test_lifting_symmetric.py``): when a level has an odd length,
+    Caveat (measured, ``tests/lifting/test_lifting_symmetric.py``): when a level has an odd length,
     the reflected steps amplify the last samples of the drift.  White-noise gain of the
     last drift sample (norm of the last row of the drift operator) at J = 4, over the 16
     residues of n mod 16 (the same for n = 256..271 and 1024..1039): db2 0.41 for n a

@@ -9,7 +9,7 @@ same rows serve :func:`build_model` (name -> unfitted model), :func:`~fogdrift.m
 is the report order.
 
 Adding a model is one new module (a :class:`~fogdrift.models.DriftModel` subclass) plus one row
-here; the contract tests (``tests/test_model_contract.py``) then run over it. A hyper-parameter users may set
+here; the contract tests (``tests/models/test_model_contract.py``) then run over it. A hyper-parameter users may set
 is one :class:`ModelParam` in the row's ``params``: it becomes ``--param MODEL.NAME=VALUE`` on ``analyze`` and
 ``model``, ``AnalysisConfig.model_params`` in the library and fleets, with the constructor's default and the
 model's own ``_validate`` as its rule (nothing else to edit). This module imports nothing from the model

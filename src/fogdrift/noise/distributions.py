@@ -4,7 +4,7 @@
 that fits noise terms, ``fogdrift allan`` included, while the noise fit needs only four functions of two
 distributions.  These are the very special functions ``scipy.stats.chi2`` and ``scipy.stats.t``
 evaluate (SciPy 1.17: ``chi2._ppf = 2 gammaincinv(df/2, p)``, ``chi2._sf = chdtrc``, ``t._ppf = stdtrit``), with the
-same answers outside the support: NaN for ``df <= 0`` or NaN.  ``tests/test_noise_distributions.py`` checks them
+same answers outside the support: NaN for ``df <= 0`` or NaN.  ``tests/noise/test_noise_distributions.py`` checks them
 bit for bit against ``scipy.stats`` on a grid of arguments.
 """
 

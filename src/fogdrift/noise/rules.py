@@ -33,7 +33,7 @@ The rule (all three must hold):
     EDF of the point's 95 % interval) at each of the last :data:`N_LAST` points: a term that dominates the end of the record predicts the end of the curve.
 
 A true K with few degrees of freedom at the longest tau passes in >= 90 % of seeded simulations, a
-Gauss-Markov hump read as K fails in >= 95 % (``tests/test_noise_rules.py``).
+Gauss-Markov hump read as K fails in >= 95 % (``tests/noise/test_noise_rules.py``).
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ DOMINANCE = 0.5
 Z_SLOPE = 1.645
 #: ... and rises by less than this fraction of the model's slope there: a long stretch of many well-measured points
 #: makes the slope's standard error tiny, and a real sensor's curve bends a little (the model-discrepancy
-#: allowance); what (b) must refuse is a curve that bends over or stays flat, not one that rises a little slower (0.7: measured on 20-seed NK, NBK and GM-hump simulations, tests/test_noise_rules.py).
+#: allowance); what (b) must refuse is a curve that bends over or stays flat, not one that rises a little slower (0.7: measured on 20-seed NK, NBK and GM-hump simulations, tests/noise/test_noise_rules.py).
 RISE_FRACTION = 0.7
 #: Criterion (c) looks at this many points at the longest taus.
 N_LAST = 2

@@ -11,7 +11,7 @@ Units: rate deg/h, tau and dt in s; a term's coefficient X in these "Allan-law u
 (``law_unit``) is converted to the reported unit by ``to_unit``.
 
 The laws marked "derived" were derived from the noise PSD and the statistic's transfer function (or directly from
-the difference operator) and are checked in ``tests/test_noise.py`` and ``tests/test_noise_processes.py``: by
+the difference operator) and are checked in ``tests/noise/test_noise.py`` and ``tests/noise/test_noise_processes.py``: by
 quadrature (flicker constants, each row's PSD against its Allan law), against exact discrete sums, and on
 simulated signals at a tolerance set by the EDF.
 """

@@ -159,7 +159,7 @@ class TextTable(Table):
         comma/tab/semicolon file with decimal points, and only if every cell of every row parses as a finite
         number with exactly ``n_fields`` fields per row: each cell is parsed straight to float64 (no quoting, no
         null values, no type inference), and both parsers round correctly, so the array is loadtxt's bit for bit
-        (``tests/test_io_fast_csv.py``).  Anything else (comments, blank cells, NaN/inf, quotes, ragged rows, a
+        (``tests/io/test_io_fast_csv.py``).  Anything else (comments, blank cells, NaN/inf, quotes, ragged rows, a
         decimal comma, whitespace-separated) returns None and is read, and reported, exactly as before.  The bytes
         come through the same guarded, hashing stream (limits, binary check, ``sha256``), the header lines are
         skipped as physical lines, like loadtxt's ``skiprows``.

@@ -36,7 +36,7 @@ def sinusoid_shape(tau_s, freq_hz, dt_s, statistic="adev", *, envelope=False) ->
 
     As ``dt -> 0`` (``m sin(pi f dt) -> pi f tau``) the Allan law is IEEE-952 Annex C's
     ``(sin^2(pi f tau) / (pi f tau))^2``.  Zero at every multiple of the period.  Checked against exact
-    discrete computations on noiseless sinusoids in ``tests/test_noise_periodic.py``.
+    discrete computations on noiseless sinusoids in ``tests/noise/test_noise_periodic.py``.
 
     ``envelope=True``: the same law with ``sin(pi f tau)`` replaced by 1 (``1 / (m sin(pi f dt))^2`` for ``adev``),
     the upper envelope of the oscillating law: a real line's amplitude and frequency wander, which fills the nulls,
