@@ -59,8 +59,8 @@ from .models import MODELS, MODEL_NAMES, load_model, model_spec
 from .models.base import model_file_paths
 from .noise import fit_noise
 from .output import atomic_path
-from .signal import Channel, Sampling, SignalDescription
-from .units import check_dt_s, parse_unit
+from .signal import Channel, Sampling, SignalDescription, channel_unit
+from .units import check_dt_s
 
 __all__ = [
     "BUNDLE_FORMAT",
@@ -457,7 +457,7 @@ def load_bundle(path) -> Bundle:
                              "or damaged after the bundle was written; re-create the bundle")
     unit = d.get(raw, "input_unit", str, "")
     try:
-        unit_spec = parse_unit(unit, None)  # a unit of any quantity (gyro deg/s, accelerometer g ...)
+        unit_spec = channel_unit(unit, None)  # a unit of any quantity (gyro deg/s, accelerometer g ...)
     except ConfigError:
         d.fail("input_unit", f"unknown unit {unit!r}")
     native = d.get(raw, "native_dt_s", "positive", "")

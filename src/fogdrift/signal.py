@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 from . import units
 from .errors import ConfigError
 
-__all__ = ["Sampling", "Channel", "SignalDescription", "DT_SOURCES", "UNIT_SOURCES"]
+__all__ = ["Sampling", "Channel", "SignalDescription", "DT_SOURCES", "UNIT_SOURCES", "channel_unit"]
 
 #: Where a sample interval can come from: the file's time column, the time stamps the format carries
 #: (bag, miniSEED, HDF5 time dataset), the sample-rate option (``rate_hz``/``dt_s``, the CLI's
@@ -44,6 +44,26 @@ UNIT_SOURCES = ("option", "header", "argument", "bundle")
 
 #: Relative tolerance of "dt_s = block_average_factor x native_dt_s".
 _FACTOR_RTOL = 1e-9
+
+
+def channel_unit(text, quantity: str | None) -> units.UnitSpec:
+    """A channel's unit string (an option, a header cell, a saved description) as a :class:`~fogdrift.units.UnitSpec`.
+
+    The io layer's one door to :func:`fogdrift.units.parse_unit`: the readers, the unit option, the bundle's
+    manifest and the saved description all parse through here, so the quantity is always stated (None: a unit
+    of any quantity) and the errors are the parser's own.
+
+    Raises
+    ------
+    ConfigError
+        ``text`` is not a unit of ``quantity``; the message lists the valid units.
+
+    Examples
+    --------
+    >>> channel_unit("g", None).quantity, channel_unit(" deg/s ", "angular_rate").text
+    ('specific_force', 'deg/s')
+    """
+    return units.parse_unit(text, quantity)
 
 
 def _choice(value, allowed, name):
@@ -141,7 +161,7 @@ class Channel:
     name : str
         Axis (column) name.
     unit : fogdrift.units.UnitSpec
-        The unit the numbers were read in, as parsed once by :func:`fogdrift.units.parse_unit`
+        The unit the numbers were read in, as parsed once by :func:`channel_unit`
         (``unit.text`` is ``"deg/s"``, ``"inc:arcsec"``, ``"mg"`` ...; ``unit.quantity`` the
         physical quantity).
     unit_source : str
@@ -202,7 +222,7 @@ class Channel:
         if not isinstance(d, dict):
             raise ConfigError(f"channel must be an object; got {type(d).__name__}")
         try:
-            spec = units.parse_unit(d["unit_as_read"], d["quantity"])
+            spec = channel_unit(d["unit_as_read"], d["quantity"])
             return cls(name=d["name"], unit=spec, unit_source=d["unit_source"], declared_unit=d.get("declared_unit"),
                        scale_to_internal=d["scale_to_internal"])
         except KeyError as exc:

@@ -4,6 +4,11 @@ Every other module names :data:`fogdrift.units.S_PER_H`, :data:`~fogdrift.units.
 :data:`~fogdrift.units.DEG_PER_RAD` (or :data:`~fogdrift.units.ARCSEC_PER_DEG`) instead of the number, so the code
 scanned here (comments and string literals excepted, f-string expressions included) holds no ``3600`` literal and
 no ``pi / 180`` or ``180 / pi`` -- which also rules out a module of its own defining ``DEG = math.pi / 180``.
+
+One door per floor to the unit parser: besides ``fogdrift.units`` itself, at most one module of each floor of
+:data:`test_structure_layers.LAYERS` reaches :func:`fogdrift.units.parse_unit`; the rest of the floor parses
+through that module (the io floor through :func:`fogdrift.signal.channel_unit`) or carries the parsed
+:class:`~fogdrift.units.UnitSpec`.
 """
 
 from __future__ import annotations
@@ -14,9 +19,14 @@ import math
 import tokenize
 from pathlib import Path
 
+import sys
+
 import pytest
 
 from fogdrift import units
+
+sys.path.insert(0, str(Path(__file__).parent))  # the floors of tests/project/test_structure_layers.py
+from test_structure_layers import LAYERS, _top, floors  # noqa: E402
 
 SRC = Path(__file__).resolve().parents[2] / "src" / "fogdrift"
 HOME = SRC / "units.py"
@@ -111,3 +121,51 @@ def test_code_says_what_and_why_not_which_issue():
              for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
              if re.search(r"\bissues? \d+\b", line, re.IGNORECASE)]
     assert found == []
+
+
+def reaches_parse_unit(source: str) -> bool:
+    """Whether the code (docstrings and comments aside) calls ``parse_unit``: by name, as an attribute
+    (``units.parse_unit``) or through an import of the name (an alias is a call all the same)."""
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Name) and node.id == "parse_unit":
+            return True
+        if isinstance(node, ast.Attribute) and node.attr == "parse_unit":
+            return True
+        if isinstance(node, ast.ImportFrom) and any(a.name == "parse_unit" for a in node.names):
+            return True
+    return False
+
+
+def parse_unit_callers(src: Path, package: str, layers=LAYERS) -> dict[str, list[str]]:
+    """Floor name -> the modules on it that call ``parse_unit`` (``<package>.units``, its home, left out)."""
+    floor = floors(layers)
+    out: dict[str, list[str]] = {}
+    for path in sorted((src / package).rglob("*.py")):
+        parts = path.relative_to(src).with_suffix("").parts
+        module = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        if module != f"{package}.units" and reaches_parse_unit(path.read_text(encoding="utf-8")):
+            out.setdefault(layers[floor[_top(module, package)]][0], []).append(module)
+    return out
+
+
+def test_one_parse_unit_caller_per_floor():
+    """Each floor has at most one module that calls the unit parser; the others go through it."""
+    callers = parse_unit_callers(SRC.parent, "fogdrift")
+    crowded = {name: mods for name, mods in callers.items() if len(mods) > 1}
+    assert crowded == {}, ("more than one module of a floor calls fogdrift.units.parse_unit (parse through the "
+                           f"floor's one caller, e.g. fogdrift.signal.channel_unit on the io floor): {crowded}")
+    assert callers.get("io") == ["fogdrift.signal"]
+
+
+def test_the_caller_count_sees_a_second_module_on_a_floor(tmp_path):
+    """A second io module calling the parser is found, by name or attribute; a docstring mention is not a call."""
+    files = {"__init__.py": "", "units.py": "def parse_unit(u, q=None):\n    return u\n",
+             "io/__init__.py": "", "io/a.py": "from ..units import parse_unit as pu\nx = pu('deg/s')\n",
+             "io/b.py": "from .. import units\nx = units.parse_unit('g', None)\n",
+             "io/c.py": '"""Parsed by parse_unit("deg/s")."""\n# parse_unit(u)\ns = "parse_unit(u)"\n',
+             "top.py": "from .units import parse_unit\n"}
+    for name, text in files.items():
+        (tmp_path / "lay" / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / "lay" / name).write_text(text)
+    layers = (("core", ("lay", "units")), ("io", ("io",)), ("high", ("top",)))
+    assert parse_unit_callers(tmp_path, "lay", layers) == {"io": ["lay.io.a", "lay.io.b"], "high": ["lay.top"]}

@@ -121,3 +121,20 @@ def test_export_the_cli_writes_what_the_workflow_writes(tmp_path):
         assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "py" / name).read_bytes(), name
     a, b = (json.loads((tmp_path / d / "allan.json").read_text()) for d in ("cli", "py"))
     assert a == b
+
+
+def test_separate_and_model_runs_share_one_base():
+    """The two runs at the modelling rate are one dataclass (record, config, factor, axes, findings) under two names,
+    and ``analyze`` decides its configuration and factor with the same helper."""
+    import dataclasses
+
+    from fogdrift.workflows import analyze as wf_analyze
+    from fogdrift.workflows._modelled import ModelledRun, modelling
+    from fogdrift.workflows.model import ModelRun
+    from fogdrift.workflows.separate import SeparateRun
+
+    names = [f.name for f in dataclasses.fields(ModelledRun)]
+    assert names == ["record", "config", "factor", "axes", "findings"]
+    for cls in (SeparateRun, ModelRun):
+        assert issubclass(cls, ModelledRun) and [f.name for f in dataclasses.fields(cls)] == names
+    assert wf_analyze.modelling is modelling

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 from .. import units
 from ..errors import ConfigError
+from ..signal import channel_unit
 
 __all__ = ["quantity_of_name", "UnitChoice", "parse_unit_choice", "QUANTITY_WORDS", "KEY_OF_QUANTITY"]
 
@@ -141,7 +142,7 @@ def parse_unit_choice(text) -> UnitChoice:
         raise ConfigError(f"unit must be a unit string (deg/s, g, ...) or gyro=U,accel=U; got {text!r}")
     s = text.strip()
     if "=" not in s:
-        return UnitChoice(text=s, single=units.parse_unit(s, None), by_quantity={}, by_column={})
+        return UnitChoice(text=s, single=channel_unit(s, None), by_quantity={}, by_column={})
     by_q, by_c = {}, {}
     for part in s.split(","):
         key, eq, u = part.partition("=")
@@ -152,9 +153,9 @@ def parse_unit_choice(text) -> UnitChoice:
             q = _QUANTITY_OF_KEY[key.lower()]
             if q in by_q:
                 raise ConfigError(f"unit {s!r}: {key.lower()}= given twice")
-            by_q[q] = units.parse_unit(u, q)
+            by_q[q] = channel_unit(u, q)
         else:
             if key in by_c:
                 raise ConfigError(f"unit {s!r}: column {key!r} given twice")
-            by_c[key] = units.parse_unit(u, None)
+            by_c[key] = channel_unit(u, None)
     return UnitChoice(text=s, single=None, by_quantity=by_q, by_column=by_c)

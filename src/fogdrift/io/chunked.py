@@ -25,8 +25,8 @@ from typing import Callable
 import numpy as np
 
 from ..errors import ConfigError, DataFormatError
-from ..signal import Channel, Sampling, SignalDescription
-from ..units import TIME_UNITS, check_dt_s, parse_unit, valid_units
+from ..signal import Channel, Sampling, SignalDescription, channel_unit
+from ..units import TIME_UNITS, check_dt_s, valid_units
 from ._checks import check_path
 from .hashing import file_sha256
 from .load import _interval_option
@@ -262,7 +262,7 @@ def open_source(path, *, column=None, unit=None, rate_hz=None, dt_s=None, layout
     if dt is None:
         raise ConfigError(f"{p}: the out-of-core path needs the sample rate; pass {{opt:rate_hz}} (or dt_s)")
     if unit is not None:
-        parse_unit(unit)
+        channel_unit(unit, "angular_rate")
     if layout is not None:
         n, name, read, what, check, declared = _binary(p, column, layout, scale, header_bytes, sequence)
     else:
@@ -281,12 +281,12 @@ def open_source(path, *, column=None, unit=None, rate_hz=None, dt_s=None, layout
             raise ConfigError(f"{p}: no rate unit: {what} declares none; pass {{opt:unit}} ({', '.join(valid_units())}; "
                               "units are never guessed)")
         try:
-            parse_unit(declared)
+            channel_unit(declared, "angular_rate")
         except ConfigError:
             raise DataFormatError(f"unknown unit {declared!r} declared in the file; expected one of {valid_units()} "
                                   "(or pass {opt:unit})", path=p, column=str(name)) from None
         unit = declared
-    factor = parse_unit(unit).scale_to_internal(dt)
+    factor = channel_unit(unit, "angular_rate").scale_to_internal(dt)
     return ChunkSource(path=p, n_samples=int(n), dt_s=dt, name=str(name), scale_to_dph=factor,
                        describe=f"{what}, unit {unit}", _read=read, check=check)
 
@@ -450,7 +450,7 @@ def open_rows(path, *, columns=None, time_column="auto", rate_hz=None, dt_s=None
     if unit is None:
         raise ConfigError(f"{p}: no rate unit: a .npy array declares none; pass {{opt:unit}} "
                           f"({', '.join(valid_units())}; units are never guessed)")
-    spec = parse_unit(unit)
+    spec = channel_unit(unit, "angular_rate")
     if time_unit is not None and time_unit not in TIME_UNITS:
         raise ConfigError(f"unknown time unit {time_unit!r}; expected one of {list(TIME_UNITS)} ({{opt:time_unit}})")
     t_scale = TIME_UNITS[time_unit] if time_unit else 1.0

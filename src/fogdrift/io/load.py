@@ -17,7 +17,7 @@ import numpy as np
 from .. import units
 from .channel_quantity import UnitChoice, check_name, parse_unit_choice
 from ..errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
-from ..signal import Channel, Sampling, SignalDescription
+from ..signal import Channel, Sampling, SignalDescription, channel_unit
 from ._checks import (
     check_path,
     first_nonfinite,
@@ -575,7 +575,7 @@ def _rate_unit(table: Table, r_idx, unit, notes: list):
     specs, first_of = [], {}
     for j in r_idx:
         try:
-            spec = units.parse_unit(declared[j].strip(), None)
+            spec = channel_unit(declared[j].strip(), None)
         except ConfigError:
             raise _header_error(
                 table, f"unknown unit {declared[j]!r} {_SAID(table.format, 'declared by the file')}; expected one "

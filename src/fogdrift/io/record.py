@@ -16,7 +16,7 @@ import numpy as np
 from .. import units
 from .._util import check_distinct_names
 from ..errors import ConfigError, DataFormatError, InsufficientDataError
-from ..signal import Channel, Sampling, SignalDescription
+from ..signal import Channel, Sampling, SignalDescription, channel_unit
 from ..temperature import temperature_summary
 from .channel_quantity import check_name
 from ._checks import first_nonfinite, int_arg, split_keys, take_columns, to_dph
@@ -179,7 +179,7 @@ class GyroRecord:
 
     def _default_signal(self) -> SignalDescription:
         """The description of a record built from its fields (no file: every source is "argument")."""
-        spec = units.parse_unit(self.input_unit, None)
+        spec = channel_unit(self.input_unit, None)
         sampling = Sampling(dt_s=self.dt_s, dt_source="argument", block_average_factor=self.block_average_factor)
         return SignalDescription(sampling, tuple(
             Channel(name=n, unit=spec, unit_source="argument", declared_unit=d, scale_to_internal=self.scale_to_internal)
@@ -654,7 +654,7 @@ def from_array(rate, *, dt_s, unit="deg/h", axis_names=None, source="<array>") -
     array([10., 10., 20.])
     """
     dt = units.check_dt_s(dt_s, "dt_s")
-    spec = units.parse_unit(unit, None)  # any quantity: a gyro's deg/h or an accelerometer's m/s^2, g ...
+    spec = channel_unit(unit, None)  # any quantity: a gyro's deg/h or an accelerometer's m/s^2, g ...
     sampling = Sampling(dt_s=dt, dt_source="argument")
     try:
         arr = np.asarray(rate)

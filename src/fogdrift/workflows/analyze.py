@@ -14,12 +14,13 @@ from ..compensate.holdout import write_compensated_test_block
 from ..evaluation import evaluated_analysis
 from ..evaluation import evaluations as evaluations_of
 from ..io.readers.command_memory import check_records_memory
-from ..pipeline import AnalysisConfig, model_factor, run_analysis
+from ..pipeline import model_factor, run_analysis
 from ..plausibility import check_record
 from ..report import write_report
 from ..spec import analysis_judgements
 from ..units import S_PER_H
 
+from ._modelled import modelling
 from .allan import Screened, screen
 
 __all__ = ["AnalyzeRun", "Prepared", "prepare_analyze", "run_analyze", "write_analyze", "HEADING_DEFAULTS"]
@@ -79,8 +80,7 @@ def prepare_analyze(record, config=None, *, apply_to=None, segments="auto") -> P
     """Decide the modelling factors (a modelling rate that does not divide a record's rate is refused here, before
     any work) and screen the record; :func:`run_analyze` takes the result as ``prepared=``."""
     check_records_memory("analyze", record, apply_to)
-    cfg = (config or AnalysisConfig()).validate()
-    factor = model_factor(record, cfg)
+    cfg, factor = modelling(record, config)
     other = None if apply_to is None else model_factor(apply_to, cfg)
     return Prepared(cfg, factor, other, screen(record, segments, command="analyze"))
 

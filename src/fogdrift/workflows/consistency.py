@@ -14,8 +14,8 @@ from ..evaluation.consistency import (check_consistency, components_from_gmwm, c
 from ..pipeline import AnalysisConfig
 from ..pipeline import run_allan as _allan_fit
 from ..report import write_json
+from ..signal import channel_unit
 from ..spec import channel_kind
-from ..units import parse_unit
 
 __all__ = ["ConsistencyRun", "check_declared_units", "model_components", "run_consistency", "write_consistency",
            "INFLATION_DEFINITION"]
@@ -110,7 +110,7 @@ def check_declared_units(rec, name: str) -> None:
         if c.declared_unit is None or c.unit_source != "option":
             continue
         try:
-            declared = parse_unit(c.declared_unit, c.quantity)
+            declared = channel_unit(c.declared_unit, c.quantity)
             same = declared.kind == c.unit.kind and declared.factor == c.unit.factor
         except ConfigError:
             same = False

@@ -4,39 +4,27 @@ and the self-describing model ``bundle/`` that ``fogdrift compensate`` applies t
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
 from ..bundle import write_bundle
-from ..pipeline import AnalysisConfig, model_factor, run_models
-from ..plausibility import check_record
+from ..pipeline import run_models
 from ..report import write_model_outputs
+from ._modelled import ModelledRun, modelling, plausibility_findings
 
 __all__ = ["ModelRun", "run_model", "write_model"]
 
 
 @dataclass
-class ModelRun:
-    """What ``fogdrift model`` computed for one record.
+class ModelRun(ModelledRun):
+    """What ``fogdrift model`` computed for one record (the fields of :class:`ModelledRun`).
 
     Attributes
     ----------
-    record : GyroRecord
-    config : fogdrift.pipeline.AnalysisConfig
-    factor : int
-        The block-average factor from the record's rate to the modelling rate (decided here, once).
     axes : list of fogdrift.pipeline.ModelAxis
         One per axis: the fitted models, their predictions and metrics on the test block.
-    findings : list
-        Plausibility findings (:func:`fogdrift.plausibility.check_record`).
     """
-
-    record: object
-    config: object
-    factor: int
-    axes: list
-    findings: list = field(default_factory=list)
 
 
 def run_model(record, config=None, *, progress: Callable | None = None, findings=None) -> ModelRun:
@@ -57,9 +45,8 @@ def run_model(record, config=None, *, progress: Callable | None = None, findings
     ConfigError
         A modelling rate that does not divide the record's rate by an integer (before any work).
     """
-    cfg = (config or AnalysisConfig()).validate()
-    factor = model_factor(record, cfg)
-    found = list(check_record(record)) if findings is None else list(findings)
+    cfg, factor = modelling(record, config)
+    found = plausibility_findings(record, findings)
     return ModelRun(record, cfg, factor, run_models(record, cfg, progress=progress, factor=factor), found)
 
 

@@ -11,36 +11,26 @@ modelling rate, with the Allan tables of the input, the drift and the noise (:fu
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-from ..pipeline import AnalysisConfig, model_factor, run_separation
-from ..plausibility import check_record
+from ..pipeline import run_separation
 from ..report import write_separation_outputs
+from ._modelled import ModelledRun, modelling, plausibility_findings
 
 __all__ = ["SeparateRun", "run_separate", "write_separate"]
 
 
 @dataclass
-class SeparateRun:
-    """What ``fogdrift separate`` computed for one record.
+class SeparateRun(ModelledRun):
+    """What ``fogdrift separate`` computed for one record (the fields of :class:`ModelledRun`).
 
     Attributes
     ----------
-    record : GyroRecord
-    config : fogdrift.pipeline.AnalysisConfig
-    factor : int
-        The block-average factor from the record's rate to the modelling rate (decided here, once).
     axes : list of fogdrift.pipeline.SeparationAxis
         One per axis: the bias-removed rate, its drift and noise [deg/h] and their Allan tables.
     findings : list
         Plausibility findings (:func:`fogdrift.plausibility.check_record`): a wrong unit or time unit.
     """
-
-    record: object
-    config: object
-    factor: int
-    axes: list
-    findings: list = field(default_factory=list)
 
 
 def run_separate(record, config=None, *, findings=None) -> SeparateRun:
@@ -60,9 +50,8 @@ def run_separate(record, config=None, *, findings=None) -> SeparateRun:
     ConfigError
         A modelling rate that does not divide the record's rate by an integer (before any work).
     """
-    cfg = (config or AnalysisConfig()).validate()
-    factor = model_factor(record, cfg)
-    found = list(check_record(record)) if findings is None else list(findings)
+    cfg, factor = modelling(record, config)
+    found = plausibility_findings(record, findings)
     return SeparateRun(record, cfg, factor, run_separation(record, cfg, factor=factor), found)
 
 
