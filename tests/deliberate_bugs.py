@@ -1,9 +1,12 @@
-"""Deliberate bugs for issue 14's holes outside the pipeline: apply one (an exact one-line replacement), run the
-test that guards it, restore the file; prints one markdown row per bug (docs/testing-rounds.md).
+"""Deliberate bugs: each entry is one plausible one-line bug (an exact replacement in one source file) and the test
+that must fail on it.  Run by hand, it applies each alone, runs its test and restores the file, printing one markdown
+row per bug (docs/testing-rounds.md):
 
     .venv/bin/python tests/deliberate_bugs.py        # needs a clean src/ (refuses otherwise); ~5 min on 2 cores
 
-Not collected by pytest (no ``test_`` prefix): it edits the source, so it must not run inside the suite.
+Not collected by pytest (no ``test_`` prefix): it edits the source, so it must not run inside the suite.  The suite
+checks that every entry still applies (``tests/project/test_deliberate_bugs.py``: the text to replace is found once,
+the bugged file still compiles, the named tests exist), so that an entry cannot go stale silently.
 """
 import os
 import pathlib
@@ -19,7 +22,7 @@ BUGS = [
      "src/fogdrift/lifting/_kernels.py", "    return p - j if j > m - 1 else j\n", "    return p - j - 1 if j > m - 1 else j\n",
      ["tests/lifting/test_lifting_symmetric.py"]),
     ("K conversion factor 60 -> 61 (deg/h^1.5)",
-     "src/fogdrift/noise/terms.py", '"K [deg/h^1.5]", 60.0,', '"K [deg/h^1.5]", 61.0,',
+     "src/fogdrift/noise/processes/random_walk.py", '"K [deg/h^1.5]", 60.0,', '"K [deg/h^1.5]", 61.0,',
      ["tests/noise/test_noise.py", "-k", "single_term"]),
     ("p0 divides by |y_hat| instead of |y|",
      "src/fogdrift/metrics.py", "    ay = np.abs(a)\n", "    ay = np.abs(b)\n",
@@ -29,14 +32,14 @@ BUGS = [
      "return self.x1_mean_ + self.x1_std_ * out - 0.5 * x1_prev  # eq. (13)",
      ["tests/models/test_elman.py", "-k", "eq13 or restores"]),
     ("EDF flicker PM (alpha = +1): (N-1)/(2m) -> (N-1)/m",
-     "src/fogdrift/allan/ci.py", "np.log((N - 1) / (2 * mm)) * np.log(", "np.log((N - 1) / mm) * np.log(",
+     "src/fogdrift/allan/ci.py", "np.log((n - 1) / (2 * q)) * np.log(", "np.log((n - 1) / q) * np.log(",
      ["tests/allan/test_allan_ci.py"]),
     ("Elman normalisation from training + validation data (leakage)",
      "src/fogdrift/models/elman.py", "        self.x_mean_ = float(np.mean(s_fit))\n",
      "        self.x_mean_ = float(np.mean(np.concatenate([s_fit, s_va])))\n",
      ["tests/models/test_elman.py", "-k", "validation_block"]),
     ("report figures saved blank (figure cleared before saving)",
-     "src/fogdrift/report/figures.py", "            fig.savefig(tmp, dpi=DPI)", "            fig.clf(); fig.savefig(tmp, dpi=DPI)",
+     "src/fogdrift/report/figures.py", "            fig.savefig(tmp, **{", "            fig.clf(); fig.savefig(tmp, **{",
      ["tests/report/test_golden.py", "-k", "figures_have_content"]),
     # H-structure
     ("out-of-core Allan: the old copied tail (auto alpha from the slopes, without the long-tau EDF rule)",
@@ -93,10 +96,10 @@ H_TESTS24 = [
      "src/fogdrift/gmwm/estimator.py", "    df = J - mdl.n_params\n", "    df = len(wv) - mdl.n_params\n",
      ["tests/gmwm/test_rules_gmwm.py", "-k", "chi2_survival"]),
     ("GMWM J test: p-value with one degree of freedom too many",
-     "src/fogdrift/gmwm/estimator.py", "jp = float(stats.chi2.sf(q, df))", "jp = float(stats.chi2.sf(q, df + 1))",
+     "src/fogdrift/gmwm/estimator.py", "jp = float(chi2_sf(j_q, df))", "jp = float(chi2_sf(j_q, df + 1))",
      ["tests/gmwm/test_rules_gmwm.py", "-k", "chi2_survival"]),
     ("GMWM J test: the chi2 cdf instead of the survival function",
-     "src/fogdrift/gmwm/estimator.py", "jp = float(stats.chi2.sf(q, df))", "jp = float(stats.chi2.cdf(q, df))",
+     "src/fogdrift/gmwm/estimator.py", "jp = float(chi2_sf(j_q, df))", "jp = float(1.0 - chi2_sf(j_q, df))",
      ["tests/gmwm/test_rules_gmwm.py", "-k", "uniform"]),
     ("WIC without its penalty (Q alone)",
      "src/fogdrift/gmwm/estimator.py", "penalty=penalty, wic=q + penalty,", "penalty=penalty, wic=q,",
@@ -110,8 +113,8 @@ H_TESTS24 = [
      "fit = _finish(wv, mdl, idx, *step1[mdl])",
      ["tests/gmwm/test_rules_gmwm.py", "-k", "nested"]),
     ("heading: angle error integrated without dt",
-     "src/fogdrift/evaluation/heading.py", "        return np.cumsum(resid) * (dt_s / 3600.0)\n",
-     "        return np.cumsum(resid) / 3600.0\n",
+     "src/fogdrift/evaluation/heading.py", "        return np.cumsum(resid) * (dt_s / S_PER_H)\n",
+     "        return np.cumsum(resid) / S_PER_H\n",
      ["tests/evaluation/test_rules_evaluation.py", "-k", "ramp_at_dt"]),
     ("heading: horizons taken in samples, not seconds",
      "src/fogdrift/evaluation/heading.py", "        H = int(round(h / dt))\n", "        H = int(round(h))\n",
@@ -163,11 +166,11 @@ H_TESTS36 = [
      "        return r * (h * h / 2.0 + h * T / 2.0) ** 2\n",
      ["tests/evaluation/test_consistency.py", "-k", "ramp_closed_form_by_hand_at_a_slope"]),
     ("unit table: K in m/s/h/sqrt(h) divided by 3600, not 3600^1.5",
-     "src/fogdrift/export/conversions.py", '("K", "m/s/h/sqrt(h)"): ("accel", 1.0 / 216000.0)',
-     '("K", "m/s/h/sqrt(h)"): ("accel", 1.0 / 3600.0)', ["tests/export/test_unit_table.py"]),
+     "src/fogdrift/export/conversions.py", '("K", "m/s/h/sqrt(h)"): ("accel", 1.0 / S_PER_H**1.5)',
+     '("K", "m/s/h/sqrt(h)"): ("accel", 1.0 / S_PER_H)', ["tests/export/test_unit_table.py"]),
     ("unit table: R in m/s/h^2 divided by 3600, not 3600^2",
-     "src/fogdrift/export/conversions.py", '("R", "m/s/h^2"): ("accel", 1.0 / 3600.0 ** 2)',
-     '("R", "m/s/h^2"): ("accel", 1.0 / 3600.0)', ["tests/export/test_unit_table.py"]),
+     "src/fogdrift/export/conversions.py", '("R", "m/s/h^2"): ("accel", 1.0 / S_PER_H ** 2)',
+     '("R", "m/s/h^2"): ("accel", 1.0 / S_PER_H)', ["tests/export/test_unit_table.py"]),
     ("export: an accelerometer's K in m/s^2/sqrt(h) (what allan writes) taken as m/s^2/sqrt(s)",
      "src/fogdrift/export/conversions.py", '("K", "m/s^2/sqrt(h)"): ("accel", 1.0 / 60.0)',
      '("K", "m/s^2/sqrt(h)"): ("accel", 1.0)',
@@ -189,8 +192,8 @@ H_TESTS36 = [
      "src/fogdrift/interrupt.py", "if _wait_for_shields(SHIELD_MAX_S) and self._done.wait(self.grace_s):",
      "if False and self._done.wait(self.grace_s):", ["tests/test_interrupt.py", "-k", "shielded"]),
     ("watchdog exit (OutputDir.abort) leaves the folder's lock file",
-     "src/fogdrift/output.py", "            self._pending.clear()\n            self._folder_lock.release()\n",
-     "            self._pending.clear()\n", ["tests/test_output_lock.py", "-k", "watchdogs_exit"]),
+     "src/fogdrift/output.py", "                    self._end()\n            self._folder_lock.release()\n",
+     "                    self._end()\n", ["tests/test_output_lock.py", "-k", "watchdogs_exit"]),
     ("batch: a Ctrl-C cuts into the local cluster's start (its workers outlive the batch)",
      "src/fogdrift/fleet/runner.py", "            with _sigint_blocked_for_children(), interrupt.shielded():\n",
      "            with _sigint_blocked_for_children():\n",
