@@ -349,7 +349,7 @@ def test_spec_file_errors_name_the_yaml_line_and_an_unreadable_path(tmp_path):
     p.write_text("gyro:\n  arw: \"2 deg/sqrt(h)\"\n  b: [unclosed\n", encoding="utf-8")
     with pytest.raises(ConfigError, match=r"s\.yaml:4: not valid YAML"):
         read_spec(p)
-    with pytest.raises(ConfigError, match=r"^spec file: cannot read .* \(.*\)$"):
+    with pytest.raises(ConfigError, match=r"spec file: cannot read"):
         read_spec(tmp_path)   # a directory
 
 

@@ -48,10 +48,10 @@ def test_rate_scales_to_deg_per_hour_by_hand():
     assert rate_scale_to_dph("rad/s") == pytest.approx(180.0 / math.pi * 3600.0, rel=1e-15)
     assert rate_scale_to_dph("deg/h") == 1.0
     for bad in ("DEG/S", "inc:deg", "mg", None, 3):
-        with pytest.raises(ConfigError, match=r"^unknown rate unit .*; expected one of \['arcsec/s', 'deg/h', "
-                                              r"'deg/s', 'rad/h', 'rad/s'\] or an increment unit \['inc:arcsec', "
-                                              r"'inc:deg', 'inc:rad'\]$"):
+        with pytest.raises(ConfigError, match=r"unknown rate unit") as ei:
             rate_scale_to_dph(bad)
+        assert all(f"'{u}'" in str(ei.value) for u in ("arcsec/s", "deg/h", "deg/s", "rad/h", "rad/s", "inc:arcsec",
+                                                         "inc:deg", "inc:rad"))  # every accepted unit named
 
 
 def test_increment_scales_to_deg_per_hour_by_hand():
@@ -60,9 +60,9 @@ def test_increment_scales_to_deg_per_hour_by_hand():
     assert increment_scale_to_dph("rad", 2.0) == pytest.approx(180.0 / math.pi * 1800.0, rel=1e-15)
     assert increment_scale_to_dph("arcsec", 0.01) == pytest.approx(100.0, rel=1e-15)
     for bad in ("deg/s", "m/s", None):
-        with pytest.raises(ConfigError, match=r"^unknown increment unit .*; expected one of \['arcsec', 'deg', "
-                                              r"'rad'\]$"):
+        with pytest.raises(ConfigError, match=r"unknown increment unit") as ei:
             increment_scale_to_dph(bad, 1.0)
+        assert all(f"'{u}'" in str(ei.value) for u in ("arcsec", "deg", "rad"))
     with pytest.raises(ConfigError, match="dt_s"):
         increment_scale_to_dph("deg", 0.0)
 
@@ -75,7 +75,7 @@ def test_temperature_offsets(unit, offset):
 
 @pytest.mark.parametrize("unit", ["F", "degF", None, 1.0])
 def test_unknown_temperature_unit_is_one_line(unit):
-    with pytest.raises(ConfigError, match=r"^unknown temperature unit .*; expected one of \[.*\] \(any case\)$"):
+    with pytest.raises(ConfigError, match=r"unknown temperature unit.*any case"):
         temperature_offset_to_c(unit)
 
 
@@ -83,8 +83,7 @@ def test_parse_unit_records_the_base_and_names_every_quantity_when_none_is_given
     from fogdrift.units import parse_unit
 
     assert parse_unit("deg/s").base == "deg/s" and parse_unit("inc:arcsec").base == "arcsec"
-    with pytest.raises(ConfigError, match=r"^unknown unit 'furlong'; expected a unit of angular rate or specific "
-                                          r"force, one of \['deg/h', "):
+    with pytest.raises(ConfigError, match=r"'furlong'.*angular rate or specific force.*'deg/h'"):
         parse_unit("furlong", None)
 
 
@@ -109,7 +108,7 @@ def test_check_rate_hz_messages(rate, match):
 def test_check_dt_s_refuses_infinity_and_time_unit_message():
     from fogdrift.units import check_dt_s, time_scale_to_s
 
-    with pytest.raises(ConfigError, match=r"^dt_s must be a finite number > 0 \(seconds\); got inf$"):
+    with pytest.raises(ConfigError, match=r"dt_s.*> 0.*inf"):
         check_dt_s(math.inf)
-    with pytest.raises(ConfigError, match=r"^unknown time unit 'min'; expected one of \['s', 'ms', 'us', 'ns'\]$"):
+    with pytest.raises(ConfigError, match=r"'min'.*'s', 'ms', 'us', 'ns'"):
         time_scale_to_s("min")

@@ -55,7 +55,7 @@ def test_two_dimensional_allowed_where_axes_are_columns():
     with pytest.raises(DataFormatError) as err:
         separate(np.ones((2, 2, 2)), "haar", 1)
     assert str(err.value) == "x must be 1-D (n_samples,) or 2-D (n_samples, n_axes); got shape (2, 2, 2)"
-    with pytest.raises(DataFormatError, match=r"^x\[3, 1\] is nan; expected finite values$"):
+    with pytest.raises(DataFormatError, match=r"x\[3, 1\].* nan"):
         separate(np.where(np.arange(16).reshape(8, 2) == 7, np.nan, 1.0), "haar", 1)
 
 
@@ -80,7 +80,7 @@ def test_too_short_is_insufficient_data_with_counts(call, message):
 
 
 def test_length_mismatch_and_contiguous_float64():
-    with pytest.raises(DataFormatError, match=r"^y and yhat must have the same length; got 3 and 2$"):
+    with pytest.raises(DataFormatError, match=r"y and yhat.*same length.*\b3\b.*\b2\b"):
         metrics.rmse([1.0, 2.0, 3.0], [1.0, 2.0])
     out = check_series(np.arange(10)[::2])
     assert out.dtype == np.float64 and out.flags.c_contiguous and out.tolist() == [0.0, 2.0, 4.0, 6.0, 8.0]

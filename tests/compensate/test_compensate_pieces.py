@@ -242,7 +242,7 @@ def test_bad_factor_and_segment_are_one_line(bad):
 def test_push_checks_the_shape_and_counts():
     eng = _engine([_axis("gx"), _axis("gz")], factor=2, segment=2)
     for bad in (np.zeros(4), np.zeros((4, 1)), np.zeros((4, 3)), np.zeros((2, 2, 2))):
-        with pytest.raises(ConfigError, match=r"^rate_dph must have shape \(n, 2\); got \("):
+        with pytest.raises(ConfigError, match=r"rate_dph.*shape \(n, 2\)"):
             eng.push(np.arange(4.0), bad)
     assert eng.push(np.arange(3.0), np.ones((3, 2))) == []  # less than a segment: held
     assert eng.n_in == 3 and eng.n_out == 0
@@ -471,7 +471,7 @@ def test_one_declared_unit_for_every_rate_column():
 
     assert _one_declared([], "p") is None and _one_declared([None, None], "p") is None
     assert _one_declared(["deg/s", "deg/s"], "p") == "deg/s"
-    with pytest.raises(DataFormatError, match=r"^q: rate columns declare different units \['deg/h', 'deg/s'\];"):
+    with pytest.raises(DataFormatError, match=r"q: .*different units.*'deg/h', 'deg/s'"):
         _one_declared(["deg/s", "deg/h"], "q")
     with pytest.raises(DataFormatError) as info:
         _one_declared(["deg/s", "deg/h", None], "p.csv")
@@ -692,7 +692,7 @@ def test_npz_writer_abort_and_a_short_write_leave_nothing(tmp_path, monkeypatch)
     assert os.listdir(tmp_path) == [] and all(fh.closed for fh in w._files.values())
     w = NpzWriter(tmp_path / "b.npz", 3, ["gz"], "deg/h", 1.0, False)
     w.write(np.arange(2.0), np.ones((2, 1)), np.ones((2, 1)), None)
-    with pytest.raises(RuntimeError, match=r"^NPZ writer got 2 rows, expected 3$"):
+    with pytest.raises(RuntimeError, match=r"NPZ writer.*2 rows.*3"):
         w.close()
     assert os.listdir(tmp_path) == []
     calls = []

@@ -36,7 +36,7 @@ def test_from_si_is_the_division_by_the_factor(value_si, term, unit, expected):
 
 
 def test_from_si_refuses_an_unknown_unit_in_one_line():
-    with pytest.raises(ConfigError, match=r"^unit 'furlong' of term N is not one fogdrift can convert$"):
+    with pytest.raises(ConfigError, match=r"'furlong'.*term N"):
         from_si(1.0, "N", "furlong")
     with pytest.raises(ConfigError, match="is not one fogdrift can convert"):
         from_si(1.0, "N", "mg")  # a unit of B, not of N
@@ -44,7 +44,7 @@ def test_from_si_refuses_an_unknown_unit_in_one_line():
 
 @pytest.mark.parametrize("tc", [-1.0, 0.0, math.inf, math.nan])
 def test_gm_discrete_refuses_a_correlation_time_that_is_not_finite_and_positive(tc):
-    with pytest.raises(ConfigError, match=r"^Gauss-Markov correlation time must be a finite number > 0 s; got "):
+    with pytest.raises(ConfigError, match=r"correlation time.*> 0 s"):
         gm_discrete(1.0, tc, 100.0)
 
 
@@ -57,7 +57,7 @@ def test_gm_discrete_below_one_second_by_hand():
 
 @pytest.mark.parametrize("rate", [0.0, -100.0, math.inf, math.nan, "fast", None])
 def test_rate_validator_refuses_what_is_not_a_finite_positive_number(rate):
-    with pytest.raises(ConfigError, match=r"^the update rate must be a finite number > 0 Hz; got "):
+    with pytest.raises(ConfigError, match=r"update rate.*> 0 Hz"):
         white_discrete(1.0, rate)
     with pytest.raises(ConfigError, match="the update rate must be"):
         walk_discrete(1.0, rate)

@@ -998,7 +998,7 @@ def test_resolve_messages_by_hand(tmp_path):
     ch.terms["K"] = _term("K", None, 0.0, 0.0, "deg/h^1.5", "absent", "", "s")      # a bound of 0 is no bound
     with pytest.raises(ConfigError, match="the record gives no upper bound either"):
         resolve(ch, "K", "bound")
-    with pytest.raises(ConfigError, match=r"^gyro gz: the result has no term M$"):
+    with pytest.raises(ConfigError, match=r"gyro gz.*no term M"):
         resolve(ch, "M", "bound")
     with pytest.raises(ConfigError) as ei:
         resolve(ch, "N", "Bound")

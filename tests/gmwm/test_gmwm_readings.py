@@ -944,7 +944,7 @@ def test_selection_on_white_noise_and_the_result_dicts():
 
 def test_selection_input_errors():
     wv = haar_wvar(simulate_latent("WN", [1.0], 16, seed=1), 0.01)  # 3 scales
-    with pytest.raises(InsufficientDataError, match=r"^3 scales are too few for any candidate \(need 4\)$") as ei:
+    with pytest.raises(InsufficientDataError, match=r"3 scales .*too few.*need 4") as ei:
         select_model(wv, ["WN+RW", "WN+RW+GM"])
     assert (ei.value.needed, ei.value.got) == (4, 3)
     one = select_model(wv, "WN")  # a single model string is one candidate (3 scales >= 1 + 2)

@@ -154,7 +154,7 @@ def test_rows_at_and_one_above_the_limit(monkeypatch):
     e = info.value
     assert e.limit == "FOGDRIFT_MAX_ROWS" and e.path == "f.csv" and e.line is None
     assert e.reason == f"11 rows; expected at most 10 (FOGDRIFT_MAX_ROWS); {RAISE.format('FOGDRIFT_MAX_ROWS')}"
-    with pytest.raises(ResourceLimitError, match=r"^f.csv: 12 records; expected at most 10 "):
+    with pytest.raises(ResourceLimitError, match=r"f\.csv.*12 records.*at most 10"):
         limits.check_rows(12, "f.csv", what="records")
     monkeypatch.setenv(limits.ENV_ROWS, "0")
     limits.check_rows(10 ** 15, "f.csv")

@@ -58,7 +58,7 @@ def test_repr_lists_the_parameters_in_constructor_order():
 
 
 def test_unfitted_model_refuses_to_save(tmp_path):
-    with pytest.raises(NotFittedError, match=r"^Persistence is not fitted yet; call fit\(y_train\) first$"):
+    with pytest.raises(NotFittedError, match=r"Persistence.*not fitted.*fit\("):
         Persistence().save(tmp_path / "m")
     assert list(tmp_path.iterdir()) == []
 
@@ -188,7 +188,7 @@ def test_state_without_a_fitted_attribute(tmp_path):
 def test_state_missing_an_array(tmp_path):
     AR(order=2).fit(np.random.default_rng(1).standard_normal(200)).save(tmp_path / "ar")
     np.savez(tmp_path / "ar.npz")
-    with pytest.raises(ModelFileError, match=r"^.*ar\.json: the stored state does not describe a fitted AR"):
+    with pytest.raises(ModelFileError, match=r"ar\.json.*not describe a fitted AR"):
         load_model(tmp_path / "ar")
 
 

@@ -108,9 +108,9 @@ def test_law_shapes_leading_power_and_small_m_series():
     want = tau * (1.0 + (1.0 / 24.0) / (11.0 / 40.0) * r2 + (1.0 / 60.0) / (11.0 / 40.0) * r2**2)
     np.testing.assert_allclose(k_mdev.shape(tau, DT_S), want, rtol=1e-14)
     np.testing.assert_array_equal(k_mdev.shape(tau, leading_only=True), tau)
-    with pytest.raises(ConfigError, match=r"^this law needs the sample interval dt_s$"):
+    with pytest.raises(ConfigError, match=r"needs the sample interval dt_s"):
         k_mdev.shape(tau)
-    with pytest.raises(ConfigError, match=r"^this law needs the sample interval dt_s$"):
+    with pytest.raises(ConfigError, match=r"needs the sample interval dt_s"):
         VARIANCE_LAWS["mdev"]["Q"].scale(None)
     np.testing.assert_array_equal(VARIANCE_LAWS["hdev"]["Q"].shape(tau), tau**-2.0)
     # integer taus (a list of whole seconds) with a negative power: computed in floating point
