@@ -67,7 +67,7 @@ def share_ratio(model, n_samples, term, share, draws=SPREAD_DRAWS, seed=0) -> fl
     tau = m * dt
     ctx, L, Xall, yw0 = whitened(names, A, tau, m, n, dt)
     mu = ctx.X @ A
-    Vs = ctx.relcov(A, exact_ramp=True, allowance=False) * np.outer(mu, mu)
+    Vs = ctx.relcov(A, exact_ramp=True, allowance=False, finite_record=True) * np.outer(mu, mu)
     S = np.linalg.solve(L, np.linalg.solve(L, Vs).T).T
     Ls = np.linalg.cholesky(0.5 * (S + S.T) + 1e-12 * np.trace(S) / len(S) * np.eye(len(S)))
     cols = [all_terms().index(u) for u in PLANNED if u in ctx.laws]
@@ -138,7 +138,8 @@ def model_curves(model, n_samples, draws, seed=0):
     tau = m * dt
     probe = FitContext(tau, m, np.ones_like(tau), np.full_like(tau, 2.0), n, dt, "adev", names)
     mu = probe.X @ A
-    C = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", names).relcov(A, exact_ramp=True, allowance=False)
+    C = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", names).relcov(A, exact_ramp=True, allowance=False,
+                                                                     finite_record=True)
     nu = 2.0 / np.diag(C)
     sd = np.sqrt(np.diag(C))
     Lc = np.linalg.cholesky(C / np.outer(sd, sd) + 1e-10 * np.eye(tau.size))
