@@ -32,6 +32,8 @@ n_cells)`` with ``n_cells ~ 48 log2(500 m_max)``; 18 octave taus take ~0.03 s, 4
 
 Limits.  The large-``M`` formula overstates the standard deviation where ``m`` is a sizeable fraction of ``N``
 (about +7 % at ``m = N/8`` and +20 % at ``m = N/4`` in the Monte Carlo check): intervals there are conservative.
+The sum over the record's finite number of terms (:func:`finite_record_covariance`) holds there; the fit keeps the
+large-``M`` formula (its intervals were validated with it), the planner's simulated records take the sum.
 
 References
 ----------
@@ -325,7 +327,8 @@ def finite_record_covariance(m, n_samples, spectrum, *, exact_from=1 / 64, tail=
     if m.ndim != 1 or m.size == 0 or np.any(m < 1) or np.any(M < 1):
         raise ConfigError(f"averaging factors must be >= 1 and leave >= 1 term with N = {n}; got {m!r}")
     Mf = M.astype(np.float64)
-    out = estimator_covariance(m, n, spectrum, per_octave=per_octave) * np.sqrt(np.outer(Mf, Mf)) / np.maximum.outer(Mf, Mf)
+    out = estimator_covariance(m, n, spectrum, per_octave=per_octave)
+    out *= np.sqrt(np.outer(Mf, Mf)) / np.maximum.outer(Mf, Mf)  # n_ij = min(M_i, M_j) where c_ij is not small
     grids, sines = {}, {}
 
     def sin2(P, mm):
