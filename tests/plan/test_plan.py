@@ -277,8 +277,9 @@ def test_share_ratio_reproduces_the_seed_spread():
 def test_the_80_percent_length_is_the_fixed_point_of_the_spread(monkeypatch):
     """share_s solves L = crossing(w_share * ratio(L)): the spread is taken at the length it is applied to.  The
     ratio falls with length (MEMS B: 1.216 at 57 906 samples, 1.137 at 106 415), so the two substitution passes of
-    before (at the nearest half-octave grid point) stopped at 86 650 samples where the fixed point is 91 974; the
-    seeds reach +-25 % there in 76 of 96 (before: 64 of 96; docs/plan.md).  A stand-in ratio (no records: exact)."""
+    before (at the nearest half-octave grid point) stopped at 86 650 samples where the fixed point is 91 974 (90 578
+    with the records' finite-record covariance; seeds 1-96 reach +-25 % there in 82, 1-600 in 473; docs/plan.md).
+    A stand-in ratio (no records: exact)."""
     import fogdrift.plan.core as core
     from fogdrift.plan.spread import SPREAD_DRAWS
 

@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from ..allan.ci import edf_simple_safe
-from .covariance import estimator_covariance, expected_variance, ramp_cross_variance
+from .covariance import estimator_covariance, expected_variance, finite_record_covariance, ramp_cross_variance
 from .discrepancy import discrepancy_relcov
 from .distributions import chi2_ppf
 from .processes import model_sdf
@@ -89,8 +89,13 @@ class FitContext:
         """Squared coefficient of each term in its Allan-law unit, from the law coefficients ``A``."""
         return {t: max(A[_names().index(t)], 0.0) / self.laws[t].scale(self.dt) for t in self.laws}
 
-    def relcov(self, A, exact_ramp=False, allowance=True):
+    def relcov(self, A, exact_ramp=False, allowance=True, finite_record=False):
         """Relative covariance of the working points under the model ``A`` (its spectrum, this statistic).
+
+        ``finite_record=True`` (overlapping Allan variance only): the estimators' covariance summed exactly over
+        the record's terms (:func:`~fogdrift.noise.covariance.finite_record_covariance`) instead of the large-``M``
+        integral the fit itself uses; the planner's simulated records take it, since where ``m`` is a sizeable
+        fraction of ``N`` the integral overstates the long taus' scatter and their correlation.
 
         A deterministic rate ramp has no spectrum.  For model *selection* (``exact_ramp=False``) it is given the
         variance of a rate random walk with the same Allan variance at the longest tau -- conservative, so that a
@@ -120,7 +125,10 @@ class FitContext:
 
             def spec(f, base=base, phi=phi, s2=s2):
                 return base(f) + s2 * (1 - phi * phi) / (1 - 2 * phi * np.cos(2 * np.pi * np.asarray(f)) + phi * phi)
-        V = estimator_covariance(self.m, self.n, spec, statistic=self.statistic)
+        if finite_record and self.statistic == "adev":
+            V = finite_record_covariance(self.m, self.n, spec)
+        else:
+            V = estimator_covariance(self.m, self.n, spec, statistic=self.statistic)
         if exact_ramp and a_allan[4] > 0 and self.statistic != "hdev":  # per-sample units: A_R dt^2
             # a strided sum (fast / non-overlapping sampling) no longer telescopes: about `stride` boundary blocks
             V = V + np.diag(self.strides * ramp_cross_variance(self.m, self.n, spec, a_allan[4] * self.dt**2))

@@ -6,7 +6,8 @@ the estimate the width is relative to, the selected model (its degrees of freedo
 widening, and which models are plausible and so enter the union.  All four are taken here from the fit's rules
 applied to Gaussian records of the linearised problem: in the fit's whitened metric (``V``: the estimators'
 covariance plus the 2 % allowance, :func:`~fogdrift.plan.analytic.whitened`) a record's curve is the expected
-one plus ``e ~ N(0, S)``, ``S = L^-1 V_s L^-T`` with ``V_s`` the sampling covariance alone (a record that follows
+one plus ``e ~ N(0, S)``, ``S = L^-1 V_s L^-T`` with ``V_s`` the sampling covariance alone, summed over the record's
+finite number of Allan terms (:func:`~fogdrift.noise.covariance.finite_record_covariance`; a record that follows
 the model departs from it by its sampling error, not by the allowance: its ``chi2_red`` averages about 0.5).
 Per record: every subset of the planned terms is fitted by non-negative least squares, the model of least IC
 (``Q + 2 k``) is selected, the plausible models are those within the window (6), the threshold is
@@ -67,7 +68,7 @@ def share_ratio(model, n_samples, term, share, draws=SPREAD_DRAWS, seed=0) -> fl
     tau = m * dt
     ctx, L, Xall, yw0 = whitened(names, A, tau, m, n, dt)
     mu = ctx.X @ A
-    Vs = ctx.relcov(A, exact_ramp=True, allowance=False) * np.outer(mu, mu)
+    Vs = ctx.relcov(A, exact_ramp=True, allowance=False, finite_record=True) * np.outer(mu, mu)
     S = np.linalg.solve(L, np.linalg.solve(L, Vs).T).T
     Ls = np.linalg.cholesky(0.5 * (S + S.T) + 1e-12 * np.trace(S) / len(S) * np.eye(len(S)))
     cols = [all_terms().index(u) for u in PLANNED if u in ctx.laws]
@@ -107,7 +108,8 @@ def fit_rule_widths(model, n_samples, term, draws=100, seed=0) -> np.ndarray:
     fit's own :func:`~fogdrift.noise.identify.identify` on ``draws`` Allan curves of ``n_samples`` samples drawn
     from the model: on the fit's octave taus (from ``model.tau_min_s``), ``cbrt(y_i / mu_i) = c_i + s_i z_i`` with
     ``c = 1 - 2 / (9 nu)``, ``s = sqrt(2 / (9 nu))``, ``nu_i`` the sampling EDF and ``z`` Gaussian with the
-    sampling correlation of the estimators (``FitContext.relcov(A, exact_ramp=True, allowance=False)``).  The fit
+    sampling correlation of the estimators (``FitContext.relcov(A, exact_ramp=True, allowance=False,
+    finite_record=True)``).  The fit
     range is fixed to those taus and the Markov candidates are off (neither changed a width on simulated records of
     the three classes of docs/plan.md)."""
     n, dt = int(n_samples), float(model.dt_s)
@@ -138,7 +140,8 @@ def model_curves(model, n_samples, draws, seed=0):
     tau = m * dt
     probe = FitContext(tau, m, np.ones_like(tau), np.full_like(tau, 2.0), n, dt, "adev", names)
     mu = probe.X @ A
-    C = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", names).relcov(A, exact_ramp=True, allowance=False)
+    C = FitContext(tau, m, mu, mu * 2.0, n, dt, "adev", names).relcov(A, exact_ramp=True, allowance=False,
+                                                                     finite_record=True)
     nu = 2.0 / np.diag(C)
     sd = np.sqrt(np.diag(C))
     Lc = np.linalg.cholesky(C / np.outer(sd, sd) + 1e-10 * np.eye(tau.size))
