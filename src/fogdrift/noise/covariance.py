@@ -275,7 +275,7 @@ def finite_record_covariance(m, n_samples, spectrum, *, exact_from=1 / 64, tail=
     ``4 sin^2(pi f m_i) sin^2(pi f m_j) S(f) / (m_i m_j sin^2(pi f))`` (real and even: the two filters' phases
     differ by a shift of ``m_i - m_j`` samples).  The large-``M`` formula takes ``n_ij(l)`` as ``sqrt(M_i M_j)``
     at every lag; where ``m`` is a sizeable fraction of ``N`` it overstates the variance (white noise at
-    ``m = N/4``: +33 %) and the correlation of neighbouring long taus (tests/test_plan_finite_covariance.py:
+    ``m = N/4``: +33 %) and the correlation of neighbouring long taus (tests/plan/test_plan_finite_covariance.py:
     4 000 simulated records of 4 096 samples).
 
     Pairs whose shorter ``m`` is at least ``exact_from * N`` are summed: ``c_ij`` on a uniform grid of ``P``
