@@ -50,6 +50,9 @@ import numpy as np
 import optax
 
 from ..errors import ConfigError
+from . import compile_cache
+
+compile_cache.enable(jax)  # the networks' XLA programs kept between commands (compile_cache)
 
 __all__ = [
     "RecurrentCell",
