@@ -26,7 +26,9 @@ def _run(env_extra: dict, tmp_path: Path):
     r = subprocess.run([sys.executable, "-c", SCRIPT], env=env, cwd=tmp_path, capture_output=True, text=True,
                        timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]
-    return json.loads(r.stdout.strip().splitlines()[-1])
+    line = r.stdout.strip().splitlines()[-1]
+    assert len(json.loads(line)) == 100
+    return line  # the predictions' reprs: equal texts are equal bits
 
 
 def test_cache_dir_rules(monkeypatch, tmp_path):
@@ -43,8 +45,9 @@ def test_a_second_process_loads_the_programs_and_predicts_the_same_bits(tmp_path
     cold = _run({ENV: str(folder)}, tmp_path)
     written = sorted(p.name for p in folder.iterdir())
     assert any("forward" in n for n in written), written  # the network's forward pass among the programs kept
+    assert ".lockfile" in written  # a bounded cache: JAX reads and writes its entries under a file lock
     warm = _run({ENV: str(folder)}, tmp_path)
-    assert warm == cold  # floats through JSON: every bit
+    assert warm == cold
     off = _run({ENV: "0", "XDG_CACHE_HOME": str(tmp_path / "xdg")}, tmp_path)
     assert off == cold and not (tmp_path / "xdg").exists()
 

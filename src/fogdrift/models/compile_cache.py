@@ -10,7 +10,7 @@ The programs loaded are those XLA compiled, so the numbers are the same bits as 
 The folder: ``$FOGDRIFT_JAX_CACHE`` when set (an empty value or ``0``: no cache), else
 ``$XDG_CACHE_HOME/fogdrift/jax`` (``~/.cache/fogdrift/jax``).  A cache the user configured for JAX itself
 (``JAX_COMPILATION_CACHE_DIR`` or ``jax.config``) is kept as it is; a folder that cannot be made leaves JAX
-compiling every time, as without a cache.
+compiling every time, as without a cache.  ``filelock`` (a dependency) guards the entries between processes.
 """
 
 from __future__ import annotations
@@ -18,10 +18,15 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["ENV", "cache_dir", "enable"]
+__all__ = ["ENV", "MAX_BYTES", "cache_dir", "enable"]
 
 #: Environment variable naming the cache folder (empty or ``0``: no persistent cache).
 ENV = "FOGDRIFT_JAX_CACHE"
+
+#: Largest size of the cache folder [bytes]; JAX removes the least recently used programs beyond it.  Setting a size
+#: also makes JAX read and write each entry under a file lock (``filelock``), so that processes compiling at the same
+#: time (a fleet's workers) never read an entry another one is still writing.
+MAX_BYTES = 256 * 2**20
 
 
 def cache_dir(environ=None) -> Path | None:
@@ -47,7 +52,7 @@ def enable(jax) -> Path | None:
     user's own JAX cache setting is kept, the cache is turned off, or the folder cannot be made.
 
     Every program is cached, whatever its compile time or size (the networks' are small: about 300 kB for the
-    bundled record's ``analyze``).
+    bundled record's ``analyze``), in at most :data:`MAX_BYTES`, each entry read and written under a file lock.
     """
     if os.environ.get("JAX_COMPILATION_CACHE_DIR") or jax.config.jax_compilation_cache_dir:
         return None
@@ -61,4 +66,5 @@ def enable(jax) -> Path | None:
     jax.config.update("jax_compilation_cache_dir", str(folder))
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
     jax.config.update("jax_persistent_cache_min_entry_size_bytes", 0)
+    jax.config.update("jax_compilation_cache_max_size", MAX_BYTES)
     return folder
