@@ -512,6 +512,8 @@ def _markov_fits(c: FitContext, C, base_cols, tc, penalty):
 
 #: IC gain (beyond the penalty of q_c and T_c) the best Gauss-Markov model needs over the best model without M.
 MARKOV_IC_GAIN = 2.0
+#: Correlation times the Markov stage scans first (log-spaced over the fitted range), before refining the best.
+MARKOV_TC_GRID = 12
 
 
 def _markov_stage(c: FitContext, C, res, best, penalty):
@@ -533,7 +535,7 @@ def _markov_stage(c: FitContext, C, res, best, penalty):
     lo_t, hi_t = math.log(2.0 * c.tau[0]), math.log(c.tau[-1] / 2.0)
     if hi_t <= lo_t:
         return None
-    grid = np.linspace(lo_t, hi_t, 12)
+    grid = np.linspace(lo_t, hi_t, MARKOV_TC_GRID)
     ic0 = res[best]["ic"]
     scan = []
     for g, lt in enumerate(grid):
