@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from fogdrift.models.compile_cache import ENV, cache_dir
+from fogdrift.models.compile_cache import ENV, cache_dir, host_tag
 
 SCRIPT = """
 import json, numpy as np
@@ -32,21 +32,32 @@ def _run(env_extra: dict, tmp_path: Path):
 
 
 def test_cache_dir_rules(monkeypatch, tmp_path):
-    assert cache_dir({ENV: str(tmp_path)}) == tmp_path
+    tag = host_tag()
+    assert cache_dir({ENV: str(tmp_path)}) == tmp_path / tag
     assert cache_dir({ENV: ""}) is None and cache_dir({ENV: " 0 "}) is None
-    assert cache_dir({"XDG_CACHE_HOME": str(tmp_path)}) == tmp_path / "fogdrift" / "jax"
+    assert cache_dir({"XDG_CACHE_HOME": str(tmp_path)}) == tmp_path / "fogdrift" / "jax" / tag
     monkeypatch.setenv("HOME", str(tmp_path))
-    assert cache_dir({}) == tmp_path / ".cache" / "fogdrift" / "jax"
+    assert cache_dir({}) == tmp_path / ".cache" / "fogdrift" / "jax" / tag
+
+
+def test_each_processor_has_its_own_folder():
+    """Programs compiled for one processor's instruction set are never offered to another one."""
+    epyc = "processor : 0\nmodel name : AMD EPYC\nflags : fpu sse2 avx2 avx512f\n"
+    assert host_tag(epyc) == host_tag(epyc + epyc.replace("processor : 0", "processor : 1"))  # one tag per machine
+    assert host_tag(epyc) != host_tag(epyc.replace(" avx512f", ""))  # another feature set
+    assert host_tag(epyc) != host_tag(epyc.replace("AMD EPYC", "Intel Xeon"))  # another model
+    assert host_tag(epyc) == host_tag(epyc.replace("processor : 0", "processor : 7"))  # not the core's number
 
 
 @pytest.mark.slow
 def test_a_second_process_loads_the_programs_and_predicts_the_same_bits(tmp_path):
-    folder = tmp_path / "cache"
-    cold = _run({ENV: str(folder)}, tmp_path)
+    root = tmp_path / "cache"
+    folder = root / host_tag()
+    cold = _run({ENV: str(root)}, tmp_path)
     written = sorted(p.name for p in folder.iterdir())
     assert any("forward" in n for n in written), written  # the network's forward pass among the programs kept
     assert ".lockfile" in written  # a bounded cache: JAX reads and writes its entries under a file lock
-    warm = _run({ENV: str(folder)}, tmp_path)
+    warm = _run({ENV: str(root)}, tmp_path)
     assert warm == cold
     off = _run({ENV: "0", "XDG_CACHE_HOME": str(tmp_path / "xdg")}, tmp_path)
     assert off == cold and not (tmp_path / "xdg").exists()

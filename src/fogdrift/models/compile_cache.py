@@ -8,17 +8,23 @@ the compilation (measured: first-axis grey-Elman 4.6 -> 0.9 s, the whole ``analy
 The programs loaded are those XLA compiled, so the numbers are the same bits as a fresh compile's.
 
 The folder: ``$FOGDRIFT_JAX_CACHE`` when set (an empty value or ``0``: no cache), else
-``$XDG_CACHE_HOME/fogdrift/jax`` (``~/.cache/fogdrift/jax``).  A cache the user configured for JAX itself
-(``JAX_COMPILATION_CACHE_DIR`` or ``jax.config``) is kept as it is; a folder that cannot be made leaves JAX
-compiling every time, as without a cache.  ``filelock`` (a dependency) guards the entries between processes.
+``$XDG_CACHE_HOME/fogdrift/jax`` (``~/.cache/fogdrift/jax``), and in it one sub-folder per processor model and
+instruction-set features (:func:`host_tag`): JAX's own cache key names the platform ("cpu") but not the processor's
+features, and a program compiled for one processor's vector instructions must not be loaded on another that lacks
+them (a home folder shared by the machines of a cluster), as numba's cache keys its entries by them too.  A cache
+the user configured for JAX itself (``JAX_COMPILATION_CACHE_DIR`` or ``jax.config``) is kept as it is; a folder
+that cannot be made leaves JAX compiling every time, as without a cache.  ``filelock`` (a dependency) guards the
+entries between processes.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
+import platform
 from pathlib import Path
 
-__all__ = ["ENV", "MAX_BYTES", "cache_dir", "enable"]
+__all__ = ["ENV", "MAX_BYTES", "cache_dir", "enable", "host_tag"]
 
 #: Environment variable naming the cache folder (empty or ``0``: no persistent cache).
 ENV = "FOGDRIFT_JAX_CACHE"
@@ -29,22 +35,47 @@ ENV = "FOGDRIFT_JAX_CACHE"
 MAX_BYTES = 256 * 2**20
 
 
-def cache_dir(environ=None) -> Path | None:
-    """The folder of fogdrift's JAX compilation cache, or None when ``FOGDRIFT_JAX_CACHE`` turns it off.
+def host_tag(cpuinfo: str | None = None) -> str:
+    """Twelve hex digits naming this processor: its model and instruction-set feature flags (Linux
+    ``/proc/cpuinfo``; elsewhere the machine and processor names Python reports).
 
     Examples
     --------
-    >>> str(cache_dir({"FOGDRIFT_JAX_CACHE": "/tmp/jc"})), cache_dir({"FOGDRIFT_JAX_CACHE": "0"})
+    >>> a = host_tag("model name : EPYC\\nflags : fpu sse2 avx2 avx512f\\n")
+    >>> a == host_tag("model name : EPYC\\nflags : fpu sse2 avx2\\n"), len(a)
+    (False, 12)
+    """
+    if cpuinfo is None:
+        try:
+            cpuinfo = Path("/proc/cpuinfo").read_text(errors="replace")
+        except OSError:
+            cpuinfo = ""
+    keep = [line.split(":", 1)[1].strip() for line in cpuinfo.splitlines()
+            if ":" in line and line.split(":", 1)[0].strip() in ("model name", "flags", "Features", "CPU part")]
+    text = "\n".join(dict.fromkeys(keep)) or f"{platform.machine()} {platform.processor()}"
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def cache_dir(environ=None) -> Path | None:
+    """The folder of fogdrift's JAX compilation cache on this processor, or None when ``FOGDRIFT_JAX_CACHE`` turns
+    it off.
+
+    Examples
+    --------
+    >>> cache_dir({"FOGDRIFT_JAX_CACHE": "/tmp/jc"}).parent.as_posix(), cache_dir({"FOGDRIFT_JAX_CACHE": "0"})
     ('/tmp/jc', None)
-    >>> str(cache_dir({"XDG_CACHE_HOME": "/var/cache/u"}))
+    >>> cache_dir({"XDG_CACHE_HOME": "/var/cache/u"}).parent.as_posix()
     '/var/cache/u/fogdrift/jax'
     """
     env = os.environ if environ is None else environ
     chosen = env.get(ENV)
     if chosen is not None:
-        return None if chosen.strip() in ("", "0") else Path(chosen).expanduser()
-    base = env.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "fogdrift" / "jax"
+        if chosen.strip() in ("", "0"):
+            return None
+        root = Path(chosen).expanduser()
+    else:
+        root = Path(env.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")) / "fogdrift" / "jax"
+    return root / host_tag()
 
 
 def enable(jax) -> Path | None:
