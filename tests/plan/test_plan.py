@@ -343,11 +343,13 @@ def test_stated_length_verdicts_match_the_monte_carlo(mems_plan):
 
 
 # -- the command ------------------------------------------------------------------------------------------------
-def test_cli_plan_writes_json_and_figure(tmp_path):
+def test_cli_plan_writes_json_and_figure(tmp_path, monkeypatch):
     from typer.testing import CliRunner
 
+    import fogdrift.plan.core as core
     from fogdrift.cli import _commands
 
+    monkeypatch.setattr(core, "share_ratio", lambda *a, **k: 1.15)  # the 80 % length: tested above, costly here
     out = tmp_path / "p"
     res = CliRunner().invoke(_commands(), ["plan", "--model", MEMS, "--rate", "10", "--target", "N:5%,B:20%",
                                            "--length", "2h", "--out", str(out)])
@@ -356,7 +358,8 @@ def test_cli_plan_writes_json_and_figure(tmp_path):
     d = json.loads((out / "plan.json").read_text())
     assert d["terms"]["B"]["target"] == 0.2 and d["terms"]["B"]["unit"] == "deg/h"
     assert d["terms"]["B"]["target_s"] > d["terms"]["B"]["resolved_s"] > 0
-    assert (out / "plan.png").stat().st_size > 1000
+    assert d["terms"]["B"]["share_ratio"] == 1.15 and d["terms"]["B"]["share_s"] > d["terms"]["B"]["target_s"]
+    assert "80 % of records: " in res.output and (out / "plan.png").stat().st_size > 1000
 
 
 @pytest.mark.parametrize("args, words", [

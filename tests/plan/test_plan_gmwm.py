@@ -114,15 +114,41 @@ def test_gmwm_analytic_and_monte_carlo_lengths_agree(gmwm_plan, term):
     json.dumps(gmwm_plan.to_dict())
 
 
-def test_both_estimators_on_one_line():
+@pytest.fixture(scope="module")
+def both_b():
+    """The plan of B to +-10 % for both estimators (its Allan 80 % length is the costly part)."""
+    return make_plan(parse_model(MEMS, 0.1), {"B": 0.10})
+
+
+def test_both_estimators_on_one_line(both_b, monkeypatch):
     m = parse_model(MEMS, 0.1)
-    p = make_plan(m, {"B": 0.10})
+    p = both_b
     line = p.lines()[0]
     assert "(Allan fit), " in line and "(GMWM)" in line
     # B to +-10 %: the GMWM's flicker parameter needs about half the Allan fit's record
     r = p.terms["B"]
     assert 0.3 < r["gmwm"]["target_s"] / r["target_s"] < 0.8
+    import fogdrift.plan.core as core
+
+    monkeypatch.setattr(core, "share_ratio", lambda *a, **k: 1.2)  # the Allan 80 % length is not the point here
     assert "gmwm" not in make_plan(m, {"B": 0.10}, estimators=("allan",)).terms["B"]
+
+
+def test_a_plan_of_the_gmwm_alone_makes_no_allan_80_percent_length(monkeypatch, both_b):
+    """The 80 % length is the Allan fit's (its linearised records, ``share_ratio``: 10-30 s a term): a plan for the
+    GMWM alone neither computes nor reports it, and its GMWM answers are those of the plan for both."""
+    import fogdrift.plan.core as core
+
+    def refuse(*a, **k):
+        raise AssertionError("share_ratio called for a plan of the GMWM alone")
+
+    monkeypatch.setattr(core, "share_ratio", refuse)
+    p = make_plan(parse_model(MEMS, 0.1), {"B": 0.10}, estimators=("gmwm",))
+    r = p.terms["B"]
+    assert r["share_s"] is None and r["share_ratio"] is None and p.grid["width_share"] == {}
+    assert "80 % of records" not in p.lines()[0]
+    assert both_b.terms["B"]["share_s"] > both_b.terms["B"]["target_s"]
+    assert r["gmwm"] == both_b.terms["B"]["gmwm"]
 
 
 def test_cli_estimator_option(tmp_path):

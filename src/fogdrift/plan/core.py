@@ -64,7 +64,7 @@ class Plan:
     ``target_s`` (length at which its expected width reaches the target; None: not within
     :data:`MAX_LENGTH_S`), ``share_s`` (length at which :data:`RECORD_SHARE` of the records reach it: the expected width times
     ``share_ratio``, the ratio of the share's quantile to the median over linearised records,
-    :func:`~fogdrift.plan.spread.share_ratio`), ``floor_width``
+    :func:`~fogdrift.plan.spread.share_ratio`; both None in a plan of the GMWM alone), ``floor_width``
     (width at :data:`MAX_LENGTH_S`), ``mc`` (Monte-Carlo at ``target_s``: median width, fractions, coverage, seeds,
     and ``length_s``, the length the measured width implies) and ``mc_share`` (Monte-Carlo at ``share_s``).
     ``grid``: the analytic curve (``length_s`` and each term's width). ``at_length``: what ``length_s`` supports.
@@ -270,8 +270,8 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
     """Plan the record for ``model`` (:class:`~fogdrift.plan.model.PlanModel`) and ``targets`` (term -> relative
     half-width).  ``monte_carlo``: seeds per checked length (0: analytic only); ``workers``: processes;
     ``estimators``: the ones planned for, of :data:`ESTIMATORS` (the Allan fit's analytic curve is always made:
-    the plan's grid and the stated length's reading use it; without ``"allan"`` its Monte-Carlo and lines are
-    left out)."""
+    the plan's grid and the stated length's reading use it; without ``"allan"`` its 80 % length, Monte-Carlo and
+    lines are left out)."""
     estimators = tuple(e for e in ESTIMATORS if e in estimators)
     if not estimators:
         raise ConfigError(f"{{opt:estimator}} names no estimator; expected {', '.join(ESTIMATORS)} or both")
@@ -293,10 +293,11 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
             "z": {t: [c[t]["z"] for c in curves] for t in model.terms}}
     # the width RECORD_SHARE of the records stay within: the union of the models that share of the records may
     # find plausible, times the spread of the fit's rules on linearised records (plan.spread), evaluated at the
-    # length it gives (a fixed point, _share_length)
-    shared = [analytic_widths(model, n, share=RECORD_SHARE) for n in ns] if targets else curves
-    grid["width_share"], spread = {}, {}
-    for t, target in targets.items():
+    # length it gives (a fixed point, _share_length); a length of the Allan fit's, so not made for the GMWM alone
+    allan = "allan" in estimators
+    shared = [analytic_widths(model, n, share=RECORD_SHARE) for n in ns] if targets and allan else curves
+    grid["width_share"], spread = {}, {t: None for t in targets}
+    for t, target in (targets.items() if allan else ()):
         w = [c[t]["rel_width"] for c in shared]
         ratio = _share_length(model, t, target, lengths, w)[1] if crossing(lengths, w, target) else math.inf
         spread[t] = ratio
@@ -318,7 +319,8 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
         target_s = crossing(lengths, w, target)
         r = {"target": target, "unit": TERM_TABLE[t].unit, "value": model.coefficients[t],
              "resolved_s": resolved_s, "target_s": target_s, "share": RECORD_SHARE,
-             "share_s": crossing(lengths, grid["width_share"][t], target), "share_ratio": spread[t],
+             "share_s": crossing(lengths, grid["width_share"][t], target) if allan else None,
+             "share_ratio": spread[t],
              "floor_width": w[-1]}
         if target_s is not None:
             j = min(range(len(lengths)), key=lambda k: abs(math.log(lengths[k] / target_s)))
