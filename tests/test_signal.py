@@ -83,7 +83,26 @@ def test_a_description_that_does_not_match_the_record_is_refused():
     rec = from_array(np.ones(10), dt_s=0.01, unit="deg/s")
     wrong = SignalDescription(Sampling(dt_s=0.02, dt_source="argument"), rec.signal.channels)
     with pytest.raises(ConfigError, match="signal does not describe this record: dt_s"):
-        io_record.GyroRecord(rec.rate_dph, 0.01, ("axis0",), "<array>", "deg/s", 3600.0, signal=wrong)
+        io_record.GyroRecord(data_internal=rec.rate_dph, dt_s=0.01, axis_names=("axis0",), source="<array>",
+                             input_unit="deg/s", scale_to_internal=3600.0, signal=wrong)
+
+
+def test_the_record_reads_its_sampling_from_its_description_only():
+    """``dt_s`` and ``block_average_factor`` are arguments of the record and properties of its ``signal``: one
+    stored home.  Left out, they come from the description; a factor that disagrees with it is refused."""
+    rec = from_array(np.ones(12), dt_s=0.01, unit="deg/s")
+    low = rec.average_by(3)
+    assert (low.dt_s, low.block_average_factor) == (low.signal.sampling.dt_s, 3) and low.dt_s == pytest.approx(0.03)
+    again = io_record.GyroRecord(data_internal=low.rate_dph, axis_names=low.axis_names, source="<array>",
+                                 input_unit="deg/s", scale_to_internal=3600.0, signal=low.signal)
+    assert again.dt_s == low.dt_s and again.block_average_factor == 3
+    assert "dt_s" not in vars(again) and "block_average_factor" not in vars(again)
+    with pytest.raises(ConfigError, match="block_average_factor 3 vs 1"):
+        io_record.GyroRecord(data_internal=low.rate_dph, axis_names=low.axis_names, source="<array>",
+                             input_unit="deg/s", scale_to_internal=3600.0, signal=low.signal, block_average_factor=1)
+    with pytest.raises(ConfigError, match="needs its sample interval"):
+        io_record.GyroRecord(data_internal=low.rate_dph, axis_names=low.axis_names, source="<array>",
+                             input_unit="deg/s", scale_to_internal=3600.0)
 
 
 def test_description_round_trips_through_json_and_is_designed_for_specific_force():

@@ -651,8 +651,11 @@ def test_metadata_is_json_serialisable(small_csv):
 
 def test_record_constructor_checks():
     with pytest.raises(ConfigError, match="shape"):
-        GyroRecord(np.zeros(5), 1.0, ("a",), "<array>", "deg/h", 1.0)
+        GyroRecord(data_internal=np.zeros(5), dt_s=1.0, axis_names=("a",), source="<array>", input_unit="deg/h",
+                   scale_to_internal=1.0)
     with pytest.raises(ConfigError, match="axis_names"):
-        GyroRecord(np.zeros((5, 2)), 1.0, ("a",), "<array>", "deg/h", 1.0)
+        GyroRecord(data_internal=np.zeros((5, 2)), dt_s=1.0, axis_names=("a",), source="<array>", input_unit="deg/h",
+                   scale_to_internal=1.0)
     with pytest.raises(ConfigError, match="dt_s"):
-        GyroRecord(np.zeros((5, 1)), -1.0, ("a",), "<array>", "deg/h", 1.0)
+        GyroRecord(data_internal=np.zeros((5, 1)), dt_s=-1.0, axis_names=("a",), source="<array>", input_unit="deg/h",
+                   scale_to_internal=1.0)

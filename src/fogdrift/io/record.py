@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import InitVar, dataclass
 
 import numpy as np
 
@@ -29,7 +29,7 @@ _MULTIPLE_RTOL = 1e-6
 RATE_RTOL = 1e-9
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class GyroRecord:
     """A uniformly sampled multi-axis record of gyro and/or accelerometer channels, each in its internal unit.
 
@@ -39,8 +39,10 @@ class GyroRecord:
         Each channel in its quantity's internal unit (:attr:`quantities`, :data:`fogdrift.units.INTERNAL_UNITS`):
         an angular rate in deg/h, a specific force in m/s^2.  Stored as a read-only view (possibly of a memory
         map): copy it before modifying.  :attr:`rate_dph` reads the same array for a record of gyro channels only.
-    dt_s : float
-        Sample interval in s (> 0).
+    dt_s : float, optional
+        Sample interval in s (> 0): builds the default :attr:`signal`; with a ``signal`` it may be left out, and
+        if given must agree with it.  Read back as the property :attr:`dt_s`, which is ``signal.sampling.dt_s``:
+        the record stores its sampling once, in :attr:`signal`.
     axis_names : tuple of str
         One unique name per column of ``data_internal``.
     source : str
@@ -61,7 +63,8 @@ class GyroRecord:
         Unit each axis declared in the file (``gz[deg/s]`` header cells), None where the
         file declares none.  Default: None for every axis.
     block_average_factor : int, optional
-        Product of the block-averaging factors applied since loading (1 = native rate).
+        Product of the block-averaging factors applied since loading (1 = native rate; the default signal's):
+        as ``dt_s``, an argument only, read back from :attr:`signal`.
     temperature_c : ndarray, shape (n_samples,), optional
         Temperature in deg C carried with the log (``load(..., temperature=NAME)``), one value
         per sample; kept through :meth:`slice`, :meth:`select` and block averaging (averaged
@@ -71,6 +74,9 @@ class GyroRecord:
         the interval and each unit came from); kept through :meth:`select` and block averaging.
         Default: made here from ``dt_s``, ``input_unit``, ``scale_to_internal``, ``declared_units`` and
         ``block_average_factor`` with the sources ``"argument"``.  Must agree with those fields.
+        The one home of the sampling: :attr:`dt_s` and :attr:`block_average_factor` read it.
+
+    Every argument is a keyword.
 
     Notes
     -----
@@ -79,7 +85,7 @@ class GyroRecord:
     """
 
     data_internal: np.ndarray
-    dt_s: float
+    dt_s: InitVar[float | None] = None
     axis_names: tuple[str, ...]
     source: str
     input_unit: str
@@ -88,11 +94,11 @@ class GyroRecord:
     notes: tuple[str, ...] = ()
     sha256: str | None = None
     declared_units: tuple[str | None, ...] = ()
-    block_average_factor: int = 1
+    block_average_factor: InitVar[int | None] = None
     temperature_c: np.ndarray | None = None
     signal: SignalDescription | None = None
 
-    def __post_init__(self):
+    def __post_init__(self, dt_s, block_average_factor):
         r = self.data_internal
         if not isinstance(r, np.ndarray) or r.ndim != 2 or r.dtype != np.float64:
             raise ConfigError(
@@ -115,16 +121,17 @@ class GyroRecord:
         if len(declared) != len(names):
             raise ConfigError(f"declared_units must give one unit (or None) per axis {names!r}; got {declared!r}")
         object.__setattr__(self, "declared_units", declared)
-        object.__setattr__(self, "dt_s", units.check_dt_s(self.dt_s, "dt_s"))
+        if dt_s is None and self.signal is None:
+            raise ConfigError("a record needs its sample interval: give dt_s (s) or a signal description")
+        dt = None if dt_s is None else units.check_dt_s(dt_s, "dt_s")
         object.__setattr__(self, "t0_s", float(self.t0_s))
         object.__setattr__(self, "scale_to_internal", float(self.scale_to_internal))
         object.__setattr__(self, "source", str(self.source))
         object.__setattr__(self, "notes", tuple(str(n) for n in self.notes))
         object.__setattr__(self, "sha256", None if self.sha256 is None else str(self.sha256))
-        factor = int_arg(self.block_average_factor, "block_average_factor")
-        if factor < 1:
+        factor = None if block_average_factor is None else int_arg(block_average_factor, "block_average_factor")
+        if factor is not None and factor < 1:
             raise ConfigError(f"block_average_factor must be an integer >= 1; got {factor}")
-        object.__setattr__(self, "block_average_factor", factor)
         if self.temperature_c is not None:
             temp = np.asarray(self.temperature_c)
             if temp.dtype != np.float64 or temp.shape != (r.shape[0],):
@@ -137,9 +144,9 @@ class GyroRecord:
                 temp.flags.writeable = False
             object.__setattr__(self, "temperature_c", temp)
         if self.signal is None:
-            object.__setattr__(self, "signal", self._default_signal())
+            object.__setattr__(self, "signal", self._default_signal(dt, 1 if factor is None else factor))
         else:
-            self._check_signal()
+            self._check_signal(dt, factor)
 
     @property
     def rate_dph(self) -> np.ndarray:
@@ -177,24 +184,26 @@ class GyroRecord:
         """Each channel's quantity (``"angular_rate"`` or ``"specific_force"``), from :attr:`signal`."""
         return tuple(c.quantity for c in self.signal.channels)
 
-    def _default_signal(self) -> SignalDescription:
-        """The description of a record built from its fields (no file: every source is "argument")."""
+    def _default_signal(self, dt_s: float, factor: int) -> SignalDescription:
+        """The description of a record built from its fields and arguments (no file: every source is
+        "argument")."""
         spec = channel_unit(self.input_unit, None)
-        sampling = Sampling(dt_s=self.dt_s, dt_source="argument", block_average_factor=self.block_average_factor)
+        sampling = Sampling(dt_s=dt_s, dt_source="argument", block_average_factor=factor)
         return SignalDescription(sampling, tuple(
             Channel(name=n, unit=spec, unit_source="argument", declared_unit=d, scale_to_internal=self.scale_to_internal)
             for n, d in zip(self.axis_names, self.declared_units)))
 
-    def _check_signal(self) -> None:
+    def _check_signal(self, dt_s, factor) -> None:
+        """``signal`` describes this record: the sampling arguments given (None: not given) and the fields."""
         sig = self.signal
         if not isinstance(sig, SignalDescription):
             raise ConfigError(f"signal must be a fogdrift.signal.SignalDescription; got {type(sig).__name__}")
         smp = sig.sampling
         bad = []
-        if abs(smp.dt_s - self.dt_s) > 1e-12 * self.dt_s:
-            bad.append(f"dt_s {smp.dt_s!r} vs {self.dt_s!r}")
-        if smp.block_average_factor != self.block_average_factor:
-            bad.append(f"block_average_factor {smp.block_average_factor} vs {self.block_average_factor}")
+        if dt_s is not None and abs(smp.dt_s - dt_s) > 1e-12 * dt_s:
+            bad.append(f"dt_s {smp.dt_s!r} vs {dt_s!r}")
+        if factor is not None and smp.block_average_factor != factor:
+            bad.append(f"block_average_factor {smp.block_average_factor} vs {factor}")
         if sig.names != self.axis_names:
             bad.append(f"channels {list(sig.names)} vs axes {list(self.axis_names)}")
         mixed = len({(c.unit_as_read, c.scale_to_internal) for c in sig.channels}) > 1
@@ -436,9 +445,9 @@ class GyroRecord:
         note = f"block-averaged x{m} ({self.dt_s:.10g} s -> {m * self.dt_s:.10g} s), dropped {dropped} trailing samples"
         temp = None if self.temperature_c is None else block_average(self.temperature_c, m)
         signal = self.signal.averaged(m)
-        return dataclasses.replace(self, data_internal=avg, dt_s=signal.sampling.dt_s, notes=self.notes + (note,),
-                                   block_average_factor=signal.sampling.block_average_factor, temperature_c=temp,
-                                   signal=signal)
+        # the sampling is the averaged signal's (replace() would pass the old dt_s and factor on)
+        return dataclasses.replace(self, data_internal=avg, notes=self.notes + (note,), temperature_c=temp,
+                                   signal=signal, dt_s=None, block_average_factor=None)
 
     def metadata(self) -> dict:
         """JSON-serialisable description (no arrays): every field but the data, plus sizes.
@@ -493,6 +502,18 @@ class GyroRecord:
 # --------------------------------------------------------------------------------------------
 # Functions
 # --------------------------------------------------------------------------------------------
+def _sampling_property(name: str, doc: str) -> property:
+    return property(lambda self: getattr(self.signal.sampling, name), doc=doc)
+
+
+# Set after the class is made: ``dt_s`` and ``block_average_factor`` are init-only arguments of the dataclass, and
+# as attributes they read the one stored sampling, ``signal.sampling``.
+GyroRecord.dt_s = _sampling_property("dt_s", "Sample interval in s (``signal.sampling.dt_s``).")
+GyroRecord.block_average_factor = _sampling_property(
+    "block_average_factor", "Product of the block-averaging factors applied since loading, 1 = native rate "
+    "(``signal.sampling.block_average_factor``).")
+
+
 def block_average(x, factor: int) -> np.ndarray:
     """Average non-overlapping blocks of ``factor`` samples along axis 0.
 
