@@ -18,7 +18,8 @@ import pytest
 
 import fogdrift.models as models
 from fogdrift.errors import ConfigError, ModelFileError
-from fogdrift.models import MODEL_NAMES, MODELS, DriftModel, build_model, describe_models, load_model, model_spec
+from fogdrift.models import (MODEL_NAMES, MODELS, DriftModel, build_model, describe_models, load_model, model_spec,
+                             save_model)
 from fogdrift.pipeline import AnalysisConfig
 
 
@@ -151,7 +152,7 @@ def test_loading_linear_models_does_not_import_jax(tmp_path):
     y = np.sin(0.05 * np.arange(300)) + 2.0
     paths = []
     for name, model in (("gm", GM11()), ("ar", AR(order=3)), ("pers", Persistence())):
-        model.fit(y[:200]).save(tmp_path / name)
+        save_model(model.fit(y[:200]), tmp_path / name)
         paths.append(str(tmp_path / name))
     code = ("import numpy as np\nfrom fogdrift.models import load_model, build_model\n"
             f"for p in {paths!r}:\n    m = load_model(p)\n    m.predict(np.ones(20) * 2.0, history=np.ones(20))\n"
@@ -163,7 +164,7 @@ def test_loading_linear_models_does_not_import_jax(tmp_path):
     pytest.importorskip("jax")
     from fogdrift.models.elman import GreyElman
 
-    GreyElman(hidden=2, epochs=2, window=32).fit(y[:200]).save(tmp_path / "ge")
+    save_model(GreyElman(hidden=2, epochs=2, window=32).fit(y[:200]), tmp_path / "ge")
     assert "jax" in _imports_after(f"from fogdrift.models import load_model\nload_model({str(tmp_path / 'ge')!r})")
 
 
