@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import importlib.util
 import inspect
+import json
 
 import numpy as np
 import pytest
@@ -173,7 +174,8 @@ def test_save_load_round_trip(cls, params, fitted_cache, tmp_path):
 @pytest.mark.parametrize("cls, params", CASES)
 def test_the_state_as_data_holds_everything_learned(cls, params, fitted_cache, tmp_path):
     """A model rebuilt from its file has every learned attribute of the original, equal: a field that
-    ``get_state`` drops (or ``set_state`` forgets) shows here even when the predictions do not use it."""
+    ``get_state`` drops (or ``set_state`` forgets) shows here even when the predictions do not use it; and a
+    learned scalar is stored as the JSON kind it is (int, float, bool)."""
     model = _fit(cls, params, fitted_cache)
     save_model(model, tmp_path / "model")
     back = load_model(tmp_path / "model")
@@ -185,6 +187,16 @@ def test_the_state_as_data_holds_everything_learned(cls, params, fitted_cache, t
         assert_array_equal(back_arrays[key], arrays[key], err_msg=key)
     rebuilt = cls(**model.get_params()).set_state(meta, arrays)  # the same through the state API, no file
     _assert_state_equal(_fitted_state(rebuilt), _fitted_state(model))
+    # a scalar keeps its JSON kind in the file (a count written as 300.0 would change every file's bytes)
+    stored = json.loads((tmp_path / "model.json").read_text())["state"]
+    for key, value in stored.items():
+        learned = getattr(model, key, None)
+        if isinstance(learned, (bool, np.bool_)):
+            assert type(value) is bool, key
+        elif isinstance(learned, (int, np.integer)):
+            assert type(value) is int, key
+        elif isinstance(learned, (float, np.floating)):
+            assert type(value) is float or (value is None and not np.isfinite(learned)), key
 
 
 @pytest.mark.parametrize("cls, params", CASES)
