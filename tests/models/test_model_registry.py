@@ -39,6 +39,8 @@ def test_each_row_matches_its_class(spec):
     params = set(inspect.signature(cls.__init__).parameters) - {"self"}
     assert {k for k, _ in spec.settings} <= params
     assert {k for k, _ in spec.fixed} <= params
+    assert set(spec.inputs) <= params
+    assert ("progress" in spec.inputs) == ("progress" in params)  # a model that reports progress declares it
     assert all(hasattr(AnalysisConfig(), attr) for _, attr in spec.settings)
     assert getattr(models, spec.cls) is cls  # lazy package attribute
 
@@ -240,11 +242,20 @@ def test_a_recurrent_network_too_large_for_the_memory_budget_is_refused_before_a
 
 
 def test_declared_inputs_reach_only_the_models_that_declare_them():
-    """The Kalman row declares ``dt_s`` (it works in seconds) and reads ``noise_method`` from the settings; a model
-    whose row declares no input is built without them (an undeclared keyword would be a TypeError)."""
+    """The Kalman row declares ``dt_s`` (it works in seconds) and reads ``noise_method`` from the settings, the
+    Elman rows declare ``progress``; a model whose row declares no input is built without them (an undeclared
+    keyword would be a TypeError)."""
     from fogdrift.models.registry import build_model, model_spec
 
     assert model_spec("kalman").inputs == ("dt_s",) and model_spec("ar").inputs == ()
     k = build_model("kalman", {"noise_method": "gmwm"}, inputs={"dt_s": 0.5, "unused": 1})
     assert k.get_params()["dt_s"] == 0.5 and k.get_params()["noise_method"] == "gmwm"
     assert build_model("ar", {"lags": 3}, inputs={"dt_s": 0.5}).get_params()["order"] == 3
+    # the progress callback reaches the rows that declare it, and only them, from either argument
+    def report(*args):
+        pass
+
+    assert model_spec("elman").inputs == ("progress",)
+    assert build_model("elman", inputs={"progress": report}).progress is report
+    assert build_model("elman", progress=report).progress is report
+    assert build_model("kalman", progress=report, inputs={"dt_s": 0.5}).get_params()["dt_s"] == 0.5
