@@ -50,12 +50,12 @@ def test_bundle_manifest_and_model_json_are_strict(small, tmp_path):
         text = p.read_text()
         json.loads(text, parse_constant=lambda c: pytest.fail(f"{p.name}: non-standard JSON constant {c}"))
 
-    from fogdrift.models import Persistence
+    from fogdrift.models import Persistence, save_model
 
     m = Persistence().fit(np.arange(50.0))
     meta, arrays = m._get_state()
     m._get_state = lambda: ({**meta, "extra": float("nan"), "big": np.float64("inf")}, arrays)
-    json_path, _ = m.save(tmp_path / "m")
+    json_path, _ = save_model(m, tmp_path / "m")
     doc = json.loads(json_path.read_text(), parse_constant=lambda c: pytest.fail(f"model JSON holds {c}"))
     assert doc["state"]["extra"] is None and doc["state"]["big"] is None
 

@@ -11,7 +11,7 @@ Layout (no pickle; every file is JSON or NPZ)::
                              analysis settings, and per axis: bias and
                              how it was estimated, Earth-rate setting, level, causal-drift window,
                              noise model, and the model files with their SHA-256
-      <axis>/<model>.json    one fitted drift model (:meth:`fogdrift.models.DriftModel.save`)
+      <axis>/<model>.json    one fitted drift model (:func:`fogdrift.models.save_model`)
       <axis>/<model>.npz
 
 Model keys are registry names (:data:`fogdrift.models.MODEL_NAMES`: ``"ar"``, ``"kalman"``, ...).
@@ -55,8 +55,8 @@ from .allan import allan_variance
 from .errors import ConfigError, FogdriftError, ModelFileError
 from .io.hashing import file_sha256
 from .lifting import MODES, max_level, wavelist
-from .models import MODELS, MODEL_NAMES, load_model, model_spec
-from .models.base import model_file_paths
+from .models import MODELS, MODEL_NAMES, load_model, model_spec, save_model
+from .models.model_files import model_file_paths
 from .noise import fit_noise
 from .output import atomic_path
 from .signal import Channel, Sampling, SignalDescription, channel_unit
@@ -323,7 +323,7 @@ def save_bundle(bundle: Bundle, out_dir) -> Path:
         files = {}
         for name, model in ax.models.items():
             rel = f"{safe_name(ax.name)}/{safe_name(name)}"
-            json_path, npz_path = model.save(out / rel)
+            json_path, npz_path = save_model(model, out / rel)
             files[name] = {"file": rel, "class": type(model).__name__, "label": model.label,
                            "input": model.input_kind,
                            "sha256": {"json": file_sha256(json_path), "npz": file_sha256(npz_path)}}

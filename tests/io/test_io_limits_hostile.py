@@ -189,7 +189,7 @@ def test_every_json_yaml_input_refuses_hostile_documents_in_one_line(hostile, ar
 
 def test_a_model_file_of_a_bundle_is_read_within_the_limits(tmp_path):
     from fogdrift.errors import ModelFileError
-    from fogdrift.models.base import load_model
+    from fogdrift.models import load_model
 
     (tmp_path / "ar.json").write_text('{"format": "fogdrift-model", "x": ' + "[" * 1000 + "]" * 1000 + "}")
     with pytest.raises(ModelFileError, match="nested more than 64 levels"):

@@ -17,7 +17,7 @@ from fogdrift.models.ar import AR, ar_aic, ar_fit
 from fogdrift.errors import ConfigError, InsufficientDataError, NotFittedError
 from fogdrift.models.grey import GM11
 from fogdrift.metrics import rmse
-from fogdrift.models import Persistence, load_model
+from fogdrift.models import Persistence, load_model, save_model
 
 PHI = (0.6, -0.3)
 C_TRUE = 0.5
@@ -128,7 +128,7 @@ def test_ar_errors_and_persistence(tmp_path):
     model = AR(order=2).fit(y[:20])
     with pytest.raises(InsufficientDataError):
         model.forecast(3, history=y[:1])
-    model.save(tmp_path / "ar")
+    save_model(model, tmp_path / "ar")
     back = load_model(tmp_path / "ar")
     assert_allclose(back.predict(y[20:], history=y[:20]), model.predict(y[20:], history=y[:20]), rtol=0, atol=0)
 

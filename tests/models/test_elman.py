@@ -31,7 +31,7 @@ from fogdrift.models.elman import (  # noqa: E402
 )
 from fogdrift.models.training import IMPROVE_RTOL, RecurrentCell  # noqa: E402
 from fogdrift.errors import ConfigError, InsufficientDataError, NotFittedError  # noqa: E402
-from fogdrift.models import Persistence, load_model  # noqa: E402
+from fogdrift.models import Persistence, load_model, save_model  # noqa: E402
 
 
 @pytest.fixture
@@ -195,7 +195,7 @@ def test_save_load_identical(tmp_path, drift, fitted):
     y = drift
     for name, model in fitted.items():
         model.progress = lambda *a: None  # a callable parameter must not break saving
-        model.save(tmp_path / name)
+        save_model(model, tmp_path / name)
         loaded = load_model(tmp_path / name)
         assert type(loaded) is type(model) and loaded.progress is None
         np.testing.assert_array_equal(loaded.predict(y[N_TR:], history=y[:N_TR]),

@@ -31,7 +31,7 @@ from fogdrift.models.grey import (
     posterior_variance_ratio,
     small_error_probability,
 )
-from fogdrift.models import load_model
+from fogdrift.models import load_model, save_model
 
 R12_X0 = [2.874, 3.278, 3.337, 3.390, 3.679]
 TOY = np.array([-0.02, 0.01, 0.03, -0.01, 0.02, 0.04])  # method notes §3.3
@@ -289,7 +289,7 @@ def test_gm11_save_load_identical(tmp_path):
     y = np.cumsum(rng.normal(0, 0.01, 100))
     for mode in ("rolling", "whole"):
         model = GM11(mode=mode, window=5).fit(y[:70])
-        model.save(tmp_path / mode)
+        save_model(model, tmp_path / mode)
         back = load_model(tmp_path / mode)
         assert isinstance(back, GM11) and back.get_params() == model.get_params()
         assert_allclose(back.predict(y[70:], history=y[:70]), model.predict(y[70:], history=y[:70]), rtol=0, atol=0)

@@ -195,3 +195,23 @@ def test_pipeline_feeds_the_kalman_the_rate(bundled_record):
     assert ref.components_ == model.components_
     e, f = ma.split["test"]
     assert_array_equal(ma.causal_predictions["Kalman"], ref.predict(ma.rate_dph[e:f], history=ma.rate_dph[:e]))
+
+
+def test_a_model_file_whose_states_do_not_match_its_components_is_refused(tmp_path):
+    """The state names are stored beside the components; a file where they disagree (edited, or written by a
+    filter with other states) is refused naming the file, not loaded into a filter of the wrong shape."""
+    import json
+
+    from fogdrift.errors import ModelFileError
+    from fogdrift.models import load_model, save_model
+
+    comps = [{"kind": "white", "arw_dprh": 1e-3}, {"kind": "gauss_markov", "tc_s": 30.0, "sigma_dph": 0.05}]
+    y = np.random.default_rng(8).normal(0.0, 0.1, 300)
+    json_path, _ = save_model(Kalman(components=comps).fit(y), tmp_path / "k")
+    doc = json.loads(json_path.read_text())
+    assert load_model(tmp_path / "k").state_names_ == tuple(doc["state"]["state_names_"])
+    doc["state"]["state_names_"] = doc["state"]["state_names_"][:1]
+    json_path.write_text(json.dumps(doc))
+    with pytest.raises(ModelFileError, match=r"k\.json: the stored state does not describe a fitted Kalman "
+                                             r"\(.*do not match the components"):
+        load_model(tmp_path / "k")

@@ -19,7 +19,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from fogdrift.errors import ConfigError, InsufficientDataError
 from fogdrift.models import kalman as kalman_module
-from fogdrift.models import load_model
+from fogdrift.models import load_model, save_model
 from fogdrift.models.components import components_from_gmwm
 from fogdrift.models.kalman import GMWM_MIN_SAMPLES, Kalman
 from fogdrift.models.statespace import components_from_allan
@@ -157,7 +157,7 @@ def test_gmwm_kalman_model_file_round_trip(tmp_path):
     rng = np.random.default_rng(3)
     y = np.cumsum(rng.normal(0.0, 0.05, 2000)) + rng.normal(0.0, 6.0, 2000)
     model = Kalman(noise_method="gmwm").fit(y[:1500])
-    json_path, _ = model.save(tmp_path / "kal")
+    json_path, _ = save_model(model, tmp_path / "kal")
     doc = json.loads(json_path.read_text())
     assert doc["params"]["noise_method"] == "gmwm"
     assert doc["state"]["identification_"]["method"] == "gmwm"

@@ -1,5 +1,5 @@
-"""``models/base.py`` at its edges: the parameter interface, the model-file layout and every refusal of
-:func:`load_model`, each with the message a user sees (the mutation run left these unasserted).
+"""``models/base.py`` and ``models/model_files.py`` at their edges: the parameter interface, the model-file layout
+and every refusal of :func:`load_model`, each with the message a user sees.
 
 Expected values are written out by hand: the JSON keys of a model file, the repr of a model, and the
 one-line ``ModelFileError`` for each way a file can be wrong (path first, then what is wrong).
@@ -14,12 +14,11 @@ import numpy as np
 import pytest
 
 from fogdrift.errors import ConfigError, ModelFileError, NotFittedError
-from fogdrift.models import AR, Persistence, load_model
-from fogdrift.models.base import FORMAT_VERSION
+from fogdrift.models import AR, FORMAT_VERSION, DriftModel, Persistence, load_model, save_model
 
 
 def _saved(tmp_path, name="m"):
-    Persistence().fit([0.1, 0.25]).save(tmp_path / name)
+    save_model(Persistence().fit([0.1, 0.25]), tmp_path / name)
     return tmp_path / f"{name}.json", tmp_path / f"{name}.npz"
 
 
@@ -59,7 +58,7 @@ def test_repr_lists_the_parameters_in_constructor_order():
 
 def test_unfitted_model_refuses_to_save(tmp_path):
     with pytest.raises(NotFittedError, match=r"Persistence.*not fitted.*fit\("):
-        Persistence().save(tmp_path / "m")
+        save_model(Persistence(), tmp_path / "m")
     assert list(tmp_path.iterdir()) == []
 
 
@@ -74,7 +73,7 @@ def test_fitted_means_an_attribute_ending_in_underscore():
 # -- the file layout -------------------------------------------------------------------------
 def test_model_file_holds_exactly_the_documented_keys(tmp_path):
     m = AR(order=2).fit(np.random.default_rng(5).standard_normal(300))
-    json_path, npz_path = m.save(tmp_path / "ar")
+    json_path, npz_path = save_model(m, tmp_path / "ar")
     doc = json.loads(json_path.read_text())
     assert list(doc) == ["format", "format_version", "class", "params", "state"]
     assert doc["format"] == "fogdrift-model" and doc["format_version"] == FORMAT_VERSION == 1
@@ -89,7 +88,7 @@ def test_model_file_holds_exactly_the_documented_keys(tmp_path):
 def test_numpy_scalars_in_the_state_are_written_as_json_numbers(tmp_path):
     m = Persistence().fit([1.0])
     m.last_ = np.float32(0.5)  # not a Python float subclass (np.float64 is): needs the json default hook
-    json_path, _ = m.save(tmp_path / "p")
+    json_path, _ = save_model(m, tmp_path / "p")
     assert json.loads(json_path.read_text())["state"] == {"last_": 0.5}
 
 
@@ -98,17 +97,18 @@ def test_numpy_scalars_in_the_state_are_written_as_json_numbers(tmp_path):
     [("drift.v2", "drift.v2"), ("drift.v2.json", "drift.v2"), ("drift.npz", "drift"), ("drift", "drift")],
 )
 def test_other_suffixes_are_part_of_the_name(tmp_path, given, stem):
-    json_path, npz_path = Persistence().fit([0.4]).save(tmp_path / given)
+    json_path, npz_path = save_model(Persistence().fit([0.4]), tmp_path / given)
     assert (json_path.name, npz_path.name) == (f"{stem}.json", f"{stem}.npz")
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([f"{stem}.json", f"{stem}.npz"])
     assert load_model(tmp_path / given).last_ == 0.4
 
 
-def test_load_through_the_class_checks_the_stored_class(tmp_path):
+def test_load_with_an_expected_class_checks_the_stored_class(tmp_path):
     _saved(tmp_path)
-    assert Persistence.load(tmp_path / "m").last_ == 0.25
+    assert load_model(tmp_path / "m", expected=Persistence).last_ == 0.25
+    assert isinstance(load_model(tmp_path / "m", expected=DriftModel), Persistence)  # a subclass is accepted
     with pytest.raises(ModelFileError) as err:
-        AR.load(tmp_path / "m")
+        load_model(tmp_path / "m", expected=AR)
     assert str(err.value) == f"{tmp_path / 'm'}: holds a Persistence, not a AR"
 
 
@@ -186,7 +186,7 @@ def test_state_without_a_fitted_attribute(tmp_path):
 
 
 def test_state_missing_an_array(tmp_path):
-    AR(order=2).fit(np.random.default_rng(1).standard_normal(200)).save(tmp_path / "ar")
+    save_model(AR(order=2).fit(np.random.default_rng(1).standard_normal(200)), tmp_path / "ar")
     np.savez(tmp_path / "ar.npz")
     with pytest.raises(ModelFileError, match=r"ar\.json.*not describe a fitted AR"):
         load_model(tmp_path / "ar")
@@ -200,7 +200,7 @@ def test_state_missing_an_array(tmp_path):
     ],
 )
 def test_parameters_that_do_not_fit_the_class(tmp_path, params, message):
-    AR(order=2).fit(np.random.default_rng(2).standard_normal(200)).save(tmp_path / "ar")
+    save_model(AR(order=2).fit(np.random.default_rng(2).standard_normal(200)), tmp_path / "ar")
     _rewrite(tmp_path / "ar.json", params=params)
     with pytest.raises(ModelFileError) as err:
         load_model(tmp_path / "ar")

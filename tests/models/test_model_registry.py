@@ -18,7 +18,8 @@ import pytest
 
 import fogdrift.models as models
 from fogdrift.errors import ConfigError, ModelFileError
-from fogdrift.models import MODEL_NAMES, MODELS, DriftModel, build_model, describe_models, load_model, model_spec
+from fogdrift.models import (MODEL_NAMES, MODELS, DriftModel, build_model, describe_models, load_model, model_spec,
+                             save_model)
 from fogdrift.pipeline import AnalysisConfig
 
 
@@ -38,6 +39,8 @@ def test_each_row_matches_its_class(spec):
     params = set(inspect.signature(cls.__init__).parameters) - {"self"}
     assert {k for k, _ in spec.settings} <= params
     assert {k for k, _ in spec.fixed} <= params
+    assert set(spec.inputs) <= params
+    assert ("progress" in spec.inputs) == ("progress" in params)  # a model that reports progress declares it
     assert all(hasattr(AnalysisConfig(), attr) for _, attr in spec.settings)
     assert getattr(models, spec.cls) is cls  # lazy package attribute
 
@@ -151,7 +154,7 @@ def test_loading_linear_models_does_not_import_jax(tmp_path):
     y = np.sin(0.05 * np.arange(300)) + 2.0
     paths = []
     for name, model in (("gm", GM11()), ("ar", AR(order=3)), ("pers", Persistence())):
-        model.fit(y[:200]).save(tmp_path / name)
+        save_model(model.fit(y[:200]), tmp_path / name)
         paths.append(str(tmp_path / name))
     code = ("import numpy as np\nfrom fogdrift.models import load_model, build_model\n"
             f"for p in {paths!r}:\n    m = load_model(p)\n    m.predict(np.ones(20) * 2.0, history=np.ones(20))\n"
@@ -163,7 +166,7 @@ def test_loading_linear_models_does_not_import_jax(tmp_path):
     pytest.importorskip("jax")
     from fogdrift.models.elman import GreyElman
 
-    GreyElman(hidden=2, epochs=2, window=32).fit(y[:200]).save(tmp_path / "ge")
+    save_model(GreyElman(hidden=2, epochs=2, window=32).fit(y[:200]), tmp_path / "ge")
     assert "jax" in _imports_after(f"from fogdrift.models import load_model\nload_model({str(tmp_path / 'ge')!r})")
 
 
@@ -239,11 +242,20 @@ def test_a_recurrent_network_too_large_for_the_memory_budget_is_refused_before_a
 
 
 def test_declared_inputs_reach_only_the_models_that_declare_them():
-    """The Kalman row declares ``dt_s`` (it works in seconds) and reads ``noise_method`` from the settings; a model
-    whose row declares no input is built without them (an undeclared keyword would be a TypeError)."""
+    """The Kalman row declares ``dt_s`` (it works in seconds) and reads ``noise_method`` from the settings, the
+    Elman rows declare ``progress``; a model whose row declares no input is built without them (an undeclared
+    keyword would be a TypeError)."""
     from fogdrift.models.registry import build_model, model_spec
 
     assert model_spec("kalman").inputs == ("dt_s",) and model_spec("ar").inputs == ()
     k = build_model("kalman", {"noise_method": "gmwm"}, inputs={"dt_s": 0.5, "unused": 1})
     assert k.get_params()["dt_s"] == 0.5 and k.get_params()["noise_method"] == "gmwm"
     assert build_model("ar", {"lags": 3}, inputs={"dt_s": 0.5}).get_params()["order"] == 3
+    # the progress callback reaches the rows that declare it, and only them, from either argument
+    def report(*args):
+        pass
+
+    assert model_spec("elman").inputs == ("progress",)
+    assert build_model("elman", inputs={"progress": report}).progress is report
+    assert build_model("elman", progress=report).progress is report
+    assert build_model("kalman", progress=report, inputs={"dt_s": 0.5}).get_params()["dt_s"] == 0.5

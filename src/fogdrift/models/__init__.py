@@ -3,7 +3,9 @@
 Layout
 ------
 * :mod:`~fogdrift.models.base` — :class:`DriftModel` (the contract: ``fit``/``predict``/``forecast``,
-  JSON + NPZ ``save``), :func:`load_model`, :data:`FORMAT_VERSION`;
+  the fitted state as data: ``get_state``/``set_state``);
+* :mod:`~fogdrift.models.model_files` — model files (JSON + NPZ, no pickle): :func:`save_model`,
+  :func:`load_model`, :data:`FORMAT_VERSION`;
 * :mod:`~fogdrift.models.registry` — the table from model name to lazily imported class, its
   settings and help text: :data:`MODEL_NAMES`, :func:`build_model`, :func:`describe_models`;
 * :mod:`~fogdrift.models.persistence` — :class:`Persistence`, the baseline;
@@ -20,7 +22,8 @@ is imported on first access, through the registry.
 from __future__ import annotations
 
 from . import registry as _registry
-from .base import FORMAT_VERSION, DriftModel, check_series, load_model
+from .base import DriftModel, check_series
+from .model_files import FORMAT_VERSION, load_model, save_model
 from .persistence import Persistence
 from .registry import (MODEL_NAMES, MODELS, ModelParam, ModelSpec, build_model, check_model_params, declared_params,
                        describe_models, model_class, model_spec, parse_model_params)
@@ -28,6 +31,7 @@ from .registry import (MODEL_NAMES, MODELS, ModelParam, ModelSpec, build_model, 
 __all__ = [
     "DriftModel",
     "FORMAT_VERSION",
+    "save_model",
     "load_model",
     "check_series",
     "Persistence",

@@ -1,4 +1,4 @@
-"""Estimator-style interface shared by every drift model, and the persistence baseline.
+"""Estimator-style interface shared by every drift model.
 
 Contract (scikit-learn shape, see ``docs`` and the style examples):
 
@@ -11,42 +11,30 @@ Contract (scikit-learn shape, see ``docs`` and the style examples):
   ``y``) and ``y[:k]``; entries with too little history are NaN;
 * ``forecast(h, history=None)`` runs free for ``h`` steps after the end of ``history``
   (default: after the end of the training block), feeding predictions back;
-* ``save(path)`` writes ``path.json`` (class, format version, hyper-parameters, small state)
-  and ``path.npz`` (arrays); :func:`load_model` reads them back without pickle.
+* ``get_state()`` gives the fitted state as data (a JSON-ready dict and a dict of arrays) and
+  ``set_state(meta, arrays)`` takes it back; the model does no file I/O:
+  :mod:`fogdrift.models.model_files` writes and reads model files (JSON + NPZ, no pickle).
 
 Series are 1-D float arrays of drift samples in deg/h at a fixed sample interval.
-
-Model files name their class (``"class": "GM11"``); :func:`load_model` finds the module of that
-class in the registry table (:mod:`fogdrift.models.registry`) and imports only that module, so
-loading a GM(1,1), AR or persistence model never imports JAX.
 """
 
 from __future__ import annotations
 
 import inspect
-import json
-from pathlib import Path
 
-import numpy as np
+from .._util import check_series
+from ..errors import ConfigError, NotFittedError
 
-from .. import documents
-from .._util import check_series, strict_json
-from ..errors import ConfigError, ModelFileError, NotFittedError
-from ..output import atomic_path
-from .registry import class_for_file, file_class_names
-
-__all__ = ["DriftModel", "load_model", "model_file_paths", "check_series", "FORMAT_VERSION"]
-
-#: Version of the model-file layout (JSON keys and NPZ array names); unchanged since the first release.
-FORMAT_VERSION = 1
+__all__ = ["DriftModel", "check_series"]
 
 
 class DriftModel:
-    """Base class of drift models: parameter handling, fitted check, JSON + NPZ persistence.
+    """Base class of drift models: parameter handling, fitted check, fitted state as data.
 
     Subclasses implement ``fit``, ``predict``, ``forecast`` and the two state hooks
     ``_get_state() -> (meta: dict, arrays: dict[str, ndarray])`` and
-    ``_set_state(meta, arrays)``; ``meta`` must be JSON-serialisable.
+    ``_set_state(meta, arrays)``; ``meta`` must be JSON-serialisable.  :meth:`get_state` and
+    :meth:`set_state` are their public faces (the first checks that the model is fitted).
     """
 
     #: Name shown in tables and reports (the registry row repeats it for CLI help).
@@ -106,113 +94,26 @@ class DriftModel:
     def _set_state(self, meta: dict, arrays: dict) -> None:  # pragma: no cover - abstract
         raise NotImplementedError
 
-    # -- persistence ----------------------------------------------------------------------
-    def save(self, path) -> tuple[Path, Path]:
-        """Write ``<path>.json`` and ``<path>.npz``; returns both paths."""
+    # -- state as data ------------------------------------------------------------------------
+    def get_state(self) -> tuple[dict, dict]:
+        """The fitted state as data: ``(meta, arrays)``.
+
+        ``meta`` is a JSON-ready dict (numbers, strings, lists), ``arrays`` a dict of NumPy arrays by name;
+        :func:`~fogdrift.models.model_files.save_model` writes them, with :meth:`get_params`, to a model file.
+
+        Raises
+        ------
+        NotFittedError
+            The model is not fitted.
+        """
         self._check_fitted()
-        json_path, npz_path = model_file_paths(path)
-        meta, arrays = self._get_state()
-        doc = {
-            "format": "fogdrift-model",
-            "format_version": FORMAT_VERSION,
-            "class": type(self).__name__,
-            "params": self._serialisable_params(),
-            "state": meta,
-        }
-        # each file complete or absent (temporary name, renamed when written): fogdrift.output.atomic_path
-        with atomic_path(json_path) as tmp:
-            tmp.write_text(strict_json(doc))
-        with atomic_path(npz_path) as tmp:
-            np.savez(tmp, **{k: np.asarray(v) for k, v in arrays.items()})
-        return json_path, npz_path
+        return self._get_state()
 
-    @classmethod
-    def load(cls, path):
-        """Load a model saved by :meth:`save`; the stored class must be ``cls`` or a subclass."""
-        model = load_model(path)
-        if not isinstance(model, cls):
-            raise ModelFileError(f"{path}: holds a {type(model).__name__}, not a {cls.__name__}")
-        return model
+    def set_state(self, meta: dict, arrays: dict):
+        """Take a fitted state as :meth:`get_state` gives it; returns ``self``.
 
-
-def model_file_paths(path) -> tuple[Path, Path]:
-    """The two files of a model saved under ``path``: ``(<base>.json, <base>.npz)``.
-
-    A ``.json`` or ``.npz`` suffix of ``path`` is dropped; any other suffix is part of the name
-    (``drift.v2`` -> ``drift.v2.json``, not ``drift.json``).
-
-    Examples
-    --------
-    >>> [p.name for p in model_file_paths("models/drift.v2")]
-    ['drift.v2.json', 'drift.v2.npz']
-    >>> [p.name for p in model_file_paths("models/drift.npz")]
-    ['drift.json', 'drift.npz']
-    """
-    base = Path(path)
-    if base.suffix in (".json", ".npz"):
-        base = base.with_suffix("")
-    return base.with_name(base.name + ".json"), base.with_name(base.name + ".npz")
-
-
-def load_model(path) -> DriftModel:
-    """Load a drift model from ``<path>.json`` + ``<path>.npz`` (no pickle).
-
-    Parameters
-    ----------
-    path : str or Path
-        Base path as given to :meth:`DriftModel.save` (a ``.json`` or ``.npz`` suffix is dropped).
-
-    Returns
-    -------
-    DriftModel
-        A fitted model of the class named in the file; only that class's module is imported.
-
-    Raises
-    ------
-    ModelFileError
-        Missing or corrupt file, another format version, a class the registry does not know, or
-        parameters/state that do not describe a fitted model of that class.
-    """
-    json_path, npz_path = model_file_paths(path)
-    try:
-        doc = documents.read(json_path, yaml=False)
-    except FileNotFoundError:
-        raise ModelFileError(f"{json_path}: model file not found") from None
-    except documents.DocumentError as exc:
-        raise ModelFileError(str(exc)) from None
-    except json.JSONDecodeError as exc:
-        raise ModelFileError(f"{json_path}:{exc.lineno}:{exc.colno}: not valid JSON ({exc.msg})") from exc
-    if not isinstance(doc, dict) or doc.get("format") != "fogdrift-model":
-        raise ModelFileError(f"{json_path}: not a fogdrift model file")
-    if doc.get("format_version") != FORMAT_VERSION:
-        raise ModelFileError(
-            f"{json_path}: format version {doc.get('format_version')!r}; this fogdrift reads {FORMAT_VERSION}"
-        )
-    cls = class_for_file(doc.get("class"))
-    if cls is None:
-        raise ModelFileError(f"{json_path}: unknown model class {doc.get('class')!r}; "
-                             f"expected one of {', '.join(file_class_names())}")
-    try:
-        with np.load(npz_path, allow_pickle=False) as npz:
-            arrays = {k: npz[k] for k in npz.files}
-    except FileNotFoundError:
-        raise ModelFileError(f"{npz_path}: model array file not found") from None
-    except (ValueError, OSError) as exc:
-        raise ModelFileError(f"{npz_path}: cannot read arrays ({exc})") from exc
-    params, state = doc.get("params", {}), doc.get("state")
-    if not isinstance(params, dict):
-        raise ModelFileError(f"{json_path}: 'params' must be an object, not {type(params).__name__}")
-    if not isinstance(state, dict):
-        raise ModelFileError(f"{json_path}: no fitted state (the 'state' object is missing or not an object)")
-    try:
-        model = cls(**params)
-    except TypeError as exc:
-        raise ModelFileError(f"{json_path}: parameters do not fit a {cls.__name__} ({exc})") from exc
-    try:
-        model._set_state(state, arrays)
-    except (KeyError, TypeError, ValueError, IndexError) as exc:
-        raise ModelFileError(
-            f"{json_path}: the stored state does not describe a fitted {cls.__name__} "
-            f"(missing or malformed {exc!s}); save the model again"
-        ) from exc
-    return model
+        The hyper-parameters come from the constructor; ``KeyError``, ``TypeError``, ``ValueError`` or
+        ``IndexError`` say that ``meta``/``arrays`` do not describe a fitted model of this class.
+        """
+        self._set_state(meta, arrays)
+        return self

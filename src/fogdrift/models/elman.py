@@ -341,7 +341,7 @@ class Elman(DriftModel):
         Network dtype; float64 needs ``jax_enable_x64``.
     progress : callable or None
         ``progress(epoch, n_epochs, train_loss, val_loss)`` called after every epoch (in
-        batches of 25 epochs). Not saved by :meth:`save`.
+        batches of 25 epochs). Written as null in a model file (:func:`~fogdrift.models.save_model`).
 
     Attributes
     ----------
@@ -567,15 +567,7 @@ class Elman(DriftModel):
             out[t] = self.x_mean_ + self.x_std_ * z_hat
         return out
 
-    # -- persistence ---------------------------------------------------------------------------
-    def save(self, path):
-        """Write ``<path>.json`` + ``<path>.npz`` (the ``progress`` callable is not saved)."""
-        progress, self.progress = self.progress, None
-        try:
-            return super().save(path)
-        finally:
-            self.progress = progress
-
+    # -- fitted state as data (the ``progress`` callable is a parameter, saved as null) ---------
     def _get_state(self):
         meta = {"x_mean_": self.x_mean_, "x_std_": self.x_std_, "n_train_": self.n_train_,
                 "best_epoch_": self.best_epoch_, "n_epochs_": self.n_epochs_, "x1_last_": self.x1_last_}

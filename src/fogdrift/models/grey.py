@@ -741,7 +741,7 @@ class GM11(DriftModel):
             buf[:, w + i] = _gm11_next_batch(buf[:, i:i + w])
         return buf[:, w:] - self.shift_
 
-    # -- persistence ----------------------------------------------------------------------------
+    # -- fitted state as data ------------------------------------------------------------------
     def _get_state(self):
         meta = {
             k: getattr(self, k)

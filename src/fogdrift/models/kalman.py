@@ -31,7 +31,7 @@ import numpy as np
 
 from .._util import check_series
 from ..allan import allan_variance
-from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError, ModelFileError
+from ..errors import ConfigError, FogdriftError, FogdriftWarning, InsufficientDataError
 from ..gmwm.analysis import analyse_gmwm
 from ..noise import fit_noise
 from ..noise.terms import TERMS
@@ -348,7 +348,7 @@ class Kalman(DriftModel):
             raise ConfigError(f"h must be an integer >= 0; got {h!r}")
         return forecast_uncertainty(self._ss, int(h), self._start_state(history, state))
 
-    # -- persistence ----------------------------------------------------------------------------
+    # -- fitted state as data ------------------------------------------------------------------
     def _get_state(self):
         meta = {"components_": self.components_, "identification_": self.identification_,
                 "bias_prior_dph_": self.bias_prior_dph_, "state_names_": list(self.state_names_)}
@@ -361,8 +361,7 @@ class Kalman(DriftModel):
         self._ss = state_space(self.components_, dt_s=self._validate(), bias_prior_dph=self.bias_prior_dph_)
         self.state_names_ = self._ss.names
         if tuple(meta["state_names_"]) != self.state_names_:
-
-            raise ModelFileError(f"Kalman model file: states {meta['state_names_']} do not match the components "
-                                 f"({list(self.state_names_)})")
+            raise ValueError(f"states {meta['state_names_']} do not match the components "
+                             f"({list(self.state_names_)})")
         self.x_end_ = np.asarray(arrays["x_end_"], dtype=np.float64)
         self.P_end_ = np.asarray(arrays["P_end_"], dtype=np.float64)

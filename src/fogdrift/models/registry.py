@@ -90,9 +90,10 @@ class ModelSpec:
     params : tuple of ModelParam
         Hyper-parameters users may set by name (:func:`parse_model_params`, ``AnalysisConfig.model_params``).
     inputs : tuple of str
-        Constructor keywords the caller supplies from the data, not from the settings (``"dt_s"``: the sample
-        interval at the modelling rate, for a model that works in seconds); :func:`build_model` takes them as
-        ``inputs=``.
+        Constructor keywords the caller supplies at run time, not from the settings: ``"dt_s"`` (the sample
+        interval at the modelling rate, for a model that works in seconds; :func:`build_model` takes it in
+        ``inputs=``) and ``"progress"`` (the per-epoch callback of a model that trains; ``progress=``).  A model
+        is given only what its row declares.
     """
 
     name: str
@@ -128,6 +129,8 @@ def recurrent_memory_need(n_hidden: int, n_inputs: int) -> int:
 
 _RECURRENT = (("lags", "lags"), ("hidden", "hidden"), ("activation", "activation"), ("training", "training"),
               ("epochs", "epochs"), ("seed", "seed"))
+#: The recurrent rows report their training epochs to the caller's progress callback.
+_RECURRENT_INPUTS = ("progress",)
 _RECURRENT_PARAMS = (
     ModelParam("patience", int, "early stopping: epochs without a better validation loss before training stops"),
     ModelParam("learning_rate", float, "step size of the optimiser (default: the training scheme's own)"),
@@ -139,9 +142,10 @@ _RECURRENT_PARAMS = (
 MODELS: tuple[ModelSpec, ...] = (
     ModelSpec("grey-elman", "fogdrift.models.elman", "GreyElman", "grey-Elman",
               "Elman network on the AGO of the drift, restored by IAGO (Tang et al. 2012)", _RECURRENT,
-              params=_RECURRENT_PARAMS),
+              params=_RECURRENT_PARAMS, inputs=_RECURRENT_INPUTS),
     ModelSpec("elman", "fogdrift.models.elman", "Elman", "Elman",
-              "Elman recurrent network on the last `lags` drift samples", _RECURRENT, params=_RECURRENT_PARAMS),
+              "Elman recurrent network on the last `lags` drift samples", _RECURRENT, params=_RECURRENT_PARAMS,
+              inputs=_RECURRENT_INPUTS),
     ModelSpec("gm11", "fogdrift.models.grey", "GM11", "GM(1,1)",
               "rolling GM(1,1) grey model over the last `gm_window` samples", (("window", "gm_window"),),
               (("mode", "rolling"),),
@@ -299,8 +303,8 @@ def build_model(name: str, settings=None, progress=None, *, inputs=None):
         :class:`~fogdrift.pipeline.AnalysisConfig` (``lags``, ``hidden``, ``activation``,
         ``training``, ``epochs``, ``seed``, ``gm_window``). None: the class defaults.
     progress : callable, optional
-        ``progress(epoch, n_epochs, train_loss, val_loss)``, passed to models that take one
-        (the recurrent ones); ignored by the others.
+        ``progress(epoch, n_epochs, train_loss, val_loss)``, passed to the models whose row declares it
+        (``ModelSpec.inputs``: the recurrent ones); ignored by the others.
     inputs : mapping, optional
         Values from the data (``{"dt_s": 1.0}``); a model receives those its row declares (``ModelSpec.inputs``),
         the others are not passed.
@@ -337,9 +341,8 @@ def build_model(name: str, settings=None, progress=None, *, inputs=None):
     if settings is not None:
         mp = settings.get("model_params") if isinstance(settings, Mapping) else getattr(settings, "model_params", None)
         kwargs.update((mp or {}).get(spec.name, {}))
-    if progress is not None and "progress" in cls._param_names():
-        kwargs["progress"] = progress
-    kwargs.update({k: v for k, v in (inputs or {}).items() if k in spec.inputs})
+    given = {**(inputs or {}), **({} if progress is None else {"progress": progress})}
+    kwargs.update({k: v for k, v in given.items() if k in spec.inputs})
     return cls(**kwargs)
 
 

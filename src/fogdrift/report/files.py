@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from .._util import strict_json
+from ..models import save_model
 from ..noise import TERM_TABLE
 from ..output import atomic_path
 from ..units import INTERNAL_UNITS
@@ -119,7 +120,7 @@ def write_model_outputs(model_axes, out_dir) -> dict:
     for ma in model_axes:
         for label, model in ma.fitted.items():
             safe = label.replace("(", "").replace(")", "").replace(",", "").replace(" ", "_").lower()
-            model.save(out / "models" / f"{_safe(ma.name)}_{_safe(safe)}")
+            save_model(model, out / "models" / f"{_safe(ma.name)}_{_safe(safe)}")
         plot_models(ma, out / f"fig8_models_{_safe(ma.name)}.png")
         plot_residuals(ma, out / f"fig9_residual_{_safe(ma.name)}.png")
     write_json({"axes": [ma.to_dict() for ma in model_axes]}, out / "metrics.json")
