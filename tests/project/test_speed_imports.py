@@ -118,3 +118,13 @@ def test_run_freezes_the_imported_objects_only_while_the_command_runs(tmp_path):
         with run("allan", tmp_path / "b", default_out=Path("out/allan")):
             raise ConfigError("bad setting")
     assert gc.get_freeze_count() == 0
+
+
+def test_the_allan_workflow_and_its_cli_load_no_html_report():
+    """``fogdrift allan`` writes its JSON, CSV and PNG without the HTML report's module (report.html, with the
+    evaluation verdicts and the report's sections); ``fogdrift.report.write_report`` still imports it on use."""
+    mods = _modules("import fogdrift.workflows.allan, fogdrift.cli.allan")
+    assert "fogdrift.report.files" in mods
+    assert "fogdrift.report.html" not in mods and "fogdrift.evaluation" not in mods
+    mods = _modules("from fogdrift.report import write_report\nassert write_report.__module__ == 'fogdrift.report.html'")
+    assert "fogdrift.report.html" in mods

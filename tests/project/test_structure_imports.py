@@ -208,6 +208,9 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
                                  ("fogdrift.models.grey",)),
     "fogdrift.io.load": ("optional readers: the reader registry imports a reader module on first use", (
         "fogdrift.io.registry",)),
+    "fogdrift.report": ("the HTML report (report.html: the evaluation verdicts, the model registry, the sections) "
+                        "loads where a report is written; allan and noise write their files without it",
+                        ("fogdrift.report.html",)),
     "fogdrift.lifting._kernels": (NUMBA, ("fogdrift.lifting._numba",)),
     "fogdrift.noise.engine": (NUMBA, ("fogdrift.noise._kernels",)),
 }

@@ -17,7 +17,6 @@ and white noise, 6 Allan of the drift, 8 model against drift, 9 residual, 10–1
 from .figures import (pyplot, _safe, save_figure, plot_allan, plot_models, plot_residuals, plot_separation,
                       plot_separation_allan, plot_signal, plot_spectrum)
 from .files import write_allan_outputs, write_json, write_model_outputs, write_separation_outputs
-from .html import write_report
 from .tables import (METRICS_HEADERS, NOISE_HEADERS, b_headline, b_min_cell, shaped_cell, causal_metrics_rows, fit_cell, fit_summary, metrics_rows, noise_notes,
                      noise_row, not_estimable_notes, readout_text, term_text)
 
@@ -49,3 +48,13 @@ __all__ = [
     "plot_models",
     "plot_residuals",
 ]
+
+
+def __getattr__(name):
+    """``write_report`` is imported on first use: the HTML report's module brings the evaluation verdicts, the model
+    registry and the report's sections, which the per-command outputs (``allan``, ``noise``) never use."""
+    if name == "write_report":
+        from .html import write_report
+
+        return write_report
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

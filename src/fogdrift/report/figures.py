@@ -9,6 +9,7 @@ metric scores, and scale their y axis on the scored part only.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import itertools
 import re
@@ -34,12 +35,29 @@ UNSCORED = "0.8"
 
 
 def pyplot():
+    """:mod:`matplotlib.pyplot` on the Agg backend (no window), for the figures drawn through pyplot."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def subplots(nrows=1, ncols=1, *, figsize=None, **kwargs):
+    """A figure and its grid of axes, as :func:`matplotlib.pyplot.subplots` makes them (``kwargs`` go to
+    :meth:`matplotlib.figure.Figure.subplots`: ``squeeze``, ``sharex`` ...), on matplotlib's Agg canvas.
+
+    Pyplot is not imported: a PNG needs neither its figure manager nor its backend switching (its import, about
+    0.02 s on top of the figure's own modules), and no registry holds the figure (:func:`save_figure` has nothing
+    to close).  The figure takes the rcParams in force, as pyplot's does, and draws the same pixels.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(nrows, ncols, **kwargs)
 
 
 def _styled(fn):
@@ -49,7 +67,6 @@ def _styled(fn):
     def wrapper(*args, **kwargs):
         import matplotlib
 
-        pyplot()
         with matplotlib.rc_context(STYLE):
             return fn(*args, **kwargs)
 
@@ -115,6 +132,31 @@ def _plain_log_ticks(ax) -> None:
 PAD_IN = 0.1
 
 
+@contextlib.contextmanager
+def _ticks_held(axes):
+    """Inside the block, each axis of ``axes`` works out its ticks once (locations, labels, positions).
+
+    Matplotlib's tight box of one axes updates the ticks of an axis once for the axis, once for its label's
+    position and once for each spine along it (Axis._update_ticks: the locator run and every tick label formatted
+    and moved again): eight updates per axes where two serve.  While :func:`_place` measures, no axes moves and no
+    limit changes, so every update gives the ticks of the first; the first is kept for the block.  The draw
+    updates the ticks again at the final position.
+    """
+    held = []
+    try:
+        for ax in axes:
+            for axis in (ax.xaxis, ax.yaxis):
+                update = getattr(axis, "_update_ticks", None)
+                if update is None:  # a matplotlib without this private method: measured as it measures itself
+                    continue
+                axis._update_ticks = functools.partial(list, update())  # a fresh list each call, as matplotlib's
+                held.append(axis)
+        yield
+    finally:
+        for axis in held:
+            del axis._update_ticks  # matplotlib's method again
+
+
 def _place(fig, pad_in=PAD_IN):
     """Place the axes of ``fig`` (one :func:`matplotlib.pyplot.subplots` grid, no layout engine) so that every
     axes' tick labels, axis labels and texts fit inside the figure without running into the neighbours'.
@@ -146,14 +188,15 @@ def _place(fig, pad_in=PAD_IN):
     dpi = fig.dpi
     left, right = np.zeros(ncols), np.zeros(ncols)
     below, above = np.zeros(nrows), np.zeros(nrows)
-    for ax in axes:
-        ss = ax.get_subplotspec()
-        tb, bb = ax.get_tightbbox(renderer, for_layout_only=True), ax.bbox
-        c0, c1, r0, r1 = ss.colspan.start, ss.colspan.stop - 1, ss.rowspan.start, ss.rowspan.stop - 1
-        left[c0] = max(left[c0], (bb.x0 - tb.x0) / dpi)
-        right[c1] = max(right[c1], (tb.x1 - bb.x1) / dpi)
-        below[r1] = max(below[r1], (bb.y0 - tb.y0) / dpi)
-        above[r0] = max(above[r0], (tb.y1 - bb.y1) / dpi)
+    with _ticks_held(axes):
+        for ax in axes:
+            ss = ax.get_subplotspec()
+            tb, bb = ax.get_tightbbox(renderer, for_layout_only=True), ax.bbox
+            c0, c1, r0, r1 = ss.colspan.start, ss.colspan.stop - 1, ss.rowspan.start, ss.rowspan.stop - 1
+            left[c0] = max(left[c0], (bb.x0 - tb.x0) / dpi)
+            right[c1] = max(right[c1], (tb.x1 - bb.x1) / dpi)
+            below[r1] = max(below[r1], (bb.y0 - tb.y0) / dpi)
+            above[r0] = max(above[r0], (tb.y1 - bb.y1) / dpi)
     top = above[0] + pad_in
     if sup:
         sup.set_y(1 - pad_in / h)
@@ -185,7 +228,8 @@ def save_figure(fig, path, **savefig) -> Path:
         with atomic_path(path) as tmp:
             fig.savefig(tmp, **{"dpi": DPI, **savefig})
     finally:
-        pyplot().close(fig)
+        if fig.canvas.manager is not None:  # a pyplot figure: pyplot holds it until it is closed
+            pyplot().close(fig)
     return path
 
 
@@ -266,10 +310,9 @@ DENSE_TAUS = 200
 def plot_allan(axes_list, path, title=None) -> Path:
     """Fig. 3: log-log deviation with 68 % error bars, the fitted curve over the fitted range (points used marked,
     left-out taus shaded), each selected term's asymptote, and the fit statistic."""
-    plt = pyplot()
     n = len(axes_list)
     size = (FIG_WIDTH_IN, 5.6) if n == 1 else (5.6 * n, 4.8)
-    fig, axs = plt.subplots(1, n, figsize=size, squeeze=False)
+    fig, axs = subplots(1, n, figsize=size, squeeze=False)
     for ax, aa in zip(axs[0], axes_list):
         r, fit = aa.allan, aa.noise
         label = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}.get(getattr(r, "statistic", "adev"), "deviation")
@@ -317,8 +360,7 @@ def plot_allan(axes_list, path, title=None) -> Path:
 def plot_signal(record, path, split_s=None) -> Path:
     """Fig. 1: the rate of every axis over time (min/max envelope of long records and the mean), with the
     train / validation / test blocks shaded when ``split_s`` ``{"train": (t0, t1), ...}`` [s] is given."""
-    plt = pyplot()
-    fig, axs = plt.subplots(record.n_axes, 1, figsize=(FIG_WIDTH_IN, 1.0 + 2.3 * record.n_axes), squeeze=False,
+    fig, axs = subplots(record.n_axes, 1, figsize=(FIG_WIDTH_IN, 1.0 + 2.3 * record.n_axes), squeeze=False,
                             sharex=True)
     for i, (ax, name) in enumerate(zip(axs[:, 0], record.axis_names)):
         tb, lo, hi, mean = _envelope((record.t0_s, record.dt_s), record.axis(name))
@@ -344,9 +386,8 @@ def plot_spectrum(axes, path) -> Path:
     """Fig. 2: the Welch power spectral density of every axis, as the workflow computed it (each axis's
     ``spectrum``, :class:`fogdrift.pipeline.AxisSpectrum`; the DC bin left out), one panel per unit (a gyro's in
     (deg/h)²/Hz, an accelerometer's in (m/s²)²/Hz)."""
-    plt = pyplot()
     units = list(dict.fromkeys(ax.spectrum.unit for ax in axes))
-    fig, axs = plt.subplots(len(units), 1, figsize=(FIG_WIDTH_IN, 4.8 if len(units) == 1 else 7.6), squeeze=False)
+    fig, axs = subplots(len(units), 1, figsize=(FIG_WIDTH_IN, 4.8 if len(units) == 1 else 7.6), squeeze=False)
     for ax, unit in zip(axs[:, 0], units):
         for a in axes:
             if a.spectrum.unit == unit:
@@ -364,9 +405,8 @@ def plot_spectrum(axes, path) -> Path:
 def plot_separation(sep, path, split=None) -> Path:
     """Fig. 5: drift and white noise over time; ``split`` ``{"train": [i0, i1), ...}`` (sample indices at the
     separation's rate) draws the blocks the models use (they separate inside each block)."""
-    plt = pyplot()
     t = np.arange(sep.rate_dph.size) * sep.dt_s
-    fig, axs = plt.subplots(2, 1, figsize=(FIG_WIDTH_IN, 6.0), sharex=True)
+    fig, axs = subplots(2, 1, figsize=(FIG_WIDTH_IN, 6.0), sharex=True)
     tb, lo, hi, mean = _envelope(t, sep.rate_dph)
     if tb is not t:
         axs[0].fill_between(tb, lo, hi, color="0.75", lw=0, label="input (min–max per bin)")
@@ -394,8 +434,7 @@ def plot_separation(sep, path, split=None) -> Path:
 @_styled
 def plot_separation_allan(sep, path) -> Path:
     """Fig. 6: ADEV of original, drift and noise."""
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(FIG_WIDTH_IN, 5.2))
+    fig, ax = subplots(figsize=(FIG_WIDTH_IN, 5.2))
     for (label, aa), color in zip(sep.rows, ("k", "C3", "C0")):
         r = aa.allan
         yerr = np.vstack([r.dev_dph - r.dev_lo68_dph, r.dev_hi68_dph - r.dev_dph])
@@ -436,10 +475,9 @@ def plot_models(model_axis, path, fig_no=8, *, residual=False) -> Path:
     largest excursion; with ``residual``, Fig. 9 (:func:`plot_residuals`)."""
     if residual:
         return plot_residuals(model_axis, path, fig_no)
-    plt = pyplot()
     t, y, k = _test_axis(model_axis)
     dt = model_axis.dt_s
-    fig, axs = plt.subplots(2, 1, figsize=(FIG_WIDTH_IN, 8.0))
+    fig, axs = subplots(2, 1, figsize=(FIG_WIDTH_IN, 8.0))
     scored = slice(k, None)
     centre = k + int(np.nanargmax(np.abs(y[scored]))) if y.size > k else 0
     half = max(30, y.size // 20)
@@ -466,11 +504,10 @@ def plot_models(model_axis, path, fig_no=8, *, residual=False) -> Path:
 def plot_residuals(model_axis, path, fig_no=9) -> Path:
     """Fig. 9: residual drift after compensation (wavelet drift minus each model's one-step prediction) on the
     test block, one panel per model, each scaled on its scored part and labelled with its RMS."""
-    plt = pyplot()
     t, y, k = _test_axis(model_axis)
     preds = list(model_axis.predictions.items())
     n = max(1, len(preds))
-    fig, axs = plt.subplots(n, 1, figsize=(FIG_WIDTH_IN, 1.2 + 1.55 * n), sharex=True, squeeze=False)
+    fig, axs = subplots(n, 1, figsize=(FIG_WIDTH_IN, 1.2 + 1.55 * n), sharex=True, squeeze=False)
     for ax, (label, yhat) in zip(axs[:, 0], preds):
         r = y - yhat
         _shade_unscored(ax, t, k, model_axis.dt_s)
@@ -499,8 +536,7 @@ def plot_dynamic_adev(allan_axes, path) -> Path | None:
     shown = [a for a in allan_axes if (getattr(a, "screen", None) or {}).get("dynamic_adev")]
     if not shown:
         return None
-    plt = pyplot()
-    fig, axs = plt.subplots(len(shown), 1, figsize=(FIG_WIDTH_IN, 3.4 * len(shown) + 0.6), squeeze=False)
+    fig, axs = subplots(len(shown), 1, figsize=(FIG_WIDTH_IN, 3.4 * len(shown) + 0.6), squeeze=False)
     for ax, a in zip(axs[:, 0], shown):
         d = a.screen["dynamic_adev"]
         t, tau, adev = np.asarray(d["t_s"]), np.asarray(d["tau_s"]), np.asarray(d["adev"], dtype=np.float64)
