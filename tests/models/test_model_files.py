@@ -72,7 +72,7 @@ def test_callable_parameters_are_written_as_null():
             self.progress, self.scale = progress, scale
 
     m = WithCallback(progress=lambda *a: None, scale=2.0)
-    assert m._serialisable_params() == {"progress": None, "scale": 2.0}
+    assert m.get_params(serialisable=True) == {"progress": None, "scale": 2.0}
 
 
 # -- the state as data and the files made from it ----------------------------------------------------------------

@@ -51,13 +51,13 @@ class DriftModel:
         sig = inspect.signature(cls.__init__)
         return [p.name for p in sig.parameters.values() if p.name != "self" and p.kind != p.VAR_KEYWORD]
 
-    def get_params(self) -> dict:
-        """Hyper-parameters exactly as given to the constructor."""
-        return {name: getattr(self, name) for name in self._param_names()}
-
-    def _serialisable_params(self) -> dict:
-        """Hyper-parameters for a model file: callables (progress callbacks) are not saved."""
-        return {k: (None if callable(v) else v) for k, v in self.get_params().items()}
+    def get_params(self, serialisable: bool = False) -> dict:
+        """Hyper-parameters exactly as given to the constructor; ``serialisable=True``: as a model file or a result
+        document holds them, callables (progress callbacks) as None."""
+        params = {name: getattr(self, name) for name in self._param_names()}
+        if serialisable:
+            return {k: (None if callable(v) else v) for k, v in params.items()}
+        return params
 
     def set_params(self, **params):
         valid = set(self._param_names())

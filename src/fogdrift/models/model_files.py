@@ -94,7 +94,7 @@ def save_model(model: DriftModel, path) -> tuple[Path, Path]:
         "format": "fogdrift-model",
         "format_version": FORMAT_VERSION,
         "class": type(model).__name__,
-        "params": model._serialisable_params(),
+        "params": model.get_params(serialisable=True),
         "state": meta,
     }
     # both files are written under temporary names before either is renamed: a write that fails (disk full,

@@ -154,7 +154,7 @@ class ModelAxis:
             "fit_seconds": self.fit_seconds,
             "notes": self.notes,
             "score_from_test_index": self.score_from,
-            "model_params": {k: _plain(m._serialisable_params()) for k, m in self.fitted.items()},
+            "model_params": {k: _plain(m.get_params(serialisable=True)) for k, m in self.fitted.items()},
         }
 
 
