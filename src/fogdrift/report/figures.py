@@ -147,9 +147,10 @@ def _ticks_held(axes):
         for ax in axes:
             for axis in (ax.xaxis, ax.yaxis):
                 update = getattr(axis, "_update_ticks", None)
-                if update is None:  # a matplotlib without this private method: measured as it measures itself
+                ticks = None if update is None else update()
+                if not isinstance(ticks, list):  # another matplotlib's private method: measured as it measures
                     continue
-                axis._update_ticks = functools.partial(list, update())  # a fresh list each call, as matplotlib's
+                axis._update_ticks = functools.partial(list, ticks)  # a fresh list each call, as matplotlib's
                 held.append(axis)
         yield
     finally:
