@@ -17,7 +17,7 @@ from .model import fmt_length
 from .montecarlo import MC_MAX_SAMPLES, simulate_fits, summarise
 from .spread import SPREAD_DRAWS, share_ratio
 
-__all__ = ["Plan", "make_plan", "MAX_LENGTH_S", "RECORD_SHARE", "crossing", "ESTIMATORS"]
+__all__ = ["Plan", "make_plan", "MAX_LENGTH_S", "RECORD_SHARE", "SHARE_ALLOWANCE", "crossing", "ESTIMATORS"]
 
 #: The estimators a plan is made for: the Allan fit (:mod:`.analytic`) and the GMWM (:mod:`.gmwm`).
 ESTIMATORS = ("allan", "gmwm")
@@ -29,6 +29,11 @@ _STEP = 2.0**0.5  # grid of record lengths: half an octave
 
 #: Share of records that must reach the target width at ``share_s`` (the median record reaches it at ``target_s``).
 RECORD_SHARE = 0.8
+#: Allowance on the 80 % width for what the linearised records (:mod:`.spread`) do not hold: ``share_s`` is the
+#: length at which ``w_share * share_ratio * (1 + SHARE_ALLOWANCE)`` reaches the target.  Without it, simulated
+#: records of the MEMS class of docs/plan.md reached its B target at ``share_s`` in 928 of 1 200 seeds (77.3 %): the
+#: records' own 80 % width is about 2.5 % above the plan's there (docs/plan.md, "The allowance").
+SHARE_ALLOWANCE = 0.03
 _SHARE_ITER = 6  # secant steps at most for share_s, to a relative change of the length below _SHARE_TOL
 _SHARE_TOL = 0.005
 
@@ -62,9 +67,10 @@ class Plan:
 
     ``terms``: term -> ``target`` (width asked), ``resolved_s`` (length from which the median record resolves it),
     ``target_s`` (length at which its expected width reaches the target; None: not within
-    :data:`MAX_LENGTH_S`), ``share_s`` (length at which :data:`RECORD_SHARE` of the records reach it: the expected width times
-    ``share_ratio``, the ratio of the share's quantile to the median over linearised records,
-    :func:`~fogdrift.plan.spread.share_ratio`; both None in a plan of the GMWM alone), ``floor_width``
+    :data:`MAX_LENGTH_S`), ``share_s`` (length at which :data:`RECORD_SHARE` of the records reach it: the share
+    union's width times ``share_ratio``, the ratio of the share's quantile to the median over linearised records,
+    :func:`~fogdrift.plan.spread.share_ratio`, and ``1 +`` :data:`SHARE_ALLOWANCE`; both None in a plan of the GMWM
+    alone), ``floor_width``
     (width at :data:`MAX_LENGTH_S`), ``mc`` (Monte-Carlo at ``target_s``: median width, fractions, coverage, seeds,
     and ``length_s``, the length the measured width implies) and ``mc_share`` (Monte-Carlo at ``share_s``).
     ``grid``: the analytic curve (``length_s`` and each term's width). ``at_length``: what ``length_s`` supports.
@@ -119,25 +125,35 @@ class Plan:
             if "allan" not in self.estimators:
                 out.append(f"{t} to {w}: {self._gmwm_text(t, g, w, True)}" + self._gmwm_tail(t, g))
                 continue
+            share = r["target_s"] is not None  # the length to record first: four records in five reach the width
+            if share:
+                most = f"{100 * RECORD_SHARE:.0f} % of records"
+                if r.get("share_s") is not None:
+                    s = f"{t} to {w}: {fmt_length(r['share_s'])} for {most} (Allan fit"
+                    ms = r.get("mc_share")
+                    if ms:
+                        s += f"; {round(ms['met_fraction'] * ms['n_seeds'])} of {ms['n_seeds']} seeds reach {w} there"
+                elif math.isfinite(r.get("share_ratio") or math.inf):
+                    s = f"{t} to {w}: not within {fmt_length(MAX_LENGTH_S)} for {most} (Allan fit"
+                else:
+                    s = (f"{t} to {w}: not found for {most} (Allan fit; fewer than {most} resolve {t} at the median "
+                         "length")
+                s += f"); the median record: {fmt_length(r['target_s'])} (Allan fit)"
+            else:
+                s = f"{t} to {w}: "
             if r["target_s"] is not None:
-                s = f"{t} to {w}: {fmt_length(r['target_s'])} (Allan fit)"
+                s += "" if share else f"{fmt_length(r['target_s'])} (Allan fit)"
                 if g:
                     s += ", " + self._gmwm_text(t, g, w, False)
                 mc = r.get("mc")
                 if mc:
-                    s += f"; Allan {self._mc_text(mc)}" if g else f", {self._mc_text(mc)}"
+                    s += f"; Allan {self._mc_text(mc)}" if g or share else f", {self._mc_text(mc)}"
             else:
-                s = (f"{t} to {w}: not within {fmt_length(MAX_LENGTH_S)} (Allan fit; the model-discrepancy "
-                     f"allowance keeps it at ±{100 * r['floor_width']:.3g} % or wider)"
-                     if math.isfinite(r["floor_width"]) else f"{t} to {w}: not resolved within "
-                     f"{fmt_length(MAX_LENGTH_S)}")
+                s += (f"not within {fmt_length(MAX_LENGTH_S)} (Allan fit; the model-discrepancy "
+                      f"allowance keeps it at ±{100 * r['floor_width']:.3g} % or wider)"
+                      if math.isfinite(r["floor_width"]) else f"not resolved within {fmt_length(MAX_LENGTH_S)}")
                 if g:
                     s += ", " + self._gmwm_text(t, g, w, False)
-            if r.get("share_s") is not None:
-                s += f"; {100 * RECORD_SHARE:.0f} % of records: {fmt_length(r['share_s'])}"
-                ms = r.get("mc_share")
-                if ms:
-                    s += f" ({round(ms['met_fraction'] * ms['n_seeds'])} of {ms['n_seeds']} seeds reach {w} there)"
             if r["resolved_s"] is not None:
                 s += f"; {t} resolved from {fmt_length(r['resolved_s'])}" + (" (Allan fit)" if g else "")
             if g:
@@ -189,41 +205,53 @@ def _grid_n(dt_s):
     return out
 
 
+def _width80(w_share, ratio) -> list:
+    """The width :data:`RECORD_SHARE` of the records stay within, per length: the share union's ``w_share`` times
+    the records' spread ``ratio`` and the allowance :data:`SHARE_ALLOWANCE` (inf where ``w_share`` is)."""
+    f = ratio * (1.0 + SHARE_ALLOWANCE)
+    return [x * f if math.isfinite(x) else math.inf for x in w_share]
+
+
 def _share_length(model, term, target, lengths, w_share):
-    """``(length, ratio)``: the fixed point ``L = crossing(w_share * share_ratio(L))`` (the length at which the 80 %
-    width, the share union's width times the spread at that length, reaches ``target``; None if it never does).
+    """``(length, ratio)``: the fixed point ``L = crossing(w_share * share_ratio(L) * (1 + SHARE_ALLOWANCE))`` (the
+    length at which the 80 % width, :func:`_width80` with the spread at that length, reaches ``target``; None if it
+    never does).
 
     The ratio falls with length, so plain substitution oscillates about the fixed point (MEMS B: 57 906 ->
     106 415 -> 85 541 -> 92 502 -> ... samples); a secant step on ``log L`` finds it in 3-4 evaluations of
     ``SPREAD_DRAWS // 4`` records, then the ratio is taken there with ``SPREAD_DRAWS`` and the length read again.
     """
     dt = model.dt_s
+    end = math.log(lengths[-1])
 
     def step(x, draws):
+        """``(log crossing, ratio, beyond)``: where the 80 % width with the spread at ``exp(x)`` reaches the target;
+        a crossing beyond the grid is clamped to its end (``beyond``: the spread of a shorter record is wider, so a
+        later step may still find one); None when too few records resolve the term."""
         r = share_ratio(model, max(int(round(math.exp(x) / dt)), _MIN_SAMPLES), term, RECORD_SHARE, draws=draws)
         if not math.isfinite(r):
-            return None, r
-        at = crossing(lengths, [v * r for v in w_share], target)
-        return (None if at is None else math.log(at)), r
+            return None, r, False
+        at = crossing(lengths, _width80(w_share, r), target)
+        return (end, r, True) if at is None else (math.log(at), r, False)
 
     x0 = math.log(crossing(lengths, w_share, target))
-    g0, r = step(x0, SPREAD_DRAWS // 4)
+    g0, r, _ = step(x0, SPREAD_DRAWS // 4)
     if g0 is None:
         return None, r
     x1 = g0
     for _ in range(_SHARE_ITER):
-        g1, r = step(x1, SPREAD_DRAWS // 4)
+        g1, r, _ = step(x1, SPREAD_DRAWS // 4)
         if g1 is None:  # too few records resolve the term there: back to the last length that gave one
             x1 = g0
             break
         h0, h1 = g0 - x0, g1 - x1
         x2 = x1 - h1 * (x1 - x0) / (h1 - h0) if h1 != h0 else g1
-        x2 = min(max(x2, math.log(lengths[0])), math.log(lengths[-1]))
+        x2 = min(max(x2, math.log(lengths[0])), end)
         x0, g0, x1 = x1, g1, x2
         if abs(x1 - x0) < _SHARE_TOL:
             break
-    g, r = step(x1, SPREAD_DRAWS)
-    return (None if g is None else math.exp(g)), r
+    g, r, beyond = step(x1, SPREAD_DRAWS)
+    return (None if g is None or beyond else math.exp(g)), r
 
 
 def _mc_length(L, w_mc, target, grid_len, grid_w):
@@ -301,7 +329,7 @@ def make_plan(model, targets, *, length_s=None, monte_carlo=0, seed0=1, workers=
         w = [c[t]["rel_width"] for c in shared]
         ratio = _share_length(model, t, target, lengths, w)[1] if crossing(lengths, w, target) else math.inf
         spread[t] = ratio
-        grid["width_share"][t] = [x * ratio if math.isfinite(x) else math.inf for x in w]
+        grid["width_share"][t] = _width80(w, ratio)
     terms = {}
     seeds = list(range(seed0, seed0 + int(monte_carlo)))
     notes = []

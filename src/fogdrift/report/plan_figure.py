@@ -36,8 +36,10 @@ def plot_plan(plan, path) -> Path:
             ax.loglog(L, np.where(np.isfinite(w80), w80, np.nan), color=color, ls="--", lw=0.8,
                       label=f"{t}, 80 % of records")
         ax.axhline(100.0 * r["target"], color=color, ls=":", lw=0.9)
-        if r["target_s"] is not None:
+        if r["target_s"] is not None:  # the median record's length (open) and the 80 % one (filled)
             ax.plot([r["target_s"] / S_PER_H], [100.0 * r["target"]], "o", color=color, mfc="none")
+        if r.get("share_s") is not None:
+            ax.plot([r["share_s"] / S_PER_H], [100.0 * r["target"]], "o", color=color)
         mc = r.get("mc")
         if mc and mc.get("median_width") is not None and math.isfinite(mc["median_width"]):
             ax.plot([mc["n_samples"] * plan.model.dt_s / S_PER_H], [100.0 * mc["median_width"]], "x", color=color,
