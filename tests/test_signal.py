@@ -221,15 +221,31 @@ def test_bundle_carries_the_signal_description(bundle_dir):
     assert b.signal.sampling.dt_s == 0.5
 
 
-def test_bundle_without_a_description_still_loads(bundle_dir, tmp_path):
-    b = load_bundle(_edited(bundle_dir, tmp_path, lambda d: d.pop("signal")))
+def _v2_without_signal(d):
+    """The manifest in the format-2 layout without a description: the intervals as native_dt_s and model_dt_s."""
+    dt, k = d.pop("signal")["sampling"]["dt_s"], d["block_average_factor"]
+    d.update(format_version=2, native_dt_s=dt, native_rate_hz=1 / dt, model_dt_s=k * dt, model_rate_hz=1 / (k * dt))
+
+
+def test_format_2_bundle_without_a_description_still_loads(bundle_dir, tmp_path):
+    b = load_bundle(_edited(bundle_dir, tmp_path, _v2_without_signal))
     assert b.signal.sampling.dt_source == "bundle" and b.signal.channel("gz").unit_as_read == "deg/s"
+    assert (b.native_dt_s, b.model_dt_s, b.block_average_factor) == (0.5, 1.0, 2)
+
+
+def test_format_3_bundle_without_a_description_is_refused(bundle_dir, tmp_path):
+    with pytest.raises(ModelFileError) as ei:
+        load_bundle(_edited(bundle_dir, tmp_path, lambda d: d.pop("signal")))
+    assert str(ei.value).endswith("manifest.json: signal: missing (the training log's signal description holds the "
+                                  "bundle's sampling)")
 
 
 @pytest.mark.parametrize("edit, where", [
     (lambda d: d["axes"][0].update(causal_window=10**12), "causal_window: expected at most"),
     (lambda d: d["axes"][0].update(bias_dph=1e300), "bias_dph: expected |bias_dph|"),
-    (lambda d: d.update(native_dt_s=1e-300, model_dt_s=2e-300), "native_dt_s"),
+    (lambda d: d["signal"]["sampling"].update(dt_s=1e-300, native_dt_s=1e-300), "signal: dt_s"),
+    (lambda d: d.update(block_average_factor=10**12), "block_average_factor: the modelling interval"),
+    (lambda d: d.update(block_average_factor=0), "block_average_factor: expected an integer >= 1"),
     (lambda d: d.update(latitude_deg=400.0), "latitude_deg"),
     (lambda d: d["signal"]["channels"][0].update(unit_as_read="rad/s"), "signal.channels"),
     (lambda d: d["signal"]["sampling"].update(dt_source="magic"), "signal: dt_source"),
