@@ -104,9 +104,10 @@ def test_newer_format_is_refused_with_a_clear_message(fitted, tmp_path):
 
 
 @pytest.mark.parametrize("edit, fragment", [
-    (lambda d: d.pop("native_dt_s"), "native_dt_s: missing"),
+    (lambda d: d.pop("signal"), "signal: missing"),
     (lambda d: d.update(input_unit="furlong/s"), "input_unit: unknown unit"),
-    (lambda d: d.update(block_average_factor=7), "block_average_factor"),
+    (lambda d: d.update(block_average_factor=0), "block_average_factor"),
+    (lambda d: d.update(block_average_factor=1.5), "block_average_factor: expected an integer"),
     (lambda d: d.update(wavelet="db9"), "wavelet"),
     (lambda d: d["axes"][0].update(level=9), "axes[0].level"),
     (lambda d: d["axes"][0].update(causal_window=1), "axes[0].causal_window"),
@@ -181,6 +182,70 @@ def test_an_unsealed_version_1_bundle_is_refused_with_advice(fitted, tmp_path):
     _write(dst, doc, reseal=False)
     with pytest.raises(ModelFileError, match="no integrity seal; re-create the bundle"):
         load_bundle(dst)
+
+
+# ------------------------------------------------------------------------------------------
+# The sampling is written once, in signal.sampling; a format-2 manifest (intervals beside it) is converted
+# ------------------------------------------------------------------------------------------
+def test_manifest_writes_the_sampling_once(fitted):
+    rec, _, axes, _, out = fitted
+    doc = json.loads((out / "manifest.json").read_text())
+    assert doc["format_version"] == BUNDLE_FORMAT_VERSION == 3
+    assert not {"native_dt_s", "native_rate_hz", "model_dt_s", "model_rate_hz"} & set(doc)
+    assert [k for k in doc if "dt_s" in k or "rate_hz" in k] == []
+    assert doc["block_average_factor"] == 10 and doc["signal"]["sampling"]["dt_s"] == 0.1
+    back = load_bundle(out)
+    # the intervals read back are the ones the run used, to the last bit
+    assert back.native_dt_s == rec.dt_s and back.model_dt_s == axes[0].dt_s and back.block_average_factor == 10
+    assert back.signal == rec.signal
+
+
+def _as_format_2(doc):
+    """``doc`` (format 3) in the format-2 layout, resealed: the intervals and rates beside signal.sampling."""
+    from fogdrift.bundle import seal_manifest
+
+    dt, k = doc["signal"]["sampling"]["dt_s"], doc["block_average_factor"]
+    old = {key: v for key, v in doc.items() if key != "seal_sha256"}
+    old.update(format_version=2, native_dt_s=dt, native_rate_hz=1.0 / dt, model_dt_s=k * dt,
+               model_rate_hz=1.0 / (k * dt))
+    return seal_manifest(old)
+
+
+def test_format_2_manifest_is_converted_on_reading(fitted, tmp_path):
+    dst, doc = _copy(fitted[4], tmp_path)
+    new = load_bundle(dst)
+    (dst / "manifest.json").write_text(json.dumps(_as_format_2(doc)))
+    old = load_bundle(dst)
+    assert old.format_version == 2
+    assert (old.native_dt_s, old.model_dt_s, old.block_average_factor) == (0.1, 1.0, 10)
+    assert (old.native_dt_s, old.model_dt_s, old.signal, old.axis_names) == (new.native_dt_s, new.model_dt_s,
+                                                                             new.signal, new.axis_names)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d.update(model_dt_s=0.7), "block_average_factor: model_dt_s 0.7 is not 10 x native_dt_s 0.1"),
+    (lambda d: d.update(native_dt_s=0.2, model_dt_s=2.0), "signal.sampling.dt_s: 0.1 differs from native_dt_s 0.2"),
+    (lambda d: d.pop("native_dt_s"), "native_dt_s: missing"),
+])
+def test_format_2_intervals_that_disagree_are_refused_in_one_line(fitted, tmp_path, edit, message):
+    from fogdrift.bundle import seal_manifest
+
+    dst, doc = _copy(fitted[4], tmp_path)
+    old = _as_format_2(doc)
+    edit(old)
+    (dst / "manifest.json").write_text(json.dumps(seal_manifest(old)))
+    with pytest.raises(ModelFileError) as info:
+        load_bundle(dst)
+    assert str(info.value) == f"{dst / 'manifest.json'}: {message}"
+
+
+def test_format_3_reads_the_interval_from_the_signal_only(fitted, tmp_path):
+    """Format-2 keys left in a format-3 manifest are not read: the interval is signal.sampling's."""
+    dst, doc = _copy(fitted[4], tmp_path)
+    doc.update(native_dt_s=0.5, model_dt_s=5.0)
+    _write(dst, doc)
+    b = load_bundle(dst)
+    assert (b.native_dt_s, b.model_dt_s) == (0.1, 1.0)
 
 
 @pytest.mark.parametrize("rel", ["/etc/passwd", "../outside/ar", "gx/../../outside/ar", "gx\\..\\..\\ar", ""])

@@ -20,7 +20,7 @@ from fogdrift.errors import ConfigError, ModelFileError
 from fogdrift.io import from_array, load
 from fogdrift.io import record as io_record
 from fogdrift.pipeline import AnalysisAxis, AnalysisConfig, AllanAxis, ModelAxis, run_models
-from fogdrift.signal import Channel, Sampling, SignalDescription
+from fogdrift.signal import Channel, Sampling, SignalDescription, record_sampling
 from fogdrift.simulate import simulate
 
 runner = CliRunner()
@@ -221,15 +221,31 @@ def test_bundle_carries_the_signal_description(bundle_dir):
     assert b.signal.sampling.dt_s == 0.5
 
 
-def test_bundle_without_a_description_still_loads(bundle_dir, tmp_path):
-    b = load_bundle(_edited(bundle_dir, tmp_path, lambda d: d.pop("signal")))
+def _v2_without_signal(d):
+    """The manifest in the format-2 layout without a description: the intervals as native_dt_s and model_dt_s."""
+    dt, k = d.pop("signal")["sampling"]["dt_s"], d["block_average_factor"]
+    d.update(format_version=2, native_dt_s=dt, native_rate_hz=1 / dt, model_dt_s=k * dt, model_rate_hz=1 / (k * dt))
+
+
+def test_format_2_bundle_without_a_description_still_loads(bundle_dir, tmp_path):
+    b = load_bundle(_edited(bundle_dir, tmp_path, _v2_without_signal))
     assert b.signal.sampling.dt_source == "bundle" and b.signal.channel("gz").unit_as_read == "deg/s"
+    assert (b.native_dt_s, b.model_dt_s, b.block_average_factor) == (0.5, 1.0, 2)
+
+
+def test_format_3_bundle_without_a_description_is_refused(bundle_dir, tmp_path):
+    with pytest.raises(ModelFileError) as ei:
+        load_bundle(_edited(bundle_dir, tmp_path, lambda d: d.pop("signal")))
+    assert str(ei.value).endswith("manifest.json: signal: missing (the training log's signal description holds the "
+                                  "bundle's sampling)")
 
 
 @pytest.mark.parametrize("edit, where", [
     (lambda d: d["axes"][0].update(causal_window=10**12), "causal_window: expected at most"),
     (lambda d: d["axes"][0].update(bias_dph=1e300), "bias_dph: expected |bias_dph|"),
-    (lambda d: d.update(native_dt_s=1e-300, model_dt_s=2e-300), "native_dt_s"),
+    (lambda d: d["signal"]["sampling"].update(dt_s=1e-300, native_dt_s=1e-300), "signal: dt_s"),
+    (lambda d: d.update(block_average_factor=10**12), "block_average_factor: the modelling interval"),
+    (lambda d: d.update(block_average_factor=0), "block_average_factor: expected an integer >= 1"),
     (lambda d: d.update(latitude_deg=400.0), "latitude_deg"),
     (lambda d: d["signal"]["channels"][0].update(unit_as_read="rad/s"), "signal.channels"),
     (lambda d: d["signal"]["sampling"].update(dt_source="magic"), "signal: dt_source"),
@@ -368,3 +384,26 @@ def test_cli_apply_to_echo_names_the_flag_that_gave_the_unit(tmp_path):
     assert res.exit_code == 0, res.output
     assert "a.csv: 4000 samples" in res.output and "units: rate deg/s (declared in the header)" in res.output
     assert "b.csv: 4000 samples" in res.output and "units: rate deg/h (--apply-unit)" in res.output
+
+
+# -- a result document's record block: its sampling is read from signal.sampling, through one function ----------
+def test_record_sampling_reads_the_signal_and_never_its_synonyms():
+    meta = json.loads(json.dumps(from_array([1.0, 2.0, 3.0, 4.0], dt_s=0.01).to_rate(50.0).metadata()))
+    smp = record_sampling(meta)
+    assert (smp.dt_s, smp.rate_hz, smp.native_rate_hz, smp.block_average_factor) == (0.02, 50.0, 100.0, 2)
+    # a block that repeats the sampling beside its signal: the synonyms are not read
+    synonyms = {"dt_s": 9.0, "fs_hz": 1 / 9.0, "native_fs_hz": 3.0, "block_average_factor": 7}
+    assert record_sampling({**meta, **synonyms}) == smp
+
+
+def test_record_sampling_refuses_the_synonyms_alone_in_one_line():
+    with pytest.raises(ConfigError) as ei:
+        record_sampling({"dt_s": 0.04, "block_average_factor": 4}, "run/allan.json: the record")
+    assert str(ei.value) == ("run/allan.json: the record states its sampling only as dt_s, block_average_factor, not "
+                             "in 'signal.sampling' where this fogdrift reads it; re-run the fogdrift command that "
+                             "wrote the file")
+    with pytest.raises(ConfigError, match=r"^the model_record's signal\.sampling: dt_source must be one of"):
+        record_sampling({"signal": {"sampling": {"dt_s": 0.5, "dt_source": "guess"}}}, "the model_record")
+    with pytest.raises(ConfigError, match=r"^the record's signal: expected an object; got list$"):
+        record_sampling({"signal": [1]})
+    assert record_sampling({"n_samples": 3}) is None and record_sampling(None) is None

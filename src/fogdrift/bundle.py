@@ -5,9 +5,10 @@ Layout (no pickle; every file is JSON or NPZ)::
 
     bundle/
       manifest.json          format, format_version, fogdrift version, the training input (source,
-                             SHA-256, time range, split), input unit, native and modelling sample
-                             intervals, the training log's signal description (sampling, channels,
-                             where each came from; :mod:`fogdrift.signal`), wavelet / mode, the
+                             SHA-256, time range, split), input unit, the training log's signal
+                             description (:mod:`fogdrift.signal`: its sampling, the one place the
+                             sample interval is written, and its channels, where each came from),
+                             the block-average factor to the modelling rate, wavelet / mode, the
                              analysis settings, and per axis: bias and
                              how it was estimated, Earth-rate setting, level, causal-drift window,
                              noise model, and the model files with their SHA-256
@@ -20,7 +21,9 @@ A_-2..A_2 in (deg/h)^2 with tau in s, their covariance and the IEEE-952 terms), 
 state-space components if one was fitted, and a ``"gmwm"`` slot (None until a GMWM fit exists).
 
 :func:`load_bundle` validates everything (keys, types, units, intervals, wavelet and level, the models'
-classes and the files' SHA-256) and refuses a bundle of a newer format version with one clear line.
+classes and the files' SHA-256) and refuses a bundle of a newer format version with one clear line.  A
+format-2 manifest (the intervals written beside the signal description as ``native_dt_s``, ``model_dt_s`` and
+their rates) is read through :func:`_manifest_v2_as_v3`, the one converter.
 
 Examples
 --------
@@ -76,8 +79,12 @@ __all__ = [
 
 BUNDLE_FORMAT = "fogdrift-bundle"
 #: Version of the bundle layout (manifest keys, file names). Readers refuse a newer one.  Version 2 added the
-#: integrity seal; a version-1 bundle (no seal) is refused with the advice to re-create it.
-BUNDLE_FORMAT_VERSION = 2
+#: integrity seal; a version-1 bundle (no seal) is refused with the advice to re-create it.  Version 3 writes the
+#: sampling once, in ``signal.sampling`` (the modelling interval is ``block_average_factor`` times its ``dt_s``);
+#: a version-2 manifest is converted on reading.
+BUNDLE_FORMAT_VERSION = 3
+#: Manifest keys of format 2 that repeat the sampling of ``signal.sampling`` (dropped by the conversion).
+_V2_SAMPLING_KEYS = ("native_dt_s", "native_rate_hz", "model_dt_s", "model_rate_hz")
 MANIFEST = "manifest.json"
 #: Manifest key of the seal: SHA-256 of the canonical manifest without this key.
 SEAL_KEY = "seal_sha256"
@@ -183,8 +190,10 @@ class Bundle:
         mapped explicitly (``apply_unit``).
     native_dt_s, model_dt_s : float
         Sample interval of the training log and of the modelling series [s];
-        ``model_dt_s = block_average_factor * native_dt_s``.
+        ``model_dt_s = block_average_factor * native_dt_s``.  Not written to the manifest: read from its
+        ``signal.sampling.dt_s`` and ``block_average_factor``.
     block_average_factor : int
+        Samples of the training log (at ``native_dt_s``) per modelling sample.
     wavelet, mode : str
         Lifting wavelet and boundary mode of the drift separation.
     latitude_deg : float or None
@@ -200,8 +209,9 @@ class Bundle:
         Directory it was loaded from or saved to.
     signal : fogdrift.signal.SignalDescription or None
         The training log's signal description as loaded (native sampling, channels, where the rate and the
-        unit came from).  A bundle written before the manifest carried one gets one made from
-        ``input_unit`` and ``native_dt_s`` with the sources ``"bundle"``.
+        unit came from).  A format-2 manifest without one gets one made from ``input_unit`` and
+        ``native_dt_s`` with the sources ``"bundle"``; :func:`save_bundle` makes that one too for a bundle
+        built without a description.
     """
 
     axes: tuple
@@ -333,17 +343,21 @@ def save_bundle(bundle: Bundle, out_dir) -> Path:
             "causal_window": ax.causal_window, "causal_window_s": ax.causal_window * bundle.model_dt_s,
             "noise_model": ax.noise_model, "models": files,
         })
+    signal = bundle.signal
+    if signal is None:
+        names = bundle.training.get("axis_names") or list(bundle.axis_names)
+        signal = _bundle_signal(names, channel_unit(bundle.input_unit, None), bundle.native_dt_s)
+    elif abs(signal.sampling.dt_s - bundle.native_dt_s) > 1e-9 * bundle.native_dt_s:
+        raise ConfigError(f"the bundle's native_dt_s {bundle.native_dt_s!r} differs from its signal description's "
+                          f"sample interval {signal.sampling.dt_s!r}")
+    # the sampling is written once, in signal.sampling; the intervals are read back from it and the factor
     doc = {
         "format": BUNDLE_FORMAT, "format_version": BUNDLE_FORMAT_VERSION, "fogdrift_version": bundle.fogdrift_version,
         "created_utc": bundle.created_utc, "input_unit": bundle.input_unit, "rate_unit_internal": "deg/h",
-        "native_dt_s": bundle.native_dt_s, "native_rate_hz": 1.0 / bundle.native_dt_s,
-        "model_dt_s": bundle.model_dt_s, "model_rate_hz": 1.0 / bundle.model_dt_s,
         "block_average_factor": bundle.block_average_factor, "wavelet": bundle.wavelet, "mode": bundle.mode,
         "latitude_deg": bundle.latitude_deg, "training": bundle.training, "settings": bundle.settings,
-        "axes": axes_doc,
+        "signal": signal.to_dict(), "axes": axes_doc,
     }
-    if bundle.signal is not None:
-        doc["signal"] = bundle.signal.to_dict()
     # sealed over the strict (NaN -> null) tree that is written: one serialiser, _util.strict_json
     text = strict_json(seal_manifest(json.loads(strict_json(doc, indent=None))))
     # the manifest last and whole (temporary name, renamed): a bundle without one is incomplete, never half-read
@@ -460,17 +474,18 @@ def load_bundle(path) -> Bundle:
         unit_spec = channel_unit(unit, None)  # a unit of any quantity (gyro deg/s, accelerometer g ...)
     except ConfigError:
         d.fail("input_unit", f"unknown unit {unit!r}")
-    native = d.get(raw, "native_dt_s", "positive", "")
-    model_dt = d.get(raw, "model_dt_s", "positive", "")
-    for key, value in (("native_dt_s", native), ("model_dt_s", model_dt)):
-        try:
-            check_dt_s(value, key)
-        except ConfigError as exc:
-            d.fail(key, str(exc))
+    if version == 2:
+        raw = _manifest_v2_as_v3(raw, d, unit_spec)
+    signal = _signal_of(raw, d, unit_spec)
+    native = signal.sampling.dt_s
     factor = d.get(raw, "block_average_factor", "int", "")
-    if factor < 1 or abs(factor * native - model_dt) > 1e-9 * model_dt:
-        d.fail("block_average_factor", f"model_dt_s {model_dt!r} is not {factor} x native_dt_s {native!r}")
-    signal = _signal_of(raw, d, unit_spec, native)
+    if factor < 1:
+        d.fail("block_average_factor", f"expected an integer >= 1, got {factor}")
+    model_dt = factor * native
+    try:
+        check_dt_s(model_dt, "the modelling interval (block_average_factor x signal.sampling.dt_s)")
+    except ConfigError as exc:
+        d.fail("block_average_factor", str(exc))
     wavelet = d.get(raw, "wavelet", str, "")
     if wavelet not in wavelist():
         d.fail("wavelet", f"unknown wavelet {wavelet!r}; expected one of {wavelist()}")
@@ -567,28 +582,56 @@ def _train_stop(training) -> int | None:
     return stop if isinstance(stop, int) and not isinstance(stop, bool) and stop > 0 else None
 
 
-def _signal_of(raw: dict, d: _Doc, unit_spec, native_dt_s: float) -> SignalDescription:
-    """The manifest's signal description (checked against ``input_unit`` and ``native_dt_s``), or, for a
-    manifest without one, a description made from those two with the sources "bundle"."""
-    doc = raw.get("signal")
-    if doc is None:
+def _bundle_signal(names, unit_spec, native_dt_s: float) -> SignalDescription:
+    """A description made from the input unit and the native interval alone, with the sources ``"bundle"``: for a
+    bundle whose training log's description is not known."""
+    scale = unit_spec.scale_to_internal(native_dt_s)
+    return SignalDescription(Sampling(dt_s=native_dt_s, dt_source="bundle"), tuple(
+        Channel(name=n, unit=unit_spec, unit_source="bundle", declared_unit=None, scale_to_internal=scale)
+        for n in dict.fromkeys(names)))
+
+
+def _manifest_v2_as_v3(raw: dict, d: _Doc, unit_spec) -> dict:
+    """A format-2 manifest (its seal already checked) in the format-3 layout: ``native_dt_s``, ``model_dt_s`` and
+    their rates checked (``model_dt_s = block_average_factor x native_dt_s``, the description's interval the
+    native one) and dropped, and a manifest without a ``signal`` given one made from ``input_unit`` and
+    ``native_dt_s``.  The one place format 2 is read; everything after it reads format 3."""
+    native = d.get(raw, "native_dt_s", "positive", "")
+    model_dt = d.get(raw, "model_dt_s", "positive", "")
+    for key, value in (("native_dt_s", native), ("model_dt_s", model_dt)):
+        try:
+            check_dt_s(value, key)
+        except ConfigError as exc:
+            d.fail(key, str(exc))
+    factor = d.get(raw, "block_average_factor", "int", "")
+    if factor < 1 or abs(factor * native - model_dt) > 1e-9 * model_dt:
+        d.fail("block_average_factor", f"model_dt_s {model_dt!r} is not {factor} x native_dt_s {native!r}")
+    out = {k: v for k, v in raw.items() if k not in _V2_SAMPLING_KEYS}
+    if raw.get("signal") is None:
         names = raw.get("training", {}).get("axis_names") if isinstance(raw.get("training"), dict) else None
         if not (isinstance(names, list) and names and all(isinstance(n, str) for n in names)):
             names = [a.get("name") for a in raw.get("axes", []) if isinstance(a, dict) and isinstance(a.get("name"), str)]
-        scale = unit_spec.scale_to_internal(native_dt_s)
         try:
-            return SignalDescription(Sampling(dt_s=native_dt_s, dt_source="bundle"), tuple(
-                Channel(name=n, unit=unit_spec, unit_source="bundle", declared_unit=None, scale_to_internal=scale)
-                for n in dict.fromkeys(names)))
+            out["signal"] = _bundle_signal(names, unit_spec, native).to_dict()
         except ConfigError as exc:
             d.fail("axes", str(exc))
+        return out
+    smp = raw["signal"].get("sampling") if isinstance(raw["signal"], dict) else None
+    dt = smp.get("dt_s") if isinstance(smp, dict) else None
+    if isinstance(dt, (int, float)) and not isinstance(dt, bool) and abs(dt - native) > 1e-9 * native:
+        d.fail("signal.sampling.dt_s", f"{dt!r} differs from native_dt_s {native!r}")
+    return out
+
+
+def _signal_of(raw: dict, d: _Doc, unit_spec) -> SignalDescription:
+    """The manifest's signal description, the one home of the training log's sampling, its channels in
+    ``input_unit``."""
+    if raw.get("signal") is None:
+        d.fail("signal", "missing (the training log's signal description holds the bundle's sampling)")
     try:
-        signal = SignalDescription.from_dict(doc)
+        signal = SignalDescription.from_dict(raw["signal"])
     except ConfigError as exc:
         d.fail("signal", str(exc))
-    smp = signal.sampling
-    if abs(smp.dt_s - native_dt_s) > 1e-9 * native_dt_s:
-        d.fail("signal.sampling.dt_s", f"{smp.dt_s!r} differs from native_dt_s {native_dt_s!r}")
     odd = [c.name for c in signal.channels if c.unit_as_read != unit_spec.text]
     if odd:
         d.fail("signal.channels", f"channels {odd} are not in input_unit {unit_spec.text!r}")

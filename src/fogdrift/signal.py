@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 from . import units
 from .errors import ConfigError
 
-__all__ = ["Sampling", "Channel", "SignalDescription", "DT_SOURCES", "UNIT_SOURCES", "channel_unit"]
+__all__ = ["Sampling", "Channel", "SignalDescription", "DT_SOURCES", "UNIT_SOURCES", "channel_unit", "record_sampling"]
 
 #: Where a sample interval can come from: the file's time column, the time stamps the format carries
 #: (bag, miniSEED, HDF5 time dataset), the sample-rate option (``rate_hz``/``dt_s``, the CLI's
@@ -285,3 +285,61 @@ class SignalDescription:
             raise ConfigError("signal must be an object with 'sampling' and a list of 'channels'")
         return cls(sampling=Sampling.from_dict(d.get("sampling")),
                    channels=tuple(Channel.from_dict(c) for c in d["channels"]))
+
+
+#: Keys under which a record block may state its sampling beside (or instead of) ``signal``: they are never read,
+#: and a block with one of them but no ``signal`` is refused (the interval's provenance is not in it).
+_RECORD_SAMPLING_SYNONYMS = ("dt_s", "fs_hz", "native_fs_hz", "block_average_factor")
+
+
+def record_sampling(block, where: str = "the record") -> Sampling | None:
+    """The sampling a result document's record block states: its ``signal.sampling``, the one home of the sample
+    interval, the native interval and the block-averaging factor in every written document (the ``record`` of
+    ``allan.json`` and ``noise.json``, the ``record`` and ``model_record`` of an analysis result).  Every reader of
+    a result document gets the sampling here.
+
+    A block that also repeats the sampling as ``dt_s``/``fs_hz``/``native_fs_hz``/``block_average_factor`` beside
+    its ``signal`` is read the same way: those keys are ignored.
+
+    Parameters
+    ----------
+    block : dict or None
+        The record block as read (:meth:`fogdrift.io.GyroRecord.metadata` written to JSON).
+    where : str
+        What the messages name (``"the record"``, ``"the model_record"``); a caller that read a file puts its path
+        in front.
+
+    Returns
+    -------
+    Sampling or None
+        None for a block that states no sampling at all (a hand-written result; the caller decides).
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``where``: the block states the interval only under the keys above (no ``signal``), or
+        its ``signal.sampling`` is not a valid sampling.
+
+    Examples
+    --------
+    >>> from fogdrift.io import from_array
+    >>> block = from_array([1.0, 2.0, 3.0, 4.0], dt_s=0.01).to_rate(50.0).metadata()
+    >>> smp = record_sampling(block)
+    >>> smp.rate_hz, smp.native_rate_hz, smp.block_average_factor
+    (50.0, 100.0, 2)
+    """
+    if not isinstance(block, dict):
+        return None
+    signal = block.get("signal")
+    if signal is None:
+        old = [k for k in _RECORD_SAMPLING_SYNONYMS if block.get(k) is not None]
+        if old:
+            raise ConfigError(f"{where} states its sampling only as {', '.join(old)}, not in 'signal.sampling' "
+                              "where this fogdrift reads it; re-run the fogdrift command that wrote the file")
+        return None
+    if not isinstance(signal, dict):
+        raise ConfigError(f"{where}'s signal: expected an object; got {type(signal).__name__}")
+    try:
+        return Sampling.from_dict(signal.get("sampling"))
+    except ConfigError as exc:
+        raise ConfigError(f"{where}'s signal.sampling: {exc}") from None

@@ -234,6 +234,7 @@ def test_cli_compensate_prints_the_heading_table_and_refuses_in_one_line(bundle_
                                  "200", "--origin-step", "200", "--horizons", "60,600", "--out", str(tmp_path / "o")])
     assert result.exit_code == 0, result.output
     assert "heading error after a 200-s calibration" in result.output and "constant bias" in result.output
+    assert "(unit deg/s, 10 Hz, models at 1 Hz)" in " ".join(result.output.split())  # the log's rate: its signal
     assert (tmp_path / "o" / "compensated.npz").exists()
     np.savetxt(tmp_path / "rad.csv", np.column_stack([np.arange(100) / FS, np.zeros(100)]), delimiter=",",
                header="t_s,gx[rad/s]", comments="")

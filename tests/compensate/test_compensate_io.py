@@ -105,6 +105,9 @@ def test_increment_unit_scale_is_carried_from_the_reader(bundle, tmp_path):
     chan = res.summary["signal"]["channels"][0]
     assert chan["unit_as_read"] == "inc:arcsec" and chan["unit_source"] == "option"
     assert res.summary["signal"]["sampling"]["dt_source"] == "time column"
+    # the log's interval is written once, in its signal description; model_dt_s is the bundle's models' interval
+    assert res.summary["signal"]["sampling"]["dt_s"] == pytest.approx(0.1) and "native_dt_s" not in res.summary
+    assert res.summary["model_dt_s"] == load_bundle(bundle).model_dt_s
     np.testing.assert_allclose(_read(tmp_path / "o")["compensated"][:, 0], 5.0 - b / 10.0, atol=1e-12)
 
 

@@ -30,6 +30,12 @@ runner = CliRunner()
 # ------------------------------------------------------------------------------------------------------------------
 # result files built by hand (the shapes fogdrift allan writes)
 # ------------------------------------------------------------------------------------------------------------------
+def _record(fs_hz, **extra):
+    """A result's record block as fogdrift writes it, reduced to what export reads: the sampling in
+    ``signal.sampling`` (its one home in a result) and ``extra`` (``sha256``)."""
+    return {"signal": {"sampling": {"dt_s": 1.0 / fs_hz, "dt_source": "argument"}}, **extra}
+
+
 def _term(name, value, lo, hi, unit, status, reason=""):
     return {"name": name, "value": value, "unit": unit, "lo95": lo, "hi95": hi, "status": status,
             "estimable": status in ("resolved", "unresolved"), "reason": reason}
@@ -59,7 +65,7 @@ def _gyro_result(tmp_path, name="gyro.json", **kw):
                                "K": (0.4, 0.2, 0.6, "resolved")}, **kw),
             _allan_axis("gz", {"N": (0.10, 0.09, 0.11, "resolved"), "B": (1.0, 0.5, 1.5, "resolved")},
                         selected=("N", "B"), **kw)]
-    doc = {"source": "sim", "record": {"fs_hz": 100.0, "sha256": "ab" * 32}, "axes": axes}
+    doc = {"source": "sim", "record": _record(100.0, sha256="ab" * 32), "axes": axes}
     p = tmp_path / name
     p.write_text(json.dumps(doc))
     return p
@@ -73,7 +79,7 @@ def _accel_result(tmp_path):
                             "K": (1e-4 * (i + 1), 5e-5, 4e-4, "resolved")}, units=_ACC_UNITS)
             for i, a in enumerate(("ax", "ay", "az"))]
     p = tmp_path / "accel.json"
-    p.write_text(json.dumps({"source": "sim", "record": {"fs_hz": 100.0}, "axes": axes}))
+    p.write_text(json.dumps({"source": "sim", "record": _record(100.0), "axes": axes}))
     return p
 
 
@@ -330,7 +336,7 @@ def test_six_channel_result_split_by_units(tmp_path):
     g = json.loads(_gyro_result(tmp_path).read_text())
     a = json.loads(_accel_result(tmp_path).read_text())
     six = tmp_path / "six.json"
-    six.write_text(json.dumps({"record": {"fs_hz": 100.0}, "axes": g["axes"] + a["axes"]}))
+    six.write_text(json.dumps({"record": _record(100.0), "axes": g["axes"] + a["axes"]}))
     ctx = build_context(results=[six])
     assert [c.name for c in ctx.gyro] == ["gx", "gy", "gz"] and [c.name for c in ctx.accel] == ["ax", "ay", "az"]
     d = yaml.safe_load(render("kalibr", ctx))
@@ -361,7 +367,7 @@ def _gmwm_axis(name, n, k, gms):
 
 def test_gmwm_result_slowest_gm_is_the_bias(tmp_path):
     p = tmp_path / "noise.json"
-    p.write_text(json.dumps({"fogdrift_result": "noise", "method": "gmwm", "record": {"fs_hz": 100.0},
+    p.write_text(json.dumps({"fogdrift_result": "noise", "method": "gmwm", "record": _record(100.0),
                              "axes": [_gmwm_axis("gx", 0.3, 2.0, [(0.2, 50.0), (150.0, 4.0)]),
                                       _gmwm_axis("gy", 0.3, None, [(80.0, 3.0)])]}))
     ctx = build_context([p], missing="zero")
@@ -500,7 +506,7 @@ def test_gmwm_accelerometer_result(tmp_path):
     ax["selection"]["ieee"]["gm"][0]["sigma_gm_dph"]["unit"] = "m/s^2"
     ax["selection"]["ieee"]["b_headline"]["bound_dph"] = None
     p = tmp_path / "acc_noise.json"
-    p.write_text(json.dumps({"record": {"fs_hz": 100.0}, "axes": [ax]}))
+    p.write_text(json.dumps({"record": _record(100.0), "axes": [ax]}))
     ctx = build_context(accel=[p], missing="zero")
     assert ctx.accel[0].quantity == "accel"
     d = yaml.safe_load(render("kf-gins", ctx))["imunoise"]

@@ -9,6 +9,7 @@ import math
 
 from fogdrift.export import build_context, render
 from fogdrift.export.writers import _json_safe
+from fogdrift.io import from_array
 
 
 def _axis():
@@ -20,7 +21,8 @@ def _axis():
 
 def test_nan_tau_range_is_written_as_null(tmp_path):
     p = tmp_path / "noise.json"
-    p.write_text(json.dumps({"record": {"fs_hz": 100.0}, "axes": [_axis()]}))
+    record = from_array([0.0, 0.0], dt_s=0.01).metadata()  # the record block as fogdrift writes it
+    p.write_text(json.dumps({"record": record, "axes": [_axis()]}))
     ctx = build_context([p])
     assert all(math.isnan(x) for x in ctx.gyro[0].tau_range_s)
     d = json.loads(render("json", ctx))                       # strict JSON: no NaN token

@@ -52,6 +52,7 @@ from fogdrift.cli import app
 from fogdrift.export import build_context, render
 from fogdrift.pipeline import analyse_allan
 from fogdrift.pipeline.config import AnalysisConfig
+from fogdrift.io import from_array
 from fogdrift.simulate import simulate
 
 D2R = math.pi / 180.0
@@ -86,7 +87,8 @@ def exported(tmp_path_factory):
     dt = 1.0 / SOURCE["fs"]
     y = simulate(SOURCE["n"], dt, arw_dprh=SOURCE["N"], bias_instability_dph=SOURCE["B"], seed=SOURCE["seed"])
     axis = analyse_allan("gz", y, dt, AnalysisConfig().validate())
-    (d / "gyro.json").write_text(json.dumps({"record": {"fs_hz": SOURCE["fs"]}, "axes": [axis.to_dict()]},
+    record = from_array([0.0, 0.0], dt_s=1.0 / SOURCE["fs"]).metadata()  # the record block as fogdrift writes it
+    (d / "gyro.json").write_text(json.dumps({"record": record, "axes": [axis.to_dict()]},
                                             default=float))
     res = CliRunner().invoke(app, ["export", "--gyro", str(d / "gyro.json"), "--target", "gnss-ins-sim",
                                    "--out", str(d / "out")])
@@ -107,7 +109,8 @@ def _recovered(imu_err, seed, path):
     taus = np.geomspace(1.0 / SIM_FS, SIM_N / SIM_FS, 4001)
     adev_m = fit.term_adev_dph("M", taus)
     k = int(np.argmax(adev_m))
-    path.write_text(json.dumps({"record": {"fs_hz": SIM_FS}, "axes": [axis.to_dict()]}, default=float))
+    record = from_array([0.0, 0.0], dt_s=1.0 / SIM_FS).metadata()  # the record block as fogdrift writes it
+    path.write_text(json.dumps({"record": record, "axes": [axis.to_dict()]}, default=float))
     ns = {}
     exec(render("gnss-ins-sim", build_context([path])), ns)  # noqa: S102 - our own generated file
     return {"N": fit.to_dict()["terms"]["N"]["value"], "B": adev_m[k] / 0.664, "tau_B": taus[k],

@@ -77,7 +77,7 @@ def _one(ax, record=None, path="noise.json"):
 
 
 def test_gmwm_channel_every_field_by_hand():
-    ch = _one(_full_gmwm_axis(), {"fs_hz": 200.0, "sha256": "cd" * 32}, path="run/noise.json")
+    ch = _one(_full_gmwm_axis(), _record(200.0, sha256="cd" * 32), path="run/noise.json")
     assert (ch.name, ch.quantity, ch.method) == ("gx", "gyro", "gmwm")
     assert ch.fit == "GMWM model WN+RW+GM (J-test p = 0.43)"
     assert ch.rate_hz == 200.0 and ch.sha256 == "cd" * 32 and ch.source_file == "run/noise.json"
@@ -117,7 +117,7 @@ def test_gmwm_channel_defaults_when_fields_are_absent():
     ax["selected"] = "WN+GM"
     ie["terms"]["K_dphrh"] = _t(2.0, 0.5, 3.0)           # no unit: the gyro default deg/h^1.5, no component: '?'
     ie["gm"] = [_gm(50.0, 3.0, unit=None, component=None, ci=False)]
-    ch = _one(ax, {"fs_hz": None})
+    ch = _one(ax, {})
     assert ch.fit == "GMWM model WN+GM"                    # no J-test: no p in the words
     assert ch.rate_hz == approx(100.0, rel=1e-12)  # 1 / dt_s
     assert ch.sha256 == "" and ch.b_tau_s is None
@@ -141,7 +141,7 @@ def test_gmwm_b_headline_bound_and_flicker_term():
     ax["selection"]["ieee"]["b_headline"] = {"value_dph": None, "bound_dph": 9.0, "tau_s": 800.0,
                                              "reason": "95 % upper bound: no minimum in the range",
                                              "label": "min of the model's ADEV / 0.664"}
-    ch = _one(ax, {"fs_hz": 100.0})
+    ch = _one(ax, _record(100.0))
     b = ch.terms["B"]
     assert (b.value, b.lo95, b.hi95, b.status) == (None, 0.0, 9.0, "absent")
     assert b.si_hi95 == approx(9.0 * DPH, rel=1e-12) and b.si_lo95 == 0.0
@@ -150,7 +150,7 @@ def test_gmwm_b_headline_bound_and_flicker_term():
     assert ch.b_is_flicker is False and ch.b_tau_s == 800.0
     # a flicker component (B_dph) in the model: B is that term, not the headline, and b_is_flicker is set
     ax["selection"]["ieee"]["terms"]["B_dph"] = _t(0.7, 0.5, 0.9, "deg/h", "FLK")
-    ch = _one(ax, {"fs_hz": 100.0})
+    ch = _one(ax, _record(100.0))
     assert ch.b_is_flicker is True
     b = ch.terms["B"]
     assert (b.value, b.status, b.source) == (0.7, "resolved", "gmwm WN+RW+GM: B (component FLK)")
@@ -177,7 +177,7 @@ def test_gmwm_accelerometer_defaults_are_specific_force_units():
     ie["gm"] = [_gm(300.0, 2e-4, unit="m/s^2")]
     ie["b_headline"] = {"value_dph": None, "bound_dph": 5e-4, "tau_s": 600.0}
     ax["wvar"] = {"tau_samples": [2, 4], "ci_hi95_dph2": [1.0, 1.0], "dt_s": 0.01, "scale_s": [0.02, 0.04]}
-    ch = _one(ax, {"fs_hz": 100.0})
+    ch = _one(ax, _record(100.0))
     assert ch.quantity == "accel"                         # B's bound is read in m/s^2 (not deg/h)
     assert {k: ch.terms[k].unit for k in "NKRQB"} == {"N": "m/s/sqrt(h)", "K": "m/s^2/sqrt(s)", "R": "m/s^3",
                                                       "Q": "m/s", "B": "m/s^2"}
@@ -196,7 +196,7 @@ def test_gmwm_wavelet_bound_is_for_the_gyro_random_walk_only():
     del ie["terms"]["K_dphrh"]
     ax["wvar"] = {"tau_samples": [2, 8, 32], "ci_hi95_dph2": [9.0, 5.0, 3.0], "dt_s": 0.01,
                   "scale_s": [0.02, 0.08, 0.32]}
-    ch = _one(ax, {"fs_hz": 100.0})
+    ch = _one(ax, _record(100.0))
     k = ch.terms["K"]
     tau = 32.0                                            # the LAST scale, not the first or the second
     k_bound = 60.0 * math.sqrt(3.0 * 12.0 * tau / (tau * tau + 2.0) / 0.01)
@@ -250,7 +250,7 @@ import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_export import _accel_result, _gyro_result  # noqa: E402  (the hand-made result files of test_export)
+from test_export import _accel_result, _gyro_result, _record  # noqa: E402  (the hand-made result files of test_export)
 
 from fogdrift.export import build_context, render  # noqa: E402
 
@@ -616,7 +616,7 @@ def _gmwm_file(tmp_path):
     g3["tc_s"]["hi95"] = None                                  # T_c bounded on one side only: no T_c interval
     ax3["selection"]["ieee"]["gm"] = [g3]
     p = tmp_path / "noise.json"
-    p.write_text(json.dumps({"record": {"fs_hz": 100.0}, "axes": [ax1, ax2, ax3]}))
+    p.write_text(json.dumps({"record": _record(100.0), "axes": [ax1, ax2, ax3]}))
     return p
 
 
@@ -830,13 +830,13 @@ from fogdrift.export.model import bias_gm, describe, load_result, resolve  # noq
 
 
 def _allan_doc(ax, record=None):
-    return {"record": {"fs_hz": 100.0} if record is None else record, "axes": [ax]}
+    return {"record": _record(100.0) if record is None else record, "axes": [ax]}
 
 
 def test_allan_channel_fields_by_hand():
     ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved"), "B": (2.0, 1.5, 2.5, "resolved"),
                             "K": (0.5, 0.0, 0.7, "unresolved", "its interval reaches 0")}, b_tau=120.0)
-    (ch,) = channels_from_result(_allan_doc(ax, {"fs_hz": 50.0, "sha256": "ef" * 32}), "a.json")
+    (ch,) = channels_from_result(_allan_doc(ax, _record(50.0, sha256="ef" * 32)), "a.json")
     assert (ch.method, ch.quantity, ch.rate_hz, ch.sha256, ch.source_file) == ("allan", "gyro", 50.0, "ef" * 32,
                                                                                 "a.json")
     assert ch.fit == "model N+B+K (chi2_red 1.1, good)" and ch.no_fit is False
@@ -847,9 +847,26 @@ def test_allan_channel_fields_by_hand():
     assert (k.status, k.reason, k.lo95) == ("unresolved", "its interval reaches 0", 0.0) and k.has_estimate
     r = ch.terms["R"]
     assert (r.status, r.value, r.hi95) == ("absent", None, 0.3) and not r.has_estimate
-    # no fs_hz: the rate is 1 / dt_s
+    # no sampling in the record: the rate is 1 / the fit's dt_s
     (ch,) = channels_from_result(_allan_doc(ax, {}), "a.json")
     assert ch.rate_hz == approx(100.0, rel=1e-12) and ch.sha256 == ""
+
+
+def test_the_rate_is_read_from_the_records_signal_sampling_only():
+    ax = _allan_axis("gx", {"N": (0.15, 0.14, 0.16, "resolved")})
+    # a record block that repeats the rate as fs_hz beside signal.sampling: the signal is read
+    old = {**_record(50.0), "dt_s": 0.02, "fs_hz": 50.0, "native_fs_hz": 50.0, "block_average_factor": 1}
+    (ch,) = channels_from_result(_allan_doc(ax, old), "a.json")
+    assert ch.rate_hz == 50.0
+    old["fs_hz"] = 7.0                                                          # never read
+    assert channels_from_result(_allan_doc(ax, old), "a.json")[0].rate_hz == 50.0
+    # the sampling only under the old keys: refused in one line naming the file and what to do
+    with pytest.raises(DataFormatError) as ei:
+        channels_from_result(_allan_doc(ax, {"dt_s": 0.02, "fs_hz": 50.0}), "a.json")
+    assert str(ei.value) == ("a.json: the record states its sampling only as dt_s, fs_hz, not in 'signal.sampling' "
+                             "where this fogdrift reads it; re-run the fogdrift command that wrote the file")
+    with pytest.raises(DataFormatError, match=r"^a\.json: the record's signal\.sampling: sampling has no 'dt_source'$"):
+        channels_from_result(_allan_doc(ax, {"signal": {"sampling": {"dt_s": 0.02}}}), "a.json")
 
 
 def test_allan_no_fit_reason_and_status():
@@ -945,8 +962,8 @@ def test_allan_axis_without_a_fit_and_bad_files_are_refused(tmp_path):
     del ax["noise"]["dt_s"]
     with pytest.raises(DataFormatError) as ei:
         channels_from_result(_allan_doc(ax, {}), "a.json")       # no rate anywhere
-    assert str(ei.value) == ("a.json: the result says no sample rate (record 'fs_hz' or the fit's 'dt_s'); expected "
-                             "the allan.json or noise.json of a fogdrift run")
+    assert str(ei.value) == ("a.json: the result says no sample rate (record 'signal.sampling' or the fit's 'dt_s'); "
+                             "expected the allan.json or noise.json of a fogdrift run")
     assert "\n" not in str(ei.value)
     p = tmp_path / "axes.json"
     for text in ('{"axes": []}', '{"axes": {}}', "[1, 2]"):
@@ -1145,7 +1162,7 @@ def test_gm_from_b_without_its_tau_uses_the_end_of_the_fitted_range():
     ie = ax["selection"]["ieee"]
     ie["gm"] = []
     del ie["b_headline"]["tau_s"]                            # B read, but not where: the longest fitted tau, 500 s
-    ch = _one(ax, {"fs_hz": 100.0})
+    ch = _one(ax, _record(100.0))
     assert ch.b_tau_s is None
     g, how = bias_gm(ch, "bound")
     assert g.tc_s == approx(500.0 / 1.8926, rel=1e-4) and g.sigma_si == approx(1.0760 * 1.5 * DPH, rel=1e-4)

@@ -644,9 +644,9 @@ def test_metadata_is_json_serialisable(small_csv):
     assert back["axis_names"] == ["gx", "gy", "gz"]
     assert back["input_unit"] == "inc:arcsec"
     assert back["scale_to_dph"] == pytest.approx(100.0)
-    assert back["fs_hz"] == pytest.approx(100.0)
+    assert back["signal"]["sampling"]["rate_hz"] == pytest.approx(100.0)
     assert back["rate_unit"] == "deg/h"
-    assert set(meta) >= {"source", "dt_s", "t0_s", "notes", "duration_s"}
+    assert set(meta) >= {"source", "t0_s", "notes", "duration_s", "signal"}
 
 
 def test_record_constructor_checks():

@@ -98,10 +98,10 @@ def test_to_rate_averages_and_records_the_factor():
     lower = low.to_rate(5.0)  # factors multiply
     assert lower.block_average_factor == 20 and lower.fs_hz == pytest.approx(5.0, rel=1e-12)
     assert_allclose(lower.rate_dph, x[:1000].reshape(50, 20, 2).mean(axis=1), rtol=1e-12)
-    meta = json.loads(json.dumps(lower.metadata()))
-    assert meta["block_average_factor"] == 20
-    assert meta["fs_hz"] == pytest.approx(5.0) and meta["native_fs_hz"] == pytest.approx(100.0)
-    assert rec.metadata()["block_average_factor"] == 1
+    smp = json.loads(json.dumps(lower.metadata()))["signal"]["sampling"]
+    assert smp["block_average_factor"] == 20
+    assert smp["rate_hz"] == pytest.approx(5.0) and smp["native_rate_hz"] == pytest.approx(100.0)
+    assert rec.metadata()["signal"]["sampling"]["block_average_factor"] == 1
     assert rec.to_rate(100.0) is rec
     assert rec.block_average(0.02).block_average_factor == 2  # block_average by interval counts too
 
@@ -116,3 +116,17 @@ def test_to_rate_errors():
         rec.to_rate(1.0)
     assert (ei.value.needed, ei.value.got) == (100, 10)
     assert_array_equal(rec.to_rate(10.0).rate_dph, [[0.0]])
+
+
+def test_metadata_writes_the_sampling_once_and_reads_back():
+    """The record block holds the sampling in signal.sampling only, and it reads back as the record's."""
+    from fogdrift.signal import record_sampling
+
+    rec = from_array(np.arange(2 * 1003, dtype=float).reshape(1003, 2), dt_s=0.01, axis_names=("a", "b"))
+    low = rec.to_rate(25.0)
+    meta = json.loads(json.dumps(low.metadata()))
+    assert set(meta) == {"source", "sha256", "input_unit", "declared_units", "scale_to_dph", "rate_unit", "t0_s",
+                         "n_samples", "n_axes", "duration_s", "axis_names", "notes", "temperature", "signal"}
+    smp = record_sampling(meta)
+    assert (smp.dt_s, smp.native_dt_s, smp.block_average_factor) == (low.dt_s, rec.dt_s, 4)
+    assert smp == low.signal.sampling

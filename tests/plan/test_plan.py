@@ -409,3 +409,21 @@ def test_cli_refusals_are_one_line(tmp_path, args, words):
     assert res.exit_code == 1
     text = res.output.strip()
     assert words in text and len(text.splitlines()) == 1, text
+
+
+def test_model_file_takes_the_interval_from_the_records_signal_description(tmp_path):
+    """A result whose fit states no dt_s: the interval is the record's signal.sampling, never a synonym beside it."""
+    from fogdrift.io import from_array
+    from fogdrift.plan import read_model_file
+
+    record = json.loads(json.dumps(from_array([0.0] * 8, dt_s=0.25).to_rate(2.0).metadata()))
+    axes = [{"name": "gz", "noise": {"terms": {"N": {"value": 0.1, "unit": "deg/sqrt(h)"}}}}]
+    p = tmp_path / "allan.json"
+    p.write_text(json.dumps({"record": {**record, "dt_s": 9.0}, "axes": axes}))
+    m = read_model_file(p)
+    assert m.dt_s == 0.5 and m.coefficients == {"N": 0.1}
+    p.write_text(json.dumps({"record": {"dt_s": 0.5, "fs_hz": 2.0}, "axes": axes}))
+    with pytest.raises(ConfigError) as ei:
+        read_model_file(p)
+    assert str(ei.value) == (f"{p}: the record states its sampling only as dt_s, fs_hz, not in 'signal.sampling' "
+                             "where this fogdrift reads it; re-run the fogdrift command that wrote the file")

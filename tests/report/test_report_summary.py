@@ -72,3 +72,25 @@ def test_verdict_badge_and_tables_render():
     assert '<td class="good">0.8</td>' in h and '<td class="bad">1.1</td>' in h
     a = _artefact_table(_artefacts((0.01,)))
     assert '<td class="flag">0.5 ⚑</td>' in a and "sinusoid 0.1 Hz: gain" in a and "ramp: surviving slope" in a
+
+
+def test_recording_rows_read_the_sampling_from_the_signal_description():
+    """The rate rows come from the record blocks' signal.sampling; synonyms beside it are not read."""
+    import json
+
+    import numpy as np
+
+    from fogdrift.io import from_array
+    from fogdrift.report.summary import recording_rows
+
+    rec = from_array(np.zeros((400, 1)), dt_s=0.01, axis_names=["gz"])
+    res = NS(source="run/g.csv", record=json.loads(json.dumps(rec.metadata())),
+             model_record=json.loads(json.dumps(rec.to_rate(25.0).metadata())))
+    rows = dict(recording_rows(res))
+    assert rows["sample rate"] == "100 Hz (dt 0.01 s)"
+    assert rows["modelling rate"] == "25 Hz (native 100 Hz averaged in blocks of 4)"
+    res.record.update(dt_s=1.0, fs_hz=1.0, native_fs_hz=1.0)
+    res.model_record.update(fs_hz=1.0, native_fs_hz=3.0, block_average_factor=3)
+    assert dict(recording_rows(res)) == rows
+    res.model_record = {}
+    assert dict(recording_rows(res))["modelling rate"] == "native rate"

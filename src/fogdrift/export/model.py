@@ -27,6 +27,7 @@ from pathlib import Path
 from .. import documents
 from ..errors import ConfigError, DataFormatError
 from ..noise.terms import TERMS
+from ..signal import record_sampling
 from ..units import name_keys
 from .conversions import quantity_of_unit, single_gm_from_flicker, to_si
 
@@ -337,14 +338,18 @@ def _gmwm_channel(ax: dict, record: dict, path: str) -> ChannelModel:
 
 
 def _rate_hz(record: dict, fit: dict, path) -> float:
-    """The sample rate [Hz] of the record a result describes: its ``fs_hz``, else 1 / the fit's ``dt_s``."""
-    fs = record.get("fs_hz")
-    if fs is not None:
-        return _coefficient(fs, "record fs_hz", str(path), positive=True)
+    """The sample rate [Hz] of the record a result describes: its ``signal.sampling`` rate
+    (:func:`fogdrift.signal.record_sampling`), else 1 / the fit's ``dt_s``."""
+    try:
+        smp = record_sampling(record, "the record")
+    except ConfigError as exc:
+        raise DataFormatError(str(exc), path=path) from None
+    if smp is not None:
+        return smp.rate_hz
     dt = _coefficient(fit.get("dt_s"), "dt_s", str(path), positive=True)
     if dt is None:
-        raise DataFormatError("the result says no sample rate (record 'fs_hz' or the fit's 'dt_s'); expected the "
-                              "allan.json or noise.json of a fogdrift run", path=path)
+        raise DataFormatError("the result says no sample rate (record 'signal.sampling' or the fit's 'dt_s'); "
+                              "expected the allan.json or noise.json of a fogdrift run", path=path)
     return 1.0 / dt
 
 

@@ -457,12 +457,15 @@ class GyroRecord:
         dict
             ``source, sha256, input_unit, declared_units (list), scale_to_dph, rate_unit
             ("deg/h") (for a record with accelerometer channels ``scale_to_internal`` and ``internal_unit``:
-            ``"m/s^2"``, or a dict of each channel's internal unit for a gyro and accelerometer log), dt_s, fs_hz, native_fs_hz, block_average_factor, t0_s, n_samples,
-            n_axes, duration_s, axis_names (list), notes (list), temperature, signal``.  ``fs_hz`` is
-            the effective rate after block averaging; ``native_fs_hz`` the rate as loaded;
+            ``"m/s^2"``, or a dict of each channel's internal unit for a gyro and accelerometer log), t0_s,
+            n_samples, n_axes, duration_s, axis_names (list), notes (list), temperature, signal``.
             ``temperature`` is None or the range and drift of the temperature carried with the
             log (:meth:`fogdrift.temperature.TemperatureSummary.to_dict`, deg C and deg C/h);
-            ``signal`` is :meth:`fogdrift.signal.SignalDescription.to_dict` of :attr:`signal`.
+            ``signal`` is :meth:`fogdrift.signal.SignalDescription.to_dict` of :attr:`signal`, the one place
+            the sampling is written: ``signal.sampling`` holds the interval after block averaging
+            (``dt_s``, ``rate_hz``), the interval as loaded (``native_dt_s``, ``native_rate_hz``) and
+            ``block_average_factor``; a reader of the written block gets it with
+            :func:`fogdrift.signal.record_sampling`.
         """
         temp = None if self.temperature_c is None else temperature_summary(self.temperature_c, self.dt_s).to_dict()
         quantities = self.quantities
@@ -478,10 +481,6 @@ class GyroRecord:
             "input_unit": self.input_unit,
             "declared_units": list(self.declared_units),
             **scale,
-            "dt_s": self.dt_s,
-            "fs_hz": self.fs_hz,
-            "native_fs_hz": self.native_fs_hz,
-            "block_average_factor": self.block_average_factor,
             "t0_s": self.t0_s,
             "n_samples": self.n_samples,
             "n_axes": self.n_axes,

@@ -19,6 +19,7 @@ import numpy as np
 from .. import documents
 from ..errors import ConfigError
 from ..noise.terms import TERM_TABLE, all_terms, laws_of
+from ..signal import record_sampling
 from ..spec import norm_unit
 from ..units import ARCSEC_PER_DEG, DEG_PER_RAD, S_PER_H, S_PER_MIN, URAD_PER_ARCSEC
 
@@ -302,8 +303,9 @@ def read_model_file(path, dt_s=None, axis=None) -> PlanModel:
         noise = a.get("noise") if isinstance(a.get("noise"), dict) else a
         terms = noise.get("terms")
         dt = dt_s if dt_s is not None else noise.get("dt_s", a.get("dt_s", data.get("dt_s")))
-        if dt is None and (data.get("record") or {}).get("dt_s") is not None:
-            dt = data["record"]["dt_s"]
+        if dt is None:
+            smp = record_sampling(data.get("record"), f"{p}: the record")
+            dt = None if smp is None else smp.dt_s
         if dt is None and a.get("sample_rate_hz", data.get("sample_rate_hz")):
             dt = 1.0 / float(a.get("sample_rate_hz", data.get("sample_rate_hz")))
         if isinstance(terms, dict):

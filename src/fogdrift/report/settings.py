@@ -7,6 +7,7 @@ model's hyper-parameters and where its training stopped, and the evaluation sett
 
 from __future__ import annotations
 
+from ..signal import record_sampling
 from .glossary import plain_name, plain_setting
 from .tables import _fmt
 
@@ -100,10 +101,10 @@ def settings_rows(result, *, generated: str, title: str = "") -> list:
     add("split", "not scored", f"the first {ma0.score_from} test samples (their inputs reach into the validation "
                                "block); shaded in Figs. 8 and 9")
     # rates and separation
-    m = result.model_record or {}
+    m = record_sampling(result.model_record, "the model_record")
     add("modelling", "modelling rate (effective)",
-        f"{_fmt(m.get('fs_hz'), 6)} Hz, block average ×{m.get('block_average_factor') or 1} of the native "
-        f"{_fmt(m.get('native_fs_hz'), 6)} Hz" if m else "native rate")
+        f"{_fmt(m.rate_hz, 6)} Hz, block average ×{m.block_average_factor} of the native "
+        f"{_fmt(m.native_rate_hz, 6)} Hz" if m else "native rate")
     add("separation", "wavelet / level / mode",
         f"{cfg.wavelet} / {cfg.level} (used: " + ", ".join(f"{ax.name} {ax.separation.level}" for ax in axes)
         + f") / {cfg.mode}")

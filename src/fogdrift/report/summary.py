@@ -14,6 +14,7 @@ import numpy as np
 from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
 from ..noise import TERM_TABLE
 from ..noise.terms import DISPLAY_UNITS, TERMS
+from ..signal import record_sampling
 from ..spec import B_COMPARED, judgement_line
 from ..units import S_PER_H
 from .screen import screen_summary
@@ -49,11 +50,10 @@ def _duration(seconds) -> str:
 
 def _effective_rate(result) -> str:
     """The modelling rate actually used: the averaged record's rate and its block-average factor."""
-    m = getattr(result, "model_record", None) or {}
-    fs, k = m.get("fs_hz"), m.get("block_average_factor") or 1
-    if fs is None:
+    smp = record_sampling(getattr(result, "model_record", None), "the model_record")
+    if smp is None:
         return "native rate"
-    native = m.get("native_fs_hz") or fs
+    fs, k, native = smp.rate_hz, smp.block_average_factor, smp.native_rate_hz
     return f"{fs:.6g} Hz (native {native:.6g} Hz averaged in blocks of {k})" if k > 1 else f"{fs:.6g} Hz (native)"
 
 
@@ -67,12 +67,12 @@ def _unit_text(rec: dict) -> str:
 def recording_rows(result, sensor: str | None = None) -> list:
     """``[label, value]`` rows describing the recording: file, sensor, duration, rate, axes, units."""
     rec = result.record
-    fs = rec.get("native_fs_hz") or rec.get("fs_hz")
+    smp = record_sampling(rec, "the record")
     return [
         ["file", Path(str(result.source)).name],
         ["sensor", sensor or "not stated (the log does not carry it; analyze --sensor names it)"],
         ["duration", f"{_duration(rec.get('duration_s'))}, {rec.get('n_samples')} samples"],
-        ["sample rate", f"{fs:.6g} Hz (dt {rec.get('dt_s'):.6g} s)" if fs else "–"],
+        ["sample rate", f"{smp.native_rate_hz:.6g} Hz (dt {smp.dt_s:.6g} s)" if smp else "–"],
         ["axes", ", ".join(rec.get("axis_names", []))],
         ["rate unit", _unit_text(rec)],
         ["modelling rate", _effective_rate(result)],
