@@ -27,6 +27,35 @@ def test_python_m_help():
         assert cmd in proc.stdout
 
 
+#: Runs the code in $PROBE_CODE (``fogdrift --help``); at exit, after every atexit handler registered later, prints
+#: whether the cyclic garbage collector's objects were frozen.
+_FREEZE_PROBE = r"""
+import atexit, gc, os, sys
+atexit.register(lambda: print("frozen" if gc.get_freeze_count() else "not frozen"))
+sys.argv = ["fogdrift", "--help"]
+exec(os.environ["PROBE_CODE"])
+"""
+
+
+@pytest.mark.parametrize("code, frozen", [("from fogdrift.cli import entry\nentry()", True),
+                                          ("from fogdrift.cli import main\ntry:\n    main()\nexcept SystemExit:\n"
+                                           "    pass", False)])
+def test_only_the_entry_point_leaves_the_exit_collections_out(code, frozen):
+    """The console script and ``python -m fogdrift`` run ``fogdrift.cli.entry``: the command, then the collector's
+    objects frozen for the interpreter's exit (its full collections skipped); ``main()`` called in a process that
+    goes on leaves the collector alone."""
+    import os
+    from pathlib import Path
+
+    proc = subprocess.run([sys.executable, "-c", _FREEZE_PROBE], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PROBE_CODE": code})
+    assert proc.returncode == 0 and "allan" in proc.stdout, proc.stderr[-2000:]
+    assert proc.stdout.strip().splitlines()[-1] == ("frozen" if frozen else "not frozen")
+    root = Path(__file__).resolve().parents[2]
+    assert 'fogdrift = "fogdrift.cli:entry"' in (root / "pyproject.toml").read_text()
+    assert "entry()" in (root / "src" / "fogdrift" / "__main__.py").read_text()
+
+
 def test_allan_on_bundled_recording(bundled_path, tmp_path):
     # the whole record (the default fits the quiet segments the screen finds: tests/cli/test_segments_cli.py)
     out = _ok(runner.invoke(app, ["allan", str(bundled_path), "--unit", "deg/h", "--segments", "whole", "--out",
