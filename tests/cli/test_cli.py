@@ -28,29 +28,34 @@ def test_python_m_help():
 
 
 #: Runs the code in $PROBE_CODE (``fogdrift --help``); at exit, after every atexit handler registered later, prints
-#: whether the cyclic garbage collector's objects were frozen.
-_FREEZE_PROBE = r"""
-import atexit, gc, os, sys
-atexit.register(lambda: print("frozen" if gc.get_freeze_count() else "not frozen"))
+#: whether the cyclic garbage collector's objects were frozen, and its thresholds at the start and then.
+_GC_PROBE = r"""
+import atexit, gc, json, os, sys
+start = list(gc.get_threshold())
+atexit.register(lambda: print(json.dumps([gc.get_freeze_count() > 0, start, list(gc.get_threshold())])))
 sys.argv = ["fogdrift", "--help"]
 exec(os.environ["PROBE_CODE"])
 """
 
 
-@pytest.mark.parametrize("code, frozen", [("from fogdrift.cli import entry\nentry()", True),
-                                          ("from fogdrift.cli import main\ntry:\n    main()\nexcept SystemExit:\n"
-                                           "    pass", False)])
-def test_only_the_entry_point_leaves_the_exit_collections_out(code, frozen):
-    """The console script and ``python -m fogdrift`` run ``fogdrift.cli.entry``: the command, then the collector's
-    objects frozen for the interpreter's exit (its full collections skipped); ``main()`` called in a process that
-    goes on leaves the collector alone."""
+@pytest.mark.parametrize("code, own", [("from fogdrift.cli import entry\nentry()", True),
+                                       ("from fogdrift.cli import main\ntry:\n    main()\nexcept SystemExit:\n"
+                                        "    pass", False)])
+def test_only_the_entry_point_sets_the_collectors_policy(code, own):
+    """The console script and ``python -m fogdrift`` run ``fogdrift.cli.entry``: the command under the process's
+    collector thresholds (``GC_THRESHOLDS``), then the collector's objects frozen for the interpreter's exit (its
+    full collections skipped); ``main()`` called in a process that goes on leaves the collector as it found it."""
     import os
     from pathlib import Path
 
-    proc = subprocess.run([sys.executable, "-c", _FREEZE_PROBE], capture_output=True, text=True, timeout=120,
+    from fogdrift.cli import GC_THRESHOLDS
+
+    proc = subprocess.run([sys.executable, "-c", _GC_PROBE], capture_output=True, text=True, timeout=120,
                           env={**os.environ, "PROBE_CODE": code})
     assert proc.returncode == 0 and "allan" in proc.stdout, proc.stderr[-2000:]
-    assert proc.stdout.strip().splitlines()[-1] == ("frozen" if frozen else "not frozen")
+    frozen, start, end = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert frozen is own
+    assert tuple(end) == (GC_THRESHOLDS if own else tuple(start))
     root = Path(__file__).resolve().parents[2]
     assert 'fogdrift = "fogdrift.cli:entry"' in (root / "pyproject.toml").read_text()
     assert "entry()" in (root / "src" / "fogdrift" / "__main__.py").read_text()
