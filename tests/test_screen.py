@@ -147,3 +147,25 @@ def test_the_quiet_variogram_is_the_direct_mean_of_squared_differences(monkeypat
             num[k] += float(d @ d)
             cnt[k] += L - k
     np.testing.assert_allclose(sc._variogram(y, edges, use, L), num / (2.0 * cnt), rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize("batch", [1 << 20, 300])
+def test_the_window_statistics_are_each_window_alone_bit_for_bit(monkeypatch, batch):
+    """The levels s_j and means mu_j of the windows (gathered a batch of rows at a time) are the numbers each window
+    gives on its own: its mean, then the variance about its least-squares line, exactly (a record whose windows
+    have two lengths)."""
+    import fogdrift.screen as sc
+
+    monkeypatch.setattr(sc, "WINDOWS_BATCH_VALUES", batch)  # 300 values: a few windows per batch
+    rng = np.random.default_rng(12)
+    y = np.cumsum(rng.standard_normal(5003)) * 1e-3 + rng.standard_normal(5003) * 3.0 + 1e4
+    L = 37
+    edges, s, mu = sc._windows(y, L)
+    assert np.unique(np.diff(edges)).size == 2
+    for j in range(edges.size - 1):
+        w = y[edges[j]:edges[j + 1]]
+        t = np.arange(w.size) - (w.size - 1) / 2.0
+        m = w.mean()
+        c = w - m
+        r = c - np.dot(t, c) / np.dot(t, t) * t
+        assert mu[j] == m and s[j] == np.dot(r, r) / (w.size - 2)

@@ -115,11 +115,16 @@ def _scale(record, k) -> float:
 
 
 def _noise(x: np.ndarray) -> float:
-    """Robust deviation of the first differences / sqrt(2) (the white-noise deviation of the samples)."""
+    """Robust deviation of the first differences / sqrt(2) (the white-noise deviation of the samples).
+
+    The medians select in place, in the one array of differences: an order statistic does not depend on the order
+    of the values, so no copy is needed (the standard deviation, whose sum does, takes the differences afresh)."""
     d = np.diff(x)
-    mad = float(np.median(np.abs(d - np.median(d)))) * 1.4826
+    med = np.median(d, overwrite_input=True)
+    np.abs(np.subtract(d, med, out=d), out=d)
+    mad = float(np.median(d, overwrite_input=True)) * 1.4826
     if mad == 0.0:
-        mad = float(np.std(d))
+        mad = float(np.std(np.diff(x)))
     return mad / math.sqrt(2.0)
 
 

@@ -266,26 +266,39 @@ class ScreenResult:
 # Window statistics
 # ----------------------------------------------------------------------------------------
 def _windows(y: np.ndarray, L: int):
-    """Window edges, detrended levels s_j and means mu_j (M = N // L windows, near-equal lengths)."""
+    """Window edges, detrended levels s_j and means mu_j (M = N // L windows, near-equal lengths).
+
+    The windows of one length are gathered into rows, :data:`WINDOWS_BATCH_VALUES` values at a time: their means
+    and mean-removed values are taken row-wise (a row's sum is the same pairwise sum as its window's own), and the
+    two dot products of each window stay one BLAS dot per window, so every ``s_j`` and ``mu_j`` is the number the
+    window alone gives.
+    """
     M = y.size // L
     edges = (np.arange(M + 1) * y.size) // M
     s = np.empty(M)
     mu = np.empty(M)
-    lines = {}  # window length -> (centred sample index t, t . t): the windows have one or two lengths
-    bounds = edges.tolist()
-    for j in range(M):
-        w = y[bounds[j]:bounds[j + 1]]
-        line = lines.get(w.size)
-        if line is None:
-            t = np.arange(w.size) - (w.size - 1) / 2.0
-            line = lines[w.size] = (t, np.dot(t, t))
-        t, tt = line
-        mu[j] = m = w.mean()
-        c = w - m
-        slope = np.dot(t, c) / tt
-        r = c - slope * t
-        s[j] = np.dot(r, r) / (w.size - 2)
+    sizes = np.diff(edges)
+    for size in np.unique(sizes).tolist():  # the windows have one or two lengths
+        rows = np.flatnonzero(sizes == size)
+        t = np.arange(size) - (size - 1) / 2.0  # centred sample index
+        tt = np.dot(t, t)
+        k = np.arange(size)
+        per = max(1, WINDOWS_BATCH_VALUES // size)
+        for a in range(0, rows.size, per):
+            batch = rows[a:a + per]
+            x = y[edges[batch][:, None] + k[None, :]]
+            m = x.mean(axis=1)
+            mu[batch] = m
+            c = x - m[:, None]
+            for j, cj in zip(batch.tolist(), c):
+                slope = np.dot(t, cj) / tt
+                r = cj - slope * t
+                s[j] = np.dot(r, r) / (size - 2)
     return edges, s, mu
+
+
+#: Values (windows x window length) per batch of :func:`_windows`: about 8 MB per temporary, whatever the record length.
+WINDOWS_BATCH_VALUES = 1 << 20
 
 
 #: Values (windows x FFT length) per batch of :func:`_variogram`: the windows are transformed together, a batch at a
@@ -346,9 +359,10 @@ def _sf(law, x: float) -> float:
 
     lam, dof = law
     dof_lam, two_lam = dof * lam, 2.0 * lam  # the products k1 forms first, formed once
+    reduce_sum = np.add.reduce  # k1 runs some thousand times per screen
 
     def k1(t):
-        return float(np.sum(dof_lam / (1.0 - two_lam * t)))
+        return float(reduce_sum(dof_lam / (1.0 - two_lam * t)))  # np.sum's own reduction, without its wrapper
 
     t_hi = 0.5 / float(lam.max()) * (1.0 - 1e-12)
     t_lo = -1.0

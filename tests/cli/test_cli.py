@@ -27,6 +27,40 @@ def test_python_m_help():
         assert cmd in proc.stdout
 
 
+#: Runs the code in $PROBE_CODE (``fogdrift --help``); at exit, after every atexit handler registered later, prints
+#: whether the cyclic garbage collector's objects were frozen, and its thresholds at the start and then.
+_GC_PROBE = r"""
+import atexit, gc, json, os, sys
+start = list(gc.get_threshold())
+atexit.register(lambda: print(json.dumps([gc.get_freeze_count() > 0, start, list(gc.get_threshold())])))
+sys.argv = ["fogdrift", "--help"]
+exec(os.environ["PROBE_CODE"])
+"""
+
+
+@pytest.mark.parametrize("code, own", [("from fogdrift.cli import entry\nentry()", True),
+                                       ("from fogdrift.cli import main\ntry:\n    main()\nexcept SystemExit:\n"
+                                        "    pass", False)])
+def test_only_the_entry_point_sets_the_collectors_policy(code, own):
+    """The console script and ``python -m fogdrift`` run ``fogdrift.cli.entry``: the command under the process's
+    collector thresholds (``GC_THRESHOLDS``), then the collector's objects frozen for the interpreter's exit (its
+    full collections skipped); ``main()`` called in a process that goes on leaves the collector as it found it."""
+    import os
+    from pathlib import Path
+
+    from fogdrift.cli import GC_THRESHOLDS
+
+    proc = subprocess.run([sys.executable, "-c", _GC_PROBE], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PROBE_CODE": code})
+    assert proc.returncode == 0 and "allan" in proc.stdout, proc.stderr[-2000:]
+    frozen, start, end = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert frozen is own
+    assert tuple(end) == (GC_THRESHOLDS if own else tuple(start))
+    root = Path(__file__).resolve().parents[2]
+    assert 'fogdrift = "fogdrift.cli:entry"' in (root / "pyproject.toml").read_text()
+    assert "entry()" in (root / "src" / "fogdrift" / "__main__.py").read_text()
+
+
 def test_allan_on_bundled_recording(bundled_path, tmp_path):
     # the whole record (the default fits the quiet segments the screen finds: tests/cli/test_segments_cli.py)
     out = _ok(runner.invoke(app, ["allan", str(bundled_path), "--unit", "deg/h", "--segments", "whole", "--out",
