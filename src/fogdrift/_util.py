@@ -217,7 +217,11 @@ def _plain(x, rows, mark):
     if isinstance(x, dict):
         return {k if isinstance(k, str) else _key(k): _plain(v, rows, mark) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        vals = [_plain(v, rows, mark) for v in x]
+        if x and all(type(v) is float or type(v) is int or v is None for v in x):
+            # a list of plain numbers (a curve as a list): the walk below, without a call per number
+            vals = [None if type(v) is float and not math.isfinite(v) else v for v in x]
+        else:
+            vals = [_plain(v, rows, mark) for v in x]
         if rows is not None and vals and all(v is None or type(v) in (int, float) for v in vals):
             rows.append(json.dumps(vals, allow_nan=False))
             return f"{mark}{len(rows) - 1}"
