@@ -287,7 +287,8 @@ def test_allan_json_of_an_accelerometer_names_m_s2_everywhere(tmp_path):
     assert [p for kind, p in found if kind == "text" and "deg" in p.split(": ", 1)[1]] == []
     assert any(p.endswith("/shaped/S/description") for kind, p in found if kind == "key")   # the tone was there
     assert any(p.endswith("/outliers/robust_sigma_mps2") for kind, p in found if kind == "key")
-    assert doc["record"]["internal_unit"] == "m/s^2" and doc["record"]["scale_to_internal"] == 1.0
+    chans = doc["record"]["signal"]["channels"]
+    assert {(c["internal_unit"], c["scale_to_internal"]) for c in chans} == {("m/s^2", 1.0)}
     head = (tmp_path / "allan.csv").read_text().splitlines()[0].split(",")
     curve = doc["axes"][0]["allan"]
     assert set(head[1:]) <= set(curve)                                  # the JSON's keys are the CSV's columns
@@ -296,5 +297,5 @@ def test_allan_json_of_an_accelerometer_names_m_s2_everywhere(tmp_path):
     gyro = from_array(y, dt_s=dt, unit="deg/h", axis_names=["gx", "gy"])     # a gyro's keys stay deg/h
     write_allan_outputs(run_allan(gyro, AnalysisConfig().validate()), gyro, tmp_path)
     g = json.loads((tmp_path / "allan.json").read_text())
-    assert g["record"]["rate_unit"] == "deg/h" and "adev_dph" in g["axes"][0]["allan"]
+    assert g["record"]["signal"]["channels"][0]["internal_unit"] == "deg/h" and "adev_dph" in g["axes"][0]["allan"]
     assert "robust_sigma_dph" in g["axes"][0]["outliers"]

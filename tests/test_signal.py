@@ -20,7 +20,7 @@ from fogdrift.errors import ConfigError, ModelFileError
 from fogdrift.io import from_array, load
 from fogdrift.io import record as io_record
 from fogdrift.pipeline import AnalysisAxis, AnalysisConfig, AllanAxis, ModelAxis, run_models
-from fogdrift.signal import Channel, Sampling, SignalDescription, record_sampling
+from fogdrift.signal import Channel, Sampling, SignalDescription, record_sampling, record_units
 from fogdrift.simulate import simulate
 
 runner = CliRunner()
@@ -407,3 +407,34 @@ def test_record_sampling_refuses_the_synonyms_alone_in_one_line():
     with pytest.raises(ConfigError, match=r"^the record's signal: expected an object; got list$"):
         record_sampling({"signal": [1]})
     assert record_sampling({"n_samples": 3}) is None and record_sampling(None) is None
+
+
+#: The unit keys a record block wrote beside its signal description, with values that contradict it.
+_UNIT_SYNONYMS = {"input_unit": "rad/s", "declared_units": ["rad/s"], "scale_to_dph": 1.0, "rate_unit": "m/s^2",
+                  "scale_to_internal": 7.0, "internal_unit": "m/s^2"}
+
+
+def test_record_units_read_the_signal_and_never_the_old_keys():
+    rec = from_array([0.1, 0.2, 0.3], dt_s=0.01, unit="deg/s", axis_names=["gz"])
+    meta = json.loads(json.dumps(rec.metadata()))
+    u = record_units(meta)
+    assert (u.input_unit, u.declared_units, u.scale_to_internal, u.internal_unit, u.all_gyro) == \
+        ("deg/s", (None,), 3600.0, "deg/h", True)
+    assert u.channels == rec.signal.channels
+    # a block that repeats the units beside its signal (and contradicts it): the old keys are not read
+    assert record_units({**meta, **_UNIT_SYNONYMS}) == u
+
+
+def test_record_units_refuse_the_old_keys_alone_in_one_line():
+    with pytest.raises(ConfigError) as ei:
+        record_units({"input_unit": "deg/s", "scale_to_dph": 3600.0, "rate_unit": "deg/h"},
+                     "run/allan.json: the record")
+    assert str(ei.value) == ("run/allan.json: the record states its units only as input_unit, scale_to_dph, "
+                             "rate_unit, not in 'signal.channels' where this fogdrift reads them; re-run the fogdrift "
+                             "command that wrote the file")
+    with pytest.raises(ConfigError, match=r"^the model_record's signal.channels: expected a list of one or more"):
+        record_units({"signal": {"sampling": {}}}, "the model_record")
+    with pytest.raises(ConfigError, match=r"^the record's signal.channels: unknown unit 'furlong/s'"):
+        record_units({"signal": {"channels": [{"name": "gz", "quantity": "angular_rate", "unit_as_read": "furlong/s",
+                                               "unit_source": "option", "scale_to_internal": 1.0}]}})
+    assert record_units({"n_samples": 3}) is None and record_units(None) is None

@@ -30,7 +30,8 @@ from dataclasses import dataclass, replace
 from . import units
 from .errors import ConfigError
 
-__all__ = ["Sampling", "Channel", "SignalDescription", "DT_SOURCES", "UNIT_SOURCES", "channel_unit", "record_sampling"]
+__all__ = ["Sampling", "Channel", "SignalDescription", "DT_SOURCES", "UNIT_SOURCES", "channel_unit", "record_sampling",
+           "RecordUnits", "record_units"]
 
 #: Where a sample interval can come from: the file's time column, the time stamps the format carries
 #: (bag, miniSEED, HDF5 time dataset), the sample-rate option (``rate_hz``/``dt_s``, the CLI's
@@ -343,3 +344,108 @@ def record_sampling(block, where: str = "the record") -> Sampling | None:
         return Sampling.from_dict(signal.get("sampling"))
     except ConfigError as exc:
         raise ConfigError(f"{where}'s signal.sampling: {exc}") from None
+
+
+#: Keys under which a record block may state its units beside (or instead of) ``signal``: they are never read, and a
+#: block with one of them but no ``signal`` is refused (each channel's unit and its provenance are not in it).
+_RECORD_UNIT_SYNONYMS = ("input_unit", "declared_units", "scale_to_dph", "rate_unit", "scale_to_internal",
+                         "internal_unit")
+
+
+@dataclass(frozen=True)
+class RecordUnits:
+    """The units a result document's record block states, read from its ``signal.channels``
+    (:func:`record_units`).
+
+    Attributes
+    ----------
+    channels : tuple of Channel
+        One per axis, in the record's order.
+    """
+
+    channels: tuple[Channel, ...]
+
+    @property
+    def input_unit(self) -> str:
+        """The unit the numbers were read in: the one unit, or ``name=unit,...`` when the channels differ (the
+        text of :attr:`fogdrift.io.GyroRecord.input_unit`)."""
+        texts = [c.unit_as_read for c in self.channels]
+        if len(set(texts)) == 1:
+            return texts[0]
+        return ",".join(f"{c.name}={c.unit_as_read}" for c in self.channels)
+
+    @property
+    def declared_units(self) -> tuple[str | None, ...]:
+        """The unit each column declared in the file (None where it declared none)."""
+        return tuple(c.declared_unit for c in self.channels)
+
+    @property
+    def scale_to_internal(self) -> float | None:
+        """The one factor from the numbers as read to the internal unit, None when the channels' factors differ."""
+        scales = {c.scale_to_internal for c in self.channels}
+        return scales.pop() if len(scales) == 1 else None
+
+    @property
+    def internal_unit(self) -> str | None:
+        """The one internal unit of the channels (deg/h or m/s^2), None for a gyro and accelerometer record."""
+        names = {c.internal_unit for c in self.channels}
+        return names.pop() if len(names) == 1 else None
+
+    @property
+    def all_gyro(self) -> bool:
+        """True when every channel is an angular rate."""
+        return all(c.quantity == "angular_rate" for c in self.channels)
+
+
+def record_units(block, where: str = "the record") -> RecordUnits | None:
+    """The units a result document's record block states: its ``signal.channels`` (each channel's quantity, unit as
+    read, where the unit came from, declared unit, factor to the internal unit), the one home of the units in every
+    written document (the ``record`` of ``allan.json`` and ``noise.json``, the ``record`` and ``model_record`` of an
+    analysis result).  Every reader of a result document gets the units here.
+
+    A block that also repeats the units as ``input_unit``/``declared_units``/``scale_to_dph``/``rate_unit``/
+    ``scale_to_internal``/``internal_unit`` beside its ``signal`` is read the same way: those keys are ignored.
+
+    Parameters
+    ----------
+    block : dict or None
+        The record block as read (:meth:`fogdrift.io.GyroRecord.metadata` written to JSON).
+    where : str
+        What the messages name; a caller that read a file puts its path in front.
+
+    Returns
+    -------
+    RecordUnits or None
+        None for a block that states no units at all (a hand-written result; the caller decides).
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``where``: the block states the units only under the keys above (no ``signal``), or its
+        ``signal.channels`` is not a valid list of channels.
+
+    Examples
+    --------
+    >>> from fogdrift.io import from_array
+    >>> u = record_units(from_array([1.0, 2.0, 3.0], dt_s=0.01, unit="deg/s").metadata())
+    >>> u.input_unit, u.scale_to_internal, u.internal_unit
+    ('deg/s', 3600.0, 'deg/h')
+    """
+    if not isinstance(block, dict):
+        return None
+    signal = block.get("signal")
+    if signal is None:
+        old = [k for k in _RECORD_UNIT_SYNONYMS if block.get(k) is not None]
+        if old:
+            raise ConfigError(f"{where} states its units only as {', '.join(old)}, not in 'signal.channels' where "
+                              "this fogdrift reads them; re-run the fogdrift command that wrote the file")
+        return None
+    if not isinstance(signal, dict):
+        raise ConfigError(f"{where}'s signal: expected an object; got {type(signal).__name__}")
+    chans = signal.get("channels")
+    if not isinstance(chans, list) or not chans:
+        raise ConfigError(f"{where}'s signal.channels: expected a list of one or more channels; got {chans!r}")
+    try:
+        return RecordUnits(tuple(Channel.from_dict(c) for c in chans))
+    except ConfigError as exc:
+        raise ConfigError(f"{where}'s signal.channels: {exc}") from None

@@ -48,7 +48,8 @@ def test_raw_binary_through_cli_flags(tmp_path):
     assert result.exit_code == 1 and "raw binary declares no unit; pass --unit" in result.output
     _ok(runner.invoke(app, args + ["--unit", "inc:arcsec", "--scale", "0.01"]))
     doc = json.loads((tmp_path / "o" / "allan.json").read_text())
-    assert doc["record"]["n_samples"] == 5000 and doc["record"]["scale_to_dph"] == pytest.approx(100.0)
+    assert doc["record"]["n_samples"] == 5000
+    assert doc["record"]["signal"]["channels"][0]["scale_to_internal"] == pytest.approx(100.0)
 
 
 def test_bag_topic_flag(tmp_path):
@@ -66,8 +67,9 @@ def test_bag_topic_flag(tmp_path):
     _ok(runner.invoke(app, ["allan", str(tmp_path / "b.bag"), "--topic", "/imu/raw", "--columns", "gz",
                             "--out", str(tmp_path / "o")]))
     doc = json.loads((tmp_path / "o" / "allan.json").read_text())
-    assert doc["record"]["input_unit"] == "rad/s"
-    assert doc["record"]["scale_to_dph"] == pytest.approx(180 / math.pi * 3600)
+    ch = doc["record"]["signal"]["channels"][0]
+    assert ch["unit_as_read"] == "rad/s"
+    assert ch["scale_to_internal"] == pytest.approx(180 / math.pi * 3600)
 
 
 def test_analyze_report_shows_rate_and_temperature(tmp_path):

@@ -185,12 +185,12 @@ def test_unit_rate_and_axis_mismatches_are_refused_unless_mapped(bundle_dir, log
     assert "declares unit rad/s" in info.value.render({"unit": "--unit"}) and "--unit rad/s" in \
         info.value.render({"unit": "--unit"})
     res = _run(bundle_dir, tmp_path / "rad.csv", tmp_path / "o2", unit="rad/s", model="ar")
-    assert res.summary["unit"] == "rad/s"
+    assert res.summary["signal"]["channels"][0]["unit_as_read"] == "rad/s"
     assert (tmp_path / "o2" / "compensated.csv").read_text().splitlines()[0].startswith("t_s,gx[rad/s],gz[rad/s]")
     ref = _run(bundle_dir, d / "log.csv", tmp_path / "o3", model="ar")
     np.testing.assert_allclose(np.rad2deg(_npz(tmp_path / "o2")["compensated"]), _npz(tmp_path / "o3")["compensated"],
                                rtol=1e-9)
-    assert ref.summary["unit"] == "deg/s"
+    assert ref.summary["signal"]["channels"][0]["unit_as_read"] == "deg/s"
 
     np.savetxt(tmp_path / "fast.csv", np.column_stack([np.arange(x.shape[0]) / 20.0, x]), delimiter=",",
                header="t_s,gx[deg/s],gz[deg/s]", comments="", fmt="%.17g")
@@ -256,11 +256,11 @@ def test_csv_without_a_declared_unit_is_refused_suggesting_the_bundles(bundle_di
     assert "pass --unit deg/s (the bundle was trained on deg/s)" in info.value.render({"unit": "--unit"})
     assert not (tmp_path / "o1" / "compensated.csv").exists()
     res = _run(bundle_dir, tmp_path / "plain.csv", tmp_path / "o1", model="ar", unit="deg/s")
-    assert res.summary["unit"] == "deg/s"
+    assert res.summary["signal"]["channels"][0]["unit_as_read"] == "deg/s"
     ref = _run(bundle_dir, d / "log.csv", tmp_path / "o2", model="ar")
     np.testing.assert_array_equal(_npz(tmp_path / "o1")["compensated"], _npz(tmp_path / "o2")["compensated"])
-    assert ref.summary["unit"] == "deg/s"
+    assert ref.summary["signal"]["channels"][0]["unit_as_read"] == "deg/s"
     # the deprecated spelling still works, with a warning
     with pytest.warns(FogdriftWarning, match="deprecated"):
         res = _run(bundle_dir, tmp_path / "plain.csv", tmp_path / "o3", model="bias", apply_unit="deg/s")
-    assert res.summary["unit"] == "deg/s"
+    assert res.summary["signal"]["channels"][0]["unit_as_read"] == "deg/s"

@@ -26,6 +26,7 @@ from fogdrift.errors import ConfigError, DataFormatError
 from fogdrift.io import from_array
 from fogdrift.output import MANIFEST, TMP_PREFIX
 from fogdrift.pipeline import AnalysisConfig, run_models
+from fogdrift.signal import record_units
 from fogdrift.simulate import simulate
 
 LAT = 45.0
@@ -49,6 +50,12 @@ def _csv(path, header, x, dt=1.0):
     t = np.arange(x.shape[0]) * dt
     np.savetxt(path, np.column_stack([t, x]), delimiter=",", header=header, comments="", fmt="%.17g")
     return path
+
+
+def _log_unit(summary):
+    """(unit as read, factor to deg/h) of the compensated log, as compensation.json states them (its signal)."""
+    u = record_units(summary, "compensation.json")
+    return u.input_unit, u.scale_to_internal
 
 
 def _read(out):
@@ -79,14 +86,13 @@ def test_unit_on_a_log_that_declares_another_unit(bundle, tmp_path):
 
     res = compensate_file(bundle, log, tmp_path / "o1", **_kw(unit="deg/s"))
     got = _read(tmp_path / "o1")
-    assert res.summary["unit"] == "deg/s" and str(got["unit"]) == "deg/s"
-    assert res.summary["scale_to_dph"] == 3600.0
+    assert _log_unit(res.summary) == ("deg/s", 3600.0) and str(got["unit"]) == "deg/s"
     np.testing.assert_allclose(got["compensated"][:, 0], v - b / 3600.0, rtol=0, atol=1e-13)
     assert (tmp_path / "o1" / "compensated.csv").read_text().splitlines()[0] == "t_s,gz[deg/s],gz_drift[deg/s]"
 
     res = compensate_file(bundle, log, tmp_path / "o2", **_kw(unit="deg/h"))
     got = _read(tmp_path / "o2")
-    assert res.summary["unit"] == "deg/h" and res.summary["scale_to_dph"] == 1.0 and str(got["unit"]) == "deg/h"
+    assert _log_unit(res.summary) == ("deg/h", 1.0) and str(got["unit"]) == "deg/h"
     np.testing.assert_allclose(got["compensated"][:, 0], v - b, rtol=0, atol=1e-12)
     assert any("declares deg/s; its numbers are read as deg/h" in m for m in res.messages)
     assert (tmp_path / "o2" / "compensated.csv").read_text().splitlines()[0] == "t_s,gz[deg/h],gz_drift[deg/h]"
@@ -100,7 +106,7 @@ def test_increment_unit_scale_is_carried_from_the_reader(bundle, tmp_path):
     v = np.full(3000, 5.0)
     log = _csv(tmp_path / "inc.csv", "t_s,gz", v, dt=0.1)
     res = compensate_file(bundle, log, tmp_path / "o", **_kw(unit="inc:arcsec", accept_rate=True))
-    assert res.summary["scale_to_dph"] == pytest.approx(10.0, rel=1e-12)
+    assert _log_unit(res.summary)[1] == pytest.approx(10.0, rel=1e-12)
     assert res.summary["block_average_factor"] == 10
     chan = res.summary["signal"]["channels"][0]
     assert chan["unit_as_read"] == "inc:arcsec" and chan["unit_source"] == "option"
@@ -108,6 +114,9 @@ def test_increment_unit_scale_is_carried_from_the_reader(bundle, tmp_path):
     # the log's interval is written once, in its signal description; model_dt_s is the bundle's models' interval
     assert res.summary["signal"]["sampling"]["dt_s"] == pytest.approx(0.1) and "native_dt_s" not in res.summary
     assert res.summary["model_dt_s"] == load_bundle(bundle).model_dt_s
+    # the log's unit and factor likewise: in its channels only
+    assert not {"unit", "scale_to_dph", "input_unit"} & set(res.summary)
+    assert _log_unit(json.loads((tmp_path / "o" / "compensation.json").read_text())) == _log_unit(res.summary)
     np.testing.assert_allclose(_read(tmp_path / "o")["compensated"][:, 0], 5.0 - b / 10.0, atol=1e-12)
 
 

@@ -642,10 +642,10 @@ def test_metadata_is_json_serialisable(small_csv):
     back = json.loads(json.dumps(meta))
     assert back["n_samples"] == 50 and back["n_axes"] == 3
     assert back["axis_names"] == ["gx", "gy", "gz"]
-    assert back["input_unit"] == "inc:arcsec"
-    assert back["scale_to_dph"] == pytest.approx(100.0)
+    ch = back["signal"]["channels"][0]
+    assert ch["unit_as_read"] == "inc:arcsec" and ch["scale_to_internal"] == pytest.approx(100.0)
     assert back["signal"]["sampling"]["rate_hz"] == pytest.approx(100.0)
-    assert back["rate_unit"] == "deg/h"
+    assert ch["internal_unit"] == "deg/h"
     assert set(meta) >= {"source", "t0_s", "notes", "duration_s", "signal"}
 
 

@@ -227,7 +227,7 @@ def test_declared_rate_unit_used_when_none_given(tmp_path):
     assert rec.axis_names == ("gx", "gy") and rec.input_unit == "deg/s"
     assert_allclose(rec.rate_dph, [[3.6, -1800.0], [7.2, 900.0], [10.8, 3600.0]], rtol=1e-14)
     assert rec.declared_units == ("deg/s", "deg/s")
-    assert rec.metadata()["declared_units"] == ["deg/s", "deg/s"]
+    assert [c["declared_unit"] for c in rec.metadata()["signal"]["channels"]] == ["deg/s", "deg/s"]
     assert "unit 'deg/s' declared in the file" in rec.notes
     # a given unit wins (no behaviour change), and the record says so
     given = io_load(p, unit="deg/h")

@@ -118,6 +118,11 @@ def test_to_rate_errors():
     assert_array_equal(rec.to_rate(10.0).rate_dph, [[0.0]])
 
 
+#: The keys of a written record block: the sampling and the units are in ``signal`` only.
+RECORD_KEYS = {"source", "sha256", "t0_s", "n_samples", "n_axes", "duration_s", "axis_names", "notes", "temperature",
+               "signal"}
+
+
 def test_metadata_writes_the_sampling_once_and_reads_back():
     """The record block holds the sampling in signal.sampling only, and it reads back as the record's."""
     from fogdrift.signal import record_sampling
@@ -125,8 +130,41 @@ def test_metadata_writes_the_sampling_once_and_reads_back():
     rec = from_array(np.arange(2 * 1003, dtype=float).reshape(1003, 2), dt_s=0.01, axis_names=("a", "b"))
     low = rec.to_rate(25.0)
     meta = json.loads(json.dumps(low.metadata()))
-    assert set(meta) == {"source", "sha256", "input_unit", "declared_units", "scale_to_dph", "rate_unit", "t0_s",
-                         "n_samples", "n_axes", "duration_s", "axis_names", "notes", "temperature", "signal"}
+    assert set(meta) == RECORD_KEYS
     smp = record_sampling(meta)
     assert (smp.dt_s, smp.native_dt_s, smp.block_average_factor) == (low.dt_s, rec.dt_s, 4)
     assert smp == low.signal.sampling
+
+
+@pytest.mark.parametrize("unit, names", [
+    ("inc:arcsec", ("gx", "gz")),                 # gyro increments: the factor includes 1 / dt
+    ("mg", ("ax", "ay")),                         # accelerometer: internal m/s^2
+])
+def test_metadata_writes_the_units_once_and_reads_back(unit, names):
+    """The record block holds the units in signal.channels only; they read back as the record's own."""
+    from fogdrift.signal import record_units
+
+    rec = from_array(np.ones((40, 2)), dt_s=0.01, unit=unit, axis_names=names)
+    meta = json.loads(json.dumps(rec.metadata()))
+    assert set(meta) == RECORD_KEYS
+    u = record_units(meta)
+    assert u.input_unit == rec.input_unit == unit and u.scale_to_internal == rec.scale_to_internal
+    assert u.declared_units == rec.declared_units and u.channels == rec.signal.channels
+    assert u.internal_unit == rec.signal.channels[0].internal_unit and u.all_gyro == (unit == "inc:arcsec")
+
+
+def test_metadata_of_a_gyro_and_accelerometer_record_writes_the_units_once(tmp_path):
+    """A mixed log (each channel its own unit and factor) reads back with the record's input_unit text."""
+    from fogdrift.io import load
+    from fogdrift.signal import record_units
+
+    p = tmp_path / "imu.csv"
+    p.write_text("t_s,gx[deg/s],ax[g]\n" + "".join(f"{0.01 * i},0.1,1.0\n" for i in range(40)))
+    rec = load(p)
+    meta = json.loads(json.dumps(rec.metadata()))
+    assert set(meta) == RECORD_KEYS
+    u = record_units(meta)
+    assert u.input_unit == rec.input_unit == "gx=deg/s,ax=g"
+    assert u.scale_to_internal is None and u.internal_unit is None and not u.all_gyro
+    assert [(c.quantity, c.internal_unit) for c in u.channels] == [("angular_rate", "deg/h"),
+                                                                   ("specific_force", "m/s^2")]

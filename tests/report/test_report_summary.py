@@ -94,3 +94,37 @@ def test_recording_rows_read_the_sampling_from_the_signal_description():
     assert dict(recording_rows(res)) == rows
     res.model_record = {}
     assert dict(recording_rows(res))["modelling rate"] == "native rate"
+
+
+def test_unit_rows_read_the_units_from_the_signal_description(tmp_path):
+    """The unit rows come from the record block's signal.channels; the old keys beside it are not read, and a
+    block with only the old keys is refused in one line."""
+    import json
+
+    import numpy as np
+    import pytest
+
+    from fogdrift.errors import ConfigError
+    from fogdrift.io import from_array, load
+    from fogdrift.report.settings import unit_row
+    from fogdrift.report.summary import recording_rows
+
+    rec = from_array(np.zeros((400, 1)), dt_s=0.01, unit="deg/s", axis_names=["gz"])
+    block = json.loads(json.dumps(rec.metadata()))
+    res = NS(source="run/g.csv", record=block, model_record={})
+    assert dict(recording_rows(res))["rate unit"] == "deg/s (given by the user (--unit)); converted to deg/h"
+    assert unit_row(block) == ("rate unit (as read)", "deg/s × 3600 = deg/h")
+    old = {"input_unit": "rad/s", "declared_units": ["rad/s"], "scale_to_dph": 1.0, "rate_unit": "deg/h"}
+    res.record = {**block, **old}
+    assert dict(recording_rows(res))["rate unit"] == "deg/s (given by the user (--unit)); converted to deg/h"
+    assert unit_row(res.record) == unit_row(block)
+    with pytest.raises(ConfigError, match="^the record states its units only as input_unit, declared_units"):
+        unit_row(old)
+    acc = from_array(np.zeros((400, 2)), dt_s=0.01, unit="mg", axis_names=["ax", "ay"])
+    assert unit_row(json.loads(json.dumps(acc.metadata()))) == ("unit (as read)", "mg × 0.00980665 = m/s^2")
+    p = tmp_path / "imu.csv"
+    p.write_text("t_s,gx[deg/s],ax[g]\n" + "".join(f"{0.01 * i},0.1,1.0\n" for i in range(40)))
+    mixed = json.loads(json.dumps(load(p).metadata()))
+    assert unit_row(mixed) == ("unit (as read)", "gx deg/s × 3600 = deg/h, ax g × 9.80665 = m/s^2")
+    res.record = mixed
+    assert dict(recording_rows(res))["rate unit"] == "gx=deg/s,ax=g (declared in the file's header); converted to deg/h"

@@ -9,7 +9,7 @@ import typer
 from rich.text import Text
 
 from ..errors import ConfigError, render_options
-from ..signal import record_sampling
+from ..signal import record_sampling, record_units
 from ._app import (FLAGS, LoadOptions, OutOpt, app, console, csv_list, fitted_table, progress_count, run,
                    warn, with_load_options)
 
@@ -82,9 +82,11 @@ def compensate(
                 chunk_samples=chunk, formats=fmts, heading=heading, artefacts=artefacts, calib_s=calibration,
                 step_s=origin_step, horizons_s=hs, flags=FLAGS, progress=update, **kwargs)
         s = result.summary
-        log_hz = record_sampling(s, "compensation.json").rate_hz  # the log's rate: its signal description's
+        # the log's rate and unit: its signal description's
+        log_hz = record_sampling(s, "compensation.json").rate_hz
+        log_unit = record_units(s, "compensation.json").input_unit
         console.print(Text(f"compensated {s['n_samples']} samples of {load.file.name} with {s['model_label']} "
-                           f"(unit {s['unit']}, {log_hz:g} Hz, models at {1 / s['model_dt_s']:g} Hz)"),
+                           f"(unit {log_unit}, {log_hz:g} Hz, models at {1 / s['model_dt_s']:g} Hz)"),
                       soft_wrap=True)
         for line in result.messages:
             console.print(Text("  " + render_options(line, FLAGS)), highlight=False, soft_wrap=True)

@@ -290,7 +290,9 @@ def _compensate(bundle, path, out_dir, *, model, bias, unit, axis_map, accept_ra
         "log": str(source.path), "log_sha256": source.sha256, "held_out": held_out, "model": name,
         "model_label": "constant bias" if name == BIAS_ONLY else plans[0].model.label,
         "bias_mode": "keep" if bias_mode == "keep" else {"re_estimate_s": bias_mode},
-        "unit": match.unit, "scale_to_dph": scale, "signal": source.signal.to_dict(), "model_dt_s": b.model_dt_s,
+        # the log's unit and its factor to deg/h are its signal description's channels' (unit_as_read,
+        # scale_to_internal), written once there
+        "signal": source.signal.to_dict(), "model_dt_s": b.model_dt_s,
         "block_average_factor": match.factor, "n_samples": source.n_samples, "chunk_samples": int(chunk_samples),
         "design": "drift estimate of modelling interval j = the model's one-step prediction from modelling samples "
                   "< j, held over the interval's native samples (zero-order hold); compensated = rate - bias - "

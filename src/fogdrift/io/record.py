@@ -455,32 +455,20 @@ class GyroRecord:
         Returns
         -------
         dict
-            ``source, sha256, input_unit, declared_units (list), scale_to_dph, rate_unit
-            ("deg/h") (for a record with accelerometer channels ``scale_to_internal`` and ``internal_unit``:
-            ``"m/s^2"``, or a dict of each channel's internal unit for a gyro and accelerometer log), t0_s,
-            n_samples, n_axes, duration_s, axis_names (list), notes (list), temperature, signal``.
-            ``temperature`` is None or the range and drift of the temperature carried with the
+            ``source, sha256, t0_s, n_samples, n_axes, duration_s, axis_names (list), notes (list), temperature,
+            signal``.  ``temperature`` is None or the range and drift of the temperature carried with the
             log (:meth:`fogdrift.temperature.TemperatureSummary.to_dict`, deg C and deg C/h);
             ``signal`` is :meth:`fogdrift.signal.SignalDescription.to_dict` of :attr:`signal`, the one place
-            the sampling is written: ``signal.sampling`` holds the interval after block averaging
+            the sampling and the units are written: ``signal.sampling`` holds the interval after block averaging
             (``dt_s``, ``rate_hz``), the interval as loaded (``native_dt_s``, ``native_rate_hz``) and
-            ``block_average_factor``; a reader of the written block gets it with
-            :func:`fogdrift.signal.record_sampling`.
+            ``block_average_factor``; each of ``signal.channels`` its quantity, unit as read and where it came
+            from, declared unit, factor to the internal unit and the internal unit.  A reader of the written
+            block gets them with :func:`fogdrift.signal.record_sampling` and :func:`fogdrift.signal.record_units`.
         """
         temp = None if self.temperature_c is None else temperature_summary(self.temperature_c, self.dt_s).to_dict()
-        quantities = self.quantities
-        if all(q == "angular_rate" for q in quantities):
-            scale = {"scale_to_dph": self.scale_to_internal, "rate_unit": units.INTERNAL_UNITS["angular_rate"]}
-        else:  # accelerometer channels hold m/s^2: the keys say "internal", the unit is the channels'
-            each = {n: units.INTERNAL_UNITS[q] for n, q in zip(self.axis_names, quantities)}
-            one = set(each.values())
-            scale = {"scale_to_internal": self.scale_to_internal, "internal_unit": one.pop() if len(one) == 1 else each}
         return {
             "source": self.source,
             "sha256": self.sha256,
-            "input_unit": self.input_unit,
-            "declared_units": list(self.declared_units),
-            **scale,
             "t0_s": self.t0_s,
             "n_samples": self.n_samples,
             "n_axes": self.n_axes,

@@ -7,11 +7,11 @@ model's hyper-parameters and where its training stopped, and the evaluation sett
 
 from __future__ import annotations
 
-from ..signal import record_sampling
+from ..signal import record_sampling, record_units
 from .glossary import plain_name, plain_setting
 from .tables import _fmt
 
-__all__ = ["settings_rows"]
+__all__ = ["settings_rows", "unit_row"]
 
 #: Parameters of a model that are plumbing, not settings (never shown).
 _HIDDEN_PARAMS = {"progress"}
@@ -52,6 +52,20 @@ def _split_text(ma, t0_s: float) -> str:
     return "; ".join(parts)
 
 
+def unit_row(rec) -> tuple[str, str]:
+    """``(setting, value)`` of the input unit of a record block: the unit as read times its factor = the internal
+    unit, from the block's ``signal.channels`` (:func:`fogdrift.signal.record_units`)."""
+    u = record_units(rec, "the record")
+    if u is None:
+        return "unit (as read)", "–"
+    if u.scale_to_internal is not None and u.internal_unit is not None:
+        return ("rate unit (as read)" if u.all_gyro else "unit (as read)",
+                f"{u.input_unit} × {_fmt(u.scale_to_internal, 6)} = {u.internal_unit}")
+    # a gyro and accelerometer record: each channel has its own factor and internal unit
+    return "unit (as read)", ", ".join(f"{c.name} {c.unit_as_read} × {_fmt(c.scale_to_internal, 6)} = "
+                                       f"{c.internal_unit}" for c in u.channels)
+
+
 def settings_rows(result, *, generated: str, title: str = "") -> list:
     """``[group, setting, value]`` rows of every setting of ``result`` (an AnalysisResult).
 
@@ -73,11 +87,7 @@ def settings_rows(result, *, generated: str, title: str = "") -> list:
                                                                  "matplotlib") if k in v))
     add("input", "file", result.source)
     add("input", "SHA-256", result.sha256 or "–")
-    if "scale_to_dph" in rec:
-        add("input", "rate unit (as read)", f"{rec.get('input_unit')} × {_fmt(rec.get('scale_to_dph'), 6)} = deg/h")
-    else:  # accelerometer channels (record metadata names the internal unit)
-        add("input", "unit (as read)", f"{rec.get('input_unit')} × {_fmt(rec.get('scale_to_internal'), 6)} = "
-                                       f"{rec.get('internal_unit')}")
+    add("input", *unit_row(rec))
     add("input", "reader notes", "; ".join(rec.get("notes", [])) or "–")
     if result.applied:
         add("input", "models", "applied unchanged from the fitted recording (not refitted)")

@@ -14,7 +14,7 @@ import numpy as np
 from ..evaluation.verdicts import MIN_ORIGINS, independent_origins
 from ..noise import TERM_TABLE
 from ..noise.terms import DISPLAY_UNITS, TERMS
-from ..signal import record_sampling
+from ..signal import record_sampling, record_units
 from ..spec import B_COMPARED, judgement_line
 from ..units import S_PER_H
 from .screen import screen_summary
@@ -58,8 +58,9 @@ def _effective_rate(result) -> str:
 
 
 def _unit_text(rec: dict) -> str:
-    unit = rec.get("input_unit") or "?"
-    declared = [u for u in rec.get("declared_units") or [] if u]
+    units = record_units(rec, "the record")
+    unit = units.input_unit if units is not None else "?"
+    declared = [u for u in units.declared_units if u] if units is not None else []
     how = "declared in the file's header" if declared else "given by the user (--unit)"
     return f"{unit} ({how}); converted to deg/h" if unit != "deg/h" else f"deg/h ({how})"
 
