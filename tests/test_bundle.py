@@ -160,7 +160,8 @@ def test_model_command_writes_a_loadable_bundle(bundled_path, tmp_path):
 # ------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("edit, what", [
     (lambda d: d["axes"][0].update(bias_dph=d["axes"][0]["bias_dph"] + 5000.0), "bias +5000 deg/h"),
-    (lambda d: d.update(input_unit="rad/s" if d["input_unit"] != "rad/s" else "deg/s"), "unit"),
+    (lambda d: [c.update(unit_as_read="rad/s" if c["unit_as_read"] != "rad/s" else "deg/s")
+                for c in d["signal"]["channels"]], "unit"),
     (lambda d: d["axes"][0].update(earth_rate_dph=d["axes"][0]["earth_rate_dph"] + 1.0), "Earth rate"),
     (lambda d: d["training"].update(sha256="0" * 64), "training SHA-256"),
     (lambda d: d["axes"][0]["models"]["ar"]["sha256"].update(json="0" * 64), "a file's hash"),
@@ -201,13 +202,15 @@ def test_manifest_writes_the_sampling_once(fitted):
 
 
 def _as_format_2(doc):
-    """``doc`` (format 3) in the format-2 layout, resealed: the intervals and rates beside signal.sampling."""
+    """``doc`` (format 3) in the format-2 layout, resealed: the intervals and rates beside signal.sampling, the
+    unit beside signal.channels."""
     from fogdrift.bundle import seal_manifest
 
     dt, k = doc["signal"]["sampling"]["dt_s"], doc["block_average_factor"]
     old = {key: v for key, v in doc.items() if key != "seal_sha256"}
     old.update(format_version=2, native_dt_s=dt, native_rate_hz=1.0 / dt, model_dt_s=k * dt,
-               model_rate_hz=1.0 / (k * dt))
+               model_rate_hz=1.0 / (k * dt), input_unit=doc["signal"]["channels"][0]["unit_as_read"],
+               rate_unit_internal="deg/h")
     return seal_manifest(old)
 
 
@@ -246,6 +249,63 @@ def test_format_3_reads_the_interval_from_the_signal_only(fitted, tmp_path):
     _write(dst, doc)
     b = load_bundle(dst)
     assert (b.native_dt_s, b.model_dt_s) == (0.1, 1.0)
+
+
+# ------------------------------------------------------------------------------------------
+# The unit is written once, in signal.channels; input_unit beside it (format 2) is checked and dropped
+# ------------------------------------------------------------------------------------------
+def test_manifest_writes_the_unit_once(fitted):
+    rec, _, _, _, out = fitted
+    doc = json.loads((out / "manifest.json").read_text())
+    assert not {"input_unit", "rate_unit_internal", "unit", "scale_to_dph"} & set(doc)
+    assert [c["unit_as_read"] for c in doc["signal"]["channels"]] == ["deg/s", "deg/s"]
+    back = load_bundle(out)
+    assert back.input_unit == rec.input_unit == "deg/s" and back.signal == rec.signal
+
+
+def test_format_2_unit_is_read_from_the_channels(fitted, tmp_path):
+    """The converted manifest's unit is the channels' even where input_unit spells it otherwise (the unit it
+    names is checked to be the same, then dropped)."""
+    from fogdrift.bundle import seal_manifest
+
+    dst, doc = _copy(fitted[4], tmp_path)
+    old = _as_format_2(doc)
+    assert old["input_unit"] == "deg/s"
+    (dst / "manifest.json").write_text(json.dumps(seal_manifest(old)))
+    b = load_bundle(dst)
+    assert b.format_version == 2 and b.input_unit == "deg/s"
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_an_input_unit_that_disagrees_with_the_channels_is_refused(fitted, tmp_path, version):
+    from fogdrift.bundle import seal_manifest
+
+    dst, doc = _copy(fitted[4], tmp_path)
+    old = _as_format_2(doc) if version == 2 else {k: v for k, v in doc.items() if k != "seal_sha256"}
+    old["input_unit"] = "rad/s"
+    (dst / "manifest.json").write_text(json.dumps(seal_manifest(old)))
+    with pytest.raises(ModelFileError) as info:
+        load_bundle(dst)
+    assert str(info.value).startswith(f"{dst / 'manifest.json'}: input_unit: 'rad/s' is not the unit of "
+                                      "signal.channels ['gx', 'gz']")
+    assert "\n" not in str(info.value)
+
+
+def test_format_3_manifest_that_repeats_an_agreeing_unit_loads_the_same(fitted, tmp_path):
+    dst, doc = _copy(fitted[4], tmp_path)
+    new = load_bundle(dst)
+    doc.update(input_unit="deg/s", rate_unit_internal="deg/h")
+    _write(dst, doc)
+    back = load_bundle(dst)
+    assert (back.input_unit, back.signal, back.native_dt_s) == (new.input_unit, new.signal, new.native_dt_s)
+
+
+def test_a_manifest_with_channels_in_two_units_is_refused(fitted, tmp_path):
+    dst, doc = _copy(fitted[4], tmp_path)
+    doc["signal"]["channels"][1].update(unit_as_read="rad/s")
+    _write(dst, doc)
+    with pytest.raises(ModelFileError, match=r"signal.channels: the channels are in 2 units \['deg/s', 'rad/s'\]"):
+        load_bundle(dst)
 
 
 @pytest.mark.parametrize("rel", ["/etc/passwd", "../outside/ar", "gx/../../outside/ar", "gx\\..\\..\\ar", ""])

@@ -222,9 +222,12 @@ def test_bundle_carries_the_signal_description(bundle_dir):
 
 
 def _v2_without_signal(d):
-    """The manifest in the format-2 layout without a description: the intervals as native_dt_s and model_dt_s."""
-    dt, k = d.pop("signal")["sampling"]["dt_s"], d["block_average_factor"]
-    d.update(format_version=2, native_dt_s=dt, native_rate_hz=1 / dt, model_dt_s=k * dt, model_rate_hz=1 / (k * dt))
+    """The manifest in the format-2 layout without a description: the intervals as native_dt_s and model_dt_s, the
+    unit as input_unit."""
+    sig = d.pop("signal")
+    dt, k = sig["sampling"]["dt_s"], d["block_average_factor"]
+    d.update(format_version=2, native_dt_s=dt, native_rate_hz=1 / dt, model_dt_s=k * dt, model_rate_hz=1 / (k * dt),
+             input_unit=sig["channels"][0]["unit_as_read"], rate_unit_internal="deg/h")
 
 
 def test_format_2_bundle_without_a_description_still_loads(bundle_dir, tmp_path):
@@ -237,7 +240,7 @@ def test_format_3_bundle_without_a_description_is_refused(bundle_dir, tmp_path):
     with pytest.raises(ModelFileError) as ei:
         load_bundle(_edited(bundle_dir, tmp_path, lambda d: d.pop("signal")))
     assert str(ei.value).endswith("manifest.json: signal: missing (the training log's signal description holds the "
-                                  "bundle's sampling)")
+                                  "bundle's sampling and unit)")
 
 
 @pytest.mark.parametrize("edit, where", [
@@ -247,7 +250,8 @@ def test_format_3_bundle_without_a_description_is_refused(bundle_dir, tmp_path):
     (lambda d: d.update(block_average_factor=10**12), "block_average_factor: the modelling interval"),
     (lambda d: d.update(block_average_factor=0), "block_average_factor: expected an integer >= 1"),
     (lambda d: d.update(latitude_deg=400.0), "latitude_deg"),
-    (lambda d: d["signal"]["channels"][0].update(unit_as_read="rad/s"), "signal.channels"),
+    (lambda d: d.update(input_unit="rad/s"), "input_unit: 'rad/s' is not the unit of signal.channels ['gz']"),
+    (lambda d: d["signal"]["channels"][0].update(unit_as_read="furlong/s"), "signal: unknown"),
     (lambda d: d["signal"]["sampling"].update(dt_source="magic"), "signal: dt_source"),
 ])
 def test_absurd_bundle_fields_are_refused_in_one_line(bundle_dir, tmp_path, edit, where):

@@ -5,9 +5,9 @@ Layout (no pickle; every file is JSON or NPZ)::
 
     bundle/
       manifest.json          format, format_version, fogdrift version, the training input (source,
-                             SHA-256, time range, split), input unit, the training log's signal
-                             description (:mod:`fogdrift.signal`: its sampling, the one place the
-                             sample interval is written, and its channels, where each came from),
+                             SHA-256, time range, split), the training log's signal description
+                             (:mod:`fogdrift.signal`: its sampling and its channels, where each came
+                             from, the one place the sample interval and the input unit are written),
                              the block-average factor to the modelling rate, wavelet / mode, the
                              analysis settings, and per axis: bias and
                              how it was estimated, Earth-rate setting, level, causal-drift window,
@@ -22,8 +22,9 @@ state-space components if one was fitted, and a ``"gmwm"`` slot (None until a GM
 
 :func:`load_bundle` validates everything (keys, types, units, intervals, wavelet and level, the models'
 classes and the files' SHA-256) and refuses a bundle of a newer format version with one clear line.  A
-format-2 manifest (the intervals written beside the signal description as ``native_dt_s``, ``model_dt_s`` and
-their rates) is read through :func:`_manifest_v2_as_v3`, the one converter.
+format-2 manifest (the intervals and the unit written beside the signal description as ``native_dt_s``,
+``model_dt_s``, their rates, ``input_unit`` and ``rate_unit_internal``) is read through :func:`_manifest_v2_as_v3`,
+the one converter.
 
 Examples
 --------
@@ -85,6 +86,9 @@ BUNDLE_FORMAT = "fogdrift-bundle"
 BUNDLE_FORMAT_VERSION = 3
 #: Manifest keys of format 2 that repeat the sampling of ``signal.sampling`` (dropped by the conversion).
 _V2_SAMPLING_KEYS = ("native_dt_s", "native_rate_hz", "model_dt_s", "model_rate_hz")
+#: Manifest keys that repeat the unit of ``signal.channels`` (``unit_as_read``; ``rate_unit_internal`` was the
+#: constant "deg/h"): checked against the channels and dropped on reading, never written.
+_UNIT_KEYS = ("input_unit", "rate_unit_internal")
 MANIFEST = "manifest.json"
 #: Manifest key of the seal: SHA-256 of the canonical manifest without this key.
 SEAL_KEY = "seal_sha256"
@@ -187,7 +191,8 @@ class Bundle:
     axes : tuple of BundleAxis
     input_unit : str
         Unit of the training log's numbers (``"deg/s"``); a log to compensate must match it or be
-        mapped explicitly (``apply_unit``).
+        mapped explicitly (``apply_unit``).  Not written to the manifest: read from its
+        ``signal.channels`` (their ``unit_as_read``).
     native_dt_s, model_dt_s : float
         Sample interval of the training log and of the modelling series [s];
         ``model_dt_s = block_average_factor * native_dt_s``.  Not written to the manifest: read from its
@@ -350,10 +355,16 @@ def save_bundle(bundle: Bundle, out_dir) -> Path:
     elif abs(signal.sampling.dt_s - bundle.native_dt_s) > 1e-9 * bundle.native_dt_s:
         raise ConfigError(f"the bundle's native_dt_s {bundle.native_dt_s!r} differs from its signal description's "
                           f"sample interval {signal.sampling.dt_s!r}")
-    # the sampling is written once, in signal.sampling; the intervals are read back from it and the factor
+    else:
+        odd = [c.name for c in signal.channels if c.unit_as_read != bundle.input_unit]
+        if odd:
+            raise ConfigError(f"the bundle's input_unit {bundle.input_unit!r} is not the unit of its signal "
+                              f"description's channels {odd}")
+    # the sampling and the unit are written once, in signal; the intervals are read back from its sampling and the
+    # factor, the input unit from its channels
     doc = {
         "format": BUNDLE_FORMAT, "format_version": BUNDLE_FORMAT_VERSION, "fogdrift_version": bundle.fogdrift_version,
-        "created_utc": bundle.created_utc, "input_unit": bundle.input_unit, "rate_unit_internal": "deg/h",
+        "created_utc": bundle.created_utc,
         "block_average_factor": bundle.block_average_factor, "wavelet": bundle.wavelet, "mode": bundle.mode,
         "latitude_deg": bundle.latitude_deg, "training": bundle.training, "settings": bundle.settings,
         "signal": signal.to_dict(), "axes": axes_doc,
@@ -469,14 +480,10 @@ def load_bundle(path) -> Bundle:
     if not isinstance(seal, str) or seal != expected:
         raise ModelFileError(f"{mpath}: the manifest does not match its integrity seal ({SEAL_KEY}): it was edited "
                              "or damaged after the bundle was written; re-create the bundle")
-    unit = d.get(raw, "input_unit", str, "")
-    try:
-        unit_spec = channel_unit(unit, None)  # a unit of any quantity (gyro deg/s, accelerometer g ...)
-    except ConfigError:
-        d.fail("input_unit", f"unknown unit {unit!r}")
-    if version == 2:
-        raw = _manifest_v2_as_v3(raw, d, unit_spec)
-    signal = _signal_of(raw, d, unit_spec)
+    # a format-3 manifest may still repeat the unit beside its description: checked and dropped the same way
+    raw = _manifest_v2_as_v3(raw, d) if version == 2 else _unit_keys_dropped(raw, d)
+    signal = _signal_of(raw, d)
+    unit = signal.channels[0].unit_as_read
     native = signal.sampling.dt_s
     factor = d.get(raw, "block_average_factor", "int", "")
     if factor < 1:
@@ -591,11 +598,13 @@ def _bundle_signal(names, unit_spec, native_dt_s: float) -> SignalDescription:
         for n in dict.fromkeys(names)))
 
 
-def _manifest_v2_as_v3(raw: dict, d: _Doc, unit_spec) -> dict:
+def _manifest_v2_as_v3(raw: dict, d: _Doc) -> dict:
     """A format-2 manifest (its seal already checked) in the format-3 layout: ``native_dt_s``, ``model_dt_s`` and
     their rates checked (``model_dt_s = block_average_factor x native_dt_s``, the description's interval the
-    native one) and dropped, and a manifest without a ``signal`` given one made from ``input_unit`` and
-    ``native_dt_s``.  The one place format 2 is read; everything after it reads format 3."""
+    native one) and dropped, a manifest without a ``signal`` given one made from ``input_unit`` and
+    ``native_dt_s``, and ``input_unit`` / ``rate_unit_internal`` checked against the channels and dropped
+    (:func:`_unit_keys_dropped`).  The one place format 2 is read; everything after it reads format 3."""
+    unit_spec = _input_unit_spec(raw, d)
     native = d.get(raw, "native_dt_s", "positive", "")
     model_dt = d.get(raw, "model_dt_s", "positive", "")
     for key, value in (("native_dt_s", native), ("model_dt_s", model_dt)):
@@ -615,24 +624,49 @@ def _manifest_v2_as_v3(raw: dict, d: _Doc, unit_spec) -> dict:
             out["signal"] = _bundle_signal(names, unit_spec, native).to_dict()
         except ConfigError as exc:
             d.fail("axes", str(exc))
-        return out
+        return _unit_keys_dropped(out, d)
     smp = raw["signal"].get("sampling") if isinstance(raw["signal"], dict) else None
     dt = smp.get("dt_s") if isinstance(smp, dict) else None
     if isinstance(dt, (int, float)) and not isinstance(dt, bool) and abs(dt - native) > 1e-9 * native:
         d.fail("signal.sampling.dt_s", f"{dt!r} differs from native_dt_s {native!r}")
-    return out
+    return _unit_keys_dropped(out, d)
 
 
-def _signal_of(raw: dict, d: _Doc, unit_spec) -> SignalDescription:
-    """The manifest's signal description, the one home of the training log's sampling, its channels in
-    ``input_unit``."""
+def _input_unit_spec(raw: dict, d: _Doc):
+    """The manifest's ``input_unit`` parsed (a unit of any quantity: gyro deg/s, accelerometer g ...)."""
+    unit = d.get(raw, "input_unit", str, "")
+    try:
+        return channel_unit(unit, None)
+    except ConfigError:
+        d.fail("input_unit", f"unknown unit {unit!r}")
+
+
+def _unit_keys_dropped(raw: dict, d: _Doc) -> dict:
+    """``raw`` without :data:`_UNIT_KEYS`: an ``input_unit`` beside the description is checked to be the unit as
+    read of every channel of ``signal.channels`` (a disagreement refused, naming the key) and never read."""
+    if "input_unit" in raw:
+        spec = _input_unit_spec(raw, d)
+        sig = raw.get("signal")
+        chans = sig.get("channels") if isinstance(sig, dict) else None
+        odd = [c.get("name") for c in (chans if isinstance(chans, list) else [])
+               if isinstance(c, dict) and c.get("unit_as_read") != spec.text]
+        if odd:
+            d.fail("input_unit", f"{spec.text!r} is not the unit of signal.channels {odd}; the manifest contradicts "
+                                 "itself: re-create the bundle")
+    return {k: v for k, v in raw.items() if k not in _UNIT_KEYS}
+
+
+def _signal_of(raw: dict, d: _Doc) -> SignalDescription:
+    """The manifest's signal description, the one home of the training log's sampling and input unit (its channels
+    in one unit)."""
     if raw.get("signal") is None:
-        d.fail("signal", "missing (the training log's signal description holds the bundle's sampling)")
+        d.fail("signal", "missing (the training log's signal description holds the bundle's sampling and unit)")
     try:
         signal = SignalDescription.from_dict(raw["signal"])
     except ConfigError as exc:
         d.fail("signal", str(exc))
-    odd = [c.name for c in signal.channels if c.unit_as_read != unit_spec.text]
-    if odd:
-        d.fail("signal.channels", f"channels {odd} are not in input_unit {unit_spec.text!r}")
+    texts = list(dict.fromkeys(c.unit_as_read for c in signal.channels))
+    if len(texts) > 1:
+        d.fail("signal.channels", f"the channels are in {len(texts)} units {texts}; a bundle's training log is read in "
+                                  "one unit")
     return signal
