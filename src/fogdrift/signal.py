@@ -329,17 +329,9 @@ def record_sampling(block, where: str = "the record") -> Sampling | None:
     >>> smp.rate_hz, smp.native_rate_hz, smp.block_average_factor
     (50.0, 100.0, 2)
     """
-    if not isinstance(block, dict):
-        return None
-    signal = block.get("signal")
+    signal = _block_signal(block, where, _RECORD_SAMPLING_SYNONYMS, "its sampling", "'signal.sampling'", "it")
     if signal is None:
-        old = [k for k in _RECORD_SAMPLING_SYNONYMS if block.get(k) is not None]
-        if old:
-            raise ConfigError(f"{where} states its sampling only as {', '.join(old)}, not in 'signal.sampling' "
-                              "where this fogdrift reads it; re-run the fogdrift command that wrote the file")
         return None
-    if not isinstance(signal, dict):
-        raise ConfigError(f"{where}'s signal: expected an object; got {type(signal).__name__}")
     try:
         return Sampling.from_dict(signal.get("sampling"))
     except ConfigError as exc:
@@ -431,17 +423,9 @@ def record_units(block, where: str = "the record") -> RecordUnits | None:
     >>> u.input_unit, u.scale_to_internal, u.internal_unit
     ('deg/s', 3600.0, 'deg/h')
     """
-    if not isinstance(block, dict):
-        return None
-    signal = block.get("signal")
+    signal = _block_signal(block, where, _RECORD_UNIT_SYNONYMS, "its units", "'signal.channels'", "them")
     if signal is None:
-        old = [k for k in _RECORD_UNIT_SYNONYMS if block.get(k) is not None]
-        if old:
-            raise ConfigError(f"{where} states its units only as {', '.join(old)}, not in 'signal.channels' where "
-                              "this fogdrift reads them; re-run the fogdrift command that wrote the file")
         return None
-    if not isinstance(signal, dict):
-        raise ConfigError(f"{where}'s signal: expected an object; got {type(signal).__name__}")
     chans = signal.get("channels")
     if not isinstance(chans, list) or not chans:
         raise ConfigError(f"{where}'s signal.channels: expected a list of one or more channels; got {chans!r}")
@@ -449,3 +433,20 @@ def record_units(block, where: str = "the record") -> RecordUnits | None:
         return RecordUnits(tuple(Channel.from_dict(c) for c in chans))
     except ConfigError as exc:
         raise ConfigError(f"{where}'s signal.channels: {exc}") from None
+
+
+def _block_signal(block, where, synonyms, what, home, pronoun):
+    """A written record block's ``signal`` object, or None when the block states none (nor ``what`` under its old
+    ``synonyms``: refused, one line naming ``where`` and the ``home`` this fogdrift reads)."""
+    if not isinstance(block, dict):
+        return None
+    signal = block.get("signal")
+    if signal is None:
+        old = [k for k in synonyms if block.get(k) is not None]
+        if old:
+            raise ConfigError(f"{where} states {what} only as {', '.join(old)}, not in {home} where this fogdrift "
+                              f"reads {pronoun}; re-run the fogdrift command that wrote the file")
+        return None
+    if not isinstance(signal, dict):
+        raise ConfigError(f"{where}'s signal: expected an object; got {type(signal).__name__}")
+    return signal
