@@ -104,7 +104,7 @@ def test_float32_input_is_not_copied_to_float64_when_only_warned():
 
 
 def test_bad_input_is_one_clear_error():
-    with pytest.raises(DataFormatError, match=r"rate_dph\[3\] is nan"):
+    with pytest.raises(DataFormatError, match=r"y\[3\] is nan"):
         O.find_outliers(np.array([1.0, 2.0, 3.0, np.nan, 5.0]))
     with pytest.raises(ConfigError, match="threshold"):
         O.find_outliers(np.ones(10), threshold=-1)

@@ -238,17 +238,17 @@ def _compiled():
     return _KERNELS
 
 
-def _as_rate(rate_dph) -> np.ndarray:
+def _as_rate(y) -> np.ndarray:
     """A 1-D float32/float64 array of the rate, checked finite, without a float64 copy of a float array.
 
     Anything else goes through :func:`fogdrift._util.check_series` (its messages)."""
-    x = rate_dph
+    x = y
     if isinstance(x, np.ndarray) and x.ndim == 1 and x.dtype in (np.float32, np.float64) and x.size >= 2:
         for a in range(0, x.size, _CHECK_CHUNK):
             if not np.isfinite(x[a:a + _CHECK_CHUNK]).all():
-                return check_series(x, "rate_dph", min_length=2)  # raises, naming the first bad sample
+                return check_series(x, "y", min_length=2)  # raises, naming the first bad sample
         return x
-    return check_series(rate_dph, "rate_dph", min_length=2)
+    return check_series(y, "y", min_length=2)
 
 
 def block_medians(x: np.ndarray, block: int) -> np.ndarray:
@@ -298,13 +298,13 @@ def _robust_sigma(x, med, block) -> float:
     return _MAD_TO_SIGMA * float(mid)
 
 
-def find_outliers(rate_dph, *, threshold=6.0, block=100):
+def find_outliers(y, *, threshold=6.0, block=100):
     """Flag samples beyond ``threshold`` robust sigmas of their block median.
 
     Parameters
     ----------
-    rate_dph : array_like, shape (n_samples,)
-        Rate [deg/h].
+    y : array_like, shape (n_samples,)
+        The series in its channel's internal unit (deg/h, m/s^2).
     threshold : float
         Threshold in robust sigmas (> 0).
     block : int
@@ -324,7 +324,7 @@ def find_outliers(rate_dph, *, threshold=6.0, block=100):
     >>> rep.count, np.flatnonzero(mask).tolist()
     (2, [10, 5000])
     """
-    x = _as_rate(rate_dph)
+    x = _as_rate(y)
     thr = float(threshold)
     if not (thr > 0 and math.isfinite(thr)):
         raise ConfigError(f"outlier threshold must be a finite number of sigmas > 0, got {threshold!r}")
@@ -348,7 +348,7 @@ def find_outliers(rate_dph, *, threshold=6.0, block=100):
     return mask, report
 
 
-def treat_outliers(rate_dph, action="clip", *, threshold=6.0, block=100):
+def treat_outliers(y, action="clip", *, threshold=6.0, block=100):
     """Return a treated copy of the rate and the report.
 
     ``action="clip"`` limits each outlier's deviation to ``+-threshold`` robust sigmas around its block median
@@ -366,7 +366,7 @@ def treat_outliers(rate_dph, action="clip", *, threshold=6.0, block=100):
     """
     if action not in OUTLIER_ACTIONS:
         raise ConfigError(f"outlier action must be one of {OUTLIER_ACTIONS}, got {action!r} (option {{opt:outliers}})")
-    x = _as_rate(rate_dph)
+    x = _as_rate(y)
     mask, report = find_outliers(x, threshold=threshold, block=block)
     if action == "warn" or report.count == 0:
         return x, report

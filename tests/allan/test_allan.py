@@ -319,7 +319,7 @@ def test_tau_grid_rejects(taus):
 
 
 def test_validation_errors():
-    with pytest.raises(DataFormatError, match=r"rate_dph\[2\]"):
+    with pytest.raises(DataFormatError, match=r"y\[2\]"):
         allan_variance([1.0, 2.0, np.nan, 3.0], 1.0)
     with pytest.raises(DataFormatError, match="1-D"):
         allan_variance(np.zeros((4, 2)), 1.0)

@@ -226,13 +226,13 @@ def test_constant_record_gives_an_empty_summary():
 
 
 @pytest.mark.parametrize("kwargs, err, text", [
-    (dict(rate_dph=[0.0, float("nan")] * 200, dt_s=0.01), DataFormatError, r"rate_dph\[1\] is nan"),
-    (dict(rate_dph=np.zeros((300, 2)), dt_s=0.01), DataFormatError, "1-D"),
-    (dict(rate_dph=["a"] * 300, dt_s=0.01), DataFormatError, "numeric"),
-    (dict(rate_dph=np.zeros(300), dt_s=0.0), ConfigError, "dt_s"),
-    (dict(rate_dph=np.zeros(300), dt_s=0.01, false_alarm=0.0), ConfigError, "false_alarm"),
-    (dict(rate_dph=np.zeros(300), dt_s=0.01, false_alarm=1.0), ConfigError, "false_alarm"),
-    (dict(rate_dph=np.zeros(300), dt_s=0.01, max_lines=0), ConfigError, "max_lines"),
+    (dict(y=[0.0, float("nan")] * 200, dt_s=0.01), DataFormatError, r"y\[1\] is nan"),
+    (dict(y=np.zeros((300, 2)), dt_s=0.01), DataFormatError, "1-D"),
+    (dict(y=["a"] * 300, dt_s=0.01), DataFormatError, "numeric"),
+    (dict(y=np.zeros(300), dt_s=0.0), ConfigError, "dt_s"),
+    (dict(y=np.zeros(300), dt_s=0.01, false_alarm=0.0), ConfigError, "false_alarm"),
+    (dict(y=np.zeros(300), dt_s=0.01, false_alarm=1.0), ConfigError, "false_alarm"),
+    (dict(y=np.zeros(300), dt_s=0.01, max_lines=0), ConfigError, "max_lines"),
 ])
 def test_bad_input_is_one_clear_error(kwargs, err, text):
     with pytest.raises(err, match=text) as info:

@@ -74,7 +74,7 @@ def _fast_strides(m: np.ndarray) -> np.ndarray:
 
 
 def allan_variance(
-    rate_dph,
+    y,
     dt_s,
     *,
     taus="octave",
@@ -88,8 +88,9 @@ def allan_variance(
 
     Parameters
     ----------
-    rate_dph : array_like, shape (n_samples,)
-        Angular rate in deg/h at a constant sample interval.  Finite values only.
+    y : array_like, shape (n_samples,)
+        The series at a constant sample interval, finite, in its channel's internal unit (an angular rate in deg/h,
+        a specific force in m/s^2: :data:`fogdrift.units.INTERNAL_UNITS`); the deviations are in that unit.
     dt_s : float
         Sample interval tau0 in s.
     taus : str, int or array_like, keyword-only
@@ -126,7 +127,7 @@ def allan_variance(
     Raises
     ------
     DataFormatError
-        ``rate_dph`` is not a finite 1-D numeric array.
+        ``y`` is not a finite 1-D numeric array.
     InsufficientDataError
         Fewer than 2 samples (3 for the Hadamard deviation).
     ConfigError
@@ -175,7 +176,7 @@ def allan_variance(
     ('hdev', [1.9722222222, 0.1805555556])
     """
     stat = get_statistic(statistic)
-    y = np.ascontiguousarray(check_series(rate_dph, "rate_dph"))
+    y = np.ascontiguousarray(check_series(y, "y"))
     dt = check_dt_s(dt_s)
     stat.check_sampling(estimator)
     n = y.size

@@ -76,14 +76,14 @@ def check_segments(segments, n_samples: int) -> list[tuple[int, int]]:
     return out
 
 
-def allan_variance_segments(rate_dph, dt_s, segments, *, taus="octave", noise_alpha="auto",
+def allan_variance_segments(y, dt_s, segments, *, taus="octave", noise_alpha="auto",
                             max_fraction=0.25) -> AllanResult:
     """The overlapping Allan variance pooled over gap-free segments of one record.
 
     Parameters
     ----------
-    rate_dph : array_like, shape (n_samples,)
-        The whole record's rate in deg/h (any unit works: the result is in its square).
+    y : array_like, shape (n_samples,)
+        The whole record's series in its channel's internal unit (deg/h, m/s^2; the variances are in its square).
     dt_s : float
         Sample interval tau0 in s.
     segments : sequence of (int, int)
@@ -128,7 +128,7 @@ def allan_variance_segments(rate_dph, dt_s, segments, *, taus="octave", noise_al
     >>> r.n_terms.tolist(), r.n_samples, [round(float(v), 6) for v in r.avar_dph2]
     ([10, 6], 12, [2.25, 1.333333])
     """
-    y = np.ascontiguousarray(check_series(rate_dph, "rate_dph"))
+    y = np.ascontiguousarray(check_series(y, "y"))
     dt = check_dt_s(dt_s)
     segs = [s for s in check_segments(segments, y.size) if s[1] - s[0] >= 2]
     if not segs:

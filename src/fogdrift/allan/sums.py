@@ -42,8 +42,8 @@ class AllanSums:
 
     Parameters
     ----------
-    rate_dph : array_like, shape (n_samples,)
-        Rate in deg/h, finite (checked as :func:`fogdrift.allan.allan_variance` checks it, same messages).
+    y : array_like, shape (n_samples,)
+        The series in its channel's internal unit (deg/h, m/s^2), finite (checked as :func:`fogdrift.allan.allan_variance` checks it, same messages).
     dt_s : float
         Sample interval [s].
     statistic : {"adev", "hdev", "mdev"}
@@ -55,10 +55,10 @@ class AllanSums:
     out-of-core pass over the array already in memory: the same sums to 1e-12 relative without the angle array.
     """
 
-    def __init__(self, rate_dph, dt_s, statistic: str = "adev", estimator: str = "overlapping"):
+    def __init__(self, y, dt_s, statistic: str = "adev", estimator: str = "overlapping"):
         self.stat = get_statistic(statistic)
-        self.source = rate_dph
-        self.y = np.ascontiguousarray(check_series(rate_dph, "rate_dph"))
+        self.source = y
+        self.y = np.ascontiguousarray(check_series(y, "y"))
         self.dt = check_dt_s(dt_s)
         self.dt_in = dt_s
         self.stat.check_sampling(estimator)
@@ -69,12 +69,12 @@ class AllanSums:
         self.m = np.empty(0, dtype=np.int64)
         self.sums = np.empty(0)
 
-    def holds(self, rate_dph, dt_s, statistic: str, estimator: str) -> bool:
+    def holds(self, y, dt_s, statistic: str, estimator: str) -> bool:
         """True when these sums are of this very array (same object or the same memory, shape and dtype), interval,
         statistic and estimator: then they can be reused as they are."""
-        same = rate_dph is self.source or rate_dph is self.y
-        if not same and isinstance(rate_dph, np.ndarray) and isinstance(self.source, np.ndarray):
-            a, b = rate_dph.__array_interface__, self.source.__array_interface__
+        same = y is self.source or y is self.y
+        if not same and isinstance(y, np.ndarray) and isinstance(self.source, np.ndarray):
+            a, b = y.__array_interface__, self.source.__array_interface__
             same = (a["data"] == b["data"] and a["shape"] == b["shape"] and a["strides"] == b["strides"]
                     and a["typestr"] == b["typestr"])
         return bool(same and dt_s == self.dt_in and statistic == self.stat.name and estimator == self.estimator)

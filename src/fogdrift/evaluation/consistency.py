@@ -176,15 +176,16 @@ def angle_error_variance_deg2(components, horizons_s, t_cal_s, *, by_component: 
     return (total, parts) if by_component else total
 
 
-def observed_angle_errors_deg(rate_dph, dt_s, t_cal_s, horizons_s, *, step_s=None, quantity="gyro"):
+def observed_angle_errors_deg(y, dt_s, t_cal_s, horizons_s, *, step_s=None, quantity="gyro"):
     """Angle errors [deg] at rolling origins of a static rate series, after a window-mean calibration.
 
     With ``quantity="accel"``: velocity errors [m/s] of a specific force [m/s^2].
 
     Parameters
     ----------
-    rate_dph : array_like, shape (n,)
-        Static rate [deg/h] (finite).
+    y : array_like, shape (n,)
+        Static series (finite) in its internal unit: a rate in deg/h (``quantity="gyro"``), a specific force in
+        m/s^2 (``"accel"``, whose "angle" is a velocity in m/s).
     dt_s : float
         Sample interval [s].
     t_cal_s : float
@@ -215,7 +216,7 @@ def observed_angle_errors_deg(rate_dph, dt_s, t_cal_s, horizons_s, *, step_s=Non
     >>> np.round(e, 6).tolist()
     [[0.005, 0.01]]
     """
-    y = np.asarray(rate_dph, dtype=np.float64).ravel()
+    y = np.asarray(y, dtype=np.float64).ravel()
     dt = float(dt_s)
     T = _t_cal(t_cal_s)
     h = _horizons(horizons_s)

@@ -173,8 +173,9 @@ def analyse_wvar(name, wvar: WvarResult, *, model="auto") -> GmwmAxis:
     return GmwmAxis(str(name), wvar, select_model(wvar, candidates_for(model)))
 
 
-def analyse_gmwm(name, rate_dph, dt_s, *, model="auto", levels=None, robust=False, spectrum="auto") -> GmwmAxis:
-    """Haar WV of one rate series (deg/h at ``dt_s`` s) and the GMWM model selection on it.
+def analyse_gmwm(name, y, dt_s, *, model="auto", levels=None, robust=False, spectrum="auto") -> GmwmAxis:
+    """Haar WV of one series (its channel's internal unit, deg/h or m/s^2, at ``dt_s`` s) and the GMWM model
+    selection on it.
 
     ``levels`` is the number of scales J (default ``floor(log2 N) - 1``); ``robust`` uses the Huber WV.
 
@@ -185,7 +186,7 @@ def analyse_gmwm(name, rate_dph, dt_s, *, model="auto", levels=None, robust=Fals
     claimed only above their envelope.
     """
     cands = candidates_for(model)  # a bad model string is refused before the WV is computed
-    rate = np.asarray(rate_dph, dtype=np.float64)
+    rate = np.asarray(y, dtype=np.float64)
     if isinstance(spectrum, str) and spectrum == "auto":
 
         spectrum = analyse_spectrum(rate, dt_s)

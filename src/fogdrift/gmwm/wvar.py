@@ -26,8 +26,8 @@ influence of a single large coefficient.  It is consistent for Gaussian ``W`` (t
 constant ``delta(c)`` makes ``E min(Z^2, c^2) = delta``) and has the requested Gaussian
 efficiency; its variance is that of the classical estimator divided by the efficiency.
 
-Units: the input is a rate in deg/h, so every WV is in (deg/h)^2; scales are given in
-samples (``tau_samples``) and in seconds (``scale_s = tau_samples * dt_s``).
+Units: the input is in its channel's internal unit (an angular rate in deg/h, a specific force in m/s^2), and every
+WV is in its square; scales are given in samples (``tau_samples``) and in seconds (``scale_s = tau_samples * dt_s``).
 
 References
 ----------
@@ -384,15 +384,15 @@ def _acvs_variance(w: np.ndarray) -> float:
     return 2.0 * a / m
 
 
-def haar_wvar(rate_dph, dt_s, *, levels=None, robust=False, efficiency=_DEFAULT_EFFICIENCY,
+def haar_wvar(y, dt_s, *, levels=None, robust=False, efficiency=_DEFAULT_EFFICIENCY,
               nonparametric_var=False, axis_names=None) -> WvarResult:
     """Haar MODWT wavelet variance of a rate series, with eta3 confidence intervals.
 
     Parameters
     ----------
-    rate_dph : array_like, shape (n_samples,) or (n_samples, n_axes)
-        Angular rate in deg/h at a constant sample interval; a 2-D array is processed
-        column by column.
+    y : array_like, shape (n_samples,) or (n_samples, n_axes)
+        The series at a constant sample interval in its channel's internal unit (deg/h for a gyro, m/s^2 for an
+        accelerometer: every WV is in its square); a 2-D array is processed column by column.
     dt_s : float
         Sample interval in s.
     levels : int or None, keyword-only
@@ -445,17 +445,17 @@ def haar_wvar(rate_dph, dt_s, *, levels=None, robust=False, efficiency=_DEFAULT_
     """
     dt = check_dt_s(dt_s)
     try:
-        arr = np.asarray(rate_dph, dtype=np.float64)
+        arr = np.asarray(y, dtype=np.float64)
     except (TypeError, ValueError):
-        raise DataFormatError(f"rate_dph must be a numeric array, got {type(rate_dph).__name__}") from None
+        raise DataFormatError(f"y must be a numeric array, got {type(y).__name__}") from None
     if arr.ndim == 2:
-        cols = [check_series(arr[:, k], f"rate_dph[:, {k}]") for k in range(arr.shape[1])]
+        cols = [check_series(arr[:, k], f"y[:, {k}]") for k in range(arr.shape[1])]
         if not cols:
-            raise DataFormatError("rate_dph has no columns; expected shape (n_samples, n_axes)")
+            raise DataFormatError("y has no columns; expected shape (n_samples, n_axes)")
     elif arr.ndim == 1:
-        cols = [check_series(arr, "rate_dph")]
+        cols = [check_series(arr, "y")]
     else:
-        raise DataFormatError(f"rate_dph must be 1-D or 2-D; expected (n_samples,) or (n_samples, n_axes), got {arr.shape}")
+        raise DataFormatError(f"y must be 1-D or 2-D; expected (n_samples,) or (n_samples, n_axes), got {arr.shape}")
     n = cols[0].size
     if n < 2:
         raise InsufficientDataError(f"a wavelet variance needs at least 2 samples, got {n}", needed=2, got=n)

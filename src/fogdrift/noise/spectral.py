@@ -615,13 +615,13 @@ def _rolloff(f: np.ndarray, p_free: np.ndarray, df: float):
 # Public functions
 
 
-def analyse_spectrum(rate_dph, dt_s, *, false_alarm=0.01, max_lines=16) -> SpectrumSummary:
+def analyse_spectrum(y, dt_s, *, false_alarm=0.01, max_lines=16) -> SpectrumSummary:
     """Find the spectral lines, periodic components and output roll-off of a rate record.
 
     Parameters
     ----------
-    rate_dph : array_like, shape (n_samples,)
-        Rate [deg/h] (float32 or float64, finite).
+    y : array_like, shape (n_samples,)
+        The series in its channel's internal unit (deg/h, m/s^2), float32 or float64, finite.
     dt_s : float
         Sample interval [s].
     false_alarm : float, keyword-only
@@ -639,7 +639,7 @@ def analyse_spectrum(rate_dph, dt_s, *, false_alarm=0.01, max_lines=16) -> Spect
     Raises
     ------
     DataFormatError
-        ``rate_dph`` not a finite 1-D numeric series.
+        ``y`` not a finite 1-D numeric series.
     ConfigError
         Bad ``dt_s``, ``false_alarm`` or ``max_lines``.
 
@@ -667,7 +667,7 @@ def analyse_spectrum(rate_dph, dt_s, *, false_alarm=0.01, max_lines=16) -> Spect
     if not (0.0 < fa <= 0.5):
         raise ConfigError(f"false_alarm must be a probability in (0, 0.5], got {false_alarm!r}")
     n_max = check_count(max_lines, "max_lines", 1)
-    x = check_series(rate_dph, "rate_dph", min_length=0)
+    x = check_series(y, "y", min_length=0)
     n = int(x.size)
     fs = 1.0 / dt
     if n < MIN_SAMPLES:

@@ -109,10 +109,10 @@ def _spectrum_of(x, dt_s, known=None):
     return analyse_spectrum(x, dt_s)
 
 
-def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False,
+def analyse_allan(name, y, dt_s, cfg: AnalysisConfig, progress=None, *, check_outliers=False,
                   spectrum="auto", outliers=None, quantity="angular_rate", sums=None, segments=None,
                   screen=None, known_spectrum=None) -> AllanAxis:
-    """Allan-family variance and noise identification of one 1-D rate series.
+    """Allan-family variance and noise identification of one 1-D series ``y`` in its internal unit (deg/h, m/s^2).
 
     The curve is computed on the configured grid (``cfg.taus``) for display; the noise fit always uses an octave
     grid of the same data, so its numbers do not depend on the display grid.  With ``check_outliers`` the rate is
@@ -140,18 +140,18 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     when it was taken of the very samples analysed here (:func:`_spectrum_of`).
     """
     if check_outliers:
-        rate_dph, outliers = treat_outliers(rate_dph, cfg.outliers)
+        y, outliers = treat_outliers(y, cfg.outliers)
     if segments is not None:
-        return _analyse_segments(name, rate_dph, dt_s, cfg, segments, spectrum=spectrum, outliers=outliers,
+        return _analyse_segments(name, y, dt_s, cfg, segments, spectrum=spectrum, outliers=outliers,
                                  quantity=quantity, screen=screen, progress=progress, known_spectrum=known_spectrum)
     if isinstance(spectrum, str) and spectrum == "auto":
-        spectrum = _spectrum_of(rate_dph, dt_s, known_spectrum)
+        spectrum = _spectrum_of(y, dt_s, known_spectrum)
     content = periodic_content(spectrum)
     # Every grid this analysis may need (display, octave, octave + the null taus of the periodic content) is known
     # before the data are touched: one pass of operator sums serves them all, and each result is rebuilt from the
     # sums (result_from_sums, the function allan_variance ends in: identical field by field).
-    if sums is None or not sums.holds(rate_dph, dt_s, cfg.statistic, cfg.estimator):
-        sums = AllanSums(rate_dph, dt_s, cfg.statistic, cfg.estimator)
+    if sums is None or not sums.holds(y, dt_s, cfg.statistic, cfg.estimator):
+        sums = AllanSums(y, dt_s, cfg.statistic, cfg.estimator)
     m_disp = sums.grid(cfg.taus)
     m_oct = m_disp if cfg.taus == "octave" else sums.grid("octave")
     taus = m_fit = None
@@ -185,7 +185,7 @@ def analyse_allan(name, rate_dph, dt_s, cfg: AnalysisConfig, progress=None, *, c
     return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers, screen=screen)
 
 
-def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, spectrum, outliers, quantity,
+def _analyse_segments(name, y, dt_s, cfg: AnalysisConfig, segments, *, spectrum, outliers, quantity,
                       screen, progress=None, known_spectrum=None) -> AllanAxis:
     """The Allan analysis of the quiet ``segments`` of a disturbed record (``(start, stop)`` samples): the overlapping
     Allan variance pooled over the segments without bridging a gap (:func:`fogdrift.allan.allan_variance_segments`;
@@ -194,17 +194,17 @@ def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, sp
     segs = sorted((int(a), int(b)) for a, b in segments)
     longest = max(segs, key=lambda s: s[1] - s[0])
     if isinstance(spectrum, str) and spectrum == "auto":
-        spectrum = _spectrum_of(rate_dph[longest[0]:longest[1]], dt_s, known_spectrum)
+        spectrum = _spectrum_of(y[longest[0]:longest[1]], dt_s, known_spectrum)
     content = periodic_content(spectrum)
     if cfg.statistic == "adev" and cfg.estimator == "overlapping":
-        res = allan_variance_segments(rate_dph, dt_s, segs, taus=cfg.taus)
-        fit_curve = res if cfg.taus == "octave" else allan_variance_segments(rate_dph, dt_s, segs, taus="octave")
+        res = allan_variance_segments(y, dt_s, segs, taus=cfg.taus)
+        fit_curve = res if cfg.taus == "octave" else allan_variance_segments(y, dt_s, segs, taus="octave")
         if content is not None:
             t = np.asarray(fit_curve.tau_s, dtype=np.float64)
             extra = null_taus(content.periods_s, dt_s, float(t[0]), float(t[-1]))
-            fit_curve = allan_variance_segments(rate_dph, dt_s, segs, taus=np.union1d(t, extra))
+            fit_curve = allan_variance_segments(y, dt_s, segs, taus=np.union1d(t, extra))
     else:
-        part = np.asarray(rate_dph[longest[0]:longest[1]], dtype=np.float64)
+        part = np.asarray(y[longest[0]:longest[1]], dtype=np.float64)
         res = allan_variance(part, dt_s, taus=cfg.taus, estimator=cfg.estimator, statistic=cfg.statistic)
         fit_curve = res if cfg.taus == "octave" else allan_variance(part, dt_s, estimator=cfg.estimator,
                                                                     statistic=cfg.statistic)
@@ -218,7 +218,7 @@ def _analyse_segments(name, rate_dph, dt_s, cfg: AnalysisConfig, segments, *, sp
     if outliers is not None:
         noise = dataclasses.replace(noise, outliers=outliers.to_dict())
     # what the whole record gives (``--segments whole``), kept beside the segments' fit for the output and the report
-    whole = analyse_allan(name, rate_dph, dt_s, cfg, outliers=outliers, quantity=quantity).noise
+    whole = analyse_allan(name, y, dt_s, cfg, outliers=outliers, quantity=quantity).noise
     return AllanAxis(name=name, allan=res, noise=noise, outliers=outliers, screen=screen, whole_noise=whole)
 
 
