@@ -384,6 +384,10 @@ def test_result_names_per_statistic(tmp_path):
     assert "statistic=hdev" in text[0]
     assert text[2] == ",".join(h.column_names()) and text[2].startswith("tau_s,m,hvar_dph2,hdev_dph,hdev_lo68_dph")
     assert allan_variance(y, 0.5, taus=[1.0], statistic="mdev").column_names()[2:4] == ("mvar_dph2", "mdev_dph")
+    h.to_csv(path, quantity="specific_force")  # an accelerometer's curve: m/s^2 in the names and the units line
+    acc = path.read_text().splitlines()
+    assert "hvar_m2ps4 [(m/s^2)^2]; hdev_* [m/s^2]" in acc[1] and "deg/h" not in acc[1]
+    assert acc[2].startswith("tau_s,m,hvar_m2ps4,hdev_mps2,hdev_lo68_mps2") and acc[3:] == text[3:]
 
 
 def test_result_serialisation_and_progress(tmp_path):

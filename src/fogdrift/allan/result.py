@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..units import KEY_SUFFIXES
+from ..units import INTERNAL_UNITS, KEY_SUFFIXES
 from .statistics import get_statistic
 
 __all__ = ["AllanResult"]
@@ -171,22 +171,25 @@ class AllanResult:
         )
         return out
 
-    def to_csv(self, path) -> None:
+    def to_csv(self, path, quantity: str = "angular_rate") -> None:
         """Write one row per tau; two ``#`` comment lines, then a header whose names carry units.
 
         Columns: ``tau_s, m, <var>_dph2 [(deg/h)^2], <dev>_dph [deg/h]``, the four deviation
         bounds in deg/h, ``n_terms, edf, noise_alpha`` (``<var>``/``<dev>``: avar/adev,
-        hvar/hdev or mvar/mdev).
+        hvar/hdev or mvar/mdev).  ``quantity`` is the channel's (:meth:`column_names`): a specific
+        force's columns are ``<var>_m2ps4 [(m/s^2)^2]``, ``<dev>_mps2 [m/s^2]``.
         """
         stat = get_statistic(self.statistic)
-        names = self.column_names()
+        names = self.column_names(quantity)
+        unit = INTERNAL_UNITS[quantity]
+        one, two = KEY_SUFFIXES[quantity]
         with open(path, "w", newline="") as fh:
             fh.write(
                 f"# fogdrift {stat.long_name}; statistic={self.statistic}; estimator={self.estimator}; "
                 f"dt_s={self.dt_s!r}; n_samples={self.n_samples}\n"
             )
             fh.write(
-                f"# units: tau_s [s]; {stat.var_name}_dph2 [(deg/h)^2]; {stat.dev_name}_* [deg/h]; "
+                f"# units: tau_s [s]; {stat.var_name}_{two} [({unit})^2]; {stat.dev_name}_* [{unit}]; "
                 f"edf rule: {self.edf_rule}\n"
             )
             writer = csv.writer(fh)
