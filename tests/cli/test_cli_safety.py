@@ -115,7 +115,7 @@ def test_adis16405_log_read_as_deg_h_is_warned(tmp_path):
     (["separate", "--mode", "wrap"], "--mode must be one of"),
     (["model", "--training", "sgd"], "--training must be 'bptt' or 'bp'"),
     (["analyze", "--terms", "Q,X"], "--terms must list noise terms"),
-    (["model", "--epochs", "0"], "epochs must be >= 1"),
+    (["model", "--epochs", "0"], "--epochs must be an integer >= 1; got 0"),
 ])
 def test_bad_options_are_refused_at_once(bundled_path, tmp_path, no_load, args, fragment):
     # the issue: "rejected in the first second", i.e. before any work: no_load fails the test if the file is read

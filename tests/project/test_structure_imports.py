@@ -204,8 +204,6 @@ DEFERRED: dict[str, tuple[str, tuple[str, ...]]] = {
                           "pipeline imports no model module); GMWM (gmwm.estimator: scipy.optimize's least squares, "
                           "gmwm.simulate: scipy.signal) only for noise_method='gmwm', so allan, separate and model "
                           "never load it (test_speed_imports)", ("fogdrift.gmwm.analysis", "fogdrift.evaluation.gmwm_vs_allan")),
-    "fogdrift.pipeline.config": ("model modules load on use, through the registry (test_model_registry)",
-                                 ("fogdrift.models.grey",)),
     "fogdrift.io.load": ("optional readers: the reader registry imports a reader module on first use", (
         "fogdrift.io.registry",)),
     "fogdrift.report": ("the HTML report (report.html: the evaluation verdicts, the model registry, the sections) "

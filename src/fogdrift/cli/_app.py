@@ -51,6 +51,7 @@ from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
 from ..io import load, load_segments
 from ..io import load as _io_load
 from ..io.registry import cli_options, reader_by_name, select_reader
+from ..models.settings import MODEL_SETTINGS
 from .. import output as _output
 from ..output import OutputDir, active
 from ..plausibility import check_record
@@ -77,12 +78,11 @@ FLAGS = {
     "wavelet": "--wavelet", "mode": "--mode", "terms": "--terms", "fit_taus": "--fit-taus",
     "tau_range_s": "--fit-taus", "taus": "--taus", "estimator": "--estimator", "statistic": "--statistic",
     "models": "--models", "latitude_deg": "--latitude", "earth_axes": "--earth-axis", "outliers": "--outliers",
-    "lags": "--lags", "hidden": "--hidden", "epochs": "--epochs", "training": "--training", "seed": "--seed", "model_params": "--param",
+    "model_params": "--param",
     "apply_unit": "--apply-unit", "axis_map": "--axis-map", "accept_rate": "--accept-rate", "bias": "--bias",
     "model": "--model", "chunk_samples": "--chunk", "out": "--out", "pdf": "--pdf",
     "method": "--method", "noise_method": "--noise-method", "scales": "--scales", "levels": "--scales",
-    "curve": "--curve", "sensor": "--sensor", "robust": "--robust", "train_fraction": "--train-fraction",
-    "val_fraction": "--val-fraction", "causal_window_s": "--causal-window", "gm_window": "--gm-window",
+    "curve": "--curve", "sensor": "--sensor", "robust": "--robust",
     "fit_tau_s": "--fit-taus", "format": "--format", "horizons": "--horizons", "calibration": "--calibration",
     "origin_step": "--origin-step", "spec": "--spec", "segments": "--segments",
     "target": "--target", "length": "--length", "monte_carlo": "--monte-carlo", "workers": "--workers", "axis": "--axis",
@@ -96,6 +96,7 @@ FLAGS = {
 _LOAD_KEYWORDS = frozenset(inspect.signature(_io_load).parameters)
 READER_FLAGS = tuple(sorted(cli_options(), key=lambda o: str(o) not in _LOAD_KEYWORDS))
 FLAGS.update({str(o): o.flag for o in READER_FLAGS})
+FLAGS.update({s.name: s.flag for s in MODEL_SETTINGS})  # the modelling stage's settings: their flags declared once
 
 
 def _version(value: bool):

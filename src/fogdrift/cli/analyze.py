@@ -17,14 +17,15 @@ from ._app import (gyro_only, EstOpt, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, Mo
 from ._screen import print_screen
 from ._spec import SpecOpt, print_judgements, read_spec_option
 from ._tables import metrics_table, noise_table
-from .model import (ALL_MODELS, EpochsOpt, HiddenOpt, LagsOpt, ModelsOpt, ParamOpt, SeedOpt, TrainingOpt,
-                    model_axes_text)
+from ._settings import with_settings
+from .model import ALL_MODELS, NETWORK_SETTINGS, ModelsOpt, ParamOpt, model_axes_text
 
 DEFAULT_OUT = Path("out/analyze")
 
 
 @app.command()
 @with_load_options
+@with_settings(*NETWORK_SETTINGS, "train_fraction", "val_fraction", "causal_window_s", "gm_window")
 def analyze(
     load,
     latitude: Annotated[Optional[float], typer.Option("--latitude", help="Latitude [deg] for Earth-rate removal.")]
@@ -40,11 +41,7 @@ def analyze(
         "--apply-time-unit", help="Time unit of the --apply-to recording (default: --time-unit, or its header's).")]
     = None,
     models: ModelsOpt = ALL_MODELS,
-    hidden: HiddenOpt = 16,
-    lags: LagsOpt = 4,
-    epochs: EpochsOpt = 2000,
-    seed: SeedOpt = 0,
-    training: TrainingOpt = "bptt",
+    settings: dict = None,
     param: ParamOpt = None,
     wavelet: WaveletOpt = "db2",
     level: LevelOpt = "4",
@@ -57,12 +54,6 @@ def analyze(
     outliers: OutliersOpt = "warn",
     segments: SegmentsOpt = "auto",
     fit_taus: FitTausOpt = ":",
-    train_fraction: Annotated[float, typer.Option("--train-fraction", help="Chronological training share.")] = 0.6,
-    val_fraction: Annotated[float, typer.Option("--val-fraction", help="Validation share (early stopping).")] = 0.2,
-    causal_window: Annotated[float, typer.Option(
-        "--causal-window", help="Window [s] of the causal (real-time) drift of the practical compensation.")] = 128.0,
-    gm_window: Annotated[int, typer.Option("--gm-window", help="Rolling window [samples] of the one-step GM(1,1).")]
-    = 8,
     heading: Annotated[bool, typer.Option(
         "--heading/--no-heading", help="Heading-error evaluation (rolling calibrations: --calibration, "
                                        "--origin-step, --horizons; free-run forecasts) and filtering-artefact check of every model on the test block: "
@@ -111,13 +102,11 @@ def analyze(
                 raise ConfigError(f"--earth-axis must look like AXIS=ORIENTATION (e.g. gz=up), got {item!r}")
             earth[name.strip()] = orient.strip()
         term_list = parse_terms(terms)
-        cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
-                             training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
-                             model_rate_hz=model_rate or None, taus=parse_taus(taus), estimator=estimator,
+        cfg = AnalysisConfig(models=tuple(csv_list(models)), **settings, wavelet=wavelet, level=parse_level(level),
+                             mode=mode, model_rate_hz=model_rate or None, taus=parse_taus(taus), estimator=estimator,
                              terms=term_list, statistic=statistic, outliers=outliers, latitude_deg=latitude,
-                             earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), train_fraction=train_fraction,
-                             val_fraction=val_fraction, causal_window_s=causal_window, gm_window=gm_window,
-                             noise_method=noise_method, model_params=parse_model_params(param)).validate()
+                             earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), noise_method=noise_method,
+                             model_params=parse_model_params(param)).validate()
         hs = parse_heading_options(calibration, origin_step, horizons)
         if apply_to is not None and not apply_to.is_file():
             raise ConfigError(f"--apply-to {apply_to}: no such file")

@@ -10,6 +10,7 @@ import typer
 from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app,
                    check_plausible, console, csv_list, echo_record, parse_level, progress, run, say,
                    with_load_options)
+from ._settings import with_settings
 from ._tables import metrics_table
 
 from ..models import MODEL_NAMES, describe_models
@@ -20,11 +21,6 @@ ALL_MODELS = ",".join(MODEL_NAMES)
 DEFAULT_OUT = Path("out/model")
 ModelsOpt = Annotated[str, typer.Option(
     "--models", help="Comma-separated drift models (any case): " + "; ".join(describe_models().splitlines()) + ".")]
-HiddenOpt = Annotated[int, typer.Option("--hidden", help="Elman hidden units.")]
-LagsOpt = Annotated[int, typer.Option("--lags", help="Input lags p of Elman/grey-Elman, order of AR.")]
-EpochsOpt = Annotated[int, typer.Option("--epochs", help="Maximum training epochs (early stopping on validation).")]
-SeedOpt = Annotated[int, typer.Option("--seed", help="Random seed.")]
-TrainingOpt = Annotated[str, typer.Option("--training", help="bptt (Adam) or bp (classic traingdx).")]
 ParamOpt = Annotated[Optional[list[str]], typer.Option(
     "--param", help="A drift model's hyper-parameter, MODEL.NAME=VALUE, repeatable (default: the model's own): "
     + describe_params() + ".")]
@@ -44,16 +40,17 @@ def model_axes_text(model_axes, record) -> str:
             f"training-block mean of each axis: {', '.join(parts)}")
 
 
+#: The modelling stage's settings (fogdrift.models.settings) that `model` and `analyze` offer as options.
+NETWORK_SETTINGS = ("hidden", "lags", "epochs", "seed", "training")
+
+
 @app.command()
 @with_load_options
+@with_settings(*NETWORK_SETTINGS)
 def model(
     load,
     models: ModelsOpt = ALL_MODELS,
-    hidden: HiddenOpt = 16,
-    lags: LagsOpt = 4,
-    epochs: EpochsOpt = 2000,
-    seed: SeedOpt = 0,
-    training: TrainingOpt = "bptt",
+    settings: dict = None,
     param: ParamOpt = None,
     wavelet: WaveletOpt = "db2",
     level: LevelOpt = "4",
@@ -70,9 +67,9 @@ def model(
 
     with run("model", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
              expect=("metrics.json",)) as r:
-        cfg = AnalysisConfig(models=tuple(csv_list(models)), hidden=hidden, lags=lags, epochs=epochs, seed=seed,
-                             training=training, wavelet=wavelet, level=parse_level(level), mode=mode,
-                             model_rate_hz=model_rate or None, model_params=parse_model_params(param)).validate()
+        cfg = AnalysisConfig(models=tuple(csv_list(models)), **settings, wavelet=wavelet, level=parse_level(level),
+                             mode=mode, model_rate_hz=model_rate or None,
+                             model_params=parse_model_params(param)).validate()
         record = load.load()
         gyro_only(record, "model")
         echo_record(load, record)

@@ -28,6 +28,7 @@ import numpy as np
 from .._util import check_series
 from ..errors import ConfigError, DataFormatError, FogdriftWarning, InsufficientDataError
 from ._grey_batch import _expm1_over, _gm11_next_batch
+from .settings import GM11_MIN_LENGTH
 from .base import DriftModel
 
 __all__ = [
@@ -45,8 +46,6 @@ __all__ = [
     "GM11",
 ]
 
-#: Smallest series GM(1,1) is fitted to: n = 4 gives 3 equations for the 2 unknowns (a, b).
-GM11_MIN_LENGTH = 4
 
 
 # ----------------------------------------------------------------------------------------------

@@ -15,6 +15,7 @@ from ..io.readers.limits import ENV_MEMORY, format_bytes, memory_budget
 from ..lifting import MODES, get_wavelet
 from ..models import MODEL_NAMES, check_model_params, model_spec
 from ..models.registry import RECURRENT_WEIGHT_COPIES, recurrent_memory_need
+from ..models.settings import MODEL_SETTINGS, setting
 from ..noise.terms import TERM_TABLE
 from ..outliers import OUTLIER_ACTIONS
 from ..units import check_rate_hz, earth_rate_projection_dph
@@ -71,25 +72,31 @@ class AnalysisConfig:
         ``{model: {parameter: value}}``: the hyper-parameters a model row declares settable
         (:func:`fogdrift.models.declared_params`; CLI ``--param MODEL.NAME=VALUE``), each checked by the model's
         own rule; empty (default): the constructors' defaults.
+
+    Notes
+    -----
+    The settings of the modelling stage (``hidden``, ``lags``, ``epochs``, ``seed``, ``training``,
+    ``train_fraction``, ``val_fraction``, ``causal_window_s``, ``gm_window``) take their default and rule from one
+    declaration each, :data:`fogdrift.models.settings.MODEL_SETTINGS`, which also makes their CLI options.
     """
 
     model_rate_hz: float | None = 1.0
     wavelet: str = "db2"
     level: int | str = 4
     mode: str = "symmetric"
-    train_fraction: float = 0.6
-    val_fraction: float = 0.2
+    train_fraction: float = setting("train_fraction").default
+    val_fraction: float = setting("val_fraction").default
     latitude_deg: float | None = None
     earth_axes: dict = field(default_factory=dict)
     models: tuple = MODEL_NAMES
-    lags: int = 4
-    hidden: int = 16
-    epochs: int = 2000
-    seed: int = 0
+    lags: int = setting("lags").default
+    hidden: int = setting("hidden").default
+    epochs: int = setting("epochs").default
+    seed: int = setting("seed").default
     activation: str = "tanh"
-    training: str = "bptt"
-    gm_window: int = 8
-    causal_window_s: float = 128.0
+    training: str = setting("training").default
+    gm_window: int = setting("gm_window").default
+    causal_window_s: float = setting("causal_window_s").default
     taus: str = "octave"
     estimator: str = "overlapping"
     statistic: str = "adev"
@@ -116,12 +123,8 @@ class AnalysisConfig:
         ConfigError
             The first invalid setting, named as ``{opt:NAME}``, with the rule and the value.
         """
-        if not (_finite_number(self.train_fraction) and _finite_number(self.val_fraction)) \
-                or not 0 < self.train_fraction < 1 or not 0 <= self.val_fraction < 1:
-            raise ConfigError(
-                f"the training share ({{opt:train_fraction}}) must be in (0, 1) and the validation share "
-                f"({{opt:val_fraction}}) in [0, 1); got {self.train_fraction}, {self.val_fraction}"
-            )
+        for s in MODEL_SETTINGS:  # each setting's own rule, from its one declaration
+            s.rule.check(s.name, getattr(self, s.name))
         if self.train_fraction + self.val_fraction >= 1:
             raise ConfigError(
                 f"the training and validation shares ({{opt:train_fraction}} + {{opt:val_fraction}}) must leave a "
@@ -144,14 +147,6 @@ class AnalysisConfig:
             raise ConfigError(f"the modelling rate ({{opt:model_rate_hz}}) must be > 0 Hz; got {self.model_rate_hz!r}")
         if self.model_rate_hz is not None:
             check_rate_hz(self.model_rate_hz, "the modelling rate ({opt:model_rate_hz})")
-        for key in ("lags", "hidden", "epochs", "gm_window", "seed"):
-            value = getattr(self, key)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-                raise ConfigError(f"{{opt:{key}}} must be an integer; got {value!r}")
-        if self.lags < 1 or self.hidden < 1 or self.epochs < 1:
-            raise ConfigError(f"{{opt:lags}}, {{opt:hidden}} and {{opt:epochs}} must be >= 1; got {self.lags}, "
-                              f"{self.hidden}, {self.epochs}")
-
         if any(("hidden", "hidden") in model_spec(m).settings for m in self.models):
             need, budget = recurrent_memory_need(self.hidden, self.lags), memory_budget()
             if budget is not None and need > budget:
@@ -160,14 +155,6 @@ class AnalysisConfig:
                                   f"x {RECURRENT_WEIGHT_COPIES} copies); expected at most the memory budget "
                                   f"{format_bytes(budget)} ({ENV_MEMORY}); choose a smaller {{opt:hidden}}")
 
-        from ..models.grey import GM11_MIN_LENGTH  # model modules load on use (the registry's rule)
-
-        if self.gm_window < GM11_MIN_LENGTH:
-            raise ConfigError(f"{{opt:gm_window}} must be an integer >= {GM11_MIN_LENGTH} samples; got {self.gm_window!r}")
-        if self.seed < 0:
-            raise ConfigError(f"{{opt:seed}} must be an integer >= 0; got {self.seed!r}")
-        if not _finite_number(self.causal_window_s) or not self.causal_window_s > 0:
-            raise ConfigError(f"the causal window ({{opt:causal_window_s}}) must be > 0 s; got {self.causal_window_s!r}")
         if self.latitude_deg is not None and not (_finite_number(self.latitude_deg)
                                                   and -90.0 <= float(self.latitude_deg) <= 90.0):
             raise ConfigError(f"latitude must be in [-90, 90] deg; got {self.latitude_deg!r} (option {{opt:latitude_deg}})")
@@ -223,8 +210,8 @@ def check_options(*, wavelet=None, mode=None, training=None, estimator=None, ter
     if mode is not None:
         if mode not in MODES:
             raise ConfigError(f"{{opt:mode}} must be one of {list(MODES)}; got {mode!r}")
-    if training is not None and training not in ("bptt", "bp"):
-        raise ConfigError(f"{{opt:training}} must be 'bptt' or 'bp'; got {training!r}")
+    if training is not None:
+        setting("training").rule.check("training", training)
     if estimator is not None:
         if estimator not in ESTIMATORS:
             raise ConfigError(f"{{opt:estimator}} must be one of {list(ESTIMATORS)}; got {estimator!r}")
