@@ -292,8 +292,8 @@ def test_allan_json_of_an_accelerometer_names_m_s2_everywhere(tmp_path):
     head = (tmp_path / "allan.csv").read_text().splitlines()[0].split(",")
     curve = doc["axes"][0]["allan"]
     assert set(head[1:]) <= set(curve)                                  # the JSON's keys are the CSV's columns
-    np.testing.assert_array_equal(curve["adev_mps2"], axes[0].allan.dev_dph)
-    np.testing.assert_array_equal(curve["avar_m2ps4"], axes[0].allan.var_dph2)
+    np.testing.assert_array_equal(curve["adev_mps2"], axes[0].allan.dev)
+    np.testing.assert_array_equal(curve["avar_m2ps4"], axes[0].allan.var)
     gyro = from_array(y, dt_s=dt, unit="deg/h", axis_names=["gx", "gy"])     # a gyro's keys stay deg/h
     write_allan_outputs(run_allan(gyro, AnalysisConfig().validate()), gyro, tmp_path)
     g = json.loads((tmp_path / "allan.json").read_text())

@@ -45,7 +45,7 @@ def test_decade_grid_ends_at_the_statistics_own_limit_when_it_is_a_1_2_5_value(s
     assert tau_grid(n, 1.0, "decade", max_fraction=0.5, statistic=statistic).tolist() == [1, 2, 5, 10, 20, 50]
     x = np.random.default_rng(0).normal(0.0, 1.0, n)
     res = allan_variance(x, 0.5, taus="decade", max_fraction=0.5, statistic=statistic)
-    assert res.tau_s[-1] == pytest.approx(25.0) and np.isfinite(res.dev_dph[-1])
+    assert res.tau_s[-1] == pytest.approx(25.0) and np.isfinite(res.dev[-1])
 
 
 # ---------------------------------------------------------------------------------------------------------------

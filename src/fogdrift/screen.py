@@ -731,5 +731,5 @@ def dynamic_adev(rate, dt_s, window_s, step_s, taus):
     starts = np.arange(0, y.size - w + 1, st)
     out = np.empty((starts.size, m.size))
     for i, a in enumerate(starts):
-        out[i] = allan_variance(y[a:a + w], dt, taus=m * dt).dev_dph
+        out[i] = allan_variance(y[a:a + w], dt, taus=m * dt).dev
     return (starts + w / 2.0) * dt, (m * dt).astype(np.float64), out

@@ -90,7 +90,7 @@ def _nbs14_1000() -> np.ndarray:
 def test_nbs14_10_point_hadamard_and_modified(statistic, estimator, expected):
     r = allan_variance(NBS14_FREQ, 1.0, taus=[1, 2], statistic=statistic, estimator=estimator)
     assert r.statistic == statistic
-    assert_allclose(r.dev_dph, expected, rtol=1e-6)
+    assert_allclose(r.dev, expected, rtol=1e-6)
 
 
 @pytest.mark.parametrize(
@@ -105,7 +105,7 @@ def test_nbs14_10_point_hadamard_and_modified(statistic, estimator, expected):
 )
 def test_nbs14_1000_point_published_values(statistic, estimator, expected):
     r = allan_variance(_nbs14_1000(), 1.0, taus=[1, 10, 100], statistic=statistic, estimator=estimator)
-    assert_allclose(r.dev_dph, expected, rtol=1e-6)
+    assert_allclose(r.dev, expected, rtol=1e-6)
 
 
 def test_r8_hadamard_and_modified_by_hand():
@@ -113,14 +113,14 @@ def test_r8_hadamard_and_modified_by_hand():
     differences of y); MVAR(1) = AVAR(1) = 2; MVAR(2) from SP 1065 eq. 14 with explicit loops."""
     y = np.array(R8)
     h = allan_variance(R8, 1.0, taus=[1], statistic="hdev")
-    assert_allclose(h.var_dph2, [71.0 / 36.0], rtol=1e-13)
+    assert_allclose(h.var, [71.0 / 36.0], rtol=1e-13)
     assert_array_equal(h.n_terms, [6])
     x = np.concatenate(([0.0], np.cumsum(y)))  # phase, 9 points
     m, n_terms, acc = 2, len(x) - 3 * 2 + 1, 0.0
     for j in range(n_terms):
         acc += sum(x[i + 2 * m] - 2 * x[i + m] + x[i] for i in range(j, j + m)) ** 2
     mod = allan_variance(R8, 1.0, taus=[1, 2], statistic="mdev")
-    assert_allclose(mod.var_dph2, [2.0, acc / (2 * m**2 * m**2 * n_terms)], rtol=1e-13)
+    assert_allclose(mod.var, [2.0, acc / (2 * m**2 * m**2 * n_terms)], rtol=1e-13)
     assert_array_equal(mod.n_terms, [7, n_terms])  # N + 2 - 3m
 
 
@@ -150,7 +150,7 @@ def test_family_ramp_and_constant(statistic):
     y = 0.5 * np.arange(300.0) + 7.0
     r = allan_variance(y, 1.0, taus=[1.0, 4.0, 16.0], statistic=statistic)
     expected = [0.0, 0.0, 0.0] if statistic == "hdev" else [0.125, 2.0, 32.0]
-    assert_allclose(r.var_dph2, expected, rtol=1e-12, atol=1e-11)
+    assert_allclose(r.var, expected, rtol=1e-12, atol=1e-11)
 
 
 # --- allantools agreement ---------------------------------------------------------------
@@ -189,7 +189,7 @@ def test_hadamard_and_modified_match_allantools(n, grid):
         keep = np.isin(np.rint(r.tau_s * 100), np.rint(np.asarray(taus) * 100))  # allantools drops m >= N/2 etc.
         assert keep.sum() >= min(len(r), 3)
         assert_allclose(taus, r.tau_s[keep], rtol=1e-12)
-        assert_allclose(r.dev_dph[keep], dev, rtol=1e-9)
+        assert_allclose(r.dev[keep], dev, rtol=1e-9)
         assert_array_equal(r.n_terms[keep], ns)
 
 
@@ -199,11 +199,11 @@ def test_family_large_offset_does_not_cancel(statistic):
     noise = rng.normal(size=1_000_000)
     a = allan_variance(noise, 0.01, taus=40, statistic=statistic)
     b = allan_variance(noise + 1.0e4, 0.01, taus=40, statistic=statistic)
-    assert_allclose(b.var_dph2, a.var_dph2, rtol=1e-9)
+    assert_allclose(b.var, a.var, rtol=1e-9)
     # white rate noise: HVAR = 1/m; MVAR = (1 + 1/m^2)/(2m) (noise_terms laws)
     m = a.m[:5].astype(float)
     law = 1.0 / m if statistic == "hdev" else (1.0 + 1.0 / m**2) / (2.0 * m)
-    assert_allclose(a.var_dph2[:5] / law, 1.0, rtol=0.03)
+    assert_allclose(a.var[:5] / law, 1.0, rtol=0.03)
 
 
 def test_large_offset_does_not_cancel():
@@ -371,13 +371,13 @@ def test_result_names_per_statistic(tmp_path):
     y = np.random.default_rng(8).normal(size=2000)
     a = allan_variance(y, 0.5, taus=[0.5, 1.0])
     assert a.statistic == "adev"
-    assert a.avar_dph2 is a.var_dph2 and a.adev_dph is a.dev_dph and a.adev_hi95_dph is a.dev_hi95_dph
+    assert a.avar_dph2 is a.var and a.adev_dph is a.dev and a.adev_hi95_dph is a.dev_hi95
     h = allan_variance(y, 0.5, taus=[0.5, 1.0], statistic="hdev")
     with pytest.raises(AttributeError, match="Hadamard"):
         _ = h.adev_dph
     d = json.loads(json.dumps(h.to_dict()))
     assert d["statistic"] == "hdev" and "hdev_dph" in d and "hvar_dph2" in d and "adev_dph" not in d
-    assert_allclose(d["hdev_lo95_dph"], h.dev_lo95_dph, rtol=1e-15)
+    assert_allclose(d["hdev_lo95_dph"], h.dev_lo95, rtol=1e-15)
     path = tmp_path / "hdev.csv"
     h.to_csv(path)
     text = path.read_text().splitlines()

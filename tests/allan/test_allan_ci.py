@@ -85,7 +85,7 @@ def test_non_overlapping_terms_and_edf(n, m, alpha):
     assert K == n // m
     diffs = [means[j + 1] - means[j] for j in range(K - 1)]
     assert r.n_terms[0] == len(diffs) == K - 1
-    assert r.var_dph2[0] == pytest.approx(np.sum(np.square(diffs)) / (2 * len(diffs)), rel=1e-10)
+    assert r.var[0] == pytest.approx(np.sum(np.square(diffs)) / (2 * len(diffs)), rel=1e-10)
     assert r.edf[0] == pytest.approx(min(max(table5(K + 1, 1, alpha), 1.0), K - 1), rel=1e-12)
 
 
@@ -95,7 +95,7 @@ def test_hadamard_non_overlapping_terms_by_hand():
     K = 1000 // 7
     assert r.n_terms[0] == K - 2  # second differences of K cluster means
     means = y[: K * 7].reshape(K, 7).mean(axis=1)
-    assert r.var_dph2[0] == pytest.approx(np.sum(np.diff(means, 2) ** 2) / (6 * (K - 2)), rel=1e-10)
+    assert r.var[0] == pytest.approx(np.sum(np.diff(means, 2) ** 2) / (6 * (K - 2)), rel=1e-10)
 
 
 # --- Greenhall & Riley -------------------------------------------------------------------
@@ -231,7 +231,7 @@ def test_family_95_bounds_cover_truth_for_white_noise(statistic):
     hits = 0
     for seed in range(40):
         r = allan_variance(np.random.default_rng(seed).normal(size=4096), 1.0, taus=[m], statistic=statistic)
-        hits += r.dev_lo95_dph[0] <= truth <= r.dev_hi95_dph[0]
+        hits += r.dev_lo95[0] <= truth <= r.dev_hi95[0]
     assert hits >= 34
 
 

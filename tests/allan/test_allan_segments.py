@@ -73,7 +73,7 @@ def test_edf_is_the_sum_of_the_used_segments_edfs():
     split = allan_variance_segments(y, 1.0, [(0, 1000), (1000, 1100)], taus=[4], noise_alpha=0)
     assert split.n_terms[0] == whole.n_terms[0] - 7  # the 2m - 1 terms across the cut
     assert split.edf[0] < whole.edf[0]
-    assert np.all(r.dev_lo95_dph < r.dev_dph) and np.all(r.dev_dph < r.dev_hi95_dph)
+    assert np.all(r.dev_lo95 < r.dev) and np.all(r.dev < r.dev_hi95)
 
 
 def test_bad_segments_are_refused():

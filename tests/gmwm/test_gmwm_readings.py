@@ -237,7 +237,7 @@ def test_allan_table_from_fogdrift_allan_equals_the_log(tmp_path):
     av = allan_variance(x, dt, taus=taus, max_fraction=0.5)
     np.testing.assert_allclose(av.tau_s, taus, rtol=1e-12)
     path = _write(tmp_path / "avar.csv", ["tau_s", "avar", "n_samples", "sample_rate_hz", "unit"],
-                  [[repr(float(t)), repr(float(v)), n, 100, "deg/h"] for t, v in zip(av.tau_s, av.var_dph2)])
+                  [[repr(float(t)), repr(float(v)), n, 100, "deg/h"] for t, v in zip(av.tau_s, av.var)])
     table = read_curve_table(path)
     assert table.kind == "Allan variance" and table.unit == "deg/h"
     (wv_tab,) = table.wvars

@@ -118,9 +118,9 @@ def _curve(var, tau_s, edf=1e5, statistic="adev", dt_s=None):
     dev = np.sqrt(var)
     e = np.broadcast_to(np.asarray(edf, float), tau_s.shape).copy()
     return AllanResult(
-        tau_s=tau_s, m=np.arange(1, tau_s.size + 1), var_dph2=np.asarray(var, float), dev_dph=dev,
-        n_terms=np.full(tau_s.size, 10**6), edf=e, dev_lo68_dph=dev, dev_hi68_dph=dev,
-        dev_lo95_dph=dev, dev_hi95_dph=dev, noise_alpha=np.zeros(tau_s.size, int),
+        tau_s=tau_s, m=np.arange(1, tau_s.size + 1), var=np.asarray(var, float), dev=dev,
+        n_terms=np.full(tau_s.size, 10**6), edf=e, dev_lo68=dev, dev_hi68=dev,
+        dev_lo95=dev, dev_hi95=dev, noise_alpha=np.zeros(tau_s.size, int),
         estimator="overlapping", edf_rule="test", dt_s=float(tau_s[0]) if dt_s is None else dt_s,
         n_samples=10**13, statistic=statistic,  # noise-free: a record long enough for EDFs of ~1e6 at every tau
     )
@@ -310,11 +310,11 @@ def test_statistic_dispatch():
     d = json.loads(json.dumps(fit.to_dict()))
     assert d["statistic"] == "hdev" and d["dt_s"] == 0.1
     # dispatch is on the statistic field, not on the class
-    duck = SimpleNamespace(statistic="hdev", tau_s=h.tau_s, var_dph2=h.var_dph2, dev_dph=h.dev_dph,
-                           dev_hi95_dph=h.dev_hi95_dph, m=h.m, n_samples=h.n_samples, dt_s=h.dt_s)
+    duck = SimpleNamespace(statistic="hdev", tau_s=h.tau_s, var=h.var, dev=h.dev,
+                           dev_hi95=h.dev_hi95, m=h.m, n_samples=h.n_samples, dt_s=h.dt_s)
     assert fit_noise(duck).terms["N"].value == fit.terms["N"].value
     with pytest.raises(ConfigError, match="statistic"):
-        fit_noise(SimpleNamespace(statistic="tdev", tau_s=h.tau_s, var_dph2=h.var_dph2, dev_hi95_dph=h.dev_hi95_dph,
+        fit_noise(SimpleNamespace(statistic="tdev", tau_s=h.tau_s, var=h.var, dev_hi95=h.dev_hi95,
                                   m=h.m, n_samples=h.n_samples, dt_s=0.1))
 
 

@@ -30,8 +30,8 @@ def _shaped(allan, amp=0.02):
     tau = np.asarray(allan.tau_s, dtype=np.float64)
     g = (1.0 + amp * np.sin(np.pi * np.log2(tau / tau[0]) / 3.0)) ** 2
     return SimpleNamespace(statistic="adev", tau_s=tau, m=np.asarray(allan.m), n_terms=np.asarray(allan.n_terms),
-                           estimator="overlapping", var_dph2=np.asarray(allan.var_dph2) * g,
-                           dev_hi95_dph=np.asarray(allan.dev_hi95_dph) * np.sqrt(g), n_samples=allan.n_samples,
+                           estimator="overlapping", var=np.asarray(allan.var) * g,
+                           dev_hi95=np.asarray(allan.dev_hi95) * np.sqrt(g), n_samples=allan.n_samples,
                            dt_s=allan.dt_s)
 
 
@@ -106,10 +106,10 @@ def _bumped(n_true=N_TRUE, seed=0):
     a = allan_variance(x, DT)
     tau = np.asarray(a.tau_s)
     bump = 40.0 * (n_true * 60.0) ** 2 / 1.0 * np.exp(-0.5 * (np.log2(tau / 1.0) / 0.6) ** 2)
-    var = np.asarray(a.var_dph2) + bump
+    var = np.asarray(a.var) + bump
     edf = np.array([edf_simple(a.n_samples + 1, int(m), 0) for m in a.m])
     return SimpleNamespace(statistic="adev", tau_s=tau, m=np.asarray(a.m), n_terms=np.asarray(a.n_terms),
-                           estimator="overlapping", var_dph2=var, dev_hi95_dph=np.sqrt(var * edf / chi2.ppf(0.025, edf)),
+                           estimator="overlapping", var=var, dev_hi95=np.sqrt(var * edf / chi2.ppf(0.025, edf)),
                            n_samples=a.n_samples, dt_s=a.dt_s)
 
 

@@ -122,7 +122,7 @@ def test_laws_on_simulated_signals(stat, term):
     for seed in range(seeds):
         r = allan_variance(simulate(n, dt, seed=seed, **{kw: value}), dt, statistic=stat, noise_alpha=alpha)
         keep = (r.m <= n // 1024) & (r.m >= (8 if term == "B" else 1))
-        ratios.append(r.var_dph2[keep] / (X**2 * law.scale(dt) * law.shape(r.tau_s[keep], dt)))
+        ratios.append(r.var[keep] / (X**2 * law.scale(dt) * law.shape(r.tau_s[keep], dt)))
         edfs.append(r.edf[keep])
     mean = np.mean(ratios, axis=0)
     tol = 5.0 * np.sqrt(2.0 / (np.mean(edfs, axis=0) * seeds)) + (0.01 if term == "B" else 0.0)

@@ -64,8 +64,8 @@ def test_markov_law_on_a_long_simulated_series():
     x = _gm(2**20, dt, tc, sigma, seed=1)
     r = allan_variance(x, dt, taus=[1.0, 5.0, 20.0, 40.0, 80.0, 320.0])
     law = 2 * sigma**2 * tc * markov_shape(r.tau_s, tc)  # A = (q_c T_c)^2 = 2 sigma^2 T_c
-    lo, hi = r.dev_lo95_dph**2, r.dev_hi95_dph**2
-    assert np.sum((law >= lo) & (law <= hi)) >= 5, (r.var_dph2 / law)
+    lo, hi = r.dev_lo95**2, r.dev_hi95**2
+    assert np.sum((law >= lo) & (law <= hi)) >= 5, (r.var / law)
 
 
 def _fit(seed, n=2**15, dt=0.2, tc=50.0, sigma=2.0, arw=0.05):

@@ -40,7 +40,7 @@ def test_sinusoid_law_equals_the_estimator_on_a_noiseless_sinusoid(statistic, fr
     r = allan_variance(y, dt, taus=taus, statistic=statistic)
     law = amp**2 * sinusoid_shape(r.tau_s, freq_hz, dt, statistic)
     # the estimator averages sin^2 over a finite record: exact to ~1/(number of cycles)
-    np.testing.assert_allclose(r.var_dph2, law, rtol=2e-3)
+    np.testing.assert_allclose(r.var, law, rtol=2e-3)
 
 
 def test_sinusoid_law_vanishes_at_whole_periods_and_matches_allantools():

@@ -20,7 +20,7 @@ Examples
 >>> from fogdrift.allan import allan_variance
 >>> y = np.random.default_rng(0).normal(size=4096)          # white rate noise, 1 (deg/h)^2
 >>> r = allan_variance(y, 1.0, statistic="mdev", taus=[1, 64])
->>> r.statistic, r.column_names()[3], round(float(r.var_dph2[1] * 64 * 2), 1)   # MVAR ~ 1/(2 m)
+>>> r.statistic, r.column_names()[3], round(float(r.var[1] * 64 * 2), 1)   # MVAR ~ 1/(2 m)
 ('mdev', 'mdev_dph', 1.0)
 """
 

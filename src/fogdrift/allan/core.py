@@ -121,8 +121,8 @@ def allan_variance(
     Returns
     -------
     AllanResult
-        With ``statistic`` set; ``var_dph2``/``dev_dph`` hold the statistic (for ``"adev"``
-        also readable as ``avar_dph2``/``adev_dph``).
+        With ``statistic`` set; ``var``/``dev`` hold the statistic (for ``"adev"``
+        also readable as ``avar_dph2``/``adev_dph``), in the series' unit.
 
     Raises
     ------
@@ -172,7 +172,7 @@ def allan_variance(
     >>> [round(float(v), 10) for v in r.avar_dph2]
     [2.0, 0.7, 1.2777777778]
     >>> h = allan_variance([1, 3, 2, 5, 4, 4, 6, 3], 1.0, taus=[1, 2], statistic="hdev")
-    >>> h.statistic, [round(float(v), 10) for v in h.var_dph2]
+    >>> h.statistic, [round(float(v), 10) for v in h.var]
     ('hdev', [1.9722222222, 0.1805555556])
     """
     stat = get_statistic(statistic)
@@ -306,14 +306,14 @@ def result_from_sums(sums, n, m, strides, dt_s, *, statistic, estimator, noise_a
     return AllanResult(
         tau_s=tau_s.astype(np.float64),
         m=m.astype(np.int64),
-        var_dph2=var,
-        dev_dph=np.sqrt(var),
+        var=var,
+        dev=np.sqrt(var),
         n_terms=n_terms.astype(np.int64),
         edf=edf,
-        dev_lo68_dph=np.sqrt(lo68),
-        dev_hi68_dph=np.sqrt(hi68),
-        dev_lo95_dph=np.sqrt(lo95),
-        dev_hi95_dph=np.sqrt(hi95),
+        dev_lo68=np.sqrt(lo68),
+        dev_hi68=np.sqrt(hi68),
+        dev_lo95=np.sqrt(lo95),
+        dev_hi95=np.sqrt(hi95),
         noise_alpha=np.asarray(alphas, dtype=np.int64),
         estimator=estimator,
         edf_rule=base + "; " + rule,

@@ -13,21 +13,22 @@ from .statistics import get_statistic
 __all__ = ["AllanResult"]
 
 #: Array fields, in serialisation order; ``var``/``dev`` stems are replaced by the statistic's.
-_ARRAYS = ("tau_s", "m", "var_dph2", "dev_dph", "dev_lo68_dph", "dev_hi68_dph", "dev_lo95_dph",
-           "dev_hi95_dph", "n_terms", "edf", "noise_alpha")
+_ARRAYS = ("tau_s", "m", "var", "dev", "dev_lo68", "dev_hi68", "dev_lo95", "dev_hi95", "n_terms", "edf", "noise_alpha")
 
 
 @dataclass(frozen=True)
 class AllanResult:
-    """An Allan-family statistic of a rate series at a grid of cluster times.
+    """An Allan-family statistic of one series at a grid of cluster times.
 
-    All arrays have shape ``(n_tau,)``.  The fields are generic (``var_dph2``, ``dev_dph``,
-    ...) and ``statistic`` says which member of the family they hold.  For the Allan deviation
-    the historical names ``avar_dph2``, ``adev_dph``, ``adev_lo68_dph``, ``adev_hi68_dph``,
-    ``adev_lo95_dph`` and ``adev_hi95_dph`` read the same arrays; for another statistic they
-    raise AttributeError (a Hadamard deviation is not an Allan deviation).  Serialised results
-    name the columns after the statistic: ``avar_dph2``/``adev_dph``, ``hvar_dph2``/``hdev_dph``
-    or ``mvar_dph2``/``mdev_dph`` (and ``<dev>_lo68_dph`` etc.).
+    All arrays have shape ``(n_tau,)``, in the unit of the series (its channel's internal unit: deg/h for a gyro,
+    m/s^2 for an accelerometer, :data:`fogdrift.units.INTERNAL_UNITS`; the variance in its square).  The fields are
+    generic (``var``, ``dev``, ...) and ``statistic`` says which member of the family they hold.  For a gyro's
+    Allan deviation the names ``avar_dph2``, ``adev_dph``, ``adev_lo68_dph``, ``adev_hi68_dph``, ``adev_lo95_dph``
+    and ``adev_hi95_dph`` read the same arrays; for another statistic they raise AttributeError (a Hadamard
+    deviation is not an Allan deviation).  Serialised results name the columns after the statistic and the
+    quantity's unit (:meth:`column_names`): ``avar_dph2``/``adev_dph``, ``hvar_dph2``/``hdev_dph`` or
+    ``mvar_dph2``/``mdev_dph`` (and ``<dev>_lo68_dph`` etc.) for a gyro, ``avar_m2ps4``/``adev_mps2`` ... for an
+    accelerometer.
 
     Attributes
     ----------
@@ -35,16 +36,16 @@ class AllanResult:
         Cluster times ``m * dt_s`` in s.
     m : ndarray of int
         Cluster sizes (averaging factors).
-    var_dph2 : ndarray
-        The statistic's variance in (deg/h)^2.
-    dev_dph : ndarray
-        Its deviation (square root) in deg/h.
+    var : ndarray
+        The statistic's variance, in the square of the series' unit ((deg/h)^2, (m/s^2)^2).
+    dev : ndarray
+        Its deviation (square root), in the series' unit.
     n_terms : ndarray of int
         Number of squared differences averaged at each tau.
     edf : ndarray
         Equivalent degrees of freedom, clipped to ``[1, n_terms]`` (rule in ``edf_rule``).
-    dev_lo68_dph, dev_hi68_dph, dev_lo95_dph, dev_hi95_dph : ndarray
-        Chi-squared confidence bounds of the deviation in deg/h (68.27 % and 95 %).
+    dev_lo68, dev_hi68, dev_lo95, dev_hi95 : ndarray
+        Chi-squared confidence bounds of the deviation (68.27 % and 95 %), in the series' unit.
     noise_alpha : ndarray of int
         Power-law alpha assumed for each tau's EDF.
     estimator : str
@@ -54,7 +55,7 @@ class AllanResult:
     dt_s : float
         Sample interval in s.
     n_samples : int
-        Number of rate samples N.
+        Number of samples N.
     statistic : str
         ``"adev"`` (Allan), ``"hdev"`` (Hadamard) or ``"mdev"`` (modified Allan); see
         :data:`fogdrift.allan.STATISTICS`.
@@ -62,14 +63,14 @@ class AllanResult:
 
     tau_s: np.ndarray
     m: np.ndarray
-    var_dph2: np.ndarray
-    dev_dph: np.ndarray
+    var: np.ndarray
+    dev: np.ndarray
     n_terms: np.ndarray
     edf: np.ndarray
-    dev_lo68_dph: np.ndarray
-    dev_hi68_dph: np.ndarray
-    dev_lo95_dph: np.ndarray
-    dev_hi95_dph: np.ndarray
+    dev_lo68: np.ndarray
+    dev_hi68: np.ndarray
+    dev_lo95: np.ndarray
+    dev_hi95: np.ndarray
     noise_alpha: np.ndarray
     estimator: str
     edf_rule: str
@@ -80,7 +81,7 @@ class AllanResult:
     def __len__(self) -> int:
         return int(self.tau_s.size)
 
-    # --- historical Allan names ---------------------------------------------------------
+    # --- a gyro's Allan deviation by its usual names ---------------------------------------
     def _allan(self, field_name: str) -> np.ndarray:
         if self.statistic != "adev":
             stat = get_statistic(self.statistic)
@@ -92,33 +93,33 @@ class AllanResult:
 
     @property
     def avar_dph2(self) -> np.ndarray:
-        """Allan variance in (deg/h)^2 (``var_dph2`` of an ``"adev"`` result)."""
-        return self._allan("var_dph2")
+        """Allan variance in (deg/h)^2 (``var`` of an ``"adev"`` result)."""
+        return self._allan("var")
 
     @property
     def adev_dph(self) -> np.ndarray:
-        """Allan deviation in deg/h (``dev_dph`` of an ``"adev"`` result)."""
-        return self._allan("dev_dph")
+        """Allan deviation in deg/h (``dev`` of an ``"adev"`` result)."""
+        return self._allan("dev")
 
     @property
     def adev_lo68_dph(self) -> np.ndarray:
-        """Lower 68 % bound of the Allan deviation (``dev_lo68_dph``)."""
-        return self._allan("dev_lo68_dph")
+        """Lower 68 % bound of the Allan deviation (``dev_lo68``)."""
+        return self._allan("dev_lo68")
 
     @property
     def adev_hi68_dph(self) -> np.ndarray:
-        """Upper 68 % bound of the Allan deviation (``dev_hi68_dph``)."""
-        return self._allan("dev_hi68_dph")
+        """Upper 68 % bound of the Allan deviation (``dev_hi68``)."""
+        return self._allan("dev_hi68")
 
     @property
     def adev_lo95_dph(self) -> np.ndarray:
-        """Lower 95 % bound of the Allan deviation (``dev_lo95_dph``)."""
-        return self._allan("dev_lo95_dph")
+        """Lower 95 % bound of the Allan deviation (``dev_lo95``)."""
+        return self._allan("dev_lo95")
 
     @property
     def adev_hi95_dph(self) -> np.ndarray:
-        """Upper 95 % bound of the Allan deviation (``dev_hi95_dph``)."""
-        return self._allan("dev_hi95_dph")
+        """Upper 95 % bound of the Allan deviation (``dev_hi95``)."""
+        return self._allan("dev_hi95")
 
     # --- serialisation ------------------------------------------------------------------
     def column_names(self, quantity: str = "angular_rate") -> tuple:
@@ -143,13 +144,11 @@ class AllanResult:
             raise ValueError(f"quantity must be one of {sorted(KEY_SUFFIXES)}; got {quantity!r}") from None
 
         def name(c: str) -> str:
-            if c.startswith("var_"):
-                c = c.replace("var_", f"{stat.var_name}_", 1)
-            elif c.startswith("dev_"):
-                c = c.replace("dev_", f"{stat.dev_name}_", 1)
-            else:
-                return c
-            return c[: -len("_dph2")] + f"_{two}" if c.endswith("_dph2") else c[: -len("_dph")] + f"_{one}"
+            if c == "var":
+                return f"{stat.var_name}_{two}"
+            if c == "dev" or c.startswith("dev_"):
+                return stat.dev_name + c[len("dev"):] + f"_{one}"
+            return c
 
         return tuple(name(c) for c in _ARRAYS)
 

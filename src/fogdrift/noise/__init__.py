@@ -121,7 +121,7 @@ def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penal
     Parameters
     ----------
     allan : AllanResult or a curve object
-        Needs ``statistic``, ``tau_s`` [s], ``var_dph2`` [(deg/h)^2], ``dev_hi95_dph`` [deg/h], ``n_samples`` and
+        Needs ``statistic``, ``tau_s`` [s], ``var`` [(deg/h)^2 or (m/s^2)^2], ``dev_hi95`` [its root], ``n_samples`` and
         ``dt_s`` [s]; ``m`` (averaging factors) if present.  A published curve (taus, variances, upper 95 %
         bounds, record length) can be given the same way, or its arrays passed to :func:`identify`.
     terms : sequence of str or None, keyword-only
@@ -177,8 +177,8 @@ def fit_noise(allan, *, terms=None, tau_range_s=None, max_per_octave=1, ic_penal
         if bad or not terms or len(set(terms)) != len(terms):
             raise ConfigError(f"terms must be distinct names from {names}, got {terms!r} (option {{opt:terms}})")
         terms = tuple(t for t in names if t in terms)
-    var = np.asarray(allan.var_dph2, dtype=np.float64)
-    hi = np.asarray(allan.dev_hi95_dph, dtype=np.float64) ** 2
+    var = np.asarray(allan.var, dtype=np.float64)
+    hi = np.asarray(allan.dev_hi95, dtype=np.float64) ** 2
 
     content = periodic_content(spectrum)
     keep = None

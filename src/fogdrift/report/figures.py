@@ -318,15 +318,15 @@ def plot_allan(axes_list, path, title=None) -> Path:
         r, fit = aa.allan, aa.noise
         label = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}.get(getattr(r, "statistic", "adev"), "deviation")
         if r.tau_s.size > DENSE_TAUS:  # a band and a line: thousands of error bars hide each other (and cost ~1 ms each)
-            ax.fill_between(r.tau_s, r.dev_lo68_dph, r.dev_hi68_dph, color="0.55", alpha=0.45, lw=0,
+            ax.fill_between(r.tau_s, r.dev_lo68, r.dev_hi68, color="0.55", alpha=0.45, lw=0,
                             label="68 % CI")
-            ax.plot(r.tau_s, r.dev_dph, "-", color="k", lw=0.8, label=label)
+            ax.plot(r.tau_s, r.dev, "-", color="k", lw=0.8, label=label)
         else:
-            yerr = np.vstack([r.dev_dph - r.dev_lo68_dph, r.dev_hi68_dph - r.dev_dph])
-            ax.errorbar(r.tau_s, r.dev_dph, yerr=yerr, fmt="o", ms=4, color="k", lw=0.8, mfc="white",
+            yerr = np.vstack([r.dev - r.dev_lo68, r.dev_hi68 - r.dev])
+            ax.errorbar(r.tau_s, r.dev, yerr=yerr, fmt="o", ms=4, color="k", lw=0.8, mfc="white",
                         label=f"{label} (68 % CI)")
         used = np.isin(np.round(r.tau_s, 12), np.round(fit.fit_tau_s, 12))
-        ax.plot(r.tau_s[used], r.dev_dph[used], "o", ms=5, color="k", zorder=4, label="fitted points")
+        ax.plot(r.tau_s[used], r.dev[used], "o", ms=5, color="k", zorder=4, label="fitted points")
         for i, e in enumerate(fit.excluded):
             ax.axvspan(e["tau_min_s"] / 1.2, e["tau_max_s"] * 1.2, color="0.85", zorder=0,
                        label="left out" if i == 0 else None)
@@ -341,9 +341,9 @@ def plot_allan(axes_list, path, title=None) -> Path:
             t = fit.terms.get(name)
             if name in fit.selected and t is not None and t.value:
                 ax.loglog(tau, fit.term_dev_dph(name, tau), style, lw=1.2, label=name)
-        pos = r.dev_lo68_dph > 0
-        lo = np.nanmin(r.dev_lo68_dph[pos]) if np.any(pos) else np.nanmin(r.dev_dph)
-        ax.set_ylim(lo / 3, np.nanmax(r.dev_hi68_dph) * 3)
+        pos = r.dev_lo68 > 0
+        lo = np.nanmin(r.dev_lo68[pos]) if np.any(pos) else np.nanmin(r.dev)
+        ax.set_ylim(lo / 3, np.nanmax(r.dev_hi68) * 3)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("τ [s]")
@@ -438,8 +438,8 @@ def plot_separation_allan(sep, path) -> Path:
     fig, ax = subplots(figsize=(FIG_WIDTH_IN, 5.2))
     for (label, aa), color in zip(sep.rows, ("k", "C3", "C0")):
         r = aa.allan
-        yerr = np.vstack([r.dev_dph - r.dev_lo68_dph, r.dev_hi68_dph - r.dev_dph])
-        ax.errorbar(r.tau_s, r.dev_dph, yerr=yerr, fmt="o-", ms=4, lw=1.0, color=color, label=literal(label))
+        yerr = np.vstack([r.dev - r.dev_lo68, r.dev_hi68 - r.dev])
+        ax.errorbar(r.tau_s, r.dev, yerr=yerr, fmt="o-", ms=4, lw=1.0, color=color, label=literal(label))
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("τ [s]")

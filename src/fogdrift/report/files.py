@@ -65,10 +65,10 @@ def write_allan_outputs(allan_axes, record, out_dir) -> dict:
     for a in allan_axes:
         r = a.allan
         for i in range(r.tau_s.size):
-            rows.append([a.name, repr(float(r.tau_s[i])), int(r.m[i]), repr(float(r.dev_dph[i])),
-                         repr(float(r.var_dph2[i])), int(r.n_terms[i]), repr(float(r.edf[i])),
-                         repr(float(r.dev_lo68_dph[i])), repr(float(r.dev_hi68_dph[i])),
-                         repr(float(r.dev_lo95_dph[i])), repr(float(r.dev_hi95_dph[i]))])
+            rows.append([a.name, repr(float(r.tau_s[i])), int(r.m[i]), repr(float(r.dev[i])),
+                         repr(float(r.var[i])), int(r.n_terms[i]), repr(float(r.edf[i])),
+                         repr(float(r.dev_lo68[i])), repr(float(r.dev_hi68[i])),
+                         repr(float(r.dev_lo95[i])), repr(float(r.dev_hi95[i]))])
     quantities = set(getattr(record, "quantities", ("angular_rate",)))
     mixed = len(quantities) != 1
     if not mixed:  # the curve's unit in the column names (allan.json's keys: AllanResult.column_names)
