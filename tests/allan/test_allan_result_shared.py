@@ -105,3 +105,30 @@ def test_result_from_sums_hand_values():
     assert_allclose(r.var_dph2, [2.0], rtol=1e-15)
     assert 1.0 <= r.edf[0] <= 7 and r.dev_lo95_dph[0] < np.sqrt(2.0) < r.dev_hi95_dph[0]
     _assert_same_result(r, allan_variance([1, 3, 2, 5, 4, 4, 6, 3], 0.5, taus=[0.5], noise_alpha=0))
+
+
+def test_to_dict_and_allan_csv_rows_write_each_value_as_its_python_number():
+    """``AllanResult.to_dict`` and the rows of ``allan.csv`` convert whole columns at once: every value is the
+    Python float (int) of its element, as one ``float(v)`` (``int(v)``) per element gives it, float32 and NaN
+    included, the columns in the header's order."""
+    from types import SimpleNamespace
+
+    from fogdrift.report.files import allan_csv_rows
+
+    res = allan_variance(simulate(5000, 0.01, arw_dprh=0.1, seed=4), 0.01, taus="all")
+    hi95 = res.dev_hi95_dph.copy()
+    hi95[3] = np.nan
+    res = dataclasses.replace(res, edf=res.edf.astype(np.float32), dev_hi95_dph=hi95)
+    d = res.to_dict()
+    for name, key in zip(("tau_s", "m", "n_terms", "edf", "dev_hi95_dph"),
+                         ("tau_s", "m", "n_terms", "edf", "adev_hi95_dph")):
+        arr = getattr(res, name)
+        want = [int(v) for v in arr] if arr.dtype.kind in "iu" else [float(v) for v in arr]
+        assert [type(v) for v in d[key]] == [type(v) for v in want], name
+        assert np.array_equal(np.array(d[key]), np.array(want), equal_nan=True), name
+    rows = allan_csv_rows([SimpleNamespace(name="gx", allan=res)])
+    want = [["gx", repr(float(res.tau_s[i])), int(res.m[i]), repr(float(res.dev_dph[i])),
+             repr(float(res.var_dph2[i])), int(res.n_terms[i]), repr(float(res.edf[i])),
+             repr(float(res.dev_lo68_dph[i])), repr(float(res.dev_hi68_dph[i])), repr(float(res.dev_lo95_dph[i])),
+             repr(float(res.dev_hi95_dph[i]))] for i in range(res.tau_s.size)]
+    assert [[str(c) for c in row] for row in rows] == [[str(c) for c in row] for row in want]

@@ -159,10 +159,8 @@ class AllanResult:
         out: dict = {"statistic": self.statistic}
         for name, key in zip(_ARRAYS, self.column_names(quantity)):
             arr = np.asarray(getattr(self, name))
-            if arr.dtype.kind in "iu":
-                out[key] = [int(v) for v in arr]
-            else:
-                out[key] = [float(v) for v in arr]
+            # tolist(): the Python int / float of every element in one C loop (int(v) / float(v) one call each)
+            out[key] = arr.tolist() if arr.dtype.kind in "iu" else arr.astype(np.float64).tolist()
         out.update(
             estimator=self.estimator,
             edf_rule=self.edf_rule,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +14,7 @@ from ..output import atomic_path
 from ..units import INTERNAL_UNITS
 from .figures import _safe, plot_allan, plot_dynamic_adev, plot_models, plot_residuals, plot_separation, plot_separation_allan
 
-__all__ = ["write_json", "allan_document", "write_allan_outputs", "write_separation_outputs", "write_model_outputs"]
+__all__ = ["write_json", "allan_document", "allan_csv_rows", "write_allan_outputs", "write_separation_outputs", "write_model_outputs"]
 
 
 def write_json(obj, path, *, indent: int | None = 2, sort_keys: bool = False) -> Path:
@@ -46,8 +47,7 @@ def _write_rows_csv(path, header, rows) -> Path:
     path = Path(path)
     with atomic_path(path) as tmp, open(tmp, "w") as fh:
         fh.write(",".join(header) + "\n")
-        for row in rows:
-            fh.write(",".join(str(c) for c in row) + "\n")
+        fh.writelines([",".join(map(str, row)) + "\n" for row in rows])
     return path
 
 
@@ -57,18 +57,27 @@ def allan_document(allan_axes, record) -> dict:
     return {"source": record.source, "record": record.metadata(), "axes": [a.to_dict() for a in allan_axes]}
 
 
+def allan_csv_rows(allan_axes) -> list:
+    """The rows of ``allan.csv`` (axis, tau_s, m, dev, var, n_terms, edf, lo68, hi68, lo95, hi95), one per tau of
+    every axis (a tuple of texts): each float as ``repr`` of its Python float, each integer as its Python int's text."""
+    rows = []
+    for a in allan_axes:
+        r = a.allan
+        # column by column (one C loop each), not one numpy scalar per cell: 25 000 taus 0.15 -> 0.04 s
+        floats = [list(map(repr, np.asarray(c, dtype=np.float64).tolist())) for c in
+                  (r.tau_s, r.dev_dph, r.var_dph2, r.edf, r.dev_lo68_dph, r.dev_hi68_dph, r.dev_lo95_dph,
+                   r.dev_hi95_dph)]
+        m, n_terms = (list(map(str, np.asarray(c).astype(np.int64).tolist())) for c in (r.m, r.n_terms))
+        tau, dev, var, edf, lo68, hi68, lo95, hi95 = floats
+        rows += zip(itertools.repeat(a.name, r.tau_s.size), tau, m, dev, var, n_terms, edf, lo68, hi68, lo95, hi95)
+    return rows
+
+
 def write_allan_outputs(allan_axes, record, out_dir) -> dict:
     """``allan.json`` (:func:`allan_document`), ``allan.csv`` (curve of every axis, with units) and ``allan.png``."""
     out = Path(out_dir)
     write_json(allan_document(allan_axes, record), out / "allan.json")
-    rows = []
-    for a in allan_axes:
-        r = a.allan
-        for i in range(r.tau_s.size):
-            rows.append([a.name, repr(float(r.tau_s[i])), int(r.m[i]), repr(float(r.dev_dph[i])),
-                         repr(float(r.var_dph2[i])), int(r.n_terms[i]), repr(float(r.edf[i])),
-                         repr(float(r.dev_lo68_dph[i])), repr(float(r.dev_hi68_dph[i])),
-                         repr(float(r.dev_lo95_dph[i])), repr(float(r.dev_hi95_dph[i]))])
+    rows = allan_csv_rows(allan_axes)
     quantities = set(getattr(record, "quantities", ("angular_rate",)))
     mixed = len(quantities) != 1
     if not mixed:  # the curve's unit in the column names (allan.json's keys: AllanResult.column_names)
@@ -77,7 +86,7 @@ def write_allan_outputs(allan_axes, record, out_dir) -> dict:
         names = tuple(c.replace("_dph2", "_internal2").replace("_dph", "_internal")
                       for c in allan_axes[0].allan.column_names())
         units = {n: INTERNAL_UNITS[q] for n, q in zip(record.axis_names, record.quantities)}
-        rows = [row + [units[row[0]]] for row in rows]
+        rows = [row + (units[row[0]],) for row in rows]
     tau, m, var, dev, lo68, hi68, lo95, hi95 = names[:8]
     _write_rows_csv(out / "allan.csv", ["axis", tau, m, dev, var, "n_terms", "edf", lo68, hi68, lo95, hi95]
                     + (["unit"] if mixed else []), rows)
