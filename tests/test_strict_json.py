@@ -115,3 +115,13 @@ def test_strict_json_long_number_lists_equal_the_round_trip(indent):
         got = json.loads(strict_json(doc, indent=indent))
         assert got == _reference(doc)
         assert strict_json(doc, indent=None) == json.dumps(_reference(doc), allow_nan=False)
+
+
+def test_raw_json_is_written_as_its_text():
+    from fogdrift._util import RawJson
+
+    vals = [0.1, 2.5e-7, 3.0]
+    raw = {"a": RawJson(json.dumps(vals)), "b": [{"c": RawJson("[1, null]")}]}
+    plain = {"a": vals, "b": [{"c": [1, None]}]}
+    for indent in (None, 2):
+        assert strict_json(raw, indent=indent) == strict_json(plain, indent=indent)

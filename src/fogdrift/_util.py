@@ -200,6 +200,17 @@ def strict_json(obj, *, indent: int | None = 2, sort_keys: bool = False) -> str:
     return re.sub(f'"{re.escape(mark)}(\\d+)"', lambda m: rows[int(m.group(1))], text)
 
 
+class RawJson:
+    """A JSON value already encoded: :func:`strict_json` writes ``text`` as it is (with ``indent``, on one line, where a
+    list of numbers goes), or its decoded value without ``indent``.  The writer that made ``text`` vouches for it
+    (strict JSON, no NaN)."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: str):
+        self.text = text
+
+
 #: The element types of a list that :func:`_plain` takes as a list of plain numbers (bool is not one: ``True`` is
 #: written as ``true``).
 _PLAIN_NUMBERS = frozenset({float, int, type(None)})
@@ -221,6 +232,11 @@ def _plain(x, rows, mark):
         return f"{mark}{len(rows) - 1}"
     if isinstance(x, dict):
         return {k if isinstance(k, str) else _key(k): _plain(v, rows, mark) for k, v in x.items()}
+    if isinstance(x, RawJson):
+        if rows is None:
+            return json.loads(x.text)
+        rows.append(x.text)
+        return f"{mark}{len(rows) - 1}"
     if isinstance(x, (list, tuple)):
         kinds = set(map(type, x))
         if x and kinds <= _PLAIN_NUMBERS:

@@ -132,3 +132,38 @@ def test_to_dict_and_allan_csv_rows_write_each_value_as_its_python_number():
              repr(float(res.dev_lo68_dph[i])), repr(float(res.dev_hi68_dph[i])), repr(float(res.dev_lo95_dph[i])),
              repr(float(res.dev_hi95_dph[i]))] for i in range(res.tau_s.size)]
     assert [[str(c) for c in row] for row in rows] == [[str(c) for c in row] for row in want]
+
+
+@pytest.mark.parametrize("quantity", ["angular_rate", "specific_force"])
+def test_allan_json_with_encoded_float_columns_is_the_documents_strict_json(tmp_path, monkeypatch, quantity):
+    """``write_allan_outputs`` hands allan.json's float columns to the JSON writer as the texts it made for
+    allan.csv: the file is byte for byte ``strict_json`` of the document (an infinity written as null, a column
+    with a NaN left to the writer), for either quantity's keys."""
+    from types import SimpleNamespace
+
+    import fogdrift.report.files as files
+    from fogdrift._util import strict_json
+
+    res = allan_variance(simulate(4000, 0.01, arw_dprh=0.1, seed=5), 0.01, taus="all")
+    hi95, edf = res.dev_hi95_dph.copy(), res.edf.copy()
+    hi95[-1], edf[2] = np.inf, np.nan
+    res = dataclasses.replace(res, dev_hi95_dph=hi95, edf=edf)
+
+    class Axis(SimpleNamespace):
+        def to_dict(self):
+            return {"name": self.name, "allan": self.allan.to_dict(quantity)}
+
+    axes = [Axis(name="gx", allan=res, noise=SimpleNamespace(quantity=quantity)),
+            Axis(name="gy", allan=dataclasses.replace(res, dev_dph=res.dev_dph * 2), noise=SimpleNamespace(
+                quantity=quantity))]
+    record = SimpleNamespace(source="mem", metadata=lambda: {"n": 1}, quantities=(quantity, quantity),
+                             axis_names=["gx", "gy"])
+    monkeypatch.setattr(files, "plot_allan", lambda *a: None)
+    monkeypatch.setattr(files, "plot_dynamic_adev", lambda *a: None)
+    written = []
+    real_write = files.write_json
+    monkeypatch.setattr(files, "write_json", lambda doc, path: written.append(doc) or real_write(doc, path))
+    files.write_allan_outputs(axes, record, tmp_path)
+    assert (tmp_path / "allan.json").read_text() == strict_json(files.allan_document(axes, record))
+    # every float column went as text but the one with a NaN (edf): 7 of 8 per axis
+    assert [sum(type(v) is files.RawJson for v in a["allan"].values()) for a in written[0]["axes"]] == [7, 7]

@@ -7,14 +7,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .._util import strict_json
+from .._util import RawJson, strict_json
 from ..models import save_model
 from ..noise import TERM_TABLE
 from ..output import atomic_path
 from ..units import INTERNAL_UNITS
 from .figures import _safe, plot_allan, plot_dynamic_adev, plot_models, plot_residuals, plot_separation, plot_separation_allan
 
-__all__ = ["write_json", "allan_document", "allan_csv_rows", "write_allan_outputs", "write_separation_outputs", "write_model_outputs"]
+__all__ = ["write_json", "allan_document", "allan_csv_rows", "write_allan_outputs", "write_separation_outputs",
+           "write_model_outputs"]
 
 
 def write_json(obj, path, *, indent: int | None = 2, sort_keys: bool = False) -> Path:
@@ -57,27 +58,64 @@ def allan_document(allan_axes, record) -> dict:
     return {"source": record.source, "record": record.metadata(), "axes": [a.to_dict() for a in allan_axes]}
 
 
-def allan_csv_rows(allan_axes) -> list:
+#: The float columns of ``allan.csv`` and ``allan.json``, as :class:`~fogdrift.allan.AllanResult` fields.
+_FLOAT_FIELDS = ("tau_s", "dev_dph", "var_dph2", "edf", "dev_lo68_dph", "dev_hi68_dph", "dev_lo95_dph", "dev_hi95_dph")
+#: ``repr`` of the non-finite floats.
+_NON_FINITE = frozenset({"nan", "inf", "-inf"})
+#: The fields of :meth:`~fogdrift.allan.AllanResult.column_names`, in its order.
+_COLUMN_FIELDS = ("tau_s", "m", "var_dph2", "dev_dph", "dev_lo68_dph", "dev_hi68_dph", "dev_lo95_dph", "dev_hi95_dph",
+                  "n_terms", "edf", "noise_alpha")
+
+
+def _float_texts(allan) -> dict:
+    """``repr`` of every value of each float column (field -> list of texts): what ``allan.csv`` writes and, finite,
+    what JSON writes (``float.__repr__``); made once for both files (25 000 taus: 0.09 s a file)."""
+    return {f: list(map(repr, np.asarray(getattr(allan, f), dtype=np.float64).tolist())) for f in _FLOAT_FIELDS}
+
+
+def allan_csv_rows(allan_axes, texts=None) -> list:
     """The rows of ``allan.csv`` (axis, tau_s, m, dev, var, n_terms, edf, lo68, hi68, lo95, hi95), one per tau of
-    every axis (a tuple of texts): each float as ``repr`` of its Python float, each integer as its Python int's text."""
+    every axis (a tuple of texts): each float as ``repr`` of its Python float, each integer as its Python int's text.
+    ``texts``: :func:`_float_texts` of each axis, made already."""
     rows = []
-    for a in allan_axes:
+    for i, a in enumerate(allan_axes):
         r = a.allan
-        # column by column (one C loop each), not one numpy scalar per cell: 25 000 taus 0.15 -> 0.04 s
-        floats = [list(map(repr, np.asarray(c, dtype=np.float64).tolist())) for c in
-                  (r.tau_s, r.dev_dph, r.var_dph2, r.edf, r.dev_lo68_dph, r.dev_hi68_dph, r.dev_lo95_dph,
-                   r.dev_hi95_dph)]
+        t = _float_texts(r) if texts is None else texts[i]
+        # column by column (one C loop each), not one numpy scalar per cell
         m, n_terms = (list(map(str, np.asarray(c).astype(np.int64).tolist())) for c in (r.m, r.n_terms))
-        tau, dev, var, edf, lo68, hi68, lo95, hi95 = floats
-        rows += zip(itertools.repeat(a.name, r.tau_s.size), tau, m, dev, var, n_terms, edf, lo68, hi68, lo95, hi95)
+        rows += zip(itertools.repeat(a.name, r.tau_s.size), t["tau_s"], m, t["dev_dph"], t["var_dph2"], n_terms,
+                    t["edf"], t["dev_lo68_dph"], t["dev_hi68_dph"], t["dev_lo95_dph"], t["dev_hi95_dph"])
     return rows
+
+
+def _with_encoded_floats(axis_doc: dict, allan, quantity: str, texts: dict) -> None:
+    """In one axis's ``allan.json`` entry, each float column that is the list of ``allan``'s values becomes its JSON
+    text, made from ``texts`` (``repr``, infinities as null): the same bytes as :func:`fogdrift._util.strict_json`
+    writes for the list.  A column that is not that list (one with a NaN: NaN never equals itself) stays a list."""
+    cols = axis_doc.get("allan") if isinstance(axis_doc, dict) else None
+    if not isinstance(cols, dict):
+        return
+    for field, key in zip(_COLUMN_FIELDS, allan.column_names(quantity)):
+        vals = cols.get(key)
+        if field not in texts or not isinstance(vals, list) or not vals:
+            continue
+        if vals != np.asarray(getattr(allan, field), dtype=np.float64).tolist():
+            continue
+        text = ", ".join(texts[field])
+        if "n" in text:  # an infinity ("inf", "-inf"; a finite repr has no "n"): strict JSON writes null
+            text = ", ".join("null" if v in _NON_FINITE else v for v in texts[field])
+        cols[key] = RawJson("[" + text + "]")
 
 
 def write_allan_outputs(allan_axes, record, out_dir) -> dict:
     """``allan.json`` (:func:`allan_document`), ``allan.csv`` (curve of every axis, with units) and ``allan.png``."""
     out = Path(out_dir)
-    write_json(allan_document(allan_axes, record), out / "allan.json")
-    rows = allan_csv_rows(allan_axes)
+    texts = [_float_texts(a.allan) for a in allan_axes]
+    doc = allan_document(allan_axes, record)
+    for a, axis_doc, t in zip(allan_axes, doc["axes"], texts):
+        _with_encoded_floats(axis_doc, a.allan, getattr(a.noise, "quantity", "angular_rate"), t)
+    write_json(doc, out / "allan.json")
+    rows = allan_csv_rows(allan_axes, texts)
     quantities = set(getattr(record, "quantities", ("angular_rate",)))
     mixed = len(quantities) != 1
     if not mixed:  # the curve's unit in the column names (allan.json's keys: AllanResult.column_names)
