@@ -41,8 +41,9 @@ def _progress_group(n_m: int, n_phase: int) -> int:
     """Cluster sizes per kernel call when progress is reported: about 1 % of the ``n_m`` asked for, at least 8, and
     no more than keep a call that 8 would run on one thread below :data:`~fogdrift.allan._kernels.PARALLEL_MIN`.
 
-    Each call costs its dispatch and thread setting (about 20 us); ``--taus all`` on 10^5 samples made 3 125 calls of
-    8 (0.46 s), 157 calls of 160 take 0.40 s.  The sums do not depend on the grouping (each m is summed on its own).
+    Each call costs its dispatch and thread setting (about 20 us): ``--taus all`` on 10^5 samples in 3 125 calls of 8
+    taus takes 0.46 s, in 157 calls of 160 taus 0.40 s.  The sums do not depend on the grouping (each m is summed on
+    its own).
     """
     group = max(8, -(-n_m // 100))
     if 8 * n_phase < _kernels.PARALLEL_MIN:
