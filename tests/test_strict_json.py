@@ -99,3 +99,29 @@ def test_strict_json_sorts_converted_keys_and_refuses_what_json_refuses():
         strict_json({(1, 2): 0})
     with pytest.raises(TypeError):
         strict_json({"z": 1j})
+
+
+@pytest.mark.parametrize("indent", [None, 2])
+def test_strict_json_long_number_lists_equal_the_round_trip(indent):
+    """Long lists of plain numbers (a 25 000-tau curve) take a path of their own: non-finite values anywhere as
+    null, int lists and huge ints as written, bools and numpy scalars through the general walk."""
+    rng = np.random.default_rng(7)
+    floats = rng.normal(size=3000).tolist()
+    cases = [floats, [*floats[:-1], math.nan], [math.inf, *floats[1:]], [*floats[:5], None, *floats[5:]],
+             list(range(3000)), [10 ** 400, 1, 2], [1, 2.5, 10 ** 30], [True, 1, 2], [1.0, np.float64(2.0), 3.0],
+             [None, None], [-0.0, 1e-320, 1.7976931348623157e308], tuple(floats[:50]), [1.5, False]]
+    for x in cases:
+        doc = {"c": x, "rows": [{"v": x}]}
+        got = json.loads(strict_json(doc, indent=indent))
+        assert got == _reference(doc)
+        assert strict_json(doc, indent=None) == json.dumps(_reference(doc), allow_nan=False)
+
+
+def test_raw_json_is_written_as_its_text():
+    from fogdrift._util import RawJson
+
+    vals = [0.1, 2.5e-7, 3.0]
+    raw = {"a": RawJson(json.dumps(vals)), "b": [{"c": RawJson("[1, null]")}]}
+    plain = {"a": vals, "b": [{"c": [1, None]}]}
+    for indent in (None, 2):
+        assert strict_json(raw, indent=indent) == strict_json(plain, indent=indent)

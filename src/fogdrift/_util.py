@@ -200,6 +200,22 @@ def strict_json(obj, *, indent: int | None = 2, sort_keys: bool = False) -> str:
     return re.sub(f'"{re.escape(mark)}(\\d+)"', lambda m: rows[int(m.group(1))], text)
 
 
+class RawJson:
+    """A JSON value already encoded: :func:`strict_json` writes ``text`` as it is (with ``indent``, on one line, where a
+    list of numbers goes), or its decoded value without ``indent``.  The writer that made ``text`` vouches for it
+    (strict JSON, no NaN)."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: str):
+        self.text = text
+
+
+#: The element types of a list that :func:`_plain` takes as a list of plain numbers (bool is not one: ``True`` is
+#: written as ``true``).
+_PLAIN_NUMBERS = frozenset({float, int, type(None)})
+
+
 def _plain(x, rows, mark):
     """``x`` as plain JSON values (dict with str keys, list, str, int, float, bool, None), NaN and infinity as
     None, in one walk: what ``json.loads(json.dumps(x, default=json_default))`` gives with non-finite numbers
@@ -216,13 +232,22 @@ def _plain(x, rows, mark):
         return f"{mark}{len(rows) - 1}"
     if isinstance(x, dict):
         return {k if isinstance(k, str) else _key(k): _plain(v, rows, mark) for k, v in x.items()}
+    if isinstance(x, RawJson):
+        if rows is None:
+            return json.loads(x.text)
+        rows.append(x.text)
+        return f"{mark}{len(rows) - 1}"
     if isinstance(x, (list, tuple)):
-        if x and all(type(v) is float or type(v) is int or v is None for v in x):
-            # a list of plain numbers (a curve as a list): the walk below, without a call per number
-            vals = [None if type(v) is float and not math.isfinite(v) else v for v in x]
+        kinds = set(map(type, x))
+        if x and kinds <= _PLAIN_NUMBERS:
+            # a list of plain numbers (a curve as a list): the walk below, without a Python call per number
+            if kinds == {int} or (kinds == {float} and all(map(math.isfinite, x))):
+                vals = list(x)
+            else:
+                vals = [None if type(v) is float and not math.isfinite(v) else v for v in x]
         else:
             vals = [_plain(v, rows, mark) for v in x]
-        if rows is not None and vals and all(v is None or type(v) in (int, float) for v in vals):
+        if rows is not None and vals and set(map(type, vals)) <= _PLAIN_NUMBERS:
             rows.append(json.dumps(vals, allow_nan=False))
             return f"{mark}{len(rows) - 1}"
         return vals

@@ -105,3 +105,65 @@ def test_result_from_sums_hand_values():
     assert_allclose(r.var, [2.0], rtol=1e-15)
     assert 1.0 <= r.edf[0] <= 7 and r.dev_lo95[0] < np.sqrt(2.0) < r.dev_hi95[0]
     _assert_same_result(r, allan_variance([1, 3, 2, 5, 4, 4, 6, 3], 0.5, taus=[0.5], noise_alpha=0))
+
+
+def test_to_dict_and_allan_csv_rows_write_each_value_as_its_python_number():
+    """``AllanResult.to_dict`` and the rows of ``allan.csv`` convert whole columns at once: every value is the
+    Python float (int) of its element, as one ``float(v)`` (``int(v)``) per element gives it, float32 and NaN
+    included, the columns in the header's order."""
+    from types import SimpleNamespace
+
+    from fogdrift.report.files import allan_csv_rows
+
+    res = allan_variance(simulate(5000, 0.01, arw_dprh=0.1, seed=4), 0.01, taus="all")
+    hi95 = res.dev_hi95.copy()
+    hi95[3] = np.nan
+    res = dataclasses.replace(res, edf=res.edf.astype(np.float32), dev_hi95=hi95)
+    d = res.to_dict()
+    for name, key in zip(("tau_s", "m", "n_terms", "edf", "dev_hi95"),
+                         ("tau_s", "m", "n_terms", "edf", "adev_hi95_dph")):
+        arr = getattr(res, name)
+        want = [int(v) for v in arr] if arr.dtype.kind in "iu" else [float(v) for v in arr]
+        assert [type(v) for v in d[key]] == [type(v) for v in want], name
+        assert np.array_equal(np.array(d[key]), np.array(want), equal_nan=True), name
+    rows = allan_csv_rows([SimpleNamespace(name="gx", allan=res)])
+    want = [["gx", repr(float(res.tau_s[i])), int(res.m[i]), repr(float(res.dev[i])),
+             repr(float(res.var[i])), int(res.n_terms[i]), repr(float(res.edf[i])),
+             repr(float(res.dev_lo68[i])), repr(float(res.dev_hi68[i])), repr(float(res.dev_lo95[i])),
+             repr(float(res.dev_hi95[i]))] for i in range(res.tau_s.size)]
+    assert [[str(c) for c in row] for row in rows] == [[str(c) for c in row] for row in want]
+
+
+@pytest.mark.parametrize("quantity", ["angular_rate", "specific_force"])
+def test_allan_json_with_encoded_float_columns_is_the_documents_strict_json(tmp_path, monkeypatch, quantity):
+    """``write_allan_outputs`` hands allan.json's float columns to the JSON writer as the texts it made for
+    allan.csv: the file is byte for byte ``strict_json`` of the document (an infinity written as null, a column
+    with a NaN left to the writer), for either quantity's keys."""
+    from types import SimpleNamespace
+
+    import fogdrift.report.files as files
+    from fogdrift._util import strict_json
+
+    res = allan_variance(simulate(4000, 0.01, arw_dprh=0.1, seed=5), 0.01, taus="all")
+    hi95, edf = res.dev_hi95.copy(), res.edf.copy()
+    hi95[-1], edf[2] = np.inf, np.nan
+    res = dataclasses.replace(res, dev_hi95=hi95, edf=edf)
+
+    class Axis(SimpleNamespace):
+        def to_dict(self):
+            return {"name": self.name, "allan": self.allan.to_dict(quantity)}
+
+    axes = [Axis(name="gx", allan=res, noise=SimpleNamespace(quantity=quantity)),
+            Axis(name="gy", allan=dataclasses.replace(res, dev=res.dev * 2), noise=SimpleNamespace(
+                quantity=quantity))]
+    record = SimpleNamespace(source="mem", metadata=lambda: {"n": 1}, quantities=(quantity, quantity),
+                             axis_names=["gx", "gy"])
+    monkeypatch.setattr(files, "plot_allan", lambda *a: None)
+    monkeypatch.setattr(files, "plot_dynamic_adev", lambda *a: None)
+    written = []
+    real_write = files.write_json
+    monkeypatch.setattr(files, "write_json", lambda doc, path: written.append(doc) or real_write(doc, path))
+    files.write_allan_outputs(axes, record, tmp_path)
+    assert (tmp_path / "allan.json").read_text() == strict_json(files.allan_document(axes, record))
+    # every float column went as text but the one with a NaN (edf): 7 of 8 per axis
+    assert [sum(type(v) is files.RawJson for v in a["allan"].values()) for a in written[0]["axes"]] == [7, 7]

@@ -117,3 +117,25 @@ print(json.dumps("matplotlib.pyplot" in sys.modules))
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert json.loads(proc.stdout.strip().splitlines()[-1]) is False
     assert (tmp_path / "allan.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("limits", [None, (1e-2, 1e3)])
+def test_log_axes_make_ticks_only_in_view_and_draw_the_same_pixels(monkeypatch, limits):
+    """``_place`` hands each log axis the ticks of its LogLocator inside the view only (``_in_view_ticks``): the
+    PNG is the one of the full locator, ticks on the view's ends included, with fewer tick objects made."""
+
+    def drawn():
+        with matplotlib.rc_context(figures.STYLE):
+            fig, axs = figures.subplots(1, 2, figsize=(12.0, 4.0), squeeze=False)
+            if limits is not None:
+                for ax in axs.ravel():
+                    ax.set_xlim(*limits)
+            png = _draw(fig, axs)
+        return png, sum(len(axis.minorTicks) + len(axis.majorTicks) for ax in fig.axes
+                        for axis in (ax.xaxis, ax.yaxis))
+
+    got, n_got = drawn()
+    monkeypatch.setattr(figures, "_in_view_ticks", lambda ax: None)
+    want, n_want = drawn()
+    assert got == want
+    assert n_got < n_want

@@ -218,3 +218,31 @@ def test_run_analysis_reuses_the_sums_for_the_native_rate_row(monkeypatch):
     assert sums[record.axis_names[0]].holds(x, 1.0, "adev", "overlapping")   # reused, not recomputed
     _same(got.axes[0].original.allan, want.axes[0].original.allan)
     assert got.axes[0].original.noise.to_dict() == want.axes[0].original.noise.to_dict()
+
+
+@pytest.mark.parametrize("statistic, estimator", [("adev", "overlapping"), ("adev", "fast"), ("hdev", "overlapping")])
+def test_sums_taken_in_progress_groups_equal_one_pass(statistic, estimator):
+    """With a progress callback the kernel runs in groups of cluster sizes (``_progress_group``): every sum is that
+    of the one-pass computation, bit for bit, and progress counts up to the number of taus."""
+    rate = _series(6_000, False)
+    one = pipeline_sums.AllanSums(rate, DT, statistic, estimator)
+    m = one.grid("all")
+    one.compute([m])
+    seen = []
+    grouped = pipeline_sums.AllanSums(rate, DT, statistic, estimator)
+    grouped.compute([m], progress=lambda done, total: seen.append((done, total)))
+    assert np.array_equal(grouped.m, one.m) and np.array_equal(grouped.sums, one.sums)
+    group = pipeline_sums._progress_group(m.size, rate.size + 1)
+    assert len(seen) == -(-m.size // group) > 1
+    assert [d for d, _ in seen] == sorted(d for d, _ in seen) and seen[-1] == (m.size, m.size)
+
+
+def test_progress_group_sizes():
+    """About 1 % of the grid, at least 8, and a group that 8 taus would run on one thread stays below the
+    parallel threshold."""
+    from fogdrift.allan._kernels import PARALLEL_MIN
+
+    assert pipeline_sums._progress_group(100, 1_000) == 8
+    assert pipeline_sums._progress_group(25_000, 100_001) == (PARALLEL_MIN - 1) // 100_001
+    assert pipeline_sums._progress_group(25_000, 1_000) == 250
+    assert pipeline_sums._progress_group(10_000, 10_000_000) == 100  # 8 taus run in parallel already

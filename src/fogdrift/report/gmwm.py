@@ -18,7 +18,7 @@ from .._util import fmt_number
 from ..gmwm.analysis import J_CAVEAT, GmwmAxis, b_detail_lines, ieee_rows
 from ..output import atomic_path
 from ..units import INTERNAL_UNITS, KEY_SUFFIXES
-from .figures import _place, save_figure, literal
+from .figures import _place, literal, save_figure, subplots
 from .files import write_json
 
 __all__ = ["write_gmwm_outputs", "plot_gmwm", "gmwm_noise_html", "fmt"]
@@ -32,13 +32,8 @@ def fmt(x, digits=4) -> str:
 
 def plot_gmwm(axes: list[GmwmAxis], path) -> Path:
     """Per axis: the WV with its 95 % interval (excluded scales hollow), the fitted model and each component."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     n = len(axes)
-    fig, axs = plt.subplots(1, n, figsize=(5.6 * n, 4.6), squeeze=False)
+    fig, axs = subplots(1, n, figsize=(5.6 * n, 4.6), squeeze=False)  # on the Agg canvas, without pyplot
     for ax, a in zip(axs[0], axes):
         wv, sel = a.wvar, a.selection
         used = np.isin(wv.level, sel.levels_used)
