@@ -28,12 +28,19 @@ import numpy as np
 
 from ._util import check_series
 from .allan._kernels import threads_for
+from .constraints import Choice, Setting
 from .errors import ConfigError
 
-__all__ = ["OutlierReport", "find_outliers", "treat_outliers", "OUTLIER_ACTIONS"]
+__all__ = ["OutlierReport", "find_outliers", "treat_outliers", "OUTLIER_ACTIONS", "OUTLIERS_SETTING"]
 
 #: Treatments accepted by :func:`treat_outliers` (``"warn"`` only reports).
 OUTLIER_ACTIONS = ("warn", "clip", "replace")
+
+#: The analyses' setting of what happens to outliers before them (:mod:`fogdrift.constraints`): the
+#: ``AnalysisConfig.outliers`` default and rule, and the ``--outliers`` option.
+OUTLIERS_SETTING = Setting("outliers", "warn", Choice(OUTLIER_ACTIONS), "--outliers",
+                           "Samples beyond 6 robust sigma: warn (default), clip (to 6 sigma) or replace (by the "
+                           "local median).")
 
 _MAD_TO_SIGMA = 1.482602218505602  # 1 / Phi^-1(3/4)
 

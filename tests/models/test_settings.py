@@ -1,8 +1,9 @@
-"""The modelling stage's settings table (fogdrift.models.settings): one declaration per setting gives the
-AnalysisConfig default, the rule validate() applies, and the CLI option (flag, type, default, help).
+"""The declared settings (fogdrift.models.settings, fogdrift.allan.settings, fogdrift.outliers.OUTLIERS_SETTING):
+one declaration per setting gives the AnalysisConfig default, the rule validate() applies, and the CLI option (flag,
+type, default, help).  The rules themselves: tests/test_constraints.py.
 
-Independent checks: the rules against hand-picked values at and beside their bounds; the defaults against the
-dataclass fields; the CLI's help and values through typer's own runner; a toy row reaching a toy command.
+Independent checks: the defaults against the dataclass fields; a value beside each rule's bound through validate();
+the CLI's help and values through typer's own runner; a toy row reaching a toy command.
 """
 
 from __future__ import annotations
@@ -10,36 +11,16 @@ from __future__ import annotations
 import dataclasses
 import math
 
-import numpy as np
 import pytest
 import typer
 from typer.testing import CliRunner
 
+from fogdrift import constraints as C
 from fogdrift.errors import ConfigError
-from fogdrift.models import settings as S
 from fogdrift.pipeline import AnalysisConfig
+from fogdrift.pipeline.config import STAGE_SETTINGS
 
-ROWS = S.MODEL_SETTINGS
-
-
-def test_rules_at_and_beside_their_bounds():
-    one = S.Integer(1)
-    assert one.holds(1) and one.holds(np.int64(7)) and one.holds(10**12)
-    assert not any(one.holds(v) for v in (0, -3, True, 1.5, "2", None, np.float64(2.0)))
-    open_ = S.Number(0.0, 1.0)
-    assert open_.holds(0.5) and open_.holds(np.float32(0.25)) and open_.holds(1e-12)
-    assert not any(open_.holds(v) for v in (0.0, 1.0, -0.1, math.nan, math.inf, False, "0.5", None))
-    left = S.Number(0.0, 1.0, "left")
-    assert left.holds(0.0) and not left.holds(1.0)
-    above = S.Number(0.0)
-    assert above.holds(1e9) and not above.holds(0.0) and not above.holds(math.inf)
-    assert S.Number(0.0, 1.0, "both").describe() == "a number in [0, 1]" and above.describe() == "a number > 0"
-    choice = S.Choice(("bptt", "bp"))
-    assert choice.holds("bp") and not choice.holds("BP") and not choice.holds(None)
-    with pytest.raises(ConfigError) as info:
-        one.check("lags", 0)
-    msg = info.value.args[0]  # by its meaning: the option, the rule's bound, the value given
-    assert msg.startswith("{opt:lags} ") and "integer >= 1" in msg and msg.endswith("got 0")
+ROWS = STAGE_SETTINGS
 
 
 @pytest.mark.parametrize("row", ROWS, ids=lambda r: r.name)
@@ -52,9 +33,9 @@ def test_a_row_is_the_config_field_its_default_and_its_flag(row):
 
 
 def _bad(rule):
-    if isinstance(rule, S.Integer):
+    if isinstance(rule, C.Integer):
         return rule.low - 1
-    if isinstance(rule, S.Number):
+    if isinstance(rule, C.Number):
         return rule.high if math.isfinite(rule.high) else rule.low
     return "no-such-choice"
 
@@ -82,12 +63,30 @@ def test_the_cli_options_come_from_the_rows():
         assert FLAGS[row.name] == row.flag
     model_help = CliRunner().invoke(app, ["model", "--help"], env={"COLUMNS": "300"}).output
     assert "--hidden" in model_help and "--gm-window" not in model_help  # a command names the rows it offers
+    allan_help = " ".join(CliRunner().invoke(app, ["allan", "--help"], env={"COLUMNS": "300"}).output.split())
+    for name in ("estimator", "statistic", "outliers"):  # the Allan stage's rows in allan (and batch) too
+        row = next(r for r in ROWS if r.name == name)
+        assert f"{row.flag} <str> {row.help} [default: {row.default}]" in allan_help
+    assert "--hidden" not in allan_help
+
+
+@pytest.mark.parametrize("name", ["estimator", "statistic", "outliers"])
+def test_the_allan_stages_choices_are_read_from_their_tables(name):
+    """A statistic, estimator or outlier treatment added to its table is a value of its option: the rule's choices
+    are the tables' own (not a copy)."""
+    from fogdrift.allan.statistics import ESTIMATORS, STATISTICS
+    from fogdrift.outliers import OUTLIER_ACTIONS
+
+    row = next(r for r in ROWS if r.name == name)
+    assert tuple(row.rule.values) == {"estimator": ESTIMATORS, "statistic": tuple(STATISTICS),
+                                      "outliers": OUTLIER_ACTIONS}[name]
 
 
 def test_a_new_row_is_an_option_of_the_commands_that_name_it(monkeypatch):
-    toy = S.Setting("toy_gain", 2, S.Integer(1), "--toy-gain", "A toy setting [samples].")
-    monkeypatch.setitem(S._BY_NAME, "toy_gain", toy)
-    from fogdrift.cli._settings import with_settings
+    from fogdrift.cli._settings import ROWS as CLI_ROWS, with_settings
+
+    toy = C.Setting("toy_gain", 2, C.Integer(1), "--toy-gain", "A toy setting [samples].")
+    monkeypatch.setitem(CLI_ROWS, "toy_gain", toy)
 
     got = {}
     probe = typer.Typer(rich_markup_mode=None)  # as the fogdrift app: "[samples]" is a unit, not markup

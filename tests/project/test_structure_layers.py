@@ -28,7 +28,7 @@ sys.path.insert(0, str(Path(__file__).parent))  # the graph reader of tests/proj
 from test_structure_imports import PACKAGE, SRC, import_cycles, import_edges  # noqa: E402
 
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("core", ("fogdrift", "errors", "_util", "units", "interrupt", "documents", "output")),
+    ("core", ("fogdrift", "errors", "_util", "units", "interrupt", "documents", "output", "constraints")),
     ("io", ("io", "signal", "temperature", "spec")),
     ("statistics", ("allan", "noise", "gmwm", "lifting", "metrics", "outliers", "simulate", "screen",
                     "screen_kinds", "health", "selfnoise", "segments", "plausibility")),

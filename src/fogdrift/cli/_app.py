@@ -51,11 +51,11 @@ from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
 from ..io import load, load_segments
 from ..io import load as _io_load
 from ..io.registry import cli_options, reader_by_name, select_reader
-from ..models.settings import MODEL_SETTINGS
 from .. import output as _output
 from ..output import OutputDir, active
 from ..plausibility import check_record
 from ._safe import SafeConsole
+from ._settings import ROWS as SETTING_ROWS
 
 app = typer.Typer(
     add_completion=False,
@@ -76,9 +76,8 @@ FLAGS = {
     "unit": "--unit", "rate_hz": "--rate", "dt_s": "--rate", "time_column": "--time-column", "columns": "--columns",
     "gaps": "--gaps", "time_unit": "--time-unit", "model_rate_hz": "--model-rate", "level": "--level",
     "wavelet": "--wavelet", "mode": "--mode", "terms": "--terms", "fit_taus": "--fit-taus",
-    "tau_range_s": "--fit-taus", "taus": "--taus", "estimator": "--estimator", "statistic": "--statistic",
-    "models": "--models", "latitude_deg": "--latitude", "earth_axes": "--earth-axis", "outliers": "--outliers",
-    "model_params": "--param",
+    "tau_range_s": "--fit-taus", "taus": "--taus", "models": "--models", "latitude_deg": "--latitude",
+    "earth_axes": "--earth-axis", "model_params": "--param",
     "apply_unit": "--apply-unit", "axis_map": "--axis-map", "accept_rate": "--accept-rate", "bias": "--bias",
     "model": "--model", "chunk_samples": "--chunk", "out": "--out", "pdf": "--pdf",
     "method": "--method", "noise_method": "--noise-method", "scales": "--scales", "levels": "--scales",
@@ -96,7 +95,7 @@ FLAGS = {
 _LOAD_KEYWORDS = frozenset(inspect.signature(_io_load).parameters)
 READER_FLAGS = tuple(sorted(cli_options(), key=lambda o: str(o) not in _LOAD_KEYWORDS))
 FLAGS.update({str(o): o.flag for o in READER_FLAGS})
-FLAGS.update({s.name: s.flag for s in MODEL_SETTINGS})  # the modelling stage's settings: their flags declared once
+FLAGS.update({s.name: s.flag for s in SETTING_ROWS.values()})  # the declared settings: each flag declared once
 
 
 def _version(value: bool):
@@ -129,18 +128,12 @@ ModeOpt = Annotated[str, typer.Option("--mode", help="Boundary mode: symmetric o
 TausOpt = Annotated[str, typer.Option("--taus", help="Tau grid: octave, decade, all, or a number of log-spaced taus.")]
 FitTausOpt = Annotated[str, typer.Option("--fit-taus", help="Tau range of the noise fit MIN:MAX [s], "
                                                             "either side may be empty, e.g. '1:'.")]
-EstOpt = Annotated[str, typer.Option("--estimator", help="overlapping, non-overlapping or fast.")]
 TermsOpt = Annotated[str, typer.Option(
     "--terms", help="Fix the noise model, e.g. N,K (default: the terms are selected from the data).")]
-StatisticOpt = Annotated[str, typer.Option(
-    "--statistic", help="adev (Allan), hdev (Hadamard: blind to a rate ramp) or mdev (modified Allan).")]
 SegmentsOpt = Annotated[str, typer.Option(
     "--segments", help="What the noise fit uses: auto (default: the quiet segments where the record screen finds a "
                        "disturbance, the whole record when it finds none), whole, or ranges in s such as "
                        "'0:600,7000:' (pooled without bridging a gap).")]
-OutliersOpt = Annotated[str, typer.Option(
-    "--outliers", help="Samples beyond 6 robust sigma: warn (default), clip (to 6 sigma) or replace (by the "
-                       "local median).")]
 
 
 @dataclass(frozen=True)

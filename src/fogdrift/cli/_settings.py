@@ -1,9 +1,12 @@
-"""CLI options made from a stage's settings table (:data:`fogdrift.models.settings.MODEL_SETTINGS`).
+"""CLI options made from the declared settings (:mod:`fogdrift.constraints`): the Allan stage's
+(:data:`fogdrift.allan.settings.ALLAN_SETTINGS`), the outlier treatment (:data:`fogdrift.outliers.OUTLIERS_SETTING`)
+and the modelling stage's (:data:`fogdrift.models.settings.MODEL_SETTINGS`).
 
 :func:`with_settings` adds one option per named row to a command -- the row's flag, type, default and help -- where
 the command's signature has its ``settings`` parameter, and hands the command the values as ``settings``
-(``{name: value}``, the :class:`~fogdrift.pipeline.AnalysisConfig` keywords).  A new setting of the stage is one
-row: every command that names it gets its option, and ``{opt:NAME}`` in a message is spelled with its flag.
+(``{name: value}``, the :class:`~fogdrift.pipeline.AnalysisConfig` keywords).  A new setting of a stage is one
+row: every command that names it gets its option, and ``{opt:NAME}`` in a message is spelled with its flag
+(:data:`ROWS` feeds ``fogdrift.cli._app.FLAGS``).
 """
 
 from __future__ import annotations
@@ -15,14 +18,19 @@ from typing import Annotated
 
 import typer
 
-from ..models.settings import setting
+from ..allan.settings import ALLAN_SETTINGS
+from ..models.settings import MODEL_SETTINGS
+from ..outliers import OUTLIERS_SETTING
 
-__all__ = ["with_settings"]
+__all__ = ["ROWS", "with_settings"]
+
+#: Every declared setting a command may offer, by name.
+ROWS = {s.name: s for s in (*ALLAN_SETTINGS, OUTLIERS_SETTING, *MODEL_SETTINGS)}
 
 
 def with_settings(*names: str):
     """Decorator: the options of the settings ``names`` in place of the command's ``settings`` parameter."""
-    rows = [setting(n) for n in names]
+    rows = [ROWS[n] for n in names]
 
     def decorate(func):
         sig = inspect.signature(func)

@@ -5,10 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..temperature import summary_line
-from ._app import (EstOpt, FitTausOpt, JsonOpt, OutliersOpt, OutOpt, SegmentsOpt, StatisticOpt, TausOpt, TermsOpt,
-                   app, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, progress,
+from ._app import (FitTausOpt, JsonOpt, OutOpt, SegmentsOpt, TausOpt, TermsOpt, app, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, progress,
                    run, with_load_options)
 from ._screen import print_screen
+from ._settings import with_settings
 from ._tables import noise_table, print_noise_notes, relabel_note
 from ._spec import SpecOpt, print_spec_for_allan, read_spec_option
 
@@ -17,13 +17,12 @@ DEFAULT_OUT = Path("out/allan")
 
 @app.command()
 @with_load_options
+@with_settings("estimator", "statistic", "outliers")
 def allan(
     load,
-    estimator: EstOpt = "overlapping",
+    settings: dict = None,
     taus: TausOpt = "octave",
     terms: TermsOpt = "",
-    statistic: StatisticOpt = "adev",
-    outliers: OutliersOpt = "warn",
     fit_taus: FitTausOpt = ":",
     segments: SegmentsOpt = "auto",
     out: OutOpt = DEFAULT_OUT,
@@ -39,9 +38,9 @@ def allan(
     with run("allan", out, default_out=DEFAULT_OUT, inputs=[load.file, spec], json_out=json_out,
              expect=("allan.json", "allan.csv", "allan.png") + (("spec.json",) if spec is not None else ())) as r:
         term_list = parse_terms(terms)
-        precheck(estimator=estimator, terms=term_list)
-        cfg = AnalysisConfig(taus=parse_taus(taus), estimator=estimator, fit_tau_s=parse_fit_taus(fit_taus),
-                             terms=term_list, statistic=statistic, outliers=outliers).validate()
+        precheck(terms=term_list)
+        cfg = AnalysisConfig(taus=parse_taus(taus), fit_tau_s=parse_fit_taus(fit_taus), terms=term_list,
+                             **settings).validate()
         limits = read_spec_option(spec)  # read before the work: a bad spec file is one line, nothing computed
         record = load.load()
         echo_record(load, record)
@@ -50,13 +49,13 @@ def allan(
         with progress("allan", record.axis_names) as (allan_cb, _):
             done = run_allan(record, cfg, progress=allan_cb, screened=screened)
         results = done.results
-        name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}[statistic]
+        name = {"adev": "ADEV", "hdev": "HDEV", "mdev": "MDEV"}[cfg.statistic]
         by_quantity = {}
         for a in results:  # one table per quantity: gyro terms, then accelerometer terms (their own units)
             by_quantity.setdefault(getattr(a.noise, "quantity", "angular_rate"), []).append(a)
         for quantity, group in by_quantity.items():
             what = "" if quantity == "angular_rate" else "accelerometer (velocity random walk N, bias instability B) "
-            console.print(noise_table(f"{load.file.name}: {what}{estimator} {name}, 95 % intervals in brackets "
+            console.print(noise_table(f"{load.file.name}: {what}{cfg.estimator} {name}, 95 % intervals in brackets "
                                       "(– (< x): not in the selected model, x its upper bound; [0, x]: in the "
                                       "model but not resolved from zero; B: the IEEE reading min ADEV/0.664, < x "
                                       "where the ADEV has no minimum; no model fits: ≈ x a term's read-out along "

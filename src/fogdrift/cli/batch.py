@@ -13,9 +13,10 @@ import typer
 
 from ..errors import ConfigError
 from ..spec import B_COMPARED
-from ._app import (FLAGS, EstOpt, FitTausOpt, OutliersOpt, StatisticOpt, TausOpt, TermsOpt,
+from ._app import (FLAGS, FitTausOpt, TausOpt, TermsOpt,
                    app, csv_list, parse_fit_taus, parse_taus, parse_terms, precheck, progress_count, run, say,
                    with_load_options)
+from ._settings import with_settings
 from ._spec import SpecOpt, read_spec_option, spec_settings
 from .noise import ModelOpt, RobustOpt, ScalesOpt
 
@@ -69,6 +70,7 @@ def _command_help() -> str:
 
 @app.command()
 @with_load_options(file="none")
+@with_settings("estimator", "statistic", "outliers")
 def batch(
     inputs: Annotated[list[Path], typer.Argument(help="Logs, folders (with --glob), ROS 2 bag folders or wildcards.")],
     load,
@@ -83,11 +85,9 @@ def batch(
                                                                      "(default: the usable cores, at most one per "
                                                                      "file); given, the default is the local "
                                                                      "cluster.")] = None,
-    estimator: EstOpt = "overlapping",
+    settings: dict = None,
     taus: TausOpt = "octave",
     terms: TermsOpt = "",
-    statistic: StatisticOpt = "adev",
-    outliers: OutliersOpt = "warn",
     fit_taus: FitTausOpt = ":",
     models: Annotated[Optional[str], typer.Option("--models", help="analyze: drift models (default: all).")] = None,
     model_rate: Annotated[Optional[float], typer.Option("--model-rate", help="analyze: modelling rate [Hz].")] = None,
@@ -116,10 +116,10 @@ def batch(
         if load.gaps not in ("error", "longest"):
             raise ConfigError(f"{{opt:gaps}} must be 'error' or 'longest' in a batch, got {load.gaps!r}")
         term_list = parse_terms(terms)
-        precheck(estimator=estimator, terms=term_list)
-        analysis = {"taus": parse_taus(taus), "estimator": estimator, "fit_tau_s": list(parse_fit_taus(fit_taus)),
-                    "terms": None if term_list is None else list(term_list), "statistic": statistic,
-                    "outliers": outliers}
+        precheck(estimator=settings["estimator"], terms=term_list)
+        analysis = {"taus": parse_taus(taus), "estimator": settings["estimator"],
+                    "fit_tau_s": list(parse_fit_taus(fit_taus)), "terms": None if term_list is None else list(term_list),
+                    "statistic": settings["statistic"], "outliers": settings["outliers"]}
         if command == "analyze":
             extra = {"models": csv_list(models), "model_rate_hz": model_rate, "epochs": epochs, "seed": seed}
             analysis.update({k: v for k, v in extra.items() if v is not None})

@@ -8,19 +8,24 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..allan import ESTIMATORS, STATISTICS
 from ..allan.grid import MAX_TAUS
 from ..errors import ConfigError
 from ..io.readers.limits import ENV_MEMORY, format_bytes, memory_budget
 from ..lifting import MODES, get_wavelet
 from ..models import MODEL_NAMES, check_model_params, model_spec
 from ..models.registry import RECURRENT_WEIGHT_COPIES, recurrent_memory_need
-from ..models.settings import MODEL_SETTINGS, setting
+from ..allan.settings import ALLAN_SETTINGS
+from ..models.settings import MODEL_SETTINGS
 from ..noise.terms import TERM_TABLE
-from ..outliers import OUTLIER_ACTIONS
+from ..outliers import OUTLIERS_SETTING
 from ..units import check_rate_hz, earth_rate_projection_dph
 
-__all__ = ["AnalysisConfig", "check_options"]
+__all__ = ["AnalysisConfig", "STAGE_SETTINGS", "check_options"]
+
+#: Every declared setting of an analysis (:mod:`fogdrift.constraints`): the Allan stage's, the outlier treatment,
+#: the modelling stage's.  Each is a field of :class:`AnalysisConfig` with the row's default and rule.
+STAGE_SETTINGS = (*ALLAN_SETTINGS, OUTLIERS_SETTING, *MODEL_SETTINGS)
+_ROW = {s.name: s for s in STAGE_SETTINGS}
 
 
 @dataclass
@@ -75,34 +80,36 @@ class AnalysisConfig:
 
     Notes
     -----
-    The settings of the modelling stage (``hidden``, ``lags``, ``epochs``, ``seed``, ``training``,
-    ``train_fraction``, ``val_fraction``, ``causal_window_s``, ``gm_window``) take their default and rule from one
-    declaration each, :data:`fogdrift.models.settings.MODEL_SETTINGS`, which also makes their CLI options.
+    The declared settings (:data:`STAGE_SETTINGS`: ``estimator`` and ``statistic`` of the Allan stage,
+    :data:`fogdrift.allan.settings.ALLAN_SETTINGS`; ``outliers``, :data:`fogdrift.outliers.OUTLIERS_SETTING`; the
+    modelling stage's ``hidden``, ``lags``, ``epochs``, ``seed``, ``training``, ``train_fraction``,
+    ``val_fraction``, ``causal_window_s``, ``gm_window``, :data:`fogdrift.models.settings.MODEL_SETTINGS`) take
+    their default and rule from one declaration each, which also makes their CLI options.
     """
 
     model_rate_hz: float | None = 1.0
     wavelet: str = "db2"
     level: int | str = 4
     mode: str = "symmetric"
-    train_fraction: float = setting("train_fraction").default
-    val_fraction: float = setting("val_fraction").default
+    train_fraction: float = _ROW["train_fraction"].default
+    val_fraction: float = _ROW["val_fraction"].default
     latitude_deg: float | None = None
     earth_axes: dict = field(default_factory=dict)
     models: tuple = MODEL_NAMES
-    lags: int = setting("lags").default
-    hidden: int = setting("hidden").default
-    epochs: int = setting("epochs").default
-    seed: int = setting("seed").default
+    lags: int = _ROW["lags"].default
+    hidden: int = _ROW["hidden"].default
+    epochs: int = _ROW["epochs"].default
+    seed: int = _ROW["seed"].default
     activation: str = "tanh"
-    training: str = setting("training").default
-    gm_window: int = setting("gm_window").default
-    causal_window_s: float = setting("causal_window_s").default
+    training: str = _ROW["training"].default
+    gm_window: int = _ROW["gm_window"].default
+    causal_window_s: float = _ROW["causal_window_s"].default
     taus: str = "octave"
-    estimator: str = "overlapping"
-    statistic: str = "adev"
+    estimator: str = _ROW["estimator"].default
+    statistic: str = _ROW["statistic"].default
     terms: tuple | None = None
     fit_tau_s: tuple = (None, None)
-    outliers: str = "warn"
+    outliers: str = _ROW["outliers"].default
     noise_method: str = "allan"
     model_params: dict = field(default_factory=dict)
 
@@ -123,7 +130,7 @@ class AnalysisConfig:
         ConfigError
             The first invalid setting, named as ``{opt:NAME}``, with the rule and the value.
         """
-        for s in MODEL_SETTINGS:  # each setting's own rule, from its one declaration
+        for s in STAGE_SETTINGS:  # each setting's own rule, from its one declaration
             s.rule.check(s.name, getattr(self, s.name))
         if self.train_fraction + self.val_fraction >= 1:
             raise ConfigError(
@@ -136,10 +143,6 @@ class AnalysisConfig:
         # canonical registry names (any case accepted); an unknown name is an error, never a fallback
         models = tuple(dict.fromkeys(model_spec(m).name for m in self.models))
 
-        if self.statistic not in STATISTICS:
-            raise ConfigError(f"statistic must be one of {tuple(STATISTICS)}, got {self.statistic!r} ({{opt:statistic}})")
-        if self.outliers not in OUTLIER_ACTIONS:
-            raise ConfigError(f"outliers must be one of {OUTLIER_ACTIONS}, got {self.outliers!r} ({{opt:outliers}})")
         if self.noise_method not in ("allan", "gmwm"):
             raise ConfigError(f"noise_method must be 'allan' or 'gmwm', got {self.noise_method!r} ({{opt:noise_method}})")
         if self.model_rate_hz is not None and (isinstance(self.model_rate_hz, bool) or not _finite_number(
@@ -210,11 +213,9 @@ def check_options(*, wavelet=None, mode=None, training=None, estimator=None, ter
     if mode is not None:
         if mode not in MODES:
             raise ConfigError(f"{{opt:mode}} must be one of {list(MODES)}; got {mode!r}")
-    if training is not None:
-        setting("training").rule.check("training", training)
-    if estimator is not None:
-        if estimator not in ESTIMATORS:
-            raise ConfigError(f"{{opt:estimator}} must be one of {list(ESTIMATORS)}; got {estimator!r}")
+    for name, value in (("training", training), ("estimator", estimator)):
+        if value is not None:
+            _ROW[name].rule.check(name, value)
     if terms is not None:
         bad = [t for t in terms if t not in TERM_TABLE]
         if bad or not terms:
