@@ -137,7 +137,7 @@ class _Phase:
         y = self.source.raw(ya, hi_i)
         buf = np.empty(y.size + 1)
         buf[0] = 0.0                                 # theta_0, used when a == 0
-        _kernels()["theta"](y, self.source.scale_to_dph, self.mu, self.offsets, ya // BLOCK, buf, BLOCK)
+        _kernels()["theta"](y, self.source.scale_to_internal, self.mu, self.offsets, ya // BLOCK, buf, BLOCK)
         return buf[a - ya: b - ya]                   # buf[t + 1] = theta[ya + t + 1]
 
     def points(self, idx) -> np.ndarray:
@@ -167,7 +167,7 @@ def _mean_and_offsets(source, leaf: int, progress):
     for a in range(0, n, step):
         y = source.raw(a, min(n, a + step))
         part = np.empty(-(-y.size // BLOCK))
-        kern(y, source.scale_to_dph, mu, part, BLOCK)
+        kern(y, source.scale_to_internal, mu, part, BLOCK)
         totals[a // BLOCK: a // BLOCK + part.size] = part
     offsets = np.empty(nb + 1)
     s = c = 0.0

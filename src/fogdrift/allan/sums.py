@@ -120,8 +120,8 @@ class AllanSums:
             sums = np.empty(m.size)
             if self.chunked:
                 y = self.y
-                source = ChunkSource(path=Path("<memory>"), n_samples=self.n, dt_s=self.dt, name="rate",
-                                     scale_to_dph=1.0, describe="in-memory float64", _read=lambda a, b: y[a:b])
+                source = ChunkSource(path=Path("<memory>"), n_samples=self.n, dt_s=self.dt, name="series",
+                                     scale_to_internal=1.0, describe="in-memory float64", _read=lambda a, b: y[a:b])
                 chunk = OUT_OF_CORE_CHUNK
                 mu, offsets = chunked._mean_and_offsets(source, chunk, None)
                 sums[:] = chunked._second_difference_sums(chunked._Phase(source, mu, offsets), m, strides, chunk,

@@ -51,8 +51,9 @@ class ChunkSource:
         Sample interval in s.
     name : str
         Column (axis) name.
-    scale_to_dph : float
-        Factor applied to the stored numbers (raw binary scale times the unit's factor).
+    scale_to_internal : float
+        Factor from the stored numbers to the internal unit (raw binary scale times the unit's factor; 1 for a
+        series already in it).
     describe : str
         Format and layout, for notes.
     """
@@ -61,15 +62,15 @@ class ChunkSource:
     n_samples: int
     dt_s: float
     name: str
-    scale_to_dph: float
+    scale_to_internal: float
     describe: str
     _read: Callable = field(repr=False, default=None)
     check: Callable | None = field(repr=False, default=None)   # check(start, stop) on the streaming pass
 
     def raw(self, start: int, stop: int) -> np.ndarray:
-        """Samples ``start .. stop-1`` as stored (after a raw binary scale factor), before ``scale_to_dph``.
+        """Samples ``start .. stop-1`` as stored (after a raw binary scale factor), before ``scale_to_internal``.
 
-        ``raw(a, b) * scale_to_dph`` (in float64) is :meth:`read`; compiled consumers multiply as they go
+        ``raw(a, b) * scale_to_internal`` (in float64) is :meth:`read`; compiled consumers multiply as they go
         and save the float64 copy.
         """
         start, stop = int(start), int(stop)
@@ -82,8 +83,8 @@ class ChunkSource:
     def read(self, start: int, stop: int) -> np.ndarray:
         """Samples ``start .. stop-1`` in deg/h (float64, a new array)."""
         x = np.asarray(self.raw(start, stop), dtype=np.float64)
-        if self.scale_to_dph != 1.0:
-            x = np.multiply(x, self.scale_to_dph, dtype=np.float64)
+        if self.scale_to_internal != 1.0:
+            x = np.multiply(x, self.scale_to_internal, dtype=np.float64)
         return x
 
 
@@ -287,7 +288,7 @@ def open_source(path, *, column=None, unit=None, rate_hz=None, dt_s=None, layout
                                   "(or pass {opt:unit})", path=p, column=str(name)) from None
         unit = declared
     factor = channel_unit(unit, "angular_rate").scale_to_internal(dt)
-    return ChunkSource(path=p, n_samples=int(n), dt_s=dt, name=str(name), scale_to_dph=factor,
+    return ChunkSource(path=p, n_samples=int(n), dt_s=dt, name=str(name), scale_to_internal=factor,
                        describe=f"{what}, unit {unit}", _read=read, check=check)
 
 
