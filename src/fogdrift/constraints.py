@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from .errors import ConfigError
@@ -103,10 +104,16 @@ class Choice(Rule):
 @dataclass(frozen=True)
 class Setting:
     """One setting: the :class:`~fogdrift.pipeline.AnalysisConfig` field ``name``, its ``default`` (the field's
-    and the CLI option's), its ``rule``, the CLI ``flag`` and the ``help`` text (units in brackets)."""
+    and the CLI option's), its ``rule``, the CLI ``flag`` and the ``help`` text (units in brackets).
+
+    A setting whose option is text that is not the value itself (``--fit-taus 1:300`` for ``(1.0, 300.0)``) gives
+    ``parse`` (text -> value, a :class:`~fogdrift.errors.ConfigError` naming ``{opt:NAME}`` for bad text) and
+    ``text``, the option's default (``parse(text) == default``)."""
 
     name: str
     default: object
     rule: Rule
     flag: str
     help: str
+    parse: Callable[[str], object] | None = None
+    text: str | None = None

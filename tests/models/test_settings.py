@@ -28,11 +28,20 @@ def test_a_row_is_the_config_field_its_default_and_its_flag(row):
     fields = {f.name: f for f in dataclasses.fields(AnalysisConfig)}
     assert row.name in fields
     assert fields[row.name].default == row.default and row.rule.holds(row.default)
-    assert isinstance(row.default, row.rule.type)
+    if row.parse is None:  # the option's value is the setting's
+        assert isinstance(row.default, row.rule.type) and row.text is None
+    else:  # the option is text: its default parses to the setting's default
+        assert row.parse(row.text) == row.default
     assert row.flag.startswith("--") and row.help.endswith(".")
 
 
 def _bad(rule):
+    from fogdrift.allan.settings import TauGrid, TauRange
+
+    if isinstance(rule, TauGrid):
+        return 0
+    if isinstance(rule, TauRange):
+        return (3.0, 2.0)
     if isinstance(rule, C.Integer):
         return rule.low - 1
     if isinstance(rule, C.Number):
@@ -58,8 +67,9 @@ def test_the_cli_options_come_from_the_rows():
         at = next(i for i, ln in enumerate(lines) if ln.strip().startswith(row.flag + " "))
         block = " ".join(lines[at:at + 3])
         block = " ".join((block[:block.index("  --", 3)] if "  --" in block[3:] else block).split())
-        assert f"{row.flag} <{row.rule.type.__name__}>" in block and row.help in block
-        assert f"[default: {row.default}]" in block
+        block = block.replace("- ", "-")  # a help line wrapped at a hyphen ("log- spaced")
+        assert f"{row.flag} <{'str' if row.parse else row.rule.type.__name__}>" in block and row.help in block
+        assert f"[default: {row.default if row.parse is None else row.text}]" in block
         assert FLAGS[row.name] == row.flag
     model_help = CliRunner().invoke(app, ["model", "--help"], env={"COLUMNS": "300"}).output
     assert "--hidden" in model_help and "--gm-window" not in model_help  # a command names the rows it offers
@@ -67,6 +77,9 @@ def test_the_cli_options_come_from_the_rows():
     for name in ("estimator", "statistic", "outliers"):  # the Allan stage's rows in allan (and batch) too
         row = next(r for r in ROWS if r.name == name)
         assert f"{row.flag} <str> {row.help} [default: {row.default}]" in allan_help
+    for name in ("taus", "fit_tau_s"):  # parsed options: their text default
+        row = next(r for r in ROWS if r.name == name)
+        assert f"{row.flag} <str> {row.help} [default: {row.text}]" in allan_help
     assert "--hidden" not in allan_help
 
 
@@ -83,7 +96,8 @@ def test_the_allan_stages_choices_are_read_from_their_tables(name):
 
 
 def test_a_new_row_is_an_option_of_the_commands_that_name_it(monkeypatch):
-    from fogdrift.cli._settings import ROWS as CLI_ROWS, with_settings
+    from fogdrift.cli._rows import ROWS as CLI_ROWS
+    from fogdrift.cli._settings import with_settings
 
     toy = C.Setting("toy_gain", 2, C.Integer(1), "--toy-gain", "A toy setting [samples].")
     monkeypatch.setitem(CLI_ROWS, "toy_gain", toy)
@@ -92,14 +106,29 @@ def test_a_new_row_is_an_option_of_the_commands_that_name_it(monkeypatch):
     probe = typer.Typer(rich_markup_mode=None)  # as the fogdrift app: "[samples]" is a unit, not markup
 
     @probe.command()
-    @with_settings("toy_gain", "seed")
+    @with_settings("toy_gain", "seed", "fit_tau_s")
     def run(name: str = "x", settings: dict = None, last: int = 0):
         got.update(settings, name=name, last=last)
 
-    res = CliRunner().invoke(probe, ["--toy-gain", "5", "--last", "3"])
+    res = CliRunner().invoke(probe, ["--toy-gain", "5", "--last", "3", "--fit-taus", "0.5:300"])
     assert res.exit_code == 0, res.output
-    assert got == {"toy_gain": 5, "seed": 0, "name": "x", "last": 3}
+    assert got == {"toy_gain": 5, "seed": 0, "fit_tau_s": (0.5, 300.0), "name": "x", "last": 3}
+    got.clear()
+    assert CliRunner().invoke(probe, []).exit_code == 0 and got["fit_tau_s"] == (None, None)  # the text default
     helped = CliRunner().invoke(probe, ["--help"], env={"COLUMNS": "300"}).output
     assert "--toy-gain" in helped and "A toy setting [samples]." in helped and "[default: 2]" in helped
     with pytest.raises(TypeError, match="settings"):
         with_settings("seed")(lambda name="x": None)
+
+
+def test_a_parsed_option_refuses_bad_text_in_one_line(tmp_path):
+    from fogdrift.cli import app
+
+    res = CliRunner().invoke(app, ["allan", str(tmp_path / "none.csv"), "--fit-taus", "300", "--out",
+                                   str(tmp_path / "o")], env={"COLUMNS": "300"})
+    out = " ".join(res.output.split())
+    assert res.exit_code == 1 and "--fit-taus must look like MIN:MAX" in out and "got '300'" in out
+    res = CliRunner().invoke(app, ["allan", str(tmp_path / "none.csv"), "--taus", "0", "--out", str(tmp_path / "p")],
+                             env={"COLUMNS": "300"})
+    out = " ".join(res.output.split())
+    assert res.exit_code == 1 and "--taus must be 'octave', 'decade', 'all' or a number of taus" in out

@@ -12,8 +12,10 @@ from .statistics import get_statistic
 
 __all__ = ["ARRAY_FIELDS", "AllanResult"]
 
-#: The array fields, in serialisation order (the order of :meth:`AllanResult.column_names`); ``var``/``dev`` stems are replaced by the statistic's.
-ARRAY_FIELDS = ("tau_s", "m", "var", "dev", "dev_lo68", "dev_hi68", "dev_lo95", "dev_hi95", "n_terms", "edf", "noise_alpha")
+#: The array fields, in serialisation order (the order of :meth:`AllanResult.column_names`); ``var``/``dev`` stems
+#: are replaced by the statistic's.
+ARRAY_FIELDS = ("tau_s", "m", "var", "dev", "dev_lo68", "dev_hi68", "dev_lo95", "dev_hi95", "n_terms", "edf",
+                "noise_alpha")
 
 
 @dataclass(frozen=True)

@@ -57,7 +57,8 @@ class AllanSums:
     Parameters
     ----------
     y : array_like, shape (n_samples,)
-        The series in its channel's internal unit (deg/h, m/s^2), finite (checked as :func:`fogdrift.allan.allan_variance` checks it, same messages).
+        The series in its channel's internal unit (deg/h, m/s^2), finite (checked as
+        :func:`fogdrift.allan.allan_variance` checks it, same messages).
     dt_s : float
         Sample interval [s].
     statistic : {"adev", "hdev", "mdev"}

@@ -55,7 +55,7 @@ from .. import output as _output
 from ..output import OutputDir, active
 from ..plausibility import check_record
 from ._safe import SafeConsole
-from ._settings import ROWS as SETTING_ROWS
+from ._rows import ROWS as SETTING_ROWS
 
 app = typer.Typer(
     add_completion=False,
@@ -76,13 +76,13 @@ FLAGS = {
     "unit": "--unit", "rate_hz": "--rate", "dt_s": "--rate", "time_column": "--time-column", "columns": "--columns",
     "gaps": "--gaps", "time_unit": "--time-unit", "model_rate_hz": "--model-rate", "level": "--level",
     "wavelet": "--wavelet", "mode": "--mode", "terms": "--terms", "fit_taus": "--fit-taus",
-    "tau_range_s": "--fit-taus", "taus": "--taus", "models": "--models", "latitude_deg": "--latitude",
+    "tau_range_s": "--fit-taus", "models": "--models", "latitude_deg": "--latitude",
     "earth_axes": "--earth-axis", "model_params": "--param",
     "apply_unit": "--apply-unit", "axis_map": "--axis-map", "accept_rate": "--accept-rate", "bias": "--bias",
     "model": "--model", "chunk_samples": "--chunk", "out": "--out", "pdf": "--pdf",
     "method": "--method", "noise_method": "--noise-method", "scales": "--scales", "levels": "--scales",
     "curve": "--curve", "sensor": "--sensor", "robust": "--robust",
-    "fit_tau_s": "--fit-taus", "format": "--format", "horizons": "--horizons", "calibration": "--calibration",
+    "format": "--format", "horizons": "--horizons", "calibration": "--calibration",
     "origin_step": "--origin-step", "spec": "--spec", "segments": "--segments",
     "target": "--target", "length": "--length", "monte_carlo": "--monte-carlo", "workers": "--workers", "axis": "--axis",
     "fleet": "--fleet", "units": "--units", "mean_target": "--mean-target",
@@ -125,9 +125,6 @@ ModelRateOpt = Annotated[float, typer.Option(
 WaveletOpt = Annotated[str, typer.Option("--wavelet", help="Lifting wavelet (fogdrift.lifting.wavelist(): haar, db2, db4).")]
 LevelOpt = Annotated[str, typer.Option("--level", help="Decomposition level or 'auto'.")]
 ModeOpt = Annotated[str, typer.Option("--mode", help="Boundary mode: symmetric or periodization.")]
-TausOpt = Annotated[str, typer.Option("--taus", help="Tau grid: octave, decade, all, or a number of log-spaced taus.")]
-FitTausOpt = Annotated[str, typer.Option("--fit-taus", help="Tau range of the noise fit MIN:MAX [s], "
-                                                            "either side may be empty, e.g. '1:'.")]
 TermsOpt = Annotated[str, typer.Option(
     "--terms", help="Fix the noise model, e.g. N,K (default: the terms are selected from the data).")]
 SegmentsOpt = Annotated[str, typer.Option(
@@ -284,24 +281,10 @@ def parse_level(text: str):
         raise ConfigError(f"--level must be an integer >= 1 or 'auto', got {text!r}") from None
 
 
-def parse_fit_taus(text: str):
-    lo, sep, hi = text.partition(":")
-    try:
-        if not sep:
-            raise ValueError
-        return (float(lo) if lo.strip() else None, float(hi) if hi.strip() else None)
-    except ValueError:
-        raise ConfigError(f"--fit-taus must look like MIN:MAX in seconds (e.g. '1:' or '0.1:300'), got {text!r}") from None
-
-
 def parse_terms(text: str):
     """'' -> None (select from the data); 'n,k' -> ('N', 'K')."""
     items = csv_list(text or "")
     return tuple(t.upper() for t in items) if items else None
-
-
-def parse_taus(text: str):
-    return int(text) if text.isdigit() else text
 
 
 # -- consoles -----------------------------------------------------------------------------------------------

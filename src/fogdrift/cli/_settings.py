@@ -1,12 +1,12 @@
-"""CLI options made from the declared settings (:mod:`fogdrift.constraints`): the Allan stage's
-(:data:`fogdrift.allan.settings.ALLAN_SETTINGS`), the outlier treatment (:data:`fogdrift.outliers.OUTLIERS_SETTING`)
-and the modelling stage's (:data:`fogdrift.models.settings.MODEL_SETTINGS`).
+"""CLI options made from the declared settings (:mod:`fogdrift.constraints`; the rows by name:
+:data:`fogdrift.cli._rows.ROWS`).
 
 :func:`with_settings` adds one option per named row to a command -- the row's flag, type, default and help -- where
 the command's signature has its ``settings`` parameter, and hands the command the values as ``settings``
-(``{name: value}``, the :class:`~fogdrift.pipeline.AnalysisConfig` keywords).  A new setting of a stage is one
+(``{name: value}``, the :class:`~fogdrift.pipeline.AnalysisConfig` keywords; an option written as text,
+``--fit-taus 1:300``, is handed on parsed by its row's ``parse``).  A new setting of a stage is one
 row: every command that names it gets its option, and ``{opt:NAME}`` in a message is spelled with its flag
-(:data:`ROWS` feeds ``fogdrift.cli._app.FLAGS``).
+(``fogdrift.cli._app.FLAGS``).
 """
 
 from __future__ import annotations
@@ -18,14 +18,10 @@ from typing import Annotated
 
 import typer
 
-from ..allan.settings import ALLAN_SETTINGS
-from ..models.settings import MODEL_SETTINGS
-from ..outliers import OUTLIERS_SETTING
+from ._app import errors
+from ._rows import ROWS
 
-__all__ = ["ROWS", "with_settings"]
-
-#: Every declared setting a command may offer, by name.
-ROWS = {s.name: s for s in (*ALLAN_SETTINGS, OUTLIERS_SETTING, *MODEL_SETTINGS)}
+__all__ = ["with_settings"]
 
 
 def with_settings(*names: str):
@@ -39,13 +35,18 @@ def with_settings(*names: str):
         hints = typing.get_type_hints(func, include_extras=True)  # resolve string annotations (PEP 563)
         own = [p.replace(annotation=hints.get(p.name, p.annotation)) for p in sig.parameters.values()]
         at = [p.name for p in own].index("settings")
-        made = [inspect.Parameter(r.name, own[at].kind, default=r.default,
-                                  annotation=Annotated[r.rule.type, typer.Option(r.flag, help=r.help)]) for r in rows]
+        made = [inspect.Parameter(r.name, own[at].kind, default=r.default if r.parse is None else r.text,
+                                  annotation=Annotated[r.rule.type if r.parse is None else str,
+                                                       typer.Option(r.flag, help=r.help)]) for r in rows]
         params = own[:at] + made + own[at + 1:]
 
         @functools.wraps(func)
         def wrapper(*args, **kwargs):
             given = {r.name: kwargs.pop(r.name) for r in rows if r.name in kwargs}
+            with errors():  # an option given as text (--fit-taus 1:300): its value, or one line naming the option
+                for r in rows:
+                    if r.parse is not None and r.name in given:
+                        given[r.name] = r.parse(given[r.name])
             return func(*args, settings=given, **kwargs)
 
         wrapper.__signature__ = sig.replace(parameters=params)

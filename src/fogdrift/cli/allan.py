@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..temperature import summary_line
-from ._app import (FitTausOpt, JsonOpt, OutOpt, SegmentsOpt, TausOpt, TermsOpt, app, console, echo_record, parse_fit_taus, parse_taus, parse_terms, precheck, progress,
-                   run, with_load_options)
+from ._app import (JsonOpt, OutOpt, SegmentsOpt, TermsOpt, app, console, echo_record, parse_terms, precheck,
+                   progress, run, with_load_options)
 from ._screen import print_screen
 from ._settings import with_settings
 from ._tables import noise_table, print_noise_notes, relabel_note
@@ -17,13 +17,11 @@ DEFAULT_OUT = Path("out/allan")
 
 @app.command()
 @with_load_options
-@with_settings("estimator", "statistic", "outliers")
+@with_settings("estimator", "taus", "statistic", "outliers", "fit_tau_s")
 def allan(
     load,
     settings: dict = None,
-    taus: TausOpt = "octave",
     terms: TermsOpt = "",
-    fit_taus: FitTausOpt = ":",
     segments: SegmentsOpt = "auto",
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
@@ -39,8 +37,7 @@ def allan(
              expect=("allan.json", "allan.csv", "allan.png") + (("spec.json",) if spec is not None else ())) as r:
         term_list = parse_terms(terms)
         precheck(terms=term_list)
-        cfg = AnalysisConfig(taus=parse_taus(taus), fit_tau_s=parse_fit_taus(fit_taus), terms=term_list,
-                             **settings).validate()
+        cfg = AnalysisConfig(terms=term_list, **settings).validate()
         limits = read_spec_option(spec)  # read before the work: a bad spec file is one line, nothing computed
         record = load.load()
         echo_record(load, record)

@@ -10,9 +10,8 @@ import typer
 
 from ..errors import ConfigError
 from ..models.registry import parse_model_params
-from ._app import (gyro_only, FitTausOpt, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, SegmentsOpt, TausOpt,
-                   TermsOpt, WaveletOpt, app, check_plausible, console,
-                   csv_list, echo_record, fitted_table, parse_fit_taus, parse_level, parse_taus, parse_terms,
+from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, SegmentsOpt, TermsOpt, WaveletOpt, app,
+                   check_plausible, console, csv_list, echo_record, fitted_table, parse_level, parse_terms,
                    progress, run, say, with_load_options)
 from ._screen import print_screen
 from ._spec import SpecOpt, print_judgements, read_spec_option
@@ -26,7 +25,7 @@ DEFAULT_OUT = Path("out/analyze")
 @app.command()
 @with_load_options
 @with_settings(*NETWORK_SETTINGS, "train_fraction", "val_fraction", "causal_window_s", "gm_window", "estimator",
-               "statistic", "outliers")
+               "taus", "statistic", "outliers", "fit_tau_s")
 def analyze(
     load,
     latitude: Annotated[Optional[float], typer.Option("--latitude", help="Latitude [deg] for Earth-rate removal.")]
@@ -48,10 +47,8 @@ def analyze(
     level: LevelOpt = "4",
     mode: ModeOpt = "symmetric",
     model_rate: ModelRateOpt = 1.0,
-    taus: TausOpt = "octave",
     terms: TermsOpt = "",
     segments: SegmentsOpt = "auto",
-    fit_taus: FitTausOpt = ":",
     heading: Annotated[bool, typer.Option(
         "--heading/--no-heading", help="Heading-error evaluation (rolling calibrations: --calibration, "
                                        "--origin-step, --horizons; free-run forecasts) and filtering-artefact check of every model on the test block: "
@@ -101,9 +98,8 @@ def analyze(
             earth[name.strip()] = orient.strip()
         term_list = parse_terms(terms)
         cfg = AnalysisConfig(models=tuple(csv_list(models)), **settings, wavelet=wavelet, level=parse_level(level),
-                             mode=mode, model_rate_hz=model_rate or None, taus=parse_taus(taus),
-                             terms=term_list, latitude_deg=latitude,
-                             earth_axes=earth, fit_tau_s=parse_fit_taus(fit_taus), noise_method=noise_method,
+                             mode=mode, model_rate_hz=model_rate or None, terms=term_list,
+                             latitude_deg=latitude, earth_axes=earth, noise_method=noise_method,
                              model_params=parse_model_params(param)).validate()
         hs = parse_heading_options(calibration, origin_step, horizons)
         if apply_to is not None and not apply_to.is_file():

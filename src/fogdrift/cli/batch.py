@@ -13,8 +13,7 @@ import typer
 
 from ..errors import ConfigError
 from ..spec import B_COMPARED
-from ._app import (FLAGS, FitTausOpt, TausOpt, TermsOpt,
-                   app, csv_list, parse_fit_taus, parse_taus, parse_terms, precheck, progress_count, run, say,
+from ._app import (FLAGS, TermsOpt, app, csv_list, parse_terms, precheck, progress_count, run, say,
                    with_load_options)
 from ._settings import with_settings
 from ._spec import SpecOpt, read_spec_option, spec_settings
@@ -70,7 +69,7 @@ def _command_help() -> str:
 
 @app.command()
 @with_load_options(file="none")
-@with_settings("estimator", "statistic", "outliers")
+@with_settings("estimator", "taus", "statistic", "outliers", "fit_tau_s")
 def batch(
     inputs: Annotated[list[Path], typer.Argument(help="Logs, folders (with --glob), ROS 2 bag folders or wildcards.")],
     load,
@@ -86,9 +85,7 @@ def batch(
                                                                      "file); given, the default is the local "
                                                                      "cluster.")] = None,
     settings: dict = None,
-    taus: TausOpt = "octave",
     terms: TermsOpt = "",
-    fit_taus: FitTausOpt = ":",
     models: Annotated[Optional[str], typer.Option("--models", help="analyze: drift models (default: all).")] = None,
     model_rate: Annotated[Optional[float], typer.Option("--model-rate", help="analyze: modelling rate [Hz].")] = None,
     epochs: Annotated[Optional[int], typer.Option("--epochs", help="analyze: training epochs.")] = None,
@@ -117,8 +114,9 @@ def batch(
             raise ConfigError(f"{{opt:gaps}} must be 'error' or 'longest' in a batch, got {load.gaps!r}")
         term_list = parse_terms(terms)
         precheck(estimator=settings["estimator"], terms=term_list)
-        analysis = {"taus": parse_taus(taus), "estimator": settings["estimator"],
-                    "fit_tau_s": list(parse_fit_taus(fit_taus)), "terms": None if term_list is None else list(term_list),
+        analysis = {"taus": settings["taus"], "estimator": settings["estimator"],
+                    "fit_tau_s": list(settings["fit_tau_s"]),
+                    "terms": None if term_list is None else list(term_list),
                     "statistic": settings["statistic"], "outliers": settings["outliers"]}
         if command == "analyze":
             extra = {"models": csv_list(models), "model_rate_hz": model_rate, "epochs": epochs, "seed": seed}

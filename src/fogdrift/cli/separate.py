@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, TausOpt, WaveletOpt, app,
-                   check_plausible, console, echo_record, parse_level, parse_taus, progress, run, say,
-                   with_load_options)
+from ._app import (gyro_only, JsonOpt, LevelOpt, ModeOpt, ModelRateOpt, OutOpt, WaveletOpt, app,
+                   check_plausible, console, echo_record, parse_level, progress, run, say, with_load_options)
+from ._settings import with_settings
 from ._tables import noise_table
 
 DEFAULT_OUT = Path("out/separate")
@@ -26,13 +26,14 @@ def modelling_rate_text(record, dt_s: float, factor: int) -> str:
 
 @app.command()
 @with_load_options
+@with_settings("taus")
 def separate(
     load,
     wavelet: WaveletOpt = "db2",
     level: LevelOpt = "4",
     mode: ModeOpt = "symmetric",
     model_rate: ModelRateOpt = 1.0,
-    taus: TausOpt = "octave",
+    settings: dict = None,
     out: OutOpt = DEFAULT_OUT,
     json_out: JsonOpt = False,
 ):
@@ -44,7 +45,7 @@ def separate(
     with run("separate", out, default_out=DEFAULT_OUT, inputs=[load.file], json_out=json_out,
              expect=("separation.npz", "separation.csv", "separation_table.csv", "separation.json")) as r:
         cfg = AnalysisConfig(wavelet=wavelet, level=parse_level(level), mode=mode,
-                             model_rate_hz=model_rate or None, taus=parse_taus(taus)).validate()
+                             model_rate_hz=model_rate or None, **settings).validate()
         record = load.load()
         gyro_only(record, "separate")
         echo_record(load, record)

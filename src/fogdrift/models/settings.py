@@ -40,7 +40,8 @@ MODEL_SETTINGS: tuple[Setting, ...] = (
     Setting("val_fraction", 0.2, Number(0.0, 1.0, "left"), "--val-fraction", "Validation share (early stopping)."),
     Setting("causal_window_s", 128.0, Number(0.0), "--causal-window",
             "Window [s] of the causal (real-time) drift of the practical compensation."),
-    Setting("gm_window", 8, Integer(GM11_MIN_LENGTH), "--gm-window", "Rolling window [samples] of the one-step GM(1,1)."),
+    Setting("gm_window", 8, Integer(GM11_MIN_LENGTH), "--gm-window",
+            "Rolling window [samples] of the one-step GM(1,1)."),
 )
 
 _BY_NAME = {s.name: s for s in MODEL_SETTINGS}

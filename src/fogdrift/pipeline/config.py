@@ -8,7 +8,6 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..allan.grid import MAX_TAUS
 from ..errors import ConfigError
 from ..io.readers.limits import ENV_MEMORY, format_bytes, memory_budget
 from ..lifting import MODES, get_wavelet
@@ -80,7 +79,8 @@ class AnalysisConfig:
 
     Notes
     -----
-    The declared settings (:data:`STAGE_SETTINGS`: ``estimator`` and ``statistic`` of the Allan stage,
+    The declared settings (:data:`STAGE_SETTINGS`: ``estimator``, ``statistic``, ``taus``, ``fit_tau_s`` of the Allan
+    stage,
     :data:`fogdrift.allan.settings.ALLAN_SETTINGS`; ``outliers``, :data:`fogdrift.outliers.OUTLIERS_SETTING`; the
     modelling stage's ``hidden``, ``lags``, ``epochs``, ``seed``, ``training``, ``train_fraction``,
     ``val_fraction``, ``causal_window_s``, ``gm_window``, :data:`fogdrift.models.settings.MODEL_SETTINGS`) take
@@ -104,11 +104,11 @@ class AnalysisConfig:
     training: str = _ROW["training"].default
     gm_window: int = _ROW["gm_window"].default
     causal_window_s: float = _ROW["causal_window_s"].default
-    taus: str = "octave"
+    taus: str = _ROW["taus"].default
     estimator: str = _ROW["estimator"].default
     statistic: str = _ROW["statistic"].default
     terms: tuple | None = None
-    fit_tau_s: tuple = (None, None)
+    fit_tau_s: tuple = _ROW["fit_tau_s"].default
     outliers: str = _ROW["outliers"].default
     noise_method: str = "allan"
     model_params: dict = field(default_factory=dict)
@@ -178,8 +178,6 @@ class AnalysisConfig:
         if not (self.level == "auto" or (isinstance(self.level, (int, np.integer)) and not isinstance(self.level, bool)
                                          and self.level >= 1)):
             raise ConfigError(f"{{opt:level}} must be an integer >= 1 or 'auto', got {self.level!r}")
-        _check_taus(self.taus)
-        _check_fit_taus(self.fit_tau_s)
         model_params = check_model_params(self.model_params, models)
         if models == tuple(self.models) and model_params == self.model_params:
             return self
@@ -220,27 +218,3 @@ def check_options(*, wavelet=None, mode=None, training=None, estimator=None, ter
         bad = [t for t in terms if t not in TERM_TABLE]
         if bad or not terms:
             raise ConfigError(f"{{opt:terms}} must list noise terms among Q, N, B, K, R; got {','.join(terms)!r}")
-
-
-def _check_taus(taus) -> None:
-    if isinstance(taus, str):
-        if taus.lower() not in ("octave", "decade", "all"):
-            raise ConfigError(f"{{opt:taus}} must be 'octave', 'decade', 'all' or a number of taus, got {taus!r}")
-    elif isinstance(taus, (int, np.integer)) and not isinstance(taus, bool):
-        if not 1 <= int(taus) <= MAX_TAUS:
-            raise ConfigError(f"{{opt:taus}} as a count must be in [1, {MAX_TAUS}], got {taus!r}")
-    else:
-        raise ConfigError(f"{{opt:taus}} must be 'octave', 'decade', 'all' or a number of taus, got {taus!r}")
-
-
-def _check_fit_taus(fit_tau_s) -> None:
-    try:
-        lo, hi = fit_tau_s
-    except (TypeError, ValueError):
-        raise ConfigError(f"{{opt:fit_tau_s}} must be (MIN, MAX) in s, either None; got {fit_tau_s!r}") from None
-    for v in (lo, hi):
-        if v is not None and not (_finite_number(v) and float(v) > 0):
-            raise ConfigError(f"{{opt:fit_tau_s}} bounds must be finite numbers of seconds > 0 (or None); "
-                              f"got {fit_tau_s!r}")
-    if lo is not None and hi is not None and not float(lo) < float(hi):
-        raise ConfigError(f"{{opt:fit_tau_s}} must have MIN < MAX; got {fit_tau_s!r}")
