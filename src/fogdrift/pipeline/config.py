@@ -8,12 +8,12 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ..allan.settings import ALLAN_SETTINGS
 from ..errors import ConfigError
 from ..io.readers.limits import ENV_MEMORY, format_bytes, memory_budget
 from ..lifting import MODES, get_wavelet
 from ..models import MODEL_NAMES, check_model_params, model_spec
 from ..models.registry import RECURRENT_WEIGHT_COPIES, recurrent_memory_need
-from ..allan.settings import ALLAN_SETTINGS
 from ..models.settings import MODEL_SETTINGS
 from ..noise.terms import TERM_TABLE
 from ..outliers import OUTLIERS_SETTING
@@ -79,12 +79,11 @@ class AnalysisConfig:
 
     Notes
     -----
-    The declared settings (:data:`STAGE_SETTINGS`: ``estimator``, ``statistic``, ``taus``, ``fit_tau_s`` of the Allan
-    stage,
-    :data:`fogdrift.allan.settings.ALLAN_SETTINGS`; ``outliers``, :data:`fogdrift.outliers.OUTLIERS_SETTING`; the
+    The declared settings (:data:`STAGE_SETTINGS`) take their default and rule from one declaration each, which
+    also makes their CLI options: the Allan stage's ``estimator``, ``statistic``, ``taus``, ``fit_tau_s``
+    (:data:`fogdrift.allan.settings.ALLAN_SETTINGS`); ``outliers`` (:data:`fogdrift.outliers.OUTLIERS_SETTING`); the
     modelling stage's ``hidden``, ``lags``, ``epochs``, ``seed``, ``training``, ``train_fraction``,
-    ``val_fraction``, ``causal_window_s``, ``gm_window``, :data:`fogdrift.models.settings.MODEL_SETTINGS`) take
-    their default and rule from one declaration each, which also makes their CLI options.
+    ``val_fraction``, ``causal_window_s``, ``gm_window`` (:data:`fogdrift.models.settings.MODEL_SETTINGS`).
     """
 
     model_rate_hz: float | None = 1.0
