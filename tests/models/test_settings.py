@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 from fogdrift import constraints as C
 from fogdrift.errors import ConfigError
 from fogdrift.pipeline import AnalysisConfig
-from fogdrift.pipeline.config import STAGE_SETTINGS
+from fogdrift.models.settings import STAGE_SETTINGS
 
 ROWS = STAGE_SETTINGS
 
@@ -96,7 +96,7 @@ def test_the_allan_stages_choices_are_read_from_their_tables(name):
 
 
 def test_a_new_row_is_an_option_of_the_commands_that_name_it(monkeypatch):
-    from fogdrift.cli._rows import ROWS as CLI_ROWS
+    from fogdrift.models.settings import SETTINGS as CLI_ROWS
     from fogdrift.cli._settings import with_settings
 
     toy = C.Setting("toy_gain", 2, C.Integer(1), "--toy-gain", "A toy setting [samples].")

@@ -51,11 +51,11 @@ from ..errors import ConfigError, FogdriftError, FogdriftWarning, render_options
 from ..io import load, load_segments
 from ..io import load as _io_load
 from ..io.registry import cli_options, reader_by_name, select_reader
+from ..models.settings import SETTINGS as SETTING_ROWS
 from .. import output as _output
 from ..output import OutputDir, active
 from ..plausibility import check_record
 from ._safe import SafeConsole
-from ._rows import ROWS as SETTING_ROWS
 
 app = typer.Typer(
     add_completion=False,

@@ -1,5 +1,5 @@
 """CLI options made from the declared settings (:mod:`fogdrift.constraints`; the rows by name:
-:data:`fogdrift.cli._rows.ROWS`).
+:data:`fogdrift.models.settings.SETTINGS`).
 
 :func:`with_settings` adds one option per named row to a command -- the row's flag, type, default and help -- where
 the command's signature has its ``settings`` parameter, and hands the command the values as ``settings``
@@ -18,15 +18,15 @@ from typing import Annotated
 
 import typer
 
+from ..models.settings import SETTINGS
 from ._app import errors
-from ._rows import ROWS
 
 __all__ = ["with_settings"]
 
 
 def with_settings(*names: str):
     """Decorator: the options of the settings ``names`` in place of the command's ``settings`` parameter."""
-    rows = [ROWS[n] for n in names]
+    rows = [SETTINGS[n] for n in names]
 
     def decorate(func):
         sig = inspect.signature(func)

@@ -9,21 +9,29 @@ type, the help text and the default), and its error messages spell ``{opt:NAME}`
 setting of the stage is one field and one row.  A hyper-parameter of one drift model is not a setting of the
 stage: it is a :class:`~fogdrift.models.registry.ModelParam` of the model's row (``--param MODEL.NAME=VALUE``).
 
+:data:`STAGE_SETTINGS` is every declared setting of an analysis, in one place: the Allan stage's
+(:data:`fogdrift.allan.settings.ALLAN_SETTINGS`), the outlier treatment (:data:`fogdrift.outliers.OUTLIERS_SETTING`)
+and this stage's; :data:`SETTINGS` holds them by name.  ``AnalysisConfig`` and the CLI read them from here.
+
 This module imports nothing heavy (the CLI reads it to build ``--help``).
 
 Examples
 --------
->>> setting("gm_window").rule.describe()
+>>> SETTINGS["gm_window"].rule.describe()
 'an integer >= 4'
->>> setting("val_fraction").rule.describe(), setting("val_fraction").rule.holds(1.0)
+>>> SETTINGS["val_fraction"].rule.describe(), SETTINGS["val_fraction"].rule.holds(1.0)
 ('a number in [0, 1)', False)
+>>> [s.name for s in STAGE_SETTINGS][:5]
+['estimator', 'statistic', 'taus', 'fit_tau_s', 'outliers']
 """
 
 from __future__ import annotations
 
+from ..allan.settings import ALLAN_SETTINGS
 from ..constraints import Choice, Integer, Number, Setting
+from ..outliers import OUTLIERS_SETTING
 
-__all__ = ["GM11_MIN_LENGTH", "MODEL_SETTINGS", "setting"]
+__all__ = ["GM11_MIN_LENGTH", "MODEL_SETTINGS", "SETTINGS", "STAGE_SETTINGS"]
 
 
 #: Smallest series GM(1,1) is fitted to: n = 4 gives 3 equations for the 2 unknowns (a, b).
@@ -44,9 +52,10 @@ MODEL_SETTINGS: tuple[Setting, ...] = (
             "Rolling window [samples] of the one-step GM(1,1)."),
 )
 
-_BY_NAME = {s.name: s for s in MODEL_SETTINGS}
+#: Every declared setting of an analysis (:mod:`fogdrift.constraints`): the Allan stage's, the outlier treatment,
+#: the modelling stage's.  Each is a field of :class:`~fogdrift.pipeline.AnalysisConfig` with the row's default and
+#: rule; a command offers those it names (``fogdrift.cli._settings.with_settings``).
+STAGE_SETTINGS: tuple[Setting, ...] = (*ALLAN_SETTINGS, OUTLIERS_SETTING, *MODEL_SETTINGS)
 
-
-def setting(name: str) -> Setting:
-    """The row of ``name`` (KeyError for a name the table does not hold)."""
-    return _BY_NAME[name]
+#: :data:`STAGE_SETTINGS` by name.
+SETTINGS: dict[str, Setting] = {s.name: s for s in STAGE_SETTINGS}

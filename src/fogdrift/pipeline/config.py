@@ -8,23 +8,16 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..allan.settings import ALLAN_SETTINGS
 from ..errors import ConfigError
 from ..io.readers.limits import ENV_MEMORY, format_bytes, memory_budget
 from ..lifting import MODES, get_wavelet
 from ..models import MODEL_NAMES, check_model_params, model_spec
 from ..models.registry import RECURRENT_WEIGHT_COPIES, recurrent_memory_need
-from ..models.settings import MODEL_SETTINGS
+from ..models.settings import SETTINGS as _ROW, STAGE_SETTINGS
 from ..noise.terms import TERM_TABLE
-from ..outliers import OUTLIERS_SETTING
 from ..units import check_rate_hz, earth_rate_projection_dph
 
 __all__ = ["AnalysisConfig", "STAGE_SETTINGS", "check_options"]
-
-#: Every declared setting of an analysis (:mod:`fogdrift.constraints`): the Allan stage's, the outlier treatment,
-#: the modelling stage's.  Each is a field of :class:`AnalysisConfig` with the row's default and rule.
-STAGE_SETTINGS = (*ALLAN_SETTINGS, OUTLIERS_SETTING, *MODEL_SETTINGS)
-_ROW = {s.name: s for s in STAGE_SETTINGS}
 
 
 @dataclass
@@ -79,7 +72,7 @@ class AnalysisConfig:
 
     Notes
     -----
-    The declared settings (:data:`STAGE_SETTINGS`) take their default and rule from one declaration each, which
+    The declared settings (:data:`fogdrift.models.settings.STAGE_SETTINGS`) take their default and rule from one declaration each, which
     also makes their CLI options: the Allan stage's ``estimator``, ``statistic``, ``taus``, ``fit_tau_s``
     (:data:`fogdrift.allan.settings.ALLAN_SETTINGS`); ``outliers`` (:data:`fogdrift.outliers.OUTLIERS_SETTING`); the
     modelling stage's ``hidden``, ``lags``, ``epochs``, ``seed``, ``training``, ``train_fraction``,
