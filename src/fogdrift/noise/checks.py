@@ -16,7 +16,7 @@ import numpy as np
 from ..units import B_FACTOR
 from .context import FitContext, point_limits
 from .distributions import chi2_ppf
-from .engine import ScoreProblem, profile_interval
+from .engine import ScoreProblem, ic_within, profile_interval
 from .periodic import Q_OVER_ENVELOPE, q_stands_above_lines
 from .result import NoiseTerm
 from .terms import DISPLAY_UNITS, TERM_TABLE, all_terms, markov_shape, periodic_shape
@@ -148,7 +148,7 @@ def _drop_rejected(c: FitContext, prob, res, best, plausible_delta=6.0):
         if not keep:
             break
         alt = min(keep, key=lambda k: res[k]["ic"])
-        if _names()[i] != "B" and res[alt]["ic"] > ic_now + plausible_delta:
+        if _names()[i] != "B" and not ic_within(res[alt]["ic"], ic_now, plausible_delta):
             break  # the data need the term: it stays at its bound (noted)
         dropped[i] = term
         best = alt

@@ -25,23 +25,27 @@ import itertools
 import math
 
 import numpy as np
-from scipy.optimize import brentq, nnls
+from scipy.optimize import brentq
 
 from .huber import HUBER_K
 
-__all__ = ["ScoreProblem", "projected_gauss_newton", "fit_subsets", "profile_interval"]
+__all__ = ["ScoreProblem", "projected_gauss_newton", "fit_subsets", "profile_interval", "ic_within", "IC_ROUNDING"]
 
 _KERNEL = {}
 
 
-def _wh_kernel():
-    """numba version of :func:`projected_gauss_newton` specialised to the whitened Wilson-Hilferty residual
-    (:mod:`._kernels`, compiled on first use and cached on disk)."""
-    if "pgn" not in _KERNEL:
-        from ._kernels import pgn
+_NO_START = np.zeros(0)  # the kernel's "no start given: take the NNLS fit"
 
-        _KERNEL["pgn"] = pgn
-    return _KERNEL["pgn"]
+
+def _wh_kernel():
+    """One compiled fit on a set of design columns (:func:`._kernels.fit_columns`: the start, then
+    :func:`projected_gauss_newton` specialised to the whitened Wilson-Hilferty residual), compiled on first use
+    and cached on disk."""
+    if "fit" not in _KERNEL:
+        from ._kernels import fit_columns
+
+        _KERNEL["fit"] = fit_columns
+    return _KERNEL["fit"]
 
 
 def projected_gauss_newton(res, jac, x0, upper, *, max_iter=100, tol=1e-10):
@@ -126,7 +130,7 @@ class ScoreProblem:
         self.c = 1.0 - 2.0 / (9.0 * nu_sampling)
         self.s = np.sqrt(2.0 / (9.0 * self.nu))
         self.y3 = np.cbrt(self.y)
-        self._memo, self._parts = {}, {}
+        self._memo = {}
         self.upper = np.asarray(upper, dtype=np.float64)
         # coefficient scale at which a column alone reaches the data somewhere (conditioning of the solver)
         with np.errstate(divide="ignore"):
@@ -160,23 +164,10 @@ class ScoreProblem:
                None if fixed is None else (fixed[0], float(fixed[1]).hex()), design)
         hit = self._memo.get(key)
         if hit is None:
-            hit = self._memo[key] = self._fit(cols, a0, fixed, design)
+            hit = self._memo[key] = self._fit(cols, a0, fixed)
         return hit[0].copy(), hit[1]
 
-    def _columns(self, free, design):
-        """What a fit on the free columns ``free`` needs of the design, formed once per design:
-        ``(scale, Xs, ub, ub (1 - 1e-9), Xs / y, 1 / y)``."""
-        key = (tuple(free), design)
-        part = self._parts.get(key)
-        if part is None:
-            scale = self.scale[free]
-            Xs = np.ascontiguousarray(self.X[:, free] * scale)
-            ub = np.ascontiguousarray(self.upper[free] / scale, dtype=np.float64)
-            wt = 1.0 / self.y
-            part = self._parts[key] = (scale, Xs, ub, ub * (1 - 1e-9), Xs * wt[:, None], wt)
-        return part
-
-    def _fit(self, cols, a0, fixed, design):
+    def _fit(self, cols, a0, fixed):
         free = [c for c in cols if fixed is None or c != fixed[0]]
         add = np.zeros(self.y.size) if fixed is None else self.X[:, fixed[0]] * fixed[1]
         if not free:
@@ -184,14 +175,27 @@ class ScoreProblem:
                 return np.array([]), math.inf
             w = _huber_py(self.W @ self.scores(add))
             return np.array([]), float(w @ w)
-        scale, Xs, ub, ub_in, Xw, wt = self._columns(free, design)
-        if a0 is None:
-            u0, _ = nnls(Xw, np.maximum(self.y - add, 0.0) * wt)
-        else:
-            u0 = np.asarray(a0, dtype=np.float64) / scale
-        u0 = np.minimum(np.maximum(u0, 1e-6), ub_in)  # np.clip's numbers (NaN kept) at 1 us instead of 2-3 per fit
-        u, q = _wh_kernel()(Xs, add, self.W, self.y3, self.c, self.s, u0, ub, 100, 1e-10)
-        return u * scale, float(q)
+        start = _NO_START if a0 is None else np.asarray(a0, dtype=np.float64)
+        a, q = _wh_kernel()(self.X, np.asarray(free, dtype=np.int64), self.scale, self.upper, self.y, add, self.W,
+                            self.y3, self.c, self.s, start, 100, 1e-10)
+        return a, float(q)
+
+
+#: Relative difference below which two information-criterion values count as the same number.  A superset whose
+#: extra terms all come out 0 has its subset's Q, so its IC lies a whole number of penalties away, often exactly on
+#: the edge of the plausible window; rounding (the order of a sum) must not decide on which side.
+IC_ROUNDING = 1e-9
+
+
+def ic_within(ic: float, ic_ref: float, delta: float) -> bool:
+    """``ic <= ic_ref + delta``, an IC equal to the edge up to rounding (:data:`IC_ROUNDING`) counted inside.
+
+    Examples
+    --------
+    >>> ic_within(16.000000000001, 10.0, 6.0), ic_within(16.001, 10.0, 6.0)
+    (True, False)
+    """
+    return ic <= ic_ref + delta + IC_ROUNDING * max(1.0, abs(ic_ref))
 
 
 def fit_subsets(problem: ScoreProblem, candidates, penalty: float):

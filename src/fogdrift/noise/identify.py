@@ -44,7 +44,7 @@ from .context import FitContext
 from .discrepancy import discrepancy_relcov
 from .distributions import chi2_sf, t_ppf
 from .covariance import estimator_covariance
-from .engine import ScoreProblem, all_subsets, fit_subsets, profile_interval
+from .engine import ScoreProblem, all_subsets, fit_subsets, ic_within, profile_interval
 from .notes import (_absent_reason, _at_bound_notes, _describe_excluded, _largest_gap_note, _misfit_note, _no_fit,
                     _unresolved_reason)
 from .result import NoiseFit, NoiseTerm
@@ -341,7 +341,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         return not any(i in k for i in dropped) and k not in refused
 
     plaus = [best] if terms is not None else [k for k, v in res.items()
-                                             if v["ic"] <= ic_best + plausible_delta and _ok(k)]
+                                             if ic_within(v["ic"], ic_best, plausible_delta) and _ok(k)]
     # (problem, fits) pairs whose intervals are united: the selection's conservative covariance, and -- when the
     # selected model holds a ramp -- the ramp's real (much smaller) covariance, which gives the estimate.  A ramp
     # that really is a random walk in disguise keeps the wide interval; a real ramp gets an unbiased value.
@@ -367,7 +367,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
     # window it still keeps the *other* terms from being resolved when it does without them (a true K whose rise
     # the record happens not to show must not turn into a resolved flicker floor)
     alt = [k for k in refused if k in views[0][1] and not any(i in k for i in dropped)
-           and views[0][1][k]["ic"] <= ic_best + plausible_delta and k not in plaus] if terms is None else []
+           and ic_within(views[0][1][k]["ic"], ic_best, plausible_delta) and k not in plaus] if terms is None else []
     A = res[best]["a"]
     q = res[best]["q"]
     n_par = len(best) + (1 if _names().index("M") in best else 0)
@@ -447,7 +447,7 @@ def identify(tau_s, var, n_samples, dt_s, *, var_hi95, m=None, statistic="adev",
         else:
             why = (_absent_reason(c, name, A, max(his)) if name in laws else
                    "not in the model: the curve is described as well without it")
-            if name in slope_notes and slope_notes[name][0] <= ic_best + plausible_delta:
+            if name in slope_notes and ic_within(slope_notes[name][0], ic_best, plausible_delta):
                 why = (f"{why}; {slope_notes[name][1]}; the model {'+'.join(_names()[j] for j in best)} describes "
                        "the curve instead")
             out_terms[name] = NoiseTerm(name, None, spec_unit, 0.0, hi_v, "absent", why)
