@@ -14,12 +14,16 @@ Cases:
 * ``csv``: reading ADIS16405 session 1 (CSV.gz, 10^6 rows x 4) in this process: ``numpy.loadtxt`` (``FAST_CSV =
   False``) against the fast path (pyarrow's reader, one thread), alternating; also checks the arrays are equal bit
   for bit.
+* ``floor``: the start-up floor of the stack the commands stand on, as a fresh process (Python; NumPy, typer and
+  rich; numba imported and one cached kernel called; matplotlib drawing one small log-log PNG on Agg; SciPy's
+  ``optimize`` and ``special``), against ``fogdrift allan --help``, ``allan`` and ``noise`` on ADIS16405 session 1:
+  what a command costs beyond the floor is fogdrift's own (reading, checks, statistics, fits, figure, files).
 * ``base``: any command, this tree against another source tree (``--base DIR``, e.g. ``git archive <commit> src |
   tar -x -C DIR``), both under the same environment: ``--cmd 'allan {ADIS1} --unit deg/s'``.
 
 Usage::
 
-    python bench/bench_startup.py [--rounds 5] [--cases blas,stats] [--base DIR --cmd '...']
+    python bench/bench_startup.py [--rounds 5] [--cases blas,stats,csv,floor] [--base DIR --cmd '...']
 """
 
 from __future__ import annotations
@@ -81,6 +85,47 @@ def pairs(name: str, rival: tuple, mine: tuple, rounds: int) -> dict:
     return row
 
 
+#: The ``floor`` case's process: what every fogdrift command that reads a record imports and starts (kept apart
+#: from fogdrift's own modules).  ``{cache}`` is a file the numba kernel is cached beside.
+FLOOR = """
+import numpy as np, typer, rich.console, numba, importlib.util, sys
+spec = importlib.util.spec_from_file_location("floor_kernel", {cache!r})
+mod = importlib.util.module_from_spec(spec); spec.loader.exec_module(mod)
+mod.total(np.ones(8))
+import matplotlib
+matplotlib.use("Agg")
+from matplotlib.figure import Figure
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+fig = Figure(figsize=(4, 3)); FigureCanvasAgg(fig); ax = fig.subplots(); ax.loglog([1, 10, 100], [1, 0.3, 0.2])
+fig.savefig({png!r}, dpi=100)
+import scipy.optimize, scipy.special
+"""
+FLOOR_KERNEL = """
+import numba
+
+@numba.njit(cache=True)
+def total(a):
+    s = 0.0
+    for x in a:
+        s += x
+    return s
+"""
+
+
+def floor_pairs(rounds: int, out: Path) -> list[dict]:
+    """The floor process against three short commands, alternating (see the module docstring)."""
+    kernel = out / "floor_kernel.py"
+    kernel.write_text(FLOOR_KERNEL)
+    floor = ([sys.executable, "-c", FLOOR.format(cache=str(kernel), png=str(out / "floor.png"))], _env(SRC))
+    rows = []
+    for name, words in (("allan --help", ["allan", "--help"]),
+                        ("allan ADIS imu1", ["allan", str(ADIS1), "--unit", "deg/s", "--out", str(out / "fa")]),
+                        ("noise ADIS imu1", ["noise", str(ADIS1), "--unit", "deg/s", "--out", str(out / "fn")])):
+        rows.append(pairs(f"stack floor vs fogdrift {name} (ratio: floor / command)", floor,
+                          ([sys.executable, "-m", "fogdrift", *words], _env(SRC)), rounds))
+    return rows
+
+
 def csv_pairs(rounds: int) -> dict:
     sys.path.insert(0, str(SRC))
     import numpy as np
@@ -133,6 +178,8 @@ def main(argv=None) -> int:
               ([py, "-c", "import fogdrift.pipeline"], _env(SRC)), args.rounds)
     if "csv" in cases:
         csv_pairs(args.rounds)
+    if "floor" in cases:
+        floor_pairs(args.rounds, out)
     if "base" in cases:
         if args.base is None:
             ap.error("the 'base' case needs --base DIR")
