@@ -93,14 +93,15 @@ def test_fit_columns_matches_the_numpy_reference(outliers):
         prob = _curve_problem(rng, outliers)
         for free in ([1], [0, 1], [1, 3], [0, 1, 2, 3], [0, 1, 2, 3, 4], [2, 4]):
             f = np.asarray(free, dtype=np.int64)
-            a, q = fit_columns(prob.X, f, prob.scale, prob.upper, prob.y, np.zeros(prob.y.size), prob.W, prob.y3,
-                               prob.c, prob.s, np.zeros(0), 100, 1e-10)
+            a = np.empty(len(free))
+            q = fit_columns(prob.X, f, prob.scale, prob.upper, prob.y, np.zeros(prob.y.size), prob.W, prob.y3,
+                            prob.c, prob.s, np.zeros(0), 100, 1e-10, a)
             a_ref, q_ref = _reference_fit(prob, free)
             assert q == pytest.approx(q_ref, rel=1e-8, abs=1e-12)
             assert q == pytest.approx(prob.q_of(_full(a, free)), rel=1e-12)
             start = a_ref * 1.3 + 1e-9
-            _, q2 = fit_columns(prob.X, f, prob.scale, prob.upper, prob.y, np.zeros(prob.y.size), prob.W, prob.y3,
-                                prob.c, prob.s, start, 100, 1e-10)
+            q2 = fit_columns(prob.X, f, prob.scale, prob.upper, prob.y, np.zeros(prob.y.size), prob.W, prob.y3,
+                             prob.c, prob.s, start, 100, 1e-10, np.empty(len(free)))
             assert q2 == pytest.approx(_reference_fit(prob, free, start)[1], rel=1e-8, abs=1e-12)
             w = prob.W @ prob.scores(prob.X[:, free] @ a)
             n_huber += bool(np.any(np.abs(w) > HUBER_K))

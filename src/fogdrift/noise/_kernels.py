@@ -319,11 +319,12 @@ def nnls(A, b, max_iter):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def fit_columns(X, free, scale_all, upper_all, y, add, W, y3, c, s, a0, max_iter, tol):  # pragma: no cover
+def fit_columns(X, free, scale_all, upper_all, y, add, W, y3, c, s, a0, max_iter, tol, out):  # pragma: no cover
     """One fit of :meth:`~fogdrift.noise.engine.ScoreProblem.fit` on the design columns ``free``: the columns
-    scaled by ``scale_all[free]``, the start ``a0`` (scaled coefficients) or, if ``a0`` is empty, the NNLS fit of
-    the relative errors ``(y - add) / y``, moved inside ``[1e-6, ub (1 - 1e-9)]``; then :func:`pgn`.  Returns
-    ``(a, Q)`` with ``a`` in the unscaled coefficients of ``free``."""
+    scaled by ``scale_all[free]``, the start ``a0`` (unscaled coefficients) or, if ``a0`` is empty, the NNLS fit
+    of the relative errors ``(y - add) / y``, moved inside ``[1e-6, ub (1 - 1e-9)]``; then :func:`pgn`.  Writes the
+    coefficients of ``free`` (unscaled) into ``out`` and returns ``Q`` (an array made here would be boxed for
+    Python at ~1.4 us a call)."""
     n = X.shape[0]
     p = free.size
     Xs = np.empty((n, p))
@@ -350,5 +351,5 @@ def fit_columns(X, free, scale_all, upper_all, y, add, W, y3, c, s, a0, max_iter
         u0[k] = min(max(u0[k], 1e-6), ub[k] * (1 - 1e-9))
     u, q = pgn(Xs, add, W, y3, c, s, u0, ub, max_iter, tol)
     for k in range(p):
-        u[k] *= scale_all[free[k]]
-    return u, q
+        out[k] = u[k] * scale_all[free[k]]
+    return q

@@ -176,8 +176,9 @@ class ScoreProblem:
             w = _huber_py(self.W @ self.scores(add))
             return np.array([]), float(w @ w)
         start = _NO_START if a0 is None else np.asarray(a0, dtype=np.float64)
-        a, q = _wh_kernel()(self.X, np.asarray(free, dtype=np.int64), self.scale, self.upper, self.y, add, self.W,
-                            self.y3, self.c, self.s, start, 100, 1e-10)
+        a = np.empty(len(free))
+        q = _wh_kernel()(self.X, np.asarray(free, dtype=np.int64), self.scale, self.upper, self.y, add, self.W,
+                         self.y3, self.c, self.s, start, 100, 1e-10, a)
         return a, float(q)
 
 

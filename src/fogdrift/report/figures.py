@@ -194,9 +194,10 @@ def _ticks_held(axes):
 
     Matplotlib's tight box of one axes updates the ticks of an axis once for the axis, once for its label's
     position and once for each spine along it (Axis._update_ticks: the locator run and every tick label formatted
-    and moved again): eight updates per axes where two serve.  While :func:`_place` measures, no axes moves and no
-    limit changes, so every update gives the ticks of the first; the first is kept for the block.  The draw
-    updates the ticks again at the final position.
+    and moved again): eight updates per axes where two serve, and a draw three per axis (the axis, its label's
+    siblings, the spines).  While :func:`_place` measures, and while :func:`save_figure` draws the placed figure,
+    no axes moves and no limit changes, so every update gives the ticks of the first; the first is kept for the
+    block (the same pixels).
     """
     held = []
     try:
@@ -283,7 +284,7 @@ def save_figure(fig, path, **savefig) -> Path:
     """
     path = Path(path)
     try:
-        with atomic_path(path) as tmp:
+        with atomic_path(path) as tmp, _ticks_held([ax for ax in fig.axes if ax.get_subplotspec() is not None]):
             fig.savefig(tmp, **{"dpi": DPI, **savefig})
     finally:
         if fig.canvas.manager is not None:  # a pyplot figure: pyplot holds it until it is closed
