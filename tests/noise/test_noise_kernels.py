@@ -94,14 +94,13 @@ def test_fit_columns_matches_the_numpy_reference(outliers):
         for free in ([1], [0, 1], [1, 3], [0, 1, 2, 3], [0, 1, 2, 3, 4], [2, 4]):
             f = np.asarray(free, dtype=np.int64)
             a = np.empty(len(free))
-            q = fit_columns(prob.X, f, prob.scale, prob.upper, prob.y, np.zeros(prob.y.size), prob.W, prob.y3,
-                            prob.c, prob.s, np.zeros(0), 100, 1e-10, a)
+            q = fit_columns(prob.X, f, *_packed(prob), np.zeros(prob.y.size), prob.W, np.zeros(0), 100, 1e-10, a)
             a_ref, q_ref = _reference_fit(prob, free)
             assert q == pytest.approx(q_ref, rel=1e-8, abs=1e-12)
             assert q == pytest.approx(prob.q_of(_full(a, free)), rel=1e-12)
             start = a_ref * 1.3 + 1e-9
-            q2 = fit_columns(prob.X, f, prob.scale, prob.upper, prob.y, np.zeros(prob.y.size), prob.W, prob.y3,
-                             prob.c, prob.s, start, 100, 1e-10, np.empty(len(free)))
+            q2 = fit_columns(prob.X, f, *_packed(prob), np.zeros(prob.y.size), prob.W, start, 100, 1e-10,
+                             np.empty(len(free)))
             assert q2 == pytest.approx(_reference_fit(prob, free, start)[1], rel=1e-8, abs=1e-12)
             w = prob.W @ prob.scores(prob.X[:, free] @ a)
             n_huber += bool(np.any(np.abs(w) > HUBER_K))
@@ -119,6 +118,12 @@ def test_pgn_stays_inside_the_bounds_and_lowers_q():
     u, q = pgn(Xs, np.zeros(prob.y.size), prob.W, prob.y3, prob.c, prob.s, u0, ub, 100, 1e-10)
     assert np.all(u >= 0) and np.all(u <= ub)
     assert q <= prob.q_of(_full(np.minimum(u0, ub) * scale, free)) + 1e-12
+
+
+def _packed(prob):
+    """The kernel's per-column rows (scale, upper) and per-point rows (y, y^(1/3), c, s), built here from the
+    problem's documented attributes."""
+    return np.stack([prob.scale, prob.upper]), np.stack([prob.y, prob.y3, prob.c, prob.s])
 
 
 def _full(a, free):

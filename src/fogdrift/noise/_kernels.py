@@ -319,12 +319,17 @@ def nnls(A, b, max_iter):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def fit_columns(X, free, scale_all, upper_all, y, add, W, y3, c, s, a0, max_iter, tol, out):  # pragma: no cover
-    """One fit of :meth:`~fogdrift.noise.engine.ScoreProblem.fit` on the design columns ``free``: the columns
-    scaled by ``scale_all[free]``, the start ``a0`` (unscaled coefficients) or, if ``a0`` is empty, the NNLS fit
-    of the relative errors ``(y - add) / y``, moved inside ``[1e-6, ub (1 - 1e-9)]``; then :func:`pgn`.  Writes the
+def fit_columns(X, free, per_column, per_point, add, W, a0, max_iter, tol, out):  # pragma: no cover
+    """One fit of :meth:`~fogdrift.noise.engine.ScoreProblem.fit` on the design columns ``free``.
+
+    ``per_column`` holds the rows ``scale, upper`` of every design column, ``per_point`` the rows ``y, y^(1/3),
+    c, s`` of every working point (packed: each argument costs the call its type check).  The columns are scaled
+    by ``scale[free]``; the start is ``a0`` (unscaled coefficients) or, if ``a0`` is empty, the NNLS fit of the
+    relative errors ``(y - add) / y``, moved inside ``[1e-6, ub (1 - 1e-9)]``; then :func:`pgn`.  Writes the
     coefficients of ``free`` (unscaled) into ``out`` and returns ``Q`` (an array made here would be boxed for
     Python at ~1.4 us a call)."""
+    scale_all, upper_all = per_column[0], per_column[1]
+    y, y3, c, s = per_point[0], per_point[1], per_point[2], per_point[3]
     n = X.shape[0]
     p = free.size
     Xs = np.empty((n, p))

@@ -135,6 +135,10 @@ class ScoreProblem:
         # coefficient scale at which a column alone reaches the data somewhere (conditioning of the solver)
         with np.errstate(divide="ignore"):
             self.scale = np.array([np.min(self.y / self.X[:, j]) for j in range(self.X.shape[1])])
+        # the compiled fit's per-column and per-point rows, packed once; the zero model a free fit adds to
+        self._per_column = np.stack([self.scale, self.upper])
+        self._per_point = np.stack([self.y, self.y3, self.c, self.s])
+        self._zero = np.zeros(self.y.size)
 
     def scores(self, mu):
         """Standard-normal scores of the data under the model values ``mu`` (positive: data above model)."""
@@ -169,7 +173,7 @@ class ScoreProblem:
 
     def _fit(self, cols, a0, fixed):
         free = [c for c in cols if fixed is None or c != fixed[0]]
-        add = np.zeros(self.y.size) if fixed is None else self.X[:, fixed[0]] * fixed[1]
+        add = self._zero if fixed is None else self.X[:, fixed[0]] * fixed[1]
         if not free:
             if not np.all(add > 0):
                 return np.array([]), math.inf
@@ -177,8 +181,8 @@ class ScoreProblem:
             return np.array([]), float(w @ w)
         start = _NO_START if a0 is None else np.asarray(a0, dtype=np.float64)
         a = np.empty(len(free))
-        q = _wh_kernel()(self.X, np.asarray(free, dtype=np.int64), self.scale, self.upper, self.y, add, self.W,
-                         self.y3, self.c, self.s, start, 100, 1e-10, a)
+        q = _wh_kernel()(self.X, np.asarray(free, dtype=np.int64), self._per_column, self._per_point, add, self.W,
+                         start, 100, 1e-10, a)
         return a, float(q)
 
 
