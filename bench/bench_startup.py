@@ -86,12 +86,13 @@ def pairs(name: str, rival: tuple, mine: tuple, rounds: int) -> dict:
 
 
 #: The ``floor`` case's process: what every fogdrift command that reads a record imports and starts (kept apart
-#: from fogdrift's own modules).  ``{cache}`` is a file the numba kernel is cached beside.
+#: from fogdrift's own modules).  ``{folder}`` holds the kernel's module, cached by numba beside it.
 FLOOR = """
-import numpy as np, typer, rich.console, numba, importlib.util, sys
-spec = importlib.util.spec_from_file_location("floor_kernel", {cache!r})
-mod = importlib.util.module_from_spec(spec); spec.loader.exec_module(mod)
-mod.total(np.ones(8))
+import sys
+sys.path.insert(0, {folder!r})
+import numpy as np, typer, rich.console, numba
+import floor_kernel
+floor_kernel.total(np.ones(8))
 import matplotlib
 matplotlib.use("Agg")
 from matplotlib.figure import Figure
@@ -116,7 +117,7 @@ def floor_pairs(rounds: int, out: Path) -> list[dict]:
     """The floor process against three short commands, alternating (see the module docstring)."""
     kernel = out / "floor_kernel.py"
     kernel.write_text(FLOOR_KERNEL)
-    floor = ([sys.executable, "-c", FLOOR.format(cache=str(kernel), png=str(out / "floor.png"))], _env(SRC))
+    floor = ([sys.executable, "-c", FLOOR.format(folder=str(out), png=str(out / "floor.png"))], _env(SRC))
     rows = []
     for name, words in (("allan --help", ["allan", "--help"]),
                         ("allan ADIS imu1", ["allan", str(ADIS1), "--unit", "deg/s", "--out", str(out / "fa")]),

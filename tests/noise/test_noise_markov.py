@@ -114,3 +114,30 @@ def test_white_noise_gets_no_markov_term():
     fits = [fit_noise(allan_variance(simulate(2**15, 0.1, arw_dprh=0.05, seed=s), 0.1), markov=True)
             for s in range(10)]
     assert sum("M" in f.selected for f in fits) <= 1
+
+
+def test_the_markov_scan_takes_the_best_claimable_model_of_the_full_refusal_list(monkeypatch):
+    """At every correlation time of the scan the candidate is the smallest-IC model the slope rule does not refuse:
+    the lazy walk down the IC order (``claims._first_claimable``) gives the subset that judging every candidate
+    first (``_best_claimable`` of ``_slope_refusals``) gives, on hump curves where the rule refuses K or R models
+    read from the hump (so the walk does skip candidates)."""
+    import importlib
+
+    from fogdrift.noise import claims
+
+    identify = importlib.import_module("fogdrift.noise.identify")  # the module (the package exports its function)
+    calls, skipped = [], []
+
+    def checked(c, prob, res, fallback=None):
+        full = claims._slope_refusals(c, prob, res)
+        want = claims._best_claimable(res, full, fallback)
+        got = claims._first_claimable(c, prob, res, fallback)
+        calls.append(got == want)
+        skipped.append(bool(full))
+        return got
+
+    monkeypatch.setattr(identify, "_first_claimable", checked)
+    for seed in range(3):
+        _fit(seed)
+    assert calls and all(calls)
+    assert any(skipped)

@@ -64,21 +64,42 @@ def _slope_refusals(c: FitContext, prob, res) -> dict:
     model says, and the model must meet the longest taus).  Such a candidate is not selectable: a hump is a
     Gauss-Markov term (M), not a random walk.  The model values use the current columns of ``c`` (the M column at
     the correlation time being tried)."""
-    lo, hi = _measured_limits(c, prob.nu)
+    limits = _measured_limits(c, prob.nu)
     out = {}
     for k, v in res.items():
-        a = v["a"]
-        mu = None
-        for name in ("K", "R"):
-            i = _names().index(name)
-            if i in k and a[i] > 0:
-                mu = c.X @ a if mu is None else mu
-                claim = slope_claim(c.tau, c.y, lo, hi, mu, _rising_var(c, a, name), SLOPES[name], name=name,
-                                    curve=_CURVE.get(c.statistic, c.statistic.upper()))
-                if not claim.ok:
-                    out[k] = claim
-                    break
+        claim = _refusal(c, limits, k, v["a"])
+        if claim is not None:
+            out[k] = claim
     return out
+
+
+def _refusal(c: FitContext, limits, k, a):
+    """The failed :func:`~fogdrift.noise.rules.slope_claim` of subset ``k`` (coefficients ``a``), or None: its K,
+    then its R, judged against the measured curve's 95 % ``limits``."""
+    lo, hi = limits
+    mu = None
+    for name in ("K", "R"):
+        i = _names().index(name)
+        if i in k and a[i] > 0:
+            mu = c.X @ a if mu is None else mu
+            claim = slope_claim(c.tau, c.y, lo, hi, mu, _rising_var(c, a, name), SLOPES[name], name=name,
+                                curve=_CURVE.get(c.statistic, c.statistic.upper()))
+            if not claim.ok:
+                return claim
+    return None
+
+
+def _first_claimable(c: FitContext, prob, res, fallback=None):
+    """``_best_claimable(res, _slope_refusals(c, prob, res), fallback)``, asking the slope rule only down the IC
+    order until a candidate passes: the same subset (ties in ``res``'s order, as :func:`min` takes them) for a
+    fraction of the rule's calls, where only the best claimable candidate is wanted."""
+    limits = None
+    for k in sorted(res, key=lambda k: res[k]["ic"]):
+        if limits is None:
+            limits = _measured_limits(c, prob.nu)
+        if _refusal(c, limits, k, res[k]["a"]) is None:
+            return k
+    return fallback
 
 
 def _rising_var(c: FitContext, a, name):

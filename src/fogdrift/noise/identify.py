@@ -48,7 +48,8 @@ from .engine import ScoreProblem, all_subsets, fit_subsets, ic_within, profile_i
 from .notes import (_absent_reason, _at_bound_notes, _describe_excluded, _largest_gap_note, _misfit_note, _no_fit,
                     _unresolved_reason)
 from .result import NoiseFit, NoiseTerm
-from .claims import _CURVE, _best_claimable, _measured_limits, _no_fit_terms, _rising_var, _slope_refusals
+from .claims import (_CURVE, _best_claimable, _first_claimable, _measured_limits, _no_fit_terms, _rising_var,
+                     _slope_refusals)
 from .rules import SLOPES, slope_claim
 from .terms import TERM_TABLE, UNESTIMABLE, all_terms, laws_of, power_terms
 
@@ -540,7 +541,7 @@ def _markov_stage(c: FitContext, C, res, best, penalty):
     scan = []
     for g, lt in enumerate(grid):
         pr, fits = _markov_fits(c, C, base_cols, math.exp(lt), penalty)
-        k = _best_claimable(fits, _slope_refusals(c, pr, fits))  # a K or R read from the hump is no candidate
+        k = _first_claimable(c, pr, fits)  # a K or R read from the hump is no candidate
         if k is not None:
             scan.append((fits[k]["ic"], lt, k, g))
     if not scan:
