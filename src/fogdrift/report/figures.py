@@ -13,6 +13,7 @@ import contextlib
 import functools
 import itertools
 import re
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -215,6 +216,11 @@ def _ticks_held(axes):
             del axis._update_ticks  # matplotlib's method again
 
 
+#: The figures :func:`_place` laid out: their axes stay where they are through the draw, so :func:`save_figure`
+#: may hold their ticks (a figure saved with ``bbox_inches`` or laid out elsewhere updates its own).
+_PLACED = weakref.WeakSet()
+
+
 def _place(fig, pad_in=PAD_IN):
     """Place the axes of ``fig`` (one :func:`matplotlib.pyplot.subplots` grid, no layout engine) so that every
     axes' tick labels, axis labels and texts fit inside the figure without running into the neighbours'.
@@ -227,6 +233,7 @@ def _place(fig, pad_in=PAD_IN):
     (the Fig. 3 PNG of ``fogdrift allan`` took 2.2x as long); the ticks measured here are the ones the draw uses.
     """
     axes = [ax for ax in fig.axes if ax.get_subplotspec() is not None]
+    _PLACED.add(fig)
     for ax in axes:
         _plain_log_ticks(ax)
         _in_view_ticks(ax)
@@ -284,7 +291,8 @@ def save_figure(fig, path, **savefig) -> Path:
     """
     path = Path(path)
     try:
-        with atomic_path(path) as tmp, _ticks_held([ax for ax in fig.axes if ax.get_subplotspec() is not None]):
+        held = _ticks_held(fig.axes) if fig in _PLACED and not savefig.get("bbox_inches") else contextlib.nullcontext()
+        with atomic_path(path) as tmp, held:
             fig.savefig(tmp, **{"dpi": DPI, **savefig})
     finally:
         if fig.canvas.manager is not None:  # a pyplot figure: pyplot holds it until it is closed
