@@ -18,6 +18,9 @@ class _Stub:
         v = fixed[1]
         return None, ((v - 5.0) ** 2 if v <= self.upper[0] else 0.0)
 
+    def profile(self, cols, col, a0=None):  # ScoreProblem.profile: Q as a function of the pinned value
+        return lambda v: self.fit(cols, a0, (col, v))[1]
+
 
 @pytest.mark.parametrize("ub, hi", [(100.0, 6.0), (7.0, 6.0), (5.5, 5.5)])
 def test_upper_side_of_a_quadratic_profile(ub, hi):

@@ -185,6 +185,26 @@ class ScoreProblem:
                          start, 100, 1e-10, a)
         return a, float(q)
 
+    def profile(self, cols, col, a0=None):
+        """``v -> Q`` of ``fit(cols, a0, fixed=(col, v))`` (the same numbers), for the many values of one profile's
+        root search: the parts that do not depend on ``v`` are formed once, and each value asked again is
+        remembered (the design must not change while the function is used)."""
+        free = [c for c in cols if c != col]
+        if not free:
+            return lambda v: self.fit(cols, a0, (col, v))[1]
+        kernel, free_idx, column = _wh_kernel(), np.asarray(free, dtype=np.int64), self.X[:, col]
+        start = _NO_START if a0 is None else np.asarray(a0, dtype=np.float64)
+        out, seen = np.empty(len(free)), {}
+
+        def q_at(v):
+            q = seen.get(v)
+            if q is None:
+                q = seen[v] = float(kernel(self.X, free_idx, self._per_column, self._per_point, column * v, self.W,
+                                           start, 100, 1e-10, out))
+            return q
+
+        return q_at
+
 
 #: Relative difference below which two information-criterion values count as the same number.  A superset whose
 #: extra terms all come out 0 has its subset's Q, so its IC lies a whole number of penalties away, often exactly on
@@ -226,9 +246,10 @@ def profile_interval(problem: ScoreProblem, cols, a_hat, col, q_min, delta, *, l
     v_hat = float(a_hat[col])
     q_at = problem.fit(cols, a0=a0, fixed=(col, v_hat))[1]
     target = min(q_min, q_at) + delta
+    q_fixed = problem.profile(cols, col, a0)
 
     def g(v):
-        return problem.fit(cols, a0=a0, fixed=(col, v))[1] - target
+        return q_fixed(v) - target
 
     ub = float(problem.upper[col])
     lo = 0.0
