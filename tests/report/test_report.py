@@ -39,7 +39,9 @@ def report_dir(bundled_path, tmp_path_factory):
 
 def test_analyze_prints_tables_and_writes_report(report_dir):
     out, text = report_dir
-    assert "report:" in text and "Table 2" in text
+    # stdout's summary (the noise table, the verdict) and the report line; progress lines ("... · Table 2") are
+    # timing-dependent (held back during the first seconds of a run) and not asserted here
+    assert "report:" in text and "Noise of the original output" in text and "compensation verdict" in text
     doc = json.loads((out / "analysis.json").read_text())
     assert doc["sha256"] == "039800de6c285c4359a60090d7d4fa0d09aaea42949eee4b5adcf37a3e484734"
     assert doc["versions"]["numpy"] and doc["config"]["model_rate_hz"] == 1.0
